@@ -1,0 +1,3 @@
+from fha_studio.main import main
+
+raise SystemExit(main())

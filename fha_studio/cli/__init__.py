@@ -1,0 +1,51 @@
+"""The command line: ``fha-studio COMMAND ...``. No Qt is imported here.
+
+Each command is a module in this package with ``register(subparsers)`` that adds its
+sub-parser and sets ``func`` (a callable taking the parsed args, returning an exit code).
+Errors meant for the user are raised as :class:`CliError` and printed as one line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+# Module names under fha_studio.cli, in the order --help lists them.
+COMMAND_MODULES: tuple[str, ...] = ()
+
+
+class CliError(Exception):
+    """A mistake in the user's input: printed as one line, exit status 2."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="fha-studio",
+        description="Commissioning tool for Harmonic Drive FHA-C actuators on HA-655 / HA-675 drivers. "
+        "Without a command it starts the GUI on the embedded simulated drive.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMAND_MODULES:
+        importlib.import_module(f"{__name__}.{name}").register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; returns the process exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.func(args) or 0)
+    except CliError as exc:
+        print(f"fha-studio {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except (FileNotFoundError, PermissionError, IsADirectoryError) as exc:
+        print(f"fha-studio {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130

@@ -1,0 +1,1 @@
+"""Logic layer: sizing, procedures, recording, analysis. No Qt."""

@@ -1,0 +1,55 @@
+"""The layer contracts: the core imports no Qt, and each layer talks only to the ones below it."""
+
+from __future__ import annotations
+
+import pkgutil
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import fha_studio
+
+ROOT = Path(__file__).resolve().parent.parent
+CORE_PACKAGES = ("catalog", "physics", "hardware", "logic", "cli")
+
+
+def core_modules() -> list[str]:
+    names = ["fha_studio", "fha_studio.paths"]
+    for info in pkgutil.walk_packages(fha_studio.__path__, "fha_studio."):
+        top = info.name.split(".")[1]
+        if top in CORE_PACKAGES:
+            names.append(info.name)
+    return names
+
+
+def test_core_imports_and_runs_with_qt_unavailable():
+    # Block the Qt bindings outright, as on a machine without them, then import every core
+    # module and run the CLI's help: any Qt import anywhere in the core fails here.
+    script = f"""
+import sys, importlib, importlib.abc
+class NoQt(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name.split('.')[0] in ('PySide6', 'pyqtgraph', 'shiboken6', 'PyQt5', 'PyQt6'):
+            raise ImportError(f'Qt is blocked in the core: {{name}}')
+        return None
+sys.meta_path.insert(0, NoQt())
+for name in {core_modules()!r}:
+    importlib.import_module(name)
+from fha_studio.cli import build_parser
+build_parser().format_help()
+leaked = [m for m in sys.modules if m.split('.')[0] in ('PySide6', 'pyqtgraph', 'shiboken6')]
+assert not leaked, leaked
+print('core ok', len({core_modules()!r}))
+"""
+    result = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert "core ok" in result.stdout
+
+
+def test_import_linter_contracts_hold():
+    lint_imports = shutil.which("lint-imports") or str(Path(sys.executable).parent / "lint-imports")
+    result = subprocess.run([lint_imports, "--no-cache"], cwd=ROOT, capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "Contracts: " in result.stdout and " broken" in result.stdout
+    assert "0 broken" in result.stdout
