@@ -1,7 +1,8 @@
 """The command line: ``fha-studio COMMAND ...``. No Qt is imported here.
 
-Each command is a module in this package with ``register(subparsers)`` that adds its
-sub-parser and sets ``func`` (a callable taking the parsed args, returning an exit code).
+Each command is a module in this package (found automatically) with ``register(subparsers)``
+that adds its sub-parser and sets ``func`` (a callable taking the parsed args, returning an exit
+code), and ``ORDER`` (an int: where --help lists it).
 Errors meant for the user are raised as :class:`CliError` and printed as one line.
 """
 
@@ -9,11 +10,9 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import pkgutil
 import sys
 from collections.abc import Sequence
-
-# Module names under fha_studio.cli, in the order --help lists them.
-COMMAND_MODULES: tuple[str, ...] = ()
 
 
 class CliError(Exception):
@@ -27,8 +26,13 @@ def build_parser() -> argparse.ArgumentParser:
         "Without a command it starts the GUI on the embedded simulated drive.",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in COMMAND_MODULES:
-        importlib.import_module(f"{__name__}.{name}").register(sub)
+    modules = [
+        importlib.import_module(f"{__name__}.{info.name}")
+        for info in pkgutil.iter_modules(__path__)
+        if not info.name.startswith("_")
+    ]
+    for module in sorted(modules, key=lambda m: (getattr(m, "ORDER", 100), m.__name__)):
+        module.register(sub)
     return parser
 
 
