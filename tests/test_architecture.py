@@ -16,7 +16,7 @@ CORE_PACKAGES = ("catalog", "physics", "hardware", "logic", "cli")
 
 
 def core_modules() -> list[str]:
-    names = ["fha_studio", "fha_studio.paths"]
+    names = ["fha_studio", "fha_studio.paths", "fha_studio.recording"]
     for info in pkgutil.walk_packages(fha_studio.__path__, "fha_studio."):
         top = info.name.split(".")[1]
         if top in CORE_PACKAGES:

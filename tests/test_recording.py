@@ -1,0 +1,206 @@
+"""The fha-recording/1 reader and streaming writer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fha_studio import recording as rec
+from fha_studio.recording import (
+    Recording,
+    RecordingError,
+    RecordingMetadata,
+    RecordingWriter,
+    make_recording,
+    parse_recording,
+    read_recording,
+    write_recording,
+)
+
+GOOD = """\
+# format: fha-recording/1
+# actuator: FHA-25C-50-US250
+# load_inertia_kgm2: 1.5
+# supply_voltage: 200
+# sample_rate_hz: 1000
+# operator: J. Smith: night shift
+t,pos,current,cmd_pos,load_pos,vel,error_pulse
+0,0,0.01,0,0,0,0
+0.001,0.0002,0.35,0.0003,0.0001,0.05,3
+0.002,0.0009,0.41,0.0011,0.0008,0.1,4
+"""
+
+
+def _meta(**kw) -> RecordingMetadata:
+    base = {"actuator": "FHA-25C-50-US250", "load_inertia_kgm2": 1.5, "sample_rate_hz": 1000.0}
+    base.update(kw)
+    return RecordingMetadata(**base)
+
+
+def test_reads_metadata_contract_columns_and_extra_channels():
+    r = parse_recording(GOOD, source="good.csv")
+    m = r.metadata
+    assert (m.actuator, m.load_inertia_kgm2, m.supply_voltage, m.sample_rate_hz) == (
+        "FHA-25C-50-US250", 1.5, 200, 1000.0)
+    assert m.extra == {"operator": "J. Smith: night shift"}
+    assert len(r) == 3
+    np.testing.assert_allclose(r.t_s, [0, 0.001, 0.002])
+    np.testing.assert_allclose(r.current_a, [0.01, 0.35, 0.41])
+    assert r.load_pos_deg is not None and r.vel_rpm is not None and r.cmd_pos_deg is not None
+    assert list(r.extra_channels) == ["error_pulse"]
+    assert r.channels["t"].dtype == np.float64
+
+
+def test_optional_columns_and_defaults():
+    text = ("# format: fha-recording/1\n# actuator: FHA-17C-100-S248\n# load_inertia_kgm2: 0\n"
+            "t,current,pos\n0,1,2\n1,1,2\n")
+    r = parse_recording(text)
+    assert r.metadata.supply_voltage == 200 and r.metadata.sample_rate_hz is None
+    assert r.cmd_pos_deg is None and r.load_pos_deg is None and r.vel_rpm is None
+    np.testing.assert_allclose(r.pos_deg, [2, 2])
+
+
+def test_custom_actuator_needs_its_constants():
+    head = "# format: fha-recording/1\n# actuator: custom\n# load_inertia_kgm2: 1\n"
+    body = "t,pos,current\n0,0,0\n1,1,1\n"
+    with pytest.raises(RecordingError) as err:
+        parse_recording(head + "# torque_constant_nm_per_a: 22\n" + body)
+    assert err.value.field == "actuator_inertia_kgm2" and err.value.line == 2
+    constants = "# torque_constant_nm_per_a: 22\n# actuator_inertia_kgm2: 0.81 kg m^2\n"
+    r = parse_recording(head + constants + body)
+    assert r.metadata.is_custom and r.metadata.torque_constant_nm_per_a == 22
+    assert r.metadata.actuator_inertia_kgm2 == 0.81 and r.metadata.motor_turns_per_output_rev is None
+
+
+LI = "load_inertia_kgm2"
+
+
+def _replace(old: str, new: str) -> str:
+    assert old in GOOD
+    return GOOD.replace(old, new)
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "field", "words"),
+    [
+        (_replace("# format: fha-recording/1\n", ""), 1, "format", "format"),
+        (_replace("fha-recording/1", "fha-recording/2"), 1, "format", "expected"),
+        (_replace("# actuator: FHA-25C-50-US250\n", ""), None, "actuator", "missing"),
+        (_replace("FHA-25C-50-US250", "FHA-99C-50-US250"), 2, "actuator", "model code"),
+        (_replace("# load_inertia_kgm2: 1.5\n", ""), None, "load_inertia_kgm2", "missing"),
+        (_replace("load_inertia_kgm2: 1.5", "load_inertia: 1.5"), 3, "load_inertia", "no unit"),
+        (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: 1.5 lb ft^2"), 3, LI, "unit"),
+        (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: heavy"), 3, LI, "not a number"),
+        (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: nan"), 3, "load_inertia_kgm2", "finite"),
+        (_replace("supply_voltage: 200", "supply_voltage: 230"), 4, "supply_voltage", "200 or 100"),
+        (_replace("sample_rate_hz: 1000", "sample_rate: 1000"), 5, "sample_rate", "sample_rate_hz"),
+        (_replace("t,pos,current,", "t,position,current,"), 7, "pos", "required column"),
+        (_replace("t,pos,current,", "t,pos,pos,"), 7, "pos", "twice"),
+        (_replace("0.001,0.0002,0.35", "0.001,0.0002,abc"), 9, "current", "not a number"),
+        (_replace("0.001,0.0002,0.35", "0.001,nan,0.35"), 9, "pos", "NaN"),
+        (_replace("0.002,0.0009", "0.001,0.0009"), 10, "t", "does not increase"),
+        (_replace("0.002,0.0009,0.41,0.0011,0.0008,0.1,4", "0.002,0.0009"), 10, None, "2 values"),
+    ],
+)
+def test_malformed_input_is_refused_naming_line_and_field(text, line, field, words):
+    with pytest.raises(RecordingError) as err:
+        parse_recording(text, source="bad.csv")
+    assert err.value.field == field
+    if line is not None:
+        assert err.value.line == line
+        assert f"line {line}" in str(err.value)
+    assert str(err.value).startswith("bad.csv")
+    assert words in str(err.value)
+    if field is not None:
+        assert f"'{field}'" in str(err.value)
+
+
+def test_header_missing_and_too_few_rows():
+    with pytest.raises(RecordingError, match="no header"):
+        parse_recording("# format: fha-recording/1\n# actuator: FHA-25C-50-US250\n# load_inertia_kgm2: 1\n")
+    with pytest.raises(RecordingError, match="at least 2"):
+        parse_recording("# format: fha-recording/1\n# actuator: FHA-25C-50-US250\n# load_inertia_kgm2: 1\n"
+                        "t,pos,current\n0,0,0\n")
+
+
+def test_not_utf8_is_refused(tmp_path):
+    path = tmp_path / "latin.csv"
+    path.write_bytes(GOOD.replace("J. Smith", "J. M\xfcller").encode("latin-1"))
+    with pytest.raises(RecordingError, match="UTF-8"):
+        read_recording(path)
+
+
+def _sample(n=2500, extra=True) -> Recording:
+    t = np.arange(n) / 1000.0
+    ch = {"t": t, "pos": 30 * np.sin(t), "current": 0.1 * np.cos(3 * t) + 1e-9,
+          "cmd_pos": 30 * np.sin(t + 1e-3), "load_pos": 30 * np.sin(t) - 1e-4}
+    if extra:
+        ch["torque_cmd_nm"] = np.full(n, -2.5)
+    return make_recording(_meta(extra={"source": "unit test"}), **ch)
+
+
+def test_write_then_read_round_trip(tmp_path):
+    original = _sample()
+    path = tmp_path / "r.csv"
+    write_recording(path, original)
+    back = read_recording(path)
+    assert back.metadata == original.metadata
+    assert list(back.channels) == list(original.channels)
+    for name in original.channels:
+        np.testing.assert_allclose(back.channels[name], original.channels[name], rtol=1e-11, atol=1e-12)
+
+
+def test_plain_numpy_loads_the_file(tmp_path):
+    original = _sample()
+    path = tmp_path / "r.csv"
+    write_recording(path, original)
+    # genfromtxt: comment lines skipped, the header row reads as NaN
+    table = np.genfromtxt(path, delimiter=",", comments="#")
+    assert np.all(np.isnan(table[0]))
+    np.testing.assert_allclose(table[1:, 0], original.t_s, atol=1e-12)
+    np.testing.assert_allclose(table[1:, 2], original.current_a, atol=1e-12)
+    # loadtxt: skip the comment lines and the header by count
+    n_head = sum(1 for line in path.read_text().splitlines() if line.startswith("#")) + 1
+    data = np.loadtxt(path, delimiter=",", comments="#", skiprows=n_head)
+    assert data.shape == (len(original), len(original.channels))
+    np.testing.assert_allclose(data[:, 1], original.pos_deg, atol=1e-9)
+
+
+def test_streaming_writer_flushes_within_a_second(tmp_path, monkeypatch):
+    clock = [1000.0]
+    monkeypatch.setattr(rec.time, "monotonic", lambda: clock[0])
+    path = tmp_path / "s.csv"
+    with RecordingWriter(path, _meta(), ["t", "pos", "current", "torque_cmd_nm"]) as w:
+        w.append([0.0, 0.0, 0.1, 1.0])
+        w.append({"t": 0.001, "pos": 0.1, "current": 0.2, "torque_cmd_nm": 2.0})
+        clock[0] += 0.5
+        w.append_rows([[0.002, 0.2, 0.3, 3.0], [0.003, 0.3, 0.4, 4.0]])
+        clock[0] += 0.6  # a second has passed since the last flush: this append reaches the file
+        w.append([0.004, 0.4, 0.5, 5.0])
+        # what a crash now would leave: everything up to the last second, readable
+        on_disk = read_recording(path)
+        assert len(on_disk) == 5 and list(on_disk.extra_channels) == ["torque_cmd_nm"]
+        w.append([0.005, 0.5, 0.6, 6.0])
+        assert w.rows_written == 6
+    assert len(read_recording(path)) == 6
+
+
+def test_writer_refuses_what_the_reader_would_refuse(tmp_path):
+    with RecordingWriter(tmp_path / "w.csv", _meta()) as w:
+        w.append([0.0, 0.0, 0.0])
+        with pytest.raises(ValueError, match="time must increase"):
+            w.append([0.0, 1.0, 1.0])
+        with pytest.raises(ValueError, match="'current' is not finite"):
+            w.append([1.0, 1.0, float("nan")])
+        with pytest.raises(ValueError, match="3 values"):
+            w.append([1.0, 1.0])
+    with pytest.raises(RecordingError, match="required column 'current'"):
+        RecordingWriter(tmp_path / "x.csv", _meta(), ["t", "pos"])
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_make_recording_checks_arrays():
+    with pytest.raises(RecordingError, match="time does not increase"):
+        make_recording(_meta(), t=[0, 0], pos=[0, 0], current=[0, 0])
+    with pytest.raises(RecordingError, match="'current'"):
+        make_recording(_meta(), t=[0, 1], pos=[0, 0], current=[0, np.nan])
