@@ -1,0 +1,1 @@
+"""The scope's logic: ring buffer, acquisition (polling and drive-side trace), analysis. No Qt."""
