@@ -197,8 +197,13 @@ def _item_from_table(path: str, index: int, raw: dict[str, Any], all_uncertain: 
             raise _fail(path, where, f"{name} must be an integer")
     if not isinstance(raw["scale"], int | float) or raw["scale"] <= 0:
         raise _fail(path, where, "scale must be a positive number")
-    if not WIRE_MINIMUM <= raw["minimum"] <= raw["maximum"] <= WIRE_MAXIMUM:
-        raise _fail(path, where, f"need {WIRE_MINIMUM} <= minimum <= maximum <= {WIRE_MAXIMUM}")
+    if raw["minimum"] > raw["maximum"]:
+        raise _fail(path, where, "minimum is above maximum")
+    # written values travel in the five-digit request field; monitor values in reply lines
+    if raw["writable"] and not WIRE_MINIMUM <= raw["minimum"] <= raw["maximum"] <= WIRE_MAXIMUM:
+        raise _fail(
+            path, where, f"a writable item needs {WIRE_MINIMUM} <= minimum <= maximum <= {WIRE_MAXIMUM}"
+        )
     assumed = raw["assumed"]
     if not isinstance(assumed, list) or not set(assumed) <= _ITEM_FIELDS:
         raise _fail(path, where, f"assumed must list field names of {sorted(_ITEM_FIELDS)}")

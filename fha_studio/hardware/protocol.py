@@ -1,0 +1,355 @@
+"""The CN3 codec of the HA-655 / HA-675: bytes <-> messages, both directions, no I/O.
+
+docs/protocol.md is the specification; this module is its executable form.
+
+Client side: ``encode_request(Request)`` -> bytes; ``decode_reply(buffer)`` -> (used, message).
+Drive side:  ``decode_request(buffer)`` -> (used, message); ``encode_reply(Reply)`` -> bytes.
+
+Decoders follow the pymodbus framer contract: the caller owns the buffer and calls
+``decode(buffer)`` which answers ``(bytes_used, message_or_None)``. ``used == 0`` means "need more
+bytes"; otherwise the caller drops ``buffer[:used]`` and, if the message is not None, handles it,
+then calls again. Skipped bytes come out as a ``Garbage`` message so that nothing vanishes
+silently. The decoders never raise for any input. ``StreamDecoder`` wraps that loop.
+
+Resynchronisation rules (docs/protocol.md, "Resynchronisation"):
+
+- Requests (drive side): a frame is ``[A-Z]{3}[+-][0-9]{5}CR``. The decoder takes the earliest
+  complete frame in the buffer and reports everything before it as garbage. Without a complete
+  frame it keeps the shortest tail that could still become one and reports the bytes before that
+  tail as garbage; so a half frame followed by a good frame loses only the half frame.
+- Replies (client side): a line ends in CR. Bytes that are neither printable ASCII (20h-7Eh) nor
+  CR are noise. Noise and empty lines before the first printable character are reported as
+  garbage. Once a reply has begun, its lines accumulate until a terminal line (``q``, ``s`` or
+  ``x``); noise or an empty line inside it is dropped and the reply comes out ``corrupt=True``, so
+  the client retries instead of trusting it. A line longer than ``MAX_LINE_CHARS`` ends the reply
+  in progress as garbage.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Generic, TypeVar
+
+CR = 0x0D
+FRAME_LENGTH = 10
+VALUE_MINIMUM = -99999
+VALUE_MAXIMUM = 99999
+#: Longest data line accepted in a reply (characters, without CR). TRB's widest line is 4 x 12.
+MAX_LINE_CHARS = 200
+
+#: Line settings of CN3 (HA-655 manual p.20): 19200 bit/s, 8N1 = 10 bits per character.
+BAUDRATE = 19200
+BITS_PER_CHARACTER = 10
+
+
+def character_time_s(baudrate: int = BAUDRATE) -> float:
+    """Seconds one character takes on the line at ``baudrate`` (8N1: 10 bits)."""
+    return BITS_PER_CHARACTER / baudrate
+
+
+class Command(StrEnum):
+    """Every command of docs/protocol.md. DGR and OWW are the documented ones; the rest extend."""
+
+    DGR = "DGR"  # absolute position (documented)
+    OWW = "OWW"  # clear multi-turn data (documented)
+    IDN = "IDN"  # identification
+    CAP = "CAP"  # supported extensions
+    PSL = "PSL"  # select a parameter-mode (system) item
+    TSL = "TSL"  # select a tune-mode item
+    JSL = "JSL"  # select a test-mode (jog) item
+    PRD = "PRD"  # read the selected item
+    PWR = "PWR"  # write the selected item
+    MON = "MON"  # read one monitor item
+    MMR = "MMR"  # read several monitor items 100-115
+    SVO = "SVO"  # servo on/off
+    JOG = "JOG"  # jog at a speed, held by repetition
+    SPD = "SPD"  # speed for MOV
+    MOV = "MOV"  # relative move
+    STP = "STP"  # stop
+    ALM = "ALM"  # current alarm
+    AHS = "AHS"  # alarm history
+    ACL = "ACL"  # alarm clear
+    IOS = "IOS"  # I/O state
+    INP = "INP"  # simulated inputs (sim only)
+    PWC = "PWC"  # simulated power cycle (sim only)
+    TCH = "TCH"  # trace channels
+    TDV = "TDV"  # trace divider
+    TTG = "TTG"  # trace trigger kind
+    TTC = "TTC"  # trace trigger channel
+    TTL = "TTL"  # trace trigger level
+    TPR = "TPR"  # trace pre-trigger samples
+    TAR = "TAR"  # arm trace
+    TST = "TST"  # trace status
+    TRB = "TRB"  # read trace block
+
+
+#: The commands a real HA-655 is known to answer (its public manual, p.21).
+DOCUMENTED_COMMANDS = frozenset({Command.DGR, Command.OWW})
+#: Commands that only the simulated drive has (a real drive answers x).
+SIM_ONLY_COMMANDS = frozenset({Command.INP, Command.PWC})
+#: Extension commands a drive lists in its CAP reply.
+EXTENSION_COMMANDS = frozenset(Command) - DOCUMENTED_COMMANDS
+
+
+class Status(StrEnum):
+    """Terminal line of a reply."""
+
+    DONE = "q"
+    SERVO_ON = "s"  # refused: the servo is on, the command was not processed
+    REJECTED = "x"  # bad command: unknown, malformed, not allowed now, out of range
+
+
+_TERMINALS = {s.value.encode(): s for s in Status}
+
+
+@dataclass(frozen=True)
+class Request:
+    """A command frame, host -> drive. ``value`` is the signed five-digit field."""
+
+    command: Command
+    value: int = 0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.command, Command):
+            raise ValueError(f"not a CN3 command: {self.command!r}")
+        if isinstance(self.value, bool) or not isinstance(self.value, int):
+            raise ValueError(f"{self.command}: value must be an integer, got {self.value!r}")
+        if not VALUE_MINIMUM <= self.value <= VALUE_MAXIMUM:
+            raise ValueError(
+                f"{self.command}: value {self.value} outside {VALUE_MINIMUM} ... {VALUE_MAXIMUM}"
+            )
+
+    def encode(self) -> bytes:
+        return encode_request(self)
+
+
+@dataclass(frozen=True)
+class UnknownRequest:
+    """A well-formed frame whose three letters are no command: the drive answers ``x``."""
+
+    name: str
+    value: int
+
+
+@dataclass(frozen=True)
+class Reply:
+    """A reply, drive -> host: data lines (without CR) and the terminal status.
+
+    ``corrupt`` is set by the decoder when noise was dropped inside the reply: its data cannot be
+    trusted and the client retries.
+    """
+
+    lines: tuple[str, ...] = ()
+    status: Status = Status.DONE
+    corrupt: bool = False
+
+    def encode(self) -> bytes:
+        return encode_reply(self)
+
+
+@dataclass(frozen=True)
+class Garbage:
+    """Bytes a decoder skipped, and why (for a bus monitor and for the client's retry decision)."""
+
+    data: bytes
+    reason: str
+
+    @property
+    def printable(self) -> bool:
+        """True when any skipped byte was printable: it may have been part of a message."""
+        return any(0x20 <= b <= 0x7E for b in self.data)
+
+
+# ---------------------------------------------------------------------------------------------
+# Requests
+# ---------------------------------------------------------------------------------------------
+
+_FRAME = re.compile(rb"[A-Z]{3}[+-][0-9]{5}\r")
+_COMMANDS_BY_NAME = {c.value: c for c in Command}
+
+
+def encode_request(request: Request) -> bytes:
+    """``Request(DGR, 0)`` -> ``b"DGR+00000\\r"``."""
+    sign = "-" if request.value < 0 else "+"
+    return f"{request.command.value}{sign}{abs(request.value):05d}\r".encode("ascii")
+
+
+def _could_start_frame(tail: bytes) -> bool:
+    """True when ``tail`` (shorter than a frame) is a prefix of some valid frame."""
+    for i, byte in enumerate(tail):
+        if i < 3:
+            ok = 0x41 <= byte <= 0x5A
+        elif i == 3:
+            ok = byte in b"+-"
+        elif i < 9:
+            ok = 0x30 <= byte <= 0x39
+        else:  # pragma: no cover - tails are shorter than a frame
+            ok = byte == CR
+        if not ok:
+            return False
+    return True
+
+
+def decode_request(buffer: bytes | bytearray) -> tuple[int, Request | UnknownRequest | Garbage | None]:
+    """Drive side: the next request in ``buffer`` (see the module's resynchronisation rule)."""
+    data = bytes(buffer)
+    match = _FRAME.search(data)
+    if match is not None:
+        if match.start() > 0:
+            return match.start(), Garbage(data[: match.start()], "bytes before a request frame")
+        name = data[:3].decode("ascii")
+        sign = -1 if data[3:4] == b"-" else 1
+        value = sign * int(data[4:9])
+        command = _COMMANDS_BY_NAME.get(name)
+        if command is None:
+            return FRAME_LENGTH, UnknownRequest(name, value)
+        return FRAME_LENGTH, Request(command, value)
+    # No complete frame: keep the earliest tail that may still grow into one.
+    start = max(0, len(data) - (FRAME_LENGTH - 1))
+    for i in range(start, len(data)):
+        if _could_start_frame(data[i:]):
+            break
+    else:
+        i = len(data)
+    if i == 0:
+        return 0, None
+    return i, Garbage(data[:i], "bytes that cannot start a request frame")
+
+
+# ---------------------------------------------------------------------------------------------
+# Replies
+# ---------------------------------------------------------------------------------------------
+
+
+def _printable(byte: int) -> bool:
+    return 0x20 <= byte <= 0x7E
+
+
+def check_data_line(line: str) -> None:
+    """Raise ValueError unless ``line`` may be sent as a data line of a reply."""
+    if not line or len(line) > MAX_LINE_CHARS:
+        raise ValueError(f"data line must have 1 ... {MAX_LINE_CHARS} characters: {line!r}")
+    if any(not 0x20 <= ord(ch) <= 0x7E for ch in line):
+        raise ValueError(f"data line must be printable ASCII: {line!r}")
+    if line in ("q", "s", "x"):
+        raise ValueError(f"a data line cannot be a lone terminal character: {line!r}")
+
+
+def encode_reply(reply: Reply) -> bytes:
+    """``Reply(("123",), DONE)`` -> ``b"123\\rq\\r"``. Raises ValueError for an invalid data line."""
+    for line in reply.lines:
+        check_data_line(line)
+    body = b"".join(line.encode("ascii") + b"\r" for line in reply.lines)
+    return body + reply.status.value.encode("ascii") + b"\r"
+
+
+def decode_reply(buffer: bytes | bytearray) -> tuple[int, Reply | Garbage | None]:
+    """Client side: the next reply in ``buffer`` (see the module's resynchronisation rule)."""
+    data = bytes(buffer)
+    n = len(data)
+    lead = 0
+    while lead < n and not _printable(data[lead]):
+        lead += 1
+    if lead:
+        return lead, Garbage(data[:lead], "noise or empty line before a reply")
+    lines: list[str] = []
+    corrupt = False
+    pos = 0
+    while True:
+        end = data.find(b"\r", pos)
+        if end < 0:
+            if n - pos > MAX_LINE_CHARS:
+                return n, Garbage(data, f"a reply line longer than {MAX_LINE_CHARS} characters")
+            return 0, None
+        raw = data[pos:end]
+        if len(raw) > MAX_LINE_CHARS:
+            return end + 1, Garbage(data[: end + 1], f"a reply line longer than {MAX_LINE_CHARS} characters")
+        pos = end + 1
+        clean = bytes(b for b in raw if _printable(b))
+        if len(clean) != len(raw) or not clean:
+            corrupt = True
+        if not clean:
+            continue
+        status = _TERMINALS.get(clean)
+        if status is not None:
+            return pos, Reply(tuple(lines), status, corrupt)
+        lines.append(clean.decode("ascii"))
+
+
+# ---------------------------------------------------------------------------------------------
+# Stream helper and value formats
+# ---------------------------------------------------------------------------------------------
+
+M = TypeVar("M")
+
+
+class StreamDecoder(Generic[M]):
+    """Holds received bytes and yields whole messages: ``feed(data)`` -> list of messages.
+
+    ``StreamDecoder(decode_request)`` on the drive side, ``StreamDecoder(decode_reply)`` on the
+    client side. Garbage messages are returned like the others.
+    """
+
+    def __init__(self, decode: Callable[[bytes | bytearray], tuple[int, M | None]]):
+        self._decode = decode
+        self._buffer = bytearray()
+
+    def feed(self, data: bytes | bytearray = b"") -> list[M]:
+        self._buffer += data
+        messages: list[M] = []
+        while self._buffer:
+            used, message = self._decode(self._buffer)
+            if used == 0:
+                break
+            del self._buffer[:used]
+            if message is not None:
+                messages.append(message)
+        return messages
+
+    @property
+    def pending(self) -> bytes:
+        """Bytes received but not yet part of a message."""
+        return bytes(self._buffer)
+
+    def clear(self) -> bytes:
+        """Drop and return the pending bytes (the client does this before each request)."""
+        dropped = bytes(self._buffer)
+        self._buffer.clear()
+        return dropped
+
+
+def format_values(values: Iterable[int]) -> str:
+    """Comma-separated integers, the format of MMR, TRB, TST and AHS lines: ``"12,-3,0"``."""
+    return ",".join(str(int(v)) for v in values)
+
+
+def parse_values(line: str) -> list[int]:
+    """The integers of a comma-separated line; ValueError naming the line when it is not one."""
+    try:
+        return [int(part) for part in line.split(",")]
+    except ValueError:
+        raise ValueError(f"expected comma-separated integers, got {line!r}") from None
+
+
+def parse_int(line: str) -> int:
+    """One signed decimal integer (``-`` only when negative, as DGR's reply); ValueError otherwise."""
+    if not re.fullmatch(r"[+-]?[0-9]{1,12}", line):
+        raise ValueError(f"expected a signed integer, got {line!r}")
+    return int(line)
+
+
+#: Single-turn counts per motor turn of the absolute encoder (DGR = multi-turn x 8192 + single-turn).
+ABSOLUTE_COUNTS_PER_TURN = 8192
+
+
+def split_absolute_position(value: int) -> tuple[int, int]:
+    """DGR's value -> (multi-turn, single-turn count 0 ... 8191)."""
+    return divmod(value, ABSOLUTE_COUNTS_PER_TURN)
+
+
+def join_absolute_position(multi_turn: int, single_turn: int) -> int:
+    """(multi-turn, single-turn count) -> DGR's value."""
+    return multi_turn * ABSOLUTE_COUNTS_PER_TURN + single_turn
