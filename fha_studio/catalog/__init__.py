@@ -1,1 +1,47 @@
-"""The actuator catalogue of the FHA-C manual (Chapter 1, 2 and 4), loaded from resources/catalog."""
+"""The actuator catalogue of the FHA-C manual (Chapters 1, 2, 3 and 4), loaded from resources/catalog.
+
+Public API: :func:`parse_model_code` -> :class:`ModelCode` (raises :class:`ModelCodeError`),
+:func:`get_actuator` -> :class:`Actuator`, :func:`compatible_drivers`, :func:`all_model_codes`,
+:func:`frames`, :func:`ratios`, :func:`options_allowed`; the raw tables are in
+:mod:`fha_studio.catalog.tables`, the manual's contradictions in :func:`discrepancies`.
+"""
+
+from fha_studio.catalog.actuator import (
+    Actuator,
+    Bearing,
+    Brake,
+    MechanicalAccuracy,
+    ScrewTightening,
+    TighteningTorques,
+    TorsionalStiffness,
+    all_model_codes,
+    compatible_drivers,
+    frames,
+    get_actuator,
+    options_allowed,
+    ratios,
+)
+from fha_studio.catalog.model_code import OPTION_ORDER, ModelCode, ModelCodeError, parse_model_code
+from fha_studio.catalog.tables import Discrepancy, discrepancies
+
+__all__ = [
+    "OPTION_ORDER",
+    "Actuator",
+    "Bearing",
+    "Brake",
+    "Discrepancy",
+    "MechanicalAccuracy",
+    "ModelCode",
+    "ModelCodeError",
+    "ScrewTightening",
+    "TighteningTorques",
+    "TorsionalStiffness",
+    "all_model_codes",
+    "compatible_drivers",
+    "discrepancies",
+    "frames",
+    "get_actuator",
+    "options_allowed",
+    "parse_model_code",
+    "ratios",
+]
