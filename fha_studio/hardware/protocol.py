@@ -84,12 +84,19 @@ class Command(StrEnum):
     TAR = "TAR"  # arm trace
     TST = "TST"  # trace status
     TRB = "TRB"  # read trace block
+    FLT = "FLT"  # inject an alarm (sim only)
+    SNO = "SNO"  # move the origin slit (sim only)
+    SNA = "SNA"  # move the dog of limit switch 1 (sim only)
+    SNB = "SNB"  # move the dog of limit switch 2 (sim only)
+    SNQ = "SNQ"  # read the sensor angles (sim only)
 
 
 #: The commands a real HA-655 is known to answer (its public manual, p.21).
 DOCUMENTED_COMMANDS = frozenset({Command.DGR, Command.OWW})
 #: Commands that only the simulated drive has (a real drive answers x).
-SIM_ONLY_COMMANDS = frozenset({Command.INP, Command.PWC})
+SIM_ONLY_COMMANDS = frozenset({
+    Command.INP, Command.PWC, Command.FLT, Command.SNO, Command.SNA, Command.SNB, Command.SNQ,
+})
 #: Extension commands a drive lists in its CAP reply.
 EXTENSION_COMMANDS = frozenset(Command) - DOCUMENTED_COMMANDS
 
