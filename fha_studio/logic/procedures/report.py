@@ -241,9 +241,8 @@ def _table(headers: list[str], rows: list[list[str]]) -> str:
 
 def render_html(report: CommissioningReport) -> str:
     """The report as one self-contained HTML document (images by file path)."""
-    out = [
-        f"<html><head><meta charset='utf-8'><title>{_e(report.title)}</title><style>{_CSS}</style></head><body>"
-    ]
+    head = f"<meta charset='utf-8'><title>{_e(report.title)}</title><style>{_CSS}</style>"
+    out = [f"<html><head>{head}</head><body>"]
     out.append(f"<h1>{_e(report.title)}</h1>")
     a, d = report.actuator, report.driver
     identity = [
