@@ -1,7 +1,8 @@
 """Size one axis: the whole of Chapter 2 for one actuator and the user's duty cycle.
 
 :func:`evaluate` is pure (explicit ratings in SI); :func:`size_axis` looks the actuator up in
-the catalogue first. The duty cycle is the manual's: one move of ``angle_deg`` per cycle of
+the catalogue first; :func:`suggest_actuators` lists the catalogue actuators a duty passes
+on. The duty cycle is the manual's: one move of ``angle_deg`` per cycle of
 ``cycle_time_s``, accelerated at maximum torque to ``speed_rpm``, run, braked at maximum torque.
 """
 
@@ -10,6 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from fha_studio import catalog
 from fha_studio.logic.sizing import duty as f
 from fha_studio.logic.sizing._data import limits
 from fha_studio.logic.sizing.bearing import BearingLoads, BearingRatings, BearingResult, check_bearing
@@ -272,7 +274,12 @@ def evaluate(ratings: ActuatorRatings, duty: DutyCycle) -> SizingResult:
         tm = nav = t_min = math.inf
     checks += [
         at_most(
-            "effective torque", tm, r.continuous_torque_nm, "2-4-6", "N m", "Tm against the continuous torque"
+            "effective torque",
+            tm,
+            r.continuous_torque_nm,
+            "2-4-6",
+            "N m",
+            f"Tm against the continuous torque; it falls to the continuous torque at a {t_min:.3g} s cycle",
         ),
         at_least(
             "cycle time",
@@ -280,7 +287,8 @@ def evaluate(ratings: ActuatorRatings, duty: DutyCycle) -> SizingResult:
             t_min,
             "2-4-6",
             "s",
-            "the shortest cycle at which Tm equals the continuous torque",
+            "the shortest cycle at which Tm equals the continuous torque: lengthen the cycle, lower the "
+            "load inertia or choose a larger frame",
         ),
         at_most(
             "average speed", nav, r.continuous_speed_rpm, "2-4-6", "r/min", "Nav against the continuous speed"
@@ -303,8 +311,12 @@ def evaluate(ratings: ActuatorRatings, duty: DutyCycle) -> SizingResult:
     if d.bearing_loads is not None:
         if r.bearing is None:
             raise SizingError(f"no cross-roller bearing data for {r.code}: cannot check the bearing loads")
-        # one move per cycle: a sway (there and back) takes two cycles
-        oscillations = 60.0 / (2 * t)
+        # an oscillation (there and back over the sway angle) covers 2 x sway / 360 rev; with the
+        # sway angle equal to the move angle this is one oscillation every two cycles
+        sway = d.bearing_loads.sway_angle_deg
+        oscillations = None
+        if sway is not None:
+            oscillations = nav * 360 / (2 * sway) if math.isfinite(nav) else 0.0
         bearing_result = check_bearing(
             r.bearing, d.bearing_loads, nav if math.isfinite(nav) else 0.0, oscillations
         )
@@ -328,3 +340,58 @@ def evaluate(ratings: ActuatorRatings, duty: DutyCycle) -> SizingResult:
         bearing_result,
         tuple(checks),
     )
+
+
+# -- the catalogue glue --------------------------------------------------------------------------
+def ratings_from_actuator(actuator: catalog.Actuator) -> ActuatorRatings:
+    """The figures Chapter 2 needs from a catalogue :class:`fha_studio.catalog.Actuator`."""
+    b = actuator.bearing
+    return ActuatorRatings(
+        code=actuator.model_code,
+        max_torque_nm=actuator.max_torque_nm,
+        max_speed_rpm=actuator.max_speed_rpm,
+        friction_torque_nm=actuator.friction_torque_nm,
+        inertia_kgm2=actuator.inertia_kgm2,
+        continuous_torque_nm=actuator.continuous_torque_nm,
+        continuous_speed_rpm=actuator.continuous_speed_rpm,
+        allowable_inertia_kgm2=actuator.allowable_inertia_kgm2,
+        bearing=BearingRatings(
+            pitch_circle_m=b.circular_pitch_of_roller_m,
+            offset_m=b.offset_m,
+            dynamic_load_rating_n=b.basic_dynamic_load_rating_n,
+            static_load_rating_n=b.basic_static_load_rating_n,
+            allowable_radial_load_n=b.allowable_radial_load_n,
+            allowable_axial_load_n=b.allowable_axial_load_n,
+            allowable_moment_nm=b.allowable_torsional_moment_nm,
+        ),
+    )
+
+
+def actuator_ratings(actuator_code: str) -> ActuatorRatings:
+    """The ratings of a catalogue model code; SizingError (one line) for a code the catalogue lacks."""
+    try:
+        return ratings_from_actuator(catalog.get_actuator(actuator_code))
+    except (ValueError, KeyError) as exc:
+        raise SizingError(f"unknown actuator {actuator_code!r}: {exc}") from None
+
+
+def size_axis(actuator_code: str, duty: DutyCycle) -> SizingResult:
+    """Chapter 2 for ``duty`` on the catalogue actuator ``actuator_code`` (e.g. ``"FHA-25C-50-US250"``)."""
+    return evaluate(actuator_ratings(actuator_code), duty)
+
+
+def size_all(
+    duty: DutyCycle, codes: list[str] | None = None, encoder_code: str = "US250"
+) -> list[SizingResult]:
+    """``duty`` on every actuator of ``codes`` (default: the catalogue's 200 V actuators with
+    ``encoder_code``, smallest frame and ratio first)."""
+    if codes is None:
+        codes = [c for c in catalog.all_model_codes(include_ac100v=False) if c.endswith(encoder_code)]
+    return [size_axis(code, duty) for code in codes]
+
+
+def suggest_actuators(
+    duty: DutyCycle, codes: list[str] | None = None, encoder_code: str = "US250"
+) -> list[SizingResult]:
+    """The actuators on which ``duty`` passes every check, in the order of :func:`size_all`."""
+    return [r for r in size_all(duty, codes, encoder_code) if r.ok]
