@@ -2,7 +2,7 @@
 
 Public API: :func:`parse_model_code` -> :class:`ModelCode` (raises :class:`ModelCodeError`),
 :func:`get_actuator` -> :class:`Actuator`, :func:`compatible_drivers`, :func:`all_model_codes`,
-:func:`frames`, :func:`ratios`, :func:`options_allowed`; the raw tables are in
+:func:`frames`, :func:`ratios`, :func:`options_allowed`, :func:`environment`; the raw tables are in
 :mod:`fha_studio.catalog.tables`, the manual's contradictions in :func:`discrepancies`.
 """
 
@@ -10,6 +10,7 @@ from fha_studio.catalog.actuator import (
     Actuator,
     Bearing,
     Brake,
+    CableLeads,
     MechanicalAccuracy,
     ScrewTightening,
     TighteningTorques,
@@ -22,14 +23,17 @@ from fha_studio.catalog.actuator import (
     ratios,
 )
 from fha_studio.catalog.model_code import OPTION_ORDER, ModelCode, ModelCodeError, parse_model_code
-from fha_studio.catalog.tables import Discrepancy, discrepancies
+from fha_studio.catalog.tables import Discrepancy, Environment, Lead, discrepancies, environment
 
 __all__ = [
     "OPTION_ORDER",
     "Actuator",
     "Bearing",
     "Brake",
+    "CableLeads",
     "Discrepancy",
+    "Environment",
+    "Lead",
     "MechanicalAccuracy",
     "ModelCode",
     "ModelCodeError",
@@ -39,6 +43,7 @@ __all__ = [
     "all_model_codes",
     "compatible_drivers",
     "discrepancies",
+    "environment",
     "frames",
     "get_actuator",
     "options_allowed",

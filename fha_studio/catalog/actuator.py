@@ -6,16 +6,20 @@ All quantities are SI (or r/min, arc-sec, mH where the name says so) and refer t
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cache
+from types import MappingProxyType
 from typing import Any
 
 from fha_studio.catalog.model_code import OPTION_ORDER, ModelCode, ModelCodeError, parse_model_code
 from fha_studio.catalog.tables import (
     FRAMES,
     RATIOS,
+    Lead,
     allowable_inertia_table,
     brake_table,
+    cable_tables,
     combination_table,
     continuous_table,
     discrepancies,
@@ -135,8 +139,24 @@ class TighteningTorques:
 
 
 @dataclass(frozen=True)
+class CableLeads:
+    """1-14 / 4-2-2 lead colours of this actuator's cables.
+
+    ``motor``: the motor cable (with the brake leads when option B is fitted). ``encoder``: the
+    encoder lead tables that apply, by name: the incremental system has a 14-wire and a 4-wire
+    (serial) variant in 1-14 and the manual does not say which one a given unit has; the absolute
+    system has one. ``connectors``: the 4-3 cable-end connectors (option C), else empty.
+    """
+
+    motor: tuple[Lead, ...]
+    # Read-only mappings, left out of the hash so that an Actuator stays hashable.
+    encoder: Mapping[str, tuple[Lead, ...]] = field(hash=False)
+    connectors: Mapping[str, str] = field(hash=False)
+
+
+@dataclass(frozen=True)
 class Actuator:
-    """One FHA-C actuator resolved from the catalogue (1-4, 1-6..1-9, 2-1, 2-3, 2-4-6, 3-3-2, 4-1, 4-2).
+    """One FHA-C actuator resolved from the catalogue (1-3, 1-4, 1-6..1-9, 1-14, 2-1, 2-3, 2-4-6, 3-3-2, 4-2).
 
     Output-referred SI quantities with units in the names. With option B, ``inertia_kgm2`` and
     ``mass_kg`` are the brake table's (4-2-1), i.e. of the actuator with its brake. With option A the
@@ -180,6 +200,7 @@ class Actuator:
     mechanical_accuracy: MechanicalAccuracy
     tightening: TighteningTorques
     compatible_drivers: tuple[str, ...]
+    cables: CableLeads
     notes: tuple[str, ...] = field(default=())
 
     @property
@@ -203,6 +224,8 @@ def _plain(value: Any) -> Any:
         return [o for o in OPTION_ORDER if o in value]
     if isinstance(value, tuple):
         return [_plain(v) for v in value]
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
     if hasattr(value, "__dataclass_fields__"):
         return {k: _plain(getattr(value, k)) for k in value.__dataclass_fields__}
     return value
@@ -279,6 +302,22 @@ def _brake(code: ModelCode, index: int) -> Brake:
         emergency_stop_cycles=int(data["emergency_stop_cycles"]),
         emergency_stop_max_motor_speed_rpm=float(data["emergency_stop_max_motor_speed_rpm"]),
         estimated=estimated,
+    )
+
+
+def _cables(mc: ModelCode) -> CableLeads:
+    c = cable_tables()
+    if mc.encoder == "incremental":
+        encoder = {"14-wire": c.incremental_14_wire, "4-wire": c.incremental_4_wire}
+        connector_keys = ("motor", "incremental_encoder")
+    else:
+        encoder = {"absolute": c.absolute}
+        connector_keys = ("motor", "absolute_encoder")
+    connectors = {k: c.connectors[k] for k in connector_keys} if "C" in mc.options else {}
+    return CableLeads(
+        motor=c.motor_brake_option if mc.has_brake else c.motor_standard,
+        encoder=MappingProxyType(encoder),
+        connectors=MappingProxyType(connectors),
     )
 
 
@@ -369,6 +408,7 @@ def _get_actuator(mc: ModelCode) -> Actuator:
         mechanical_accuracy=_mechanical_accuracy(mc.frame),
         tightening=_tightening(mc.frame),
         compatible_drivers=tuple(compatible_drivers(mc)),
+        cables=_cables(mc),
         notes=tuple(notes),
     )
 

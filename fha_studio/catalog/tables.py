@@ -8,7 +8,7 @@ Units are in the names; per-ratio values are tuples in the order of ``RATIOS``.
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -355,9 +355,9 @@ class Discrepancy:
     id: str
     section: str
     quantity: str
-    used: Any
-    printed: dict[str, Any]
-    reason: str
+    used: Any = field(hash=False)
+    printed: dict[str, Any] = field(hash=False)
+    reason: str = ""
     frame: str | None = None
     ratios: tuple[int, ...] | None = None
     encoder: str | None = None
@@ -404,3 +404,169 @@ def discrepancies() -> tuple[Discrepancy, ...]:
             )
         )
     return tuple(out)
+
+
+# --- 4-1 AC100V, as printed ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Ac100vRow:
+    """4-1 AC100V table of one frame, as printed (option A uses the 1-4 100 V rows instead)."""
+
+    frame: str
+    max_torque_nm: tuple[float, ...]
+    max_torque_kgf_m: tuple[float, ...]
+    max_speed_rpm: tuple[float, ...]
+    torque_constant_nm_per_a: tuple[float, ...]
+    torque_constant_kgf_m_per_a: tuple[float, ...]
+    max_current_a: tuple[float, ...]
+    inertia_kgm2: tuple[float, ...]
+    inertia_kgf_cm_s2: tuple[float, ...]
+    emf_constant_v_per_rpm: tuple[float, ...]
+    phase_resistance_ohm: float
+    phase_inductance_mh: float
+    allowable_radial_load_kn: float
+    allowable_radial_load_kgf: float
+    allowable_axial_load_kn: float
+    allowable_axial_load_kgf: float
+    allowable_torsional_moment_nm: float
+    allowable_torsional_moment_kgf_m: float
+    moment_stiffness_nm_per_rad: float
+    moment_stiffness_kgf_m_per_rad: float
+    one_way_accuracy_arcsec: tuple[float, ...]
+    output_resolution_ppr: tuple[int, ...]
+    mass_kg: float
+
+
+def ac100v_frames() -> tuple[str, ...]:
+    """Frames the 4-1 table covers (FHA-40C is not available for AC100V)."""
+    return tuple(load_toml("ac100v")["frames"])
+
+
+@cache
+def ac100v_table(frame: str) -> Ac100vRow:
+    """The 4-1 AC100V table of one frame (17C, 25C or 32C), as printed."""
+    row = load_toml("ac100v")["frame"][frame]
+    where = f"ac100v.toml [frame.{frame}]"
+    values: dict[str, Any] = {}
+    for name, fld in Ac100vRow.__dataclass_fields__.items():
+        if name == "frame":
+            continue
+        if "tuple" in str(fld.type):
+            values[name] = _per_ratio(row[name], where)
+        else:
+            values[name] = float(row[name])
+    values["output_resolution_ppr"] = tuple(int(v) for v in values["output_resolution_ppr"])
+    return Ac100vRow(frame=frame, **values)
+
+
+# --- 1-7 / 1-8 ----------------------------------------------------------------------------------
+
+
+@cache
+def one_way_accuracy_table(frame: str) -> tuple[float, ...]:
+    """1-7 uni-directional positioning accuracy (arc-sec) of one frame, per ratio."""
+    t = load_toml("accuracy")["one_way_positioning_accuracy"]
+    return _per_ratio(t["arcsec"][frame], f"accuracy.toml one_way_positioning_accuracy {frame}")
+
+
+@dataclass(frozen=True)
+class EncoderResolutionRow:
+    """1-8 encoder resolution of one encoder system."""
+
+    encoder: str
+    encoder_ppr: int
+    counts_per_motor_rev: int
+    output_resolution_ppr: tuple[int, ...]
+    resolvable_angle_arcsec: tuple[float, ...]
+
+
+@cache
+def encoder_resolution_table(encoder: str) -> EncoderResolutionRow:
+    """1-8 for ``"incremental"`` or ``"absolute"``."""
+    t = load_toml("accuracy")["encoder_resolution"][encoder]
+    where = f"accuracy.toml encoder_resolution.{encoder}"
+    return EncoderResolutionRow(
+        encoder=encoder,
+        encoder_ppr=int(t["encoder_ppr"]),
+        counts_per_motor_rev=int(t["counts_per_motor_rev"]),
+        output_resolution_ppr=tuple(int(v) for v in _per_ratio(t["output_resolution_ppr"], where)),
+        resolvable_angle_arcsec=_per_ratio(t["resolvable_angle_arcsec"], where),
+    )
+
+
+# --- 1-14 cables, 4-2-2 brake leads -------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Lead:
+    """One lead of a cable: its colour, its signal, and the manual's reference text (may be empty)."""
+
+    colour: str
+    signal: str
+    reference: str = ""
+
+
+@dataclass(frozen=True)
+class CableTables:
+    """1-14 lead colours (motor standard / with brake, 14-wire and 4-wire incremental, absolute) and 4-2-2."""
+
+    motor_standard: tuple[Lead, ...]
+    motor_brake_option: tuple[Lead, ...]
+    incremental_14_wire: tuple[Lead, ...]
+    incremental_4_wire: tuple[Lead, ...]
+    absolute: tuple[Lead, ...]
+    brake_leads: tuple[Lead, ...]
+    connectors: dict[str, str]
+    extension_cables: dict[str, Any]
+
+
+@cache
+def cable_tables() -> CableTables:
+    """All lead-colour tables of 1-14 and 4-2-2, with the 4-3 connectors and 4-8 extension cables."""
+    c = load_toml("cables")
+
+    def leads(rows: list[dict[str, str]]) -> tuple[Lead, ...]:
+        return tuple(Lead(r["colour"], r["signal"], r.get("reference", "")) for r in rows)
+
+    return CableTables(
+        motor_standard=tuple(Lead(r["colour"], r["standard"]) for r in c["motor"]),
+        motor_brake_option=tuple(Lead(r["colour"], r["brake_option"]) for r in c["motor"]),
+        incremental_14_wire=leads(c["incremental_14_wire"]),
+        incremental_4_wire=leads(c["incremental_4_wire"]),
+        absolute=leads(c["absolute"]),
+        brake_leads=tuple(Lead(r["colour"], r["lead"]) for r in load_toml("brake")["leads"]),
+        connectors={k: v for k, v in c["connectors"].items() if k != "section"},
+        extension_cables={k: v for k, v in c["extension_cables"].items() if k != "section"},
+    )
+
+
+# --- 3-3-1 environment --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Environment:
+    """3-3-1 environment of location (with 1-4, 1-11, 1-12): limits for service and storage."""
+
+    service_temperature_min_c: float
+    service_temperature_max_c: float
+    storage_temperature_min_c: float
+    storage_temperature_max_c: float
+    humidity_min_percent_rh: float
+    humidity_max_percent_rh: float
+    vibration_max_m_per_s2: float
+    vibration_frequency_min_hz: float
+    vibration_frequency_max_hz: float
+    impact_max_m_per_s2: float
+    altitude_max_m: float
+    protection: str
+    min_cable_bending_radius_m: float
+
+
+@cache
+def environment() -> Environment:
+    """The environment limits of 3-3-1 (same for every FHA-C actuator)."""
+    e = dict(load_toml("mechanical")["environment"])
+    e.pop("section")
+    e["min_cable_bending_radius_m"] = e.pop("min_cable_bending_radius_mm") / 1000.0
+    return Environment(**e)

@@ -37,6 +37,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _fmt(value: Any) -> str:
+    if isinstance(value, dict) and "colour" in value:  # a cable lead
+        return f"{value['colour']}={value['signal']}"
     if isinstance(value, float):
         return f"{value:.6g}"
     if isinstance(value, (list, tuple)):

@@ -87,6 +87,10 @@ def test_fields_named_in_the_architecture_contract():
     assert a.brake.holding_torque_nm == 150
     with pytest.raises(dataclasses.FrozenInstanceError):
         a.max_torque_nm = 1  # type: ignore[misc]
+    with pytest.raises(TypeError):
+        a.cables.encoder["absolute"] = ()  # type: ignore[index]
+    assert hash(a) == hash(get_actuator("FHA-32C-100-S248-B"))
+    assert get_actuator("FHA-32C-100-S248-B") is a  # cached
 
 
 def test_brake_option_takes_inertia_and_mass_from_the_brake_table():
