@@ -41,6 +41,15 @@ def test_load_torque_above_max_torque_fails_instead_of_a_negative_time():
     assert r.as_dict()["accel_time_s"] is None  # JSON-safe
 
 
+def test_overhauling_load_above_braking_torque_fails():
+    r = evaluate(RATINGS, DutyCycle(1.5, 60, 120, 2.0, load_torque_nm=-200))
+    check = next(c for c in r.checks if c.name == "load torque while braking")
+    assert not check.ok and check.limit == pytest.approx(150 + 2 * 10.6)
+    assert math.isinf(r.decel_time_s) and not r.ok
+    ok = evaluate(RATINGS, DutyCycle(1.5, 60, 120, 2.0, load_torque_nm=-20))
+    assert next(c for c in ok.checks if c.name == "load torque while braking").ok
+
+
 def test_move_too_short_to_reach_speed_is_a_failed_check():
     r = evaluate(RATINGS, DutyCycle(1.5, 60, 10, 2.0))  # needs ~32.7 deg to reach 60 r/min
     assert r.run_time_s == 0.0

@@ -229,6 +229,20 @@ def evaluate(ratings: ActuatorRatings, duty: DutyCycle) -> SizingResult:
             "<",
         )
     )
+    if tl < 0:  # a load turning with the rotation (a falling mass) works against braking
+        braking = r.max_torque_nm + 2 * tf
+        checks.append(
+            Check(
+                "load torque while braking",
+                float(-tl),
+                float(braking),
+                -tl < braking,
+                "2-4-4",
+                "N m",
+                "a load torque turning with the rotation must stay below the braking torque TM + 2 TF",
+                "<",
+            )
+        )
     accelerates = math.isfinite(ta) and math.isfinite(td)
     if accelerates:
         tr_raw = f.run_time_s(d.angle_deg, n, ta, td)
