@@ -1,0 +1,468 @@
+"""`ServoAxis`: the plant of an `AxisModel` under an HA-655-like servo, stepped at servo_rate_hz.
+
+Control structure (position mode of the HA-655 manual, tune mode items Kp/Kv/Tv/feed-forward):
+
+    speed command   w_ref = Kp x (cmd - pos) + FF x d(cmd)/dt          [rad/s]
+    current command i = Kv x (e + (1/Tv) x integral(e dt)),  e = w_ref - w     [A]
+    clamped to the current limit, with conditional integration (no wind-up while saturated).
+
+The current loop is taken as ideal (the motor torque is Kt x the commanded current within a
+servo period). Feedback is the ideal motor-side position (quantisation belongs to the monitors,
+see `MonitorOptions` in simulate.py).
+
+Frames: the physical frame has positive = CW seen from the output flange (output_pos_rad,
+load_pos_rad, output_speed_rad_s, current_a, torque_nm). The command frame is the drive's own
+count: positive = FWD command. With rotary_direction 0 (parameter 8, the default) FWD = CW, so
+the frames agree; with 1 they are mirrored. Commands (jog, move_by, pulses) and the pulse
+counters (command_pulses, feedback_pulses, error_pulses) are in the command frame.
+
+Electronic gear: command input pulses x numerator / denominator = output encoder pulses.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from fha_studio.physics import _kernel
+from fha_studio.physics.model import AxisModel
+from fha_studio.physics.motion import MotionGenerator
+from fha_studio.physics.stiffness import ARCSEC_PER_RAD
+
+MIN_SERVO_RATE_HZ = 5000.0
+RAD_S_PER_RPM = 2.0 * math.pi / 60.0
+
+
+@dataclass(frozen=True)
+class ServoSettings:
+    """Servo loop settings in SI (the sim maps the HA-655's tune/parameter values onto these).
+
+    position_loop_gain_per_s: Kp, speed command per position error (1/s).
+    speed_loop_gain_a_s_per_rad: Kv, current per output speed error (A per rad/s).
+    speed_loop_integral_time_s: Tv (inf = no integral action).
+    feed_forward_gain: share of the command speed fed forward to the speed loop (0..1).
+    current_limit_a: None = the actuator's maximum current.
+    rotary_direction: parameter 8; 0 = FWD turns CW seen from the output flange, 1 = reversed.
+    in_position_range_pulses: the IN-POS window, in output encoder pulses.
+    """
+
+    position_loop_gain_per_s: float = 30.0
+    speed_loop_gain_a_s_per_rad: float = 10.0
+    speed_loop_integral_time_s: float = 0.02
+    feed_forward_gain: float = 0.0
+    current_limit_a: float | None = None
+    electronic_gear_numerator: int = 1
+    electronic_gear_denominator: int = 1
+    rotary_direction: int = 0
+    in_position_range_pulses: int = 10
+    servo_rate_hz: float = MIN_SERVO_RATE_HZ
+
+    def __post_init__(self) -> None:
+        def check(name: str, ok: bool, what: str) -> None:
+            if not ok:
+                raise ValueError(f"servo settings: {name} must be {what}, got {getattr(self, name)!r}")
+
+        check("position_loop_gain_per_s", self.position_loop_gain_per_s >= 0, "non-negative")
+        check("speed_loop_gain_a_s_per_rad", self.speed_loop_gain_a_s_per_rad > 0, "positive")
+        check("speed_loop_integral_time_s", self.speed_loop_integral_time_s > 0, "positive (inf = off)")
+        check("feed_forward_gain", 0.0 <= self.feed_forward_gain <= 1.0, "between 0 and 1")
+        check("current_limit_a", self.current_limit_a is None or self.current_limit_a >= 0, "non-negative")
+        check("electronic_gear_numerator", isinstance(self.electronic_gear_numerator, int)
+              and self.electronic_gear_numerator > 0, "a positive integer")
+        check("electronic_gear_denominator", isinstance(self.electronic_gear_denominator, int)
+              and self.electronic_gear_denominator > 0, "a positive integer")
+        check("rotary_direction", self.rotary_direction in (0, 1), "0 (FWD = CW) or 1 (reversed)")
+        check("in_position_range_pulses", self.in_position_range_pulses >= 0, "non-negative")
+        check("servo_rate_hz", self.servo_rate_hz >= MIN_SERVO_RATE_HZ, f"at least {MIN_SERVO_RATE_HZ:g}")
+
+    @classmethod
+    def tuned_for(cls, model: AxisModel, speed_bandwidth_hz: float = 20.0,
+                  **overrides: object) -> ServoSettings:
+        """Gains from a speed-loop bandwidth on the rigid-body inertia of the model.
+
+        Kv = 2 pi f J / Kt, Tv = 4 / (2 pi f), Kp = 2 pi f / 5: a conventional cascade with the
+        position loop well inside the speed loop.
+        """
+        w = 2.0 * math.pi * speed_bandwidth_hz
+        values: dict[str, object] = dict(
+            position_loop_gain_per_s=w / 5.0,
+            speed_loop_gain_a_s_per_rad=w * model.total_inertia_kgm2 / model.torque_constant_nm_per_a,
+            speed_loop_integral_time_s=4.0 / w,
+        )
+        values.update(overrides)
+        return cls(**values)  # type: ignore[arg-type]
+
+    def replace(self, **changes: object) -> ServoSettings:
+        """A copy with some fields changed (validated again)."""
+        return replace(self, **changes)  # type: ignore[arg-type]
+
+    @property
+    def direction_sign(self) -> float:
+        """+1 when FWD = CW (rotary direction 0), -1 when reversed."""
+        return -1.0 if self.rotary_direction else 1.0
+
+
+def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelParams:
+    """Flatten model + settings for the loop (and pick the substep count)."""
+    e = model.effects
+    dt = 1.0 / settings.servo_rate_hz
+    jm, jl = model.motor_side_inertia_kgm2, model.load_side_inertia_kgm2
+    stiff = model.gear_stiffness
+    compliant = stiff is not None
+    if compliant:
+        k1, k2, k3 = stiff.k1_nm_per_rad, stiff.k2_nm_per_rad, stiff.k3_nm_per_rad
+        t1, t2, th1, th2 = stiff.t1_nm, stiff.t2_nm, stiff.theta1_rad, stiff.theta2_rad
+        j_eq = jm * jl / (jm + jl)
+        damping = 2.0 * model.gear_damping_ratio * math.sqrt(k1 * j_eq)
+        nsub = _kernel.substeps_for(jm, jl, stiff.max_stiffness_nm_per_rad, dt)
+    else:
+        k1 = k2 = k3 = t1 = t2 = th1 = th2 = damping = 0.0
+        nsub = 1
+    ratio = model.ratio or 0.0
+    tv = settings.speed_loop_integral_time_s
+    ilim = model.max_current_a if settings.current_limit_a is None else min(settings.current_limit_a,
+                                                                             model.max_current_a)
+    return _kernel.KernelParams(
+        dt=dt, nsub=nsub, direction=settings.direction_sign,
+        kp=settings.position_loop_gain_per_s, kv=settings.speed_loop_gain_a_s_per_rad,
+        tv_inv=0.0 if math.isinf(tv) else 1.0 / tv, ff=settings.feed_forward_gain, ilim=ilim,
+        kt=model.torque_constant_nm_per_a, jm=jm, jl=jl, j_total=jm + jl,
+        compliant=compliant, k1=k1, k2=k2, k3=k3, t1=t1, t2=t2, th1=th1, th2=th2, damping=damping,
+        fc=e.coulomb_friction.torque_nm if e.coulomb_friction else 0.0,
+        visc=e.viscous_friction.coefficient_nm_s_per_rad if e.viscous_friction else 0.0,
+        grav_a=e.gravity_load.amplitude_nm if e.gravity_load else 0.0,
+        grav_phase=math.radians(e.gravity_load.phase_deg) if e.gravity_load else 0.0,
+        offset=e.load_torque_offset.torque_nm if e.load_torque_offset else 0.0,
+        rip_a=e.torque_ripple.amplitude_nm if e.torque_ripple else 0.0,
+        rip_w=e.torque_ripple.cycles_per_motor_rev * ratio if e.torque_ripple else 0.0,
+        rip_phase=math.radians(e.torque_ripple.phase_deg) if e.torque_ripple else 0.0,
+        ke_a=e.kinematic_error.amplitude_arcsec / ARCSEC_PER_RAD if e.kinematic_error else 0.0,
+        ke_w=e.kinematic_error.cycles_per_motor_rev * ratio if e.kinematic_error else 0.0,
+        ke_phase=math.radians(e.kinematic_error.phase_deg) if e.kinematic_error else 0.0,
+        lm_half=0.5 * e.lost_motion.width_arcsec / ARCSEC_PER_RAD if e.lost_motion else 0.0,
+        resistance=model.phase_resistance_ohm,
+    )
+
+
+TRACE_CHANNELS = ("t", "cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd")
+
+
+class ServoAxis:
+    """One simulated axis: plant + servo + command generator. Not thread-safe (one owner).
+
+    Units: rad, rad/s, A, N m, s, J; pulses = output encoder pulses (model.output_resolution_ppr
+    per output turn). See the module docstring for frames and signs.
+    """
+
+    def __init__(self, model: AxisModel, settings: ServoSettings | None = None, *,
+                 initial_pos_rad: float = 0.0) -> None:
+        self._model = model
+        self._settings = settings if settings is not None else ServoSettings.tuned_for(model)
+        self._params = kernel_params(model, self._settings)
+        self._state = _kernel.KernelState(xm=float(initial_pos_rad), xl=float(initial_pos_rad))
+        self._state.xl = self._load_rest_position(self._state.xm)
+        self._servo_on = False
+        d = self._settings.direction_sign
+        self._state.cprev = d * self._state.xm
+        self._generator = MotionGenerator(d * self._state.xm)
+        self._pulse_offset_rad = 0.0
+        self._trace: tuple[list, ...] | None = None
+        self._trace_every = 1
+        self._trace_max = 0
+
+    # ----- configuration ------------------------------------------------------------------
+    @property
+    def model(self) -> AxisModel:
+        return self._model
+
+    @property
+    def settings(self) -> ServoSettings:
+        return self._settings
+
+    def set_settings(self, settings: ServoSettings) -> None:
+        """Change gains/limits/direction live (state kept; a direction change re-bases the command)."""
+        old_d = self._settings.direction_sign
+        self._settings = settings
+        self._params = kernel_params(self._model, settings)
+        if settings.direction_sign != old_d:
+            self._rebase_command()
+
+    def set_model(self, model: AxisModel) -> None:
+        """Swap the plant parameters (e.g. another load or effect set), keeping the state."""
+        self._model = model
+        self._params = kernel_params(model, self._settings)
+
+    @property
+    def substeps(self) -> int:
+        """Plant integration substeps per servo period (from the stiffest gear region)."""
+        return self._params.nsub
+
+    # ----- time -----------------------------------------------------------------------------
+    @property
+    def servo_period_s(self) -> float:
+        return self._params.dt
+
+    @property
+    def time_s(self) -> float:
+        """Simulated time since construction."""
+        return self._state.step_index * self._params.dt
+
+    def step(self, n: int = 1) -> None:
+        """Advance n servo periods."""
+        if n <= 0:
+            return
+        p = self._params
+        if self._servo_on:
+            k0 = self._state.step_index + 1
+            t = np.arange(k0, k0 + n) * p.dt
+            cmd = (self._generator.positions(t) + self._pulse_offset_rad).tolist()
+        else:
+            cmd = None
+        rec = self._trace
+        _kernel.run(p, self._state, cmd, n, self._servo_on, rec, self._trace_every)
+        if rec is not None:
+            overflow = len(rec[0]) - self._trace_max
+            if overflow > 0:
+                for ch in rec:
+                    del ch[:overflow]
+        if not self._servo_on:
+            self._generator.hold(self.time_s, self._state.cprev)
+            self._pulse_offset_rad = 0.0
+
+    def advance(self, seconds: float) -> None:
+        """Advance by a duration (rounded to whole servo periods)."""
+        self.step(round(seconds / self._params.dt))
+
+    # ----- servo on/off, brake -------------------------------------------------------------
+    @property
+    def servo_is_on(self) -> bool:
+        return self._servo_on
+
+    def servo_on(self) -> None:
+        """Energise: the command starts at the present position (error counter cleared)."""
+        if not self._servo_on:
+            self._rebase_command()
+            self._state.integ = 0.0
+            self._servo_on = True
+
+    def servo_off(self) -> None:
+        """De-energise: no current, the axis coasts (friction, brake and load act)."""
+        self._servo_on = False
+        self._state.current = 0.0
+
+    def set_brake(self, engaged: bool, holding_torque_nm: float = 0.0) -> None:
+        """Motor brake (non-excitation type: the sim engages it when the coil is unpowered).
+
+        While engaged, it holds the motor side up to holding_torque_nm (output-referred).
+        """
+        self._state.brake_torque = float(holding_torque_nm) if engaged else 0.0
+
+    @property
+    def brake_engaged(self) -> bool:
+        return self._state.brake_torque > 0.0
+
+    # ----- commands (command frame) ----------------------------------------------------------
+    def _default_speed(self, speed: float | None) -> float:
+        if speed is not None:
+            return abs(float(speed))
+        vmax = self._model.max_speed_rad_s
+        if vmax is None:
+            raise ValueError("motion: give a speed (the model has no maximum speed)")
+        return vmax
+
+    def _default_accel(self, accel: float | None) -> float:
+        return self._model.max_acceleration_rad_s2() if accel is None else float(accel)
+
+    def jog(self, speed_rad_s: float, accel_rad_s2: float | None = None) -> None:
+        """Ramp to speed_rad_s (signed, + = FWD) at accel (default: the torque-limited accel)."""
+        self._require_servo("jog")
+        self._generator.jog(self.time_s, float(speed_rad_s), self._default_accel(accel_rad_s2))
+
+    def stop(self, decel_rad_s2: float | None = None) -> None:
+        """Ramp the command to standstill (default: the torque-limited accel), then hold."""
+        self._generator.stop(self.time_s, self._default_accel(decel_rad_s2))
+
+    def move_by(self, angle_rad: float, speed_rad_s: float | None = None,
+                accel_rad_s2: float | None = None) -> None:
+        """Trapezoidal move by angle_rad (+ = FWD) at speed (default max speed) and accel (default
+        the torque-limited accel). The command must be at standstill."""
+        self._require_servo("move")
+        self._generator.move_by(self.time_s, float(angle_rad), self._default_speed(speed_rad_s),
+                                self._default_accel(accel_rad_s2))
+
+    def move_by_pulses(self, command_pulses: int, speed_rad_s: float | None = None,
+                       accel_rad_s2: float | None = None) -> None:
+        """move_by in command input pulses (through the electronic gear)."""
+        self.move_by(self.command_pulses_to_rad(command_pulses), speed_rad_s, accel_rad_s2)
+
+    def add_command_pulses(self, command_pulses: int) -> None:
+        """Pulse-train input: add command_pulses (through the electronic gear) to the command now."""
+        if self._servo_on:
+            self._pulse_offset_rad += self.command_pulses_to_rad(command_pulses)
+
+    def command_pulses_to_rad(self, command_pulses: float) -> float:
+        """Command input pulses -> output angle (rad) through the electronic gear."""
+        s = self._settings
+        return command_pulses * s.electronic_gear_numerator / s.electronic_gear_denominator * \
+            self._model.output_pulse_rad
+
+    @property
+    def motion_done(self) -> bool:
+        """True when the command profile has reached its final standstill (not jogging)."""
+        return not math.isnan(self._generator.target_rad) and self.time_s >= self._generator.end_time_s()
+
+    def _require_servo(self, what: str) -> None:
+        if not self._servo_on:
+            raise RuntimeError(f"cannot {what}: the servo is off")
+
+    def _rebase_command(self) -> None:
+        d = self._settings.direction_sign
+        self._generator.hold(self.time_s, d * self._state.xm)
+        self._pulse_offset_rad = 0.0
+        self._state.cprev = d * self._state.xm
+
+    def _load_rest_position(self, xm: float) -> float:
+        p = self._params
+        return xm + (p.ke_a * math.sin(p.ke_w * xm + p.ke_phase) if p.ke_a else 0.0)
+
+    # ----- state (physical frame unless said) -------------------------------------------------
+    @property
+    def output_pos_rad(self) -> float:
+        """Motor-side angle at the output (motor angle / ratio), what the motor encoder reports."""
+        return self._state.xm
+
+    @property
+    def motor_pos_rad(self) -> float:
+        """Motor shaft angle (output_pos_rad x ratio); nan without a ratio."""
+        return self._state.xm * (self._model.ratio or math.nan)
+
+    @property
+    def load_pos_rad(self) -> float:
+        """Angle of the output flange / load (after wind-up, kinematic error, lost motion)."""
+        return self._state.xl
+
+    @property
+    def twist_rad(self) -> float:
+        """Motor side minus load side."""
+        return self._state.xm - self._state.xl
+
+    @property
+    def output_speed_rad_s(self) -> float:
+        return self._state.vm
+
+    @property
+    def output_speed_rpm(self) -> float:
+        return self._state.vm / RAD_S_PER_RPM
+
+    @property
+    def motor_speed_rpm(self) -> float:
+        return self.output_speed_rpm * (self._model.ratio or math.nan)
+
+    @property
+    def load_speed_rad_s(self) -> float:
+        return self._state.vl
+
+    @property
+    def current_a(self) -> float:
+        """Motor current (A); Kt x current_a = output torque, + = CW."""
+        return self._state.current
+
+    @property
+    def torque_nm(self) -> float:
+        """Motor torque at the output, Kt x current (N m, + = CW)."""
+        return self._model.torque_constant_nm_per_a * self._state.current
+
+    @property
+    def command_pos_rad(self) -> float:
+        """The position command in the physical frame (rad)."""
+        return self._settings.direction_sign * self._state.cprev
+
+    @property
+    def speed_command_rad_s(self) -> float:
+        """Speed-loop reference (command frame, rad/s)."""
+        return self._state.vref
+
+    def _to_pulses(self, rad: float) -> int:
+        return math.floor(rad / self._model.output_pulse_rad + 0.5)
+
+    @property
+    def command_pulses(self) -> int:
+        """Command position in output encoder pulses (command frame, after the electronic gear)."""
+        return self._to_pulses(self._state.cprev)
+
+    @property
+    def feedback_pulses(self) -> int:
+        """Encoder position in output pulses (command frame)."""
+        return self._to_pulses(self._settings.direction_sign * self._state.xm)
+
+    @property
+    def error_pulses(self) -> int:
+        """Position error, command - feedback, in output pulses (the error counter)."""
+        return self.command_pulses - self.feedback_pulses
+
+    @property
+    def in_position(self) -> bool:
+        """IN-POS: servo on and |error| within the in-position range."""
+        return self._servo_on and abs(self.error_pulses) <= self._settings.in_position_range_pulses
+
+    # ----- accumulators for the drive's alarms ---------------------------------------------
+    @property
+    def current_squared_integral_a2s(self) -> float:
+        """Cumulative integral of current^2 dt (A^2 s); difference it for an I^2 t model."""
+        return self._state.i2_integral
+
+    @property
+    def motor_work_j(self) -> float:
+        """Cumulative mechanical work of the motor on the axis, integral of Kt i w dt (J)."""
+        return self._state.work_j
+
+    @property
+    def regenerated_energy_j(self) -> float:
+        """Cumulative energy returned to the DC bus (J): motor generating beyond its copper loss
+        (1.5 x phase resistance x i^2, an assumption on the current convention)."""
+        return self._state.regen_j
+
+    @property
+    def peak_speed_rad_s(self) -> float:
+        """Largest |motor-side output speed| since reset_peaks() (rad/s)."""
+        return self._state.peak_speed
+
+    @property
+    def peak_error_pulses(self) -> float:
+        """Largest |position error| since reset_peaks(), in output pulses."""
+        return self._state.peak_error / self._model.output_pulse_rad
+
+    def reset_peaks(self) -> None:
+        self._state.peak_speed = 0.0
+        self._state.peak_error = 0.0
+
+    def clear_error(self) -> None:
+        """Clear the error counter (CLEAR input): the command jumps to the present position."""
+        self._rebase_command()
+        self._state.integ = 0.0
+
+    # ----- trace ------------------------------------------------------------------------------
+    def start_trace(self, every_n_periods: int = 1, max_samples: int = 1_000_000) -> None:
+        """Record TRACE_CHANNELS every n servo periods (oldest samples dropped past max_samples)."""
+        if every_n_periods < 1 or max_samples < 1:
+            raise ValueError("trace: every_n_periods and max_samples must be at least 1")
+        self._trace = ([], [], [], [], [], [], [])
+        self._state.rec_count = 0
+        self._trace_every = int(every_n_periods)
+        self._trace_max = int(max_samples)
+
+    def read_trace(self, clear: bool = True) -> dict[str, np.ndarray]:
+        """The recorded samples (t s, cmd_pos rad, pos rad, load_pos rad, vel rad/s, current A,
+        speed_cmd rad/s command frame); clear=True empties the buffer, recording continues."""
+        if self._trace is None:
+            return {name: np.empty(0) for name in TRACE_CHANNELS}
+        out = {name: np.array(ch) for name, ch in zip(TRACE_CHANNELS, self._trace, strict=True)}
+        if clear:
+            for ch in self._trace:
+                ch.clear()
+        return out
+
+    def stop_trace(self) -> None:
+        self._trace = None

@@ -1,0 +1,165 @@
+"""`simulate()`: a whole recorded command through the closed-loop axis, and the monitors' imperfections.
+
+Used by the model check to re-simulate a recording and by tests/the sim to produce recordings
+with known hidden effects.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fha_studio.physics import _kernel
+from fha_studio.physics.model import AxisModel
+from fha_studio.physics.servo import ServoSettings, kernel_params
+
+# Keys of simulate()'s result and their units (SI, output side, physical frame: + = CW).
+SIMULATION_UNITS: dict[str, str] = {
+    "t": "s",
+    "cmd_pos": "rad",  # the command as the servo saw it
+    "pos": "rad",  # motor-side angle at the output (what the motor encoder reports)
+    "load_pos": "rad",  # output flange / load angle (an external encoder would see this)
+    "vel": "rad/s",  # motor-side speed at the output
+    "current": "A",  # motor current; torque = Kt x current
+    "torque": "N m",  # Kt x current
+    "speed_cmd": "rad/s",  # speed-loop reference (command frame)
+}
+
+
+@dataclass(frozen=True)
+class MonitorOptions:
+    """What a real drive's monitors do to the signals (applied to simulate()'s output).
+
+    quantise_position: pos to the encoder's output pulses (model.output_resolution_ppr).
+    load_encoder_ppr: pulses per turn of an external load encoder (None = not quantised).
+    current_resolution_a: step of the current monitor (0 = none); current_noise_a: its noise (std, A).
+    speed_noise_rad_s: noise (std) on vel. seed: of the noise generator.
+    """
+
+    quantise_position: bool = True
+    load_encoder_ppr: int | None = None
+    current_resolution_a: float = 0.0
+    current_noise_a: float = 0.0
+    speed_noise_rad_s: float = 0.0
+    seed: int | None = 0
+
+    @classmethod
+    def typical(cls, model: AxisModel, seed: int | None = 0) -> MonitorOptions:
+        """An assumption of a real drive's monitors: 10-bit current monitor over +-Imax with one
+        step of noise, position in encoder pulses, load encoder at the same resolution."""
+        step = 2.0 * model.max_current_a / 1024.0
+        return cls(True, model.output_resolution_ppr, step, step, 0.0, seed)
+
+
+def apply_monitor(result: dict[str, np.ndarray], model: AxisModel,
+                  monitor: MonitorOptions) -> dict[str, np.ndarray]:
+    """A copy of a simulate() result as the monitors would report it (quantised, noisy)."""
+    out = dict(result)
+    rng = np.random.default_rng(monitor.seed)
+    if monitor.quantise_position:
+        q = model.output_pulse_rad
+        out["pos"] = np.floor(result["pos"] / q + 0.5) * q
+    if monitor.load_encoder_ppr:
+        q = 2.0 * math.pi / monitor.load_encoder_ppr
+        out["load_pos"] = np.floor(result["load_pos"] / q + 0.5) * q
+    cur = result["current"]
+    if monitor.current_noise_a > 0:
+        cur = cur + rng.normal(0.0, monitor.current_noise_a, cur.shape)
+    if monitor.current_resolution_a > 0:
+        cur = np.floor(cur / monitor.current_resolution_a + 0.5) * monitor.current_resolution_a
+    out["current"] = cur
+    out["torque"] = cur * model.torque_constant_nm_per_a
+    if monitor.speed_noise_rad_s > 0:
+        out["vel"] = result["vel"] + rng.normal(0.0, monitor.speed_noise_rad_s, result["vel"].shape)
+    return out
+
+
+def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, command_pos_rad: np.ndarray, *,
+             monitor: MonitorOptions | None = None, start_at_rest: bool = True) -> dict[str, np.ndarray]:
+    """Run the closed loop through a recorded command and sample it at the recording's times.
+
+    t_s: increasing sample times (s); command_pos_rad: the position command at those times (rad,
+    output side, physical frame). The servo (servo=None: ServoSettings.tuned_for(model)) runs at
+    its rate on the command linearly interpolated between samples. The axis starts at the first
+    command, at rest, holding its static load (gravity, offset) as a servo that has been on.
+    Returns {key: array} with the keys and units of SIMULATION_UNITS, sampled at t_s (the servo
+    period ending at or just after each sample time, interpolated). monitor: quantisation/noise.
+    """
+    t = np.asarray(t_s, dtype=float)
+    cmd = np.asarray(command_pos_rad, dtype=float)
+    if t.ndim != 1 or cmd.shape != t.shape:
+        raise ValueError(f"simulate: t_s and command_pos_rad must be 1-D and equally long, got {t.shape} and "
+                         f"{cmd.shape}")
+    if t.size < 2:
+        raise ValueError("simulate: need at least two samples")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(cmd))):
+        bad = int(np.flatnonzero(~(np.isfinite(t) & np.isfinite(cmd)))[0])
+        raise ValueError(f"simulate: non-finite time or command at sample {bad}")
+    if np.any(np.diff(t) <= 0):
+        bad = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
+        raise ValueError(f"simulate: time must increase, it does not at sample {bad}")
+    settings = servo if servo is not None else ServoSettings.tuned_for(model)
+    p = kernel_params(model, settings)
+    dt = p.dt
+    n = math.ceil((t[-1] - t[0]) / dt - 1e-9) + 1
+    t_servo = t[0] + dt * np.arange(1, n + 1)
+    d = p.direction
+    cmd_servo = (d * np.interp(t_servo, t, cmd)).tolist()
+
+    state = _kernel.KernelState(step_index=0)
+    _initialise_at_rest(state, p, float(cmd[0]), start_at_rest)
+    # the initial state at t0, then the servo samples at t0 + (k+1) dt
+    rec: tuple[list, ...] = ([0.0], [d * state.cprev], [state.xm], [state.xl], [state.vm], [state.current],
+                             [state.vref])
+    _kernel.run(p, state, cmd_servo, n, True, rec, 1)
+    ts = t[0] + np.asarray(rec[0])
+    series = {"cmd_pos": rec[1], "pos": rec[2], "load_pos": rec[3], "vel": rec[4], "current": rec[5],
+              "speed_cmd": rec[6]}
+    out: dict[str, np.ndarray] = {"t": t.copy()}
+    for key, values in series.items():
+        out[key] = np.interp(t, ts, np.asarray(values))
+    out["torque"] = out["current"] * model.torque_constant_nm_per_a
+    if monitor is not None:
+        out = apply_monitor(out, model, monitor)
+    return out
+
+
+def _static_load_nm(p: _kernel.KernelParams, x: float) -> float:
+    return p.offset + (p.grav_a * math.sin(x + p.grav_phase) if p.grav_a else 0.0)
+
+
+def _hold_current(p: _kernel.KernelParams, x: float) -> float:
+    return max(-p.ilim, min(p.ilim, _static_load_nm(p, x) / p.kt))
+
+
+def _rest_load(p: _kernel.KernelParams, xm: float) -> float:
+    ke = p.ke_a * math.sin(p.ke_w * xm + p.ke_phase) if p.ke_a else 0.0
+    return xm + ke
+
+
+def _initialise_at_rest(s: _kernel.KernelState, p: _kernel.KernelParams, x0: float, hold_load: bool) -> None:
+    """Axis at rest at x0 (physical), servo on, integrator and gear wind-up holding the static load."""
+    s.xm = x0
+    s.cprev = p.direction * x0
+    s.xl = _rest_load(p, x0)
+    if not hold_load:
+        return
+    i_hold = _hold_current(p, x0)
+    s.current = i_hold
+    # integ holds the current in the command frame: ic = kv * integ at zero error
+    s.integ = p.direction * i_hold / p.kv if p.kv else 0.0
+    if p.compliant:
+        torque = _static_load_nm(p, x0)
+        # the gear carries the static load: twist from the (odd) wind-up curve, plus the dead band
+        a = abs(torque)
+        if a <= p.t1:
+            tw = a / p.k1
+        elif a <= p.t2:
+            tw = p.th1 + (a - p.t1) / p.k2
+        else:
+            tw = p.th2 + (a - p.t2) / p.k3
+        if a > 0:
+            tw += p.lm_half
+        s.xl -= math.copysign(tw, torque)

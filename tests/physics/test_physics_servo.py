@@ -1,0 +1,219 @@
+"""Servo behaviour: step response, rotary direction, electronic gear, stability, energy, model file."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fha_studio.physics import (
+    AxisModel,
+    Effects,
+    MonitorOptions,
+    ServoAxis,
+    ServoSettings,
+    catalogue_effects,
+    simulate,
+)
+
+RPM = 2 * math.pi / 60
+CODE = "FHA-25C-50-US250"
+
+
+def test_position_step_response_is_first_order_with_time_constant_one_over_kp(make_model):
+    # A small step (no saturation) with a fast speed loop (150 Hz) and Kp = 20/s: the position
+    # loop alone sets the response, x(t) = step x (1 - exp(-Kp t)); 63 % at t = 1/Kp = 50 ms.
+    model = make_model(CODE, 0.5)
+    settings = ServoSettings.tuned_for(model, speed_bandwidth_hz=150, position_loop_gain_per_s=20.0,
+                                       speed_loop_integral_time_s=math.inf)
+    axis = ServoAxis(model, settings)
+    axis.servo_on()
+    axis.add_command_pulses(1000)
+    step = 1000 * model.output_pulse_rad
+    axis.start_trace()
+    axis.advance(0.3)
+    tr = axis.read_trace()
+    for t_check in (0.05, 0.1, 0.15):
+        i = np.argmin(np.abs(tr["t"] - t_check))
+        assert tr["pos"][i] / step == pytest.approx(1 - math.exp(-20 * t_check), abs=0.02)
+    assert np.max(tr["pos"]) <= step * 1.001  # no overshoot
+    assert axis.error_pulses == pytest.approx(1000 * math.exp(-20 * 0.3), abs=2)
+    axis.advance(0.2)
+    assert axis.in_position
+
+
+@pytest.mark.parametrize(("direction", "sign"), [(0, 1.0), (1, -1.0)])
+def test_rotary_direction(make_model, direction, sign):
+    # parameter 8: 0 = a FWD command turns CW seen from the output flange (positive angle), 1 = CCW
+    model = make_model(CODE, 0.5)
+    axis = ServoAxis(model, ServoSettings.tuned_for(model, rotary_direction=direction))
+    axis.servo_on()
+    axis.jog(10 * RPM)
+    axis.advance(0.5)
+    assert math.copysign(1.0, axis.output_pos_rad) == sign
+    assert math.copysign(1.0, axis.output_speed_rad_s) == sign
+    assert math.copysign(1.0, axis.current_a) == sign  # accelerating: torque in the motion's sense
+    # the drive's own counters are in the command frame: FWD counts up either way
+    assert axis.feedback_pulses > 0
+    assert axis.command_pos_rad == pytest.approx(sign * 10 * RPM * (0.5 - 0.5 * 10 * RPM /
+                                                 model.max_acceleration_rad_s2()), rel=1e-3)
+
+
+def test_electronic_gear(make_model):
+    model = make_model(CODE, 0.5)
+    settings = ServoSettings.tuned_for(model, electronic_gear_numerator=5, electronic_gear_denominator=2)
+    axis = ServoAxis(model, settings)
+    axis.servo_on()
+    axis.add_command_pulses(400)
+    axis.advance(1.0)
+    assert axis.command_pulses == 1000
+    assert abs(axis.feedback_pulses - 1000) <= settings.in_position_range_pulses
+    axis.move_by_pulses(-400)
+    axis.advance(1.0)
+    assert axis.command_pulses == 0
+
+
+def test_servo_off_clears_the_error_and_coasts(make_model):
+    model = make_model(CODE, 0.5, Effects().with_effect("coulomb_friction", torque_nm=5.0))
+    axis = ServoAxis(model)
+    axis.servo_on()
+    axis.jog(30 * RPM)
+    axis.advance(0.5)
+    v = axis.output_speed_rad_s
+    axis.servo_off()
+    axis.step(1)
+    assert axis.current_a == 0.0
+    axis.advance(0.2)
+    # friction alone decelerates: 5 N m over J = 1.31 kg m^2
+    assert axis.output_speed_rad_s == pytest.approx(v - 5.0 / 1.31 * 0.2, rel=0.01)
+    assert axis.error_pulses == 0
+    with pytest.raises(RuntimeError, match="servo is off"):
+        axis.jog(1.0)
+
+
+def test_stiffest_gear_with_small_load_is_stable(make_model):
+    # FHA-40C-50 (K3 = 30e4 N m/rad, J_A = 4.9 kg m^2) with no load: the load side is the flange
+    # alone (2 % of J_A), the stiffest mode of the catalogue. Undamped and left to ring, the
+    # symplectic integrator keeps the energy bounded; under the servo the axis settles.
+    model = make_model("FHA-40C-50-US250", 0.0, Effects().with_effect("torsional_compliance"),
+                       gear_damping_ratio=0.0)
+    axis = ServoAxis(model)
+    g = model.gear_stiffness
+    twist0 = g.wind_up_rad(450.0)  # beyond T2: all three regions take part
+    axis._state.xl = -twist0  # a wound-up gear, released
+
+    def energy() -> float:
+        s = axis._state
+        tw = abs(s.xm - s.xl)
+        spring = float(np.trapezoid(g.torque_nm(np.linspace(0, tw, 2001)), np.linspace(0, tw, 2001)))
+        kinetic = 0.5 * model.motor_side_inertia_kgm2 * s.vm**2 + 0.5 * model.load_side_inertia_kgm2 * s.vl**2
+        return kinetic + spring
+
+    e0 = energy()
+    energies = np.array([energy() for _ in range(400) if axis.step(25) is None])
+    # symplectic Euler: the sampled energy wobbles by about omega x h around a constant, no drift
+    assert np.max(energies) < 1.25 * e0
+    assert np.min(energies) > 0.75 * e0
+    assert np.mean(energies[-100:]) == pytest.approx(np.mean(energies[:100]), rel=0.02)
+    # with the gear's damping and the servo on it comes to rest
+    damped = model.replace(gear_damping_ratio=0.05).with_effects(catalogue_effects(model))
+    axis = ServoAxis(damped)
+    axis.servo_on()
+    axis.move_by(math.radians(30))
+    axis.advance(2.0)
+    assert abs(axis.twist_rad) < 1e-6
+    assert axis.in_position
+
+
+def test_energy_balance_of_a_move(make_model):
+    # Rest to rest with Coulomb friction only: the motor's work is all friction loss, Fc x distance.
+    model = make_model(CODE, 1.5, Effects().with_effect("coulomb_friction", torque_nm=6.0))
+    axis = ServoAxis(model)
+    axis.servo_on()
+    axis.move_by(math.radians(90), speed_rad_s=40 * RPM)
+    axis.advance(1.5)
+    assert axis.motor_work_j == pytest.approx(6.0 * math.radians(90), rel=0.01)
+
+
+def test_regenerated_energy_of_a_stop(make_model):
+    # From 40 r/min to rest without friction and without winding losses (R = 0): the kinetic
+    # energy 1/2 J w^2 goes back to the bus. With the phase resistance, less comes back.
+    model = make_model(CODE, 1.5, phase_resistance_ohm=0.0)
+    axis = ServoAxis(model)
+    axis.servo_on()
+    axis.jog(40 * RPM)
+    axis.advance(1.0)
+    before = axis.regenerated_energy_j
+    axis.stop()
+    axis.advance(1.0)
+    kinetic = 0.5 * model.total_inertia_kgm2 * (40 * RPM) ** 2
+    assert axis.regenerated_energy_j - before == pytest.approx(kinetic, rel=0.02)
+    lossy = ServoAxis(make_model(CODE, 1.5))
+    lossy.servo_on()
+    lossy.jog(40 * RPM)
+    lossy.advance(1.0)
+    lossy.stop()
+    lossy.advance(1.0)
+    assert 0 < lossy.regenerated_energy_j < kinetic
+    assert lossy.current_squared_integral_a2s > 0
+    assert lossy.peak_speed_rad_s == pytest.approx(40 * RPM, rel=0.05)
+
+
+def test_model_file_round_trip(make_model, tmp_path):
+    model = make_model(CODE, 1.5)
+    model = model.with_effects(catalogue_effects(model).with_effect("gravity_load", amplitude_nm=12.5,
+                                                                    phase_deg=-30.0))
+    path = tmp_path / "axis.toml"
+    model.save(path)
+    again = AxisModel.load(path)
+    assert again == model
+    assert "[effects.gravity_load]" in path.read_text()
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ('format = "other"\n', "format must be 'fha-axis-model/1'"),
+    ('format = "fha-axis-model/1"\n', r"missing \[plant\]"),
+    ('format = "fha-axis-model/1"\n[plant]\ntorque_constant_nm_per_a = 22\nmax_current_a = 7.3\n'
+     'actuator_inertia_kgm2 = 0.8\nwidth = 3\n', "unknown plant field"),
+    ('format = "fha-axis-model/1"\n[plant]\ntorque_constant_nm_per_a = -22\nmax_current_a = 7.3\n'
+     'actuator_inertia_kgm2 = 0.8\n', "torque_constant_nm_per_a must be a positive"),
+    ('format = "fha-axis-model/1"\n[plant]\ntorque_constant_nm_per_a = 22\nmax_current_a = 7.3\n'
+     'actuator_inertia_kgm2 = 0.8\n[effects.stribeck]\nspeed = 1\n', "unknown effect id"),
+    ("format = \n", "not valid TOML"),
+])
+def test_bad_model_files_are_refused_by_name(text, message):
+    with pytest.raises(ValueError, match=message):
+        AxisModel.from_toml(text, where="axis.toml")
+
+
+def test_simulate_returns_the_contract_and_follows(make_model):
+    model = make_model(CODE, 1.5)
+    model = model.with_effects(catalogue_effects(model))
+    t = np.arange(0, 3.0, 1e-3)
+    cmd = np.radians(60) * (1 - np.cos(np.pi * t / 3.0)) / 2
+    r = simulate(model, None, t, cmd)
+    assert set(r) >= {"t", "pos", "load_pos", "current", "cmd_pos", "vel", "torque"}
+    assert all(v.shape == t.shape for v in r.values())
+    # without feed-forward the axis lags by speed / Kp (peak command speed pi/3 x pi/3 / 2 rad/s)
+    lag = (math.pi / 3) * (math.pi / 3) / 2 / ServoSettings.tuned_for(model).position_loop_gain_per_s
+    assert np.max(np.abs(r["pos"] - cmd)) == pytest.approx(lag, rel=0.05)
+    assert np.allclose(r["cmd_pos"], cmd)
+    assert np.allclose(r["torque"], 22 * r["current"])
+    # monitors: position in whole encoder pulses, current in steps
+    q = simulate(model, None, t, cmd, monitor=MonitorOptions.typical(model, seed=3))
+    pulses = q["pos"] / model.output_pulse_rad
+    assert np.allclose(pulses, np.round(pulses))
+    step = 2 * model.max_current_a / 1024
+    assert np.allclose(q["current"] / step, np.round(q["current"] / step))
+    assert 0 < np.std(q["current"] - r["current"]) < 2 * step
+
+
+@pytest.mark.parametrize(("t", "cmd", "message"), [
+    ([0.0, 1.0], [0.0], "equally long"),
+    ([0.0, 1.0, 1.0], [0.0, 0.0, 0.0], "time must increase, it does not at sample 2"),
+    ([0.0, float("nan")], [0.0, 0.0], "non-finite time or command at sample 1"),
+])
+def test_simulate_refuses_bad_input(make_model, t, cmd, message):
+    with pytest.raises(ValueError, match=message):
+        simulate(make_model(CODE), None, np.array(t), np.array(cmd))
