@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from functools import cache
+from functools import cache, lru_cache
 from types import MappingProxyType
 from typing import Any
 
@@ -418,10 +418,18 @@ def get_actuator(code: str | ModelCode) -> Actuator:
 
     Raises :class:`ModelCodeError` (a ValueError) for a code the manual does not allow.
     """
-    mc = code if isinstance(code, ModelCode) else parse_model_code(code)
-    if not isinstance(mc, ModelCode):  # pragma: no cover - defensive
-        raise ModelCodeError(code, "not a model code", "e.g. FHA-25C-50-US250")
-    return _get_actuator(mc)
+    if isinstance(code, ModelCode):
+        return _get_actuator(code)
+    if not isinstance(code, str):
+        raise ModelCodeError(
+            code, f"expected a string or ModelCode, got {type(code).__name__}", "e.g. FHA-25C-50-US250"
+        )
+    return _get_actuator_by_text(code)
+
+
+@lru_cache(maxsize=512)
+def _get_actuator_by_text(code: str) -> Actuator:
+    return _get_actuator(parse_model_code(code))
 
 
 def frames() -> tuple[str, ...]:

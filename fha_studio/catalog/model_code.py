@@ -97,6 +97,8 @@ def parse_model_code(text: str) -> ModelCode:
     if not isinstance(text, str):
         raise ModelCodeError(text, f"expected a string, got {type(text).__name__}", "e.g. FHA-25C-50-US250")
     s = text.strip().upper()
+    if any(ch.isspace() for ch in s):
+        raise ModelCodeError(text, "contains a blank", "write the code without blanks, e.g. FHA-25C-50-US250")
     parts = s.split("-")
     shape = (
         "the form is FHA-<frame>-<ratio>-<encoder>[-<options>], e.g. FHA-25C-50-US250 or FHA-32C-100-S248-B"
@@ -111,7 +113,7 @@ def parse_model_code(text: str) -> ModelCode:
     if frame not in FRAMES:
         hint = f" (did you mean {frame}C?)" if f"{frame}C" in FRAMES else ""
         raise ModelCodeError(text, f"unknown frame '{frame}'{hint}", f"allowed frames: {', '.join(FRAMES)}")
-    if not ratio_text.isdigit() or int(ratio_text) not in RATIOS:
+    if not (ratio_text.isascii() and ratio_text.isdigit()) or int(ratio_text) not in RATIOS:
         raise ModelCodeError(
             text, f"unknown reduction ratio '{ratio_text}'", f"allowed ratios: {', '.join(map(str, RATIOS))}"
         )

@@ -169,3 +169,10 @@ def test_as_dict_is_json_ready():
     assert d["options"] == ["B", "L"]
     assert d["stiffness"]["k1_nm_per_rad"] == 4.7e4
     assert d["brake"]["holding_torque_nm"] == 49
+
+
+def test_get_actuator_rejects_a_non_code():
+    with pytest.raises(ModelCodeError, match="expected a string or ModelCode"):
+        get_actuator(25)  # type: ignore[arg-type]
+    with pytest.raises(ModelCodeError, match="option A"):
+        get_actuator("FHA-40C-50-S248-A")

@@ -48,6 +48,8 @@ def test_f5_and_option_a():
         ("FHA-40C-100-US250-D", "option D", "FHA-17C, FHA-25C only"),
         ("FHA-25C-60-US250", "ratio '60'", "50, 100, 160"),
         ("FHA-25C-1:60-US250", "ratio '1:60'", "50, 100, 160"),
+        ("FHA-25C-²-US250", "ratio '²'", "50, 100, 160"),
+        ("FHA - 25C-50-US250", "contains a blank", "without blanks"),
         ("FHA-20C-50-US250", "frame '20C'", "17C, 25C, 32C, 40C"),
         ("FHA-25-50-US250", "did you mean 25C", "17C, 25C, 32C, 40C"),
         ("FHA-25C-50-US200", "encoder 'US200'", "US250 (incremental), S248 (absolute)"),
@@ -110,7 +112,16 @@ def test_any_allowed_code_parses_and_its_canonical_form_round_trips(case):
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.text(max_size=30))
+@given(
+    st.one_of(
+        st.text(max_size=30),
+        st.lists(st.text(max_size=6), max_size=7).map(lambda parts: "-".join(["FHA", *parts])),
+        st.lists(
+            st.sampled_from(["17C", "25C", "50", "160", "US250", "S248", "B", "F5", "A", "", "²", "x"]),
+            max_size=7,
+        ).map(lambda parts: "-".join(["FHA", *parts])),
+    )
+)
 def test_arbitrary_text_parses_or_raises_model_code_error(text):
     try:
         c = parse_model_code(text)
