@@ -1,0 +1,115 @@
+"""``fha-studio sim``: serve a simulated HA-655 with an FHA-C actuator on a pty or a TCP port.
+
+    fha-studio sim --pty                       prints the pty path, serves until killed
+    fha-studio sim --tcp 5000                  serves socket://127.0.0.1:5000
+    fha-studio sim --pty --actuator FHA-32C-100-S248-B-L --load-inertia 4 \\
+        --effect coulomb_friction:torque_nm=8 --eeprom my-drive.json --record run.csv
+
+Point any serial terminal or FHA Studio at the printed address: the drive speaks CN3
+(docs/protocol.md) at the pace of a 19200 baud line (``--unpaced`` for memory speed).
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from typing import Any
+
+from fha_studio.cli import CliError
+
+ORDER = 30
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "sim",
+        help="serve a simulated drive on a pty or a TCP port",
+        description="Serve a simulated HA-655/HA-675 driver with an FHA-C actuator over CN3 "
+        "(docs/protocol.md) on a pseudo-terminal or a TCP port, until killed.",
+    )
+    where = p.add_mutually_exclusive_group(required=True)
+    where.add_argument("--pty", action="store_true",
+                       help="serve on a new pseudo-terminal; prints its path")
+    where.add_argument("--tcp", type=int, metavar="PORT",
+                       help="serve socket://127.0.0.1:PORT (0: any free port)")
+    p.add_argument("--actuator", default="FHA-25C-50-US250", metavar="CODE",
+                   help="actuator model code, options included (e.g. FHA-25C-50-S248-B-L); "
+                   "default %(default)s")
+    p.add_argument("--driver", metavar="MODEL", help="driver model (default: the HA-655 of FHA-C manual 1-3)")
+    p.add_argument("--load-inertia", type=float, default=0.0, metavar="KGM2", help="load inertia [kg m^2]")
+    p.add_argument("--effect", action="append", default=[], metavar="ID:NAME=VALUE,...",
+                   help="switch on a physical effect, e.g. coulomb_friction:torque_nm=8 (repeatable)")
+    p.add_argument("--brake", choices=("yes", "no"),
+                   help="fit or leave out the motor brake (default: option B of the code)")
+    p.add_argument("--sensors", choices=("yes", "no"),
+                   help="fit or leave out the option-L sensor set (default: option L of the code)")
+    p.add_argument("--eeprom", metavar="PATH",
+                   help="EEPROM file (default: the user data directory, one file per driver and actuator)")
+    p.add_argument("--unpaced", action="store_true", help="reply at memory speed instead of 19200 baud")
+    p.add_argument("--oww-seconds", type=float, metavar="S", help="how long OWW takes (default 5 s)")
+    p.add_argument("--record", metavar="FILE.csv", help="write what the axis does as an fha-recording/1 CSV")
+    p.add_argument("--record-rate", type=float, default=1000.0, metavar="HZ",
+                   help="recording sample rate (default %(default)s Hz)")
+    p.set_defaults(func=run)
+
+
+def _flag(text: str | None) -> bool | None:
+    return None if text is None else text == "yes"
+
+
+def run(args: Any) -> int:
+    from fha_studio.hardware.sim import EepromError, SimConfig, SimConfigError, SimDrive, SimProtocolServer
+    from fha_studio.hardware.sim.options import parse_effects
+    from fha_studio.hardware.sim.serve import serve_pty, serve_tcp
+
+    try:
+        config = SimConfig(
+            actuator=args.actuator,
+            driver=args.driver,
+            load_inertia_kgm2=args.load_inertia,
+            brake=_flag(args.brake),
+            sensors=_flag(args.sensors),
+            effects=parse_effects(args.effect),
+            eeprom=args.eeprom or "user",
+            paced=not args.unpaced,
+            oww_clear_s=args.oww_seconds,
+        )
+        drive = SimDrive(config=config)
+    except (SimConfigError, EepromError) as exc:
+        raise CliError(str(exc)) from None
+
+    stop = threading.Event()
+
+    def on_signal(signum: int, frame: object) -> None:
+        stop.set()
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGTERM, signal.SIGINT)}
+    if hasattr(signal, "SIGHUP"):
+        previous[signal.SIGHUP] = signal.signal(signal.SIGHUP, on_signal)
+
+    def announce(address: str) -> None:
+        print(address, flush=True)
+        print(f"# {drive.driver} with {drive.actuator_code}, EEPROM {drive.eeprom.path}"
+              f"{'' if config.paced else ', unpaced'}", file=sys.stderr, flush=True)
+
+    server = SimProtocolServer(drive, paced=config.paced)
+    try:
+        if args.record:
+            try:
+                drive.start_recording(args.record, args.record_rate)
+            except (OSError, ValueError) as exc:
+                raise CliError(f"--record {args.record}: {exc}") from None
+        drive.start()
+        if args.pty:
+            serve_pty(server, stop, announce)
+        else:
+            try:
+                serve_tcp(server, args.tcp, stop, announce)
+            except OSError as exc:
+                raise CliError(f"--tcp {args.tcp}: {exc.strerror or exc}") from None
+    finally:
+        drive.close()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return 0

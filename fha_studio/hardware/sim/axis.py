@@ -1,0 +1,115 @@
+"""The simulated drive's actuator: model code -> catalogue entry + driver, and the physics axis.
+
+The plant and its loops are :class:`fha_studio.physics.ServoAxis`; this module only resolves
+what to build (options B and L from the code or the sim options, the driver from the combination
+table of FHA-C manual 1-3, the effects) and maps the HA-655's tune / parameter items onto the
+physics' :class:`ServoSettings`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from fha_studio.catalog import get_actuator, parse_model_code
+from fha_studio.catalog.model_code import OPTION_ORDER
+from fha_studio.hardware.sim.options import SimConfig, SimConfigError
+from fha_studio.physics import AxisModel, Effects, ServoAxis, ServoSettings
+
+DEFAULT_SERVO_RATE_HZ = 5000.0
+
+
+@dataclass(frozen=True)
+class ResolvedActuator:
+    """The actuator the sim drives, its driver, and whether the option-L sensors are fitted."""
+
+    actuator: Any  # fha_studio.catalog Actuator
+    driver: str
+    has_sensors: bool
+
+    @property
+    def code(self) -> str:
+        return self.actuator.model_code
+
+    @property
+    def absolute_encoder(self) -> bool:
+        return self.actuator.encoder == "absolute"
+
+    @property
+    def brake_holding_torque_nm(self) -> float | None:
+        brake = self.actuator.brake
+        return None if brake is None else float(brake.holding_torque_nm)
+
+    @property
+    def continuous_current_a(self) -> float:
+        """Continuous torque (2-4-6) over the torque constant: the I^2 t reference of alarm 20."""
+        return float(self.actuator.continuous_torque_nm) / float(self.actuator.torque_constant_nm_per_a)
+
+
+def resolve_actuator(config: SimConfig) -> ResolvedActuator:
+    """The catalogue actuator for ``config`` (brake / sensors options override the code's B / L)
+    and its driver (``config.driver`` if it is a valid combination, else the first HA-655 of 1-3).
+    Raises SimConfigError naming what is wrong."""
+    try:
+        code = parse_model_code(config.actuator)
+    except ValueError as exc:
+        raise SimConfigError(f"simulated drive actuator: {exc}") from None
+    options = set(code.options)
+    for flag, option in ((config.brake, "B"), (config.sensors, "L")):
+        if flag is True:
+            options.add(option)
+        elif flag is False:
+            options.discard(option)
+    text = "-".join([code.base_code, *(o for o in OPTION_ORDER if o in options)])
+    try:
+        actuator = get_actuator(text)
+    except ValueError as exc:
+        raise SimConfigError(f"simulated drive actuator: {exc}") from None
+    drivers = list(actuator.compatible_drivers)
+    if config.driver is not None:
+        if config.driver not in drivers:
+            raise SimConfigError(
+                f"driver {config.driver} does not drive {actuator.model_code} (FHA-C manual 1-3); "
+                f"use one of: {', '.join(drivers) or 'none exists'}"
+            )
+        driver = config.driver
+    else:
+        if not drivers:
+            raise SimConfigError(f"no driver exists for {actuator.model_code} (FHA-C manual 1-3)")
+        driver = next((d for d in drivers if d.startswith("HA-655")), drivers[0])
+    return ResolvedActuator(actuator, driver, has_sensors="L" in options)
+
+
+def build_model(resolved: ResolvedActuator, config: SimConfig) -> AxisModel:
+    """The physics model: catalogue actuator, declared load inertia, switched-on effects."""
+    try:
+        effects = Effects.from_dict(config.effects, where="sim effects")
+        return AxisModel.from_actuator(resolved.actuator, load_inertia_kgm2=config.load_inertia_kgm2,
+                                       effects=effects)
+    except (TypeError, ValueError) as exc:
+        raise SimConfigError(f"simulated drive: {exc}") from None
+
+
+def servo_settings(model: AxisModel, values: dict[str, int], servo_rate_hz: float) -> ServoSettings:
+    """The HA-655 items (wire values by key) as physics ServoSettings.
+
+    The speed loop gain is a bandwidth in Hz (tune 0): Kv = 2 pi f J / Kt on the rigid-body
+    inertia of the axis (actuator + load), as the physics' own ``tuned_for`` does.
+    """
+    bandwidth = 2.0 * math.pi * values["speed_loop_gain"]
+    return ServoSettings(
+        position_loop_gain_per_s=float(values["position_loop_gain"]),
+        speed_loop_gain_a_s_per_rad=bandwidth * model.total_inertia_kgm2 / model.torque_constant_nm_per_a,
+        speed_loop_integral_time_s=values["speed_loop_integral_compensation"] / 1000.0,
+        feed_forward_gain=values["feed_forward_gain"] / 100.0,
+        electronic_gear_numerator=int(values["electronic_gear_numerator"]),
+        electronic_gear_denominator=int(values["electronic_gear_denominator"]),
+        rotary_direction=int(values["rotary_direction"]),
+        in_position_range_pulses=int(values["in_position_range"]),
+        servo_rate_hz=servo_rate_hz,
+    )
+
+
+def build_axis(model: AxisModel, settings: ServoSettings, initial_pos_rad: float) -> ServoAxis:
+    return ServoAxis(model, settings, initial_pos_rad=initial_pos_rad)

@@ -1,0 +1,159 @@
+"""How a simulated drive is chosen: :class:`SimConfig`, built from keywords, a ``sim://`` URL or the CLI.
+
+URL form (docs/protocol.md, transports)::
+
+    sim://FHA-25C-50-US250?load_inertia=1.5&brake=1&sensors=1&paced=0&eeprom=PATH
+        &effects=coulomb_friction:torque_nm=8;viscous_friction:coefficient_nm_s_per_rad=2
+
+Options (all optional):
+
+=================  ==========================================================================
+``driver``         driver model, e.g. ``HA-655-2-200``; default: the first HA-655 of the
+                   combination table (FHA-C manual 1-3) for the actuator and supply voltage
+``load_inertia``   load inertia on the output [kg m^2] (``load_inertia_kgm2`` also accepted)
+``brake``          1/0: fit or leave out the motor brake (default: option B of the model code)
+``sensors``        1/0: fit or leave out the option-L sensor set (default: option L of the code)
+``origin_deg``,    angles of the origin slit and of the dogs of limit switch 1 (CCW end) and
+``ls1_deg``,       limit switch 2 (CW end), output flange, CW positive seen from the flange
+``ls2_deg``
+``effects``        physical effects, ``ID:NAME=VALUE,NAME=VALUE;ID...``; ``effect=`` may repeat
+``eeprom``         EEPROM file; ``user`` = the user data directory; default: a temporary file
+                   removed when the drive closes
+``paced``          1 (default): replies paced like a 19200 baud line; 0: at memory speed
+``oww_clear_s``    how long OWW takes to clear the multi-turn data [s] (default 5)
+=================  ==========================================================================
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Any
+from urllib.parse import parse_qs, unquote, urlsplit
+
+
+class SimConfigError(ValueError):
+    """A simulated-drive option is wrong; the message names the option and what is allowed."""
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Everything that chooses one simulated drive. Units in the names."""
+
+    actuator: str = "FHA-25C-50-US250"
+    driver: str | None = None
+    load_inertia_kgm2: float = 0.0
+    brake: bool | None = None
+    sensors: bool | None = None
+    origin_deg: float | None = None
+    ls1_deg: float | None = None
+    ls2_deg: float | None = None
+    effects: dict[str, dict[str, float]] = field(default_factory=dict)
+    eeprom: str | None = None
+    paced: bool = True
+    oww_clear_s: float | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.actuator, str) or not self.actuator.strip():
+            raise SimConfigError("simulated drive: an actuator model code is needed, e.g. FHA-25C-50-US250")
+        _finite("load_inertia_kgm2", self.load_inertia_kgm2, minimum=0.0)
+        for name in ("origin_deg", "ls1_deg", "ls2_deg"):
+            if getattr(self, name) is not None:
+                _finite(name, getattr(self, name))
+        if self.oww_clear_s is not None:
+            _finite("oww_clear_s", self.oww_clear_s, minimum=0.0)
+
+    def replace(self, **changes: Any) -> SimConfig:
+        return replace(self, **changes)
+
+
+def _finite(name: str, value: Any, minimum: float | None = None) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise SimConfigError(f"simulated drive option {name}: {value!r} is not a number") from None
+    if not math.isfinite(number) or (minimum is not None and number < minimum):
+        bound = f" >= {minimum:g}" if minimum is not None else ""
+        raise SimConfigError(f"simulated drive option {name}: {value!r} must be a finite number{bound}")
+    return number
+
+
+def _flag(name: str, text: str) -> bool:
+    lowered = text.strip().lower()
+    if lowered in ("1", "true", "yes", "on"):
+        return True
+    if lowered in ("0", "false", "no", "off"):
+        return False
+    raise SimConfigError(f"simulated drive option {name}: {text!r} is not 1/0 (or true/false)")
+
+
+def parse_effect(spec: str) -> tuple[str, dict[str, float]]:
+    """``"coulomb_friction:torque_nm=8"`` -> ``("coulomb_friction", {"torque_nm": 8.0})``.
+
+    Whether the id and names exist is checked by the physics (Effects.from_dict), which names them.
+    """
+    effect_id, _, rest = spec.strip().partition(":")
+    effect_id = effect_id.strip()
+    if not effect_id:
+        raise SimConfigError(f"effect {spec!r}: expected ID or ID:NAME=VALUE,NAME=VALUE")
+    params: dict[str, float] = {}
+    for part in filter(None, (p.strip() for p in rest.split(","))):
+        name, eq, value = part.partition("=")
+        if not eq or not name.strip():
+            raise SimConfigError(f"effect {spec!r}: parameter {part!r} is not NAME=VALUE")
+        params[name.strip()] = _finite(f"{effect_id}.{name.strip()}", value)
+    return effect_id, params
+
+
+def parse_effects(specs: list[str]) -> dict[str, dict[str, float]]:
+    """Several effect specs (each may hold several, separated by ``;``) -> {id: params}."""
+    effects: dict[str, dict[str, float]] = {}
+    for spec in specs:
+        for one in filter(None, (s.strip() for s in spec.split(";"))):
+            effect_id, params = parse_effect(one)
+            effects[effect_id] = params
+    return effects
+
+
+_URL_KEYS = {
+    "driver", "load_inertia", "load_inertia_kgm2", "brake", "sensors", "origin_deg", "ls1_deg",
+    "ls2_deg", "effects", "effect", "eeprom", "paced", "oww_clear_s",
+}
+
+
+def config_from_url(url: str) -> SimConfig:
+    """A SimConfig from ``sim://ACTUATOR?options``; SimConfigError names a bad option."""
+    parts = urlsplit(url)
+    if parts.scheme.lower() != "sim":
+        raise SimConfigError(f"{url!r} is not a sim:// URL")
+    actuator = unquote(parts.netloc or parts.path.lstrip("/")).strip()
+    if not actuator:
+        raise SimConfigError(f"{url!r}: the actuator model code is missing, e.g. sim://FHA-25C-50-US250")
+    query = parse_qs(parts.query, keep_blank_values=True)
+    unknown = set(query) - _URL_KEYS
+    if unknown:
+        raise SimConfigError(
+            f"{url!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_URL_KEYS))}"
+        )
+
+    def last(key: str) -> str | None:
+        return query[key][-1] if key in query else None
+
+    values: dict[str, Any] = {"actuator": actuator}
+    if last("driver") is not None:
+        values["driver"] = last("driver")
+    inertia = last("load_inertia_kgm2") if last("load_inertia_kgm2") is not None else last("load_inertia")
+    if inertia is not None:
+        values["load_inertia_kgm2"] = _finite("load_inertia", inertia, minimum=0.0)
+    for key in ("brake", "sensors", "paced"):
+        if last(key) is not None:
+            values[key] = _flag(key, last(key))
+    for key in ("origin_deg", "ls1_deg", "ls2_deg", "oww_clear_s"):
+        if last(key) is not None:
+            values[key] = _finite(key, last(key))
+    specs = query.get("effects", []) + query.get("effect", [])
+    if specs:
+        values["effects"] = parse_effects(specs)
+    if last("eeprom") is not None:
+        values["eeprom"] = last("eeprom")
+    return SimConfig(**values)

@@ -1,0 +1,38 @@
+"""Fixtures of the simulated-drive tests: drives in stepped mode, closed after each test."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from fha_studio.hardware.sim import SimDrive
+from fha_studio.hardware.sim.constants import load_sim_constants
+
+
+@pytest.fixture
+def make_drive(tmp_path):
+    """``make_drive(actuator, **options)`` -> a stepped SimDrive with its EEPROM in tmp_path
+    (``eeprom=`` overrides; ``constants={...}`` replaces some simulation constants)."""
+    drives: list[SimDrive] = []
+
+    def make(actuator: str = "FHA-25C-50-US250", constants: dict | None = None, **options) -> SimDrive:
+        options.setdefault("eeprom", str(tmp_path / f"eeprom-{len(drives)}.json"))
+        c = dataclasses.replace(load_sim_constants(), **(constants or {}))
+        drive = SimDrive(actuator, constants=c, **options)
+        drives.append(drive)
+        return drive
+
+    yield make
+    for drive in drives:
+        drive.close()
+
+
+def jog_for(drive: SimDrive, speed_rpm: float, seconds: float, repeat_s: float = 0.05) -> None:
+    """Jog as a client holding the button does: JOG repeated every ``repeat_s``."""
+    t = 0.0
+    while t < seconds - 1e-9:
+        drive.jog(speed_rpm)
+        step = min(repeat_s, seconds - t)
+        drive.advance(step)
+        t += step
