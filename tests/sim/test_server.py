@@ -71,7 +71,7 @@ def test_sim_url_options_are_parsed_and_checked():
         "viscous_friction": {"coefficient_nm_s_per_rad": 2.0},
         "gravity_load": {"amplitude_nm": 20.0, "phase_deg": 90.0},
     }
-    with pytest.raises(SimConfigError, match="unknown option.*inertia"):
+    with pytest.raises(SimConfigError, match=r"unknown option.*inertia"):
         config_from_url("sim://FHA-25C-50-US250?inertia=1")
     with pytest.raises(SimConfigError, match="load_inertia"):
         config_from_url("sim://FHA-25C-50-US250?load_inertia=-1")

@@ -71,6 +71,7 @@ BIT_ERROR_CLEAR = 10
 BIT_ALM_A = 11
 BIT_MOVING = 15
 INPUT_MASK = sum(1 << b for b in (4, 5, 6, 7, 8, 9, 10))
+SENSOR_MASK = sum(1 << b for b in (BIT_ORIGIN, BIT_LIMIT_1, BIT_LIMIT_2))
 
 SUPERVISION_PERIOD_S = 0.001  # alarms, watchdog, sensors and inhibits are checked every 1 ms
 
@@ -407,10 +408,14 @@ class SimDrive:
 
     # ------------------------------------------------------------------ I/O
     def set_inputs(self, mask: int) -> None:
-        """Set the simulated CN2 inputs (INP): bits 4, 5, 9, 10; bits 6-8 force a sensor signal on."""
+        """Set the simulated CN2 inputs (INP): bits 4, 5, 9, 10. Bits 6-8 (origin, limit switches)
+        set sensor signals of an actuator without option L; with option L the sensors drive them
+        and INP's bits 6-8 are ignored (so a client's read-modify-write of IOS latches nothing)."""
         with self._lock:
             if mask < 0 or mask & ~INPUT_MASK:
                 raise _x(f"INP {mask}: only input bits 4-10 can be set (mask {INPUT_MASK})")
+            if self.has_sensors:
+                mask &= ~SENSOR_MASK
             was_clear = self._inputs >> BIT_ERROR_CLEAR & 1
             self._inputs = mask
             if mask >> BIT_ERROR_CLEAR & 1 and not was_clear:
