@@ -30,7 +30,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from enum import StrEnum
+from enum import IntEnum, StrEnum
 from typing import Generic, TypeVar
 
 CR = 0x0D
@@ -360,3 +360,104 @@ def split_absolute_position(value: int) -> tuple[int, int]:
 def join_absolute_position(multi_turn: int, single_turn: int) -> int:
     """(multi-turn, single-turn count) -> DGR's value."""
     return multi_turn * ABSOLUTE_COUNTS_PER_TURN + single_turn
+
+
+# ---------------------------------------------------------------------------------------------
+# Numbers the extension commands share (docs/protocol.md)
+# ---------------------------------------------------------------------------------------------
+
+#: JOG and SPD values are output speed in 0.01 r/min; MOV values are output angle in 0.01 deg.
+SPEED_STEP_RPM = 0.01
+ANGLE_STEP_DEG = 0.01
+#: A JOG holds this long; without a repeat the axis decelerates to a stop (watchdog).
+JOG_HOLD_S = 0.1
+#: MMR and TCH masks: bit k selects monitor item MONITOR_MASK_BASE + k.
+MONITOR_MASK_BASE = 100
+MONITOR_MASK_ITEMS = 16
+TRACE_MAX_CHANNELS = 4
+TRACE_MAX_SAMPLES = 4096
+TRACE_BLOCK_SAMPLES = 64
+
+
+class IoBit(IntEnum):
+    """Bits of the IOS reply and monitor item 106; INP sets the input bits."""
+
+    SERVO_ON = 0
+    READY = 1
+    ALARM = 2
+    IN_POSITION = 3
+    FWD_INHIBIT = 4
+    REV_INHIBIT = 5
+    ORIGIN_SENSOR = 6
+    LIMIT_SWITCH_1 = 7
+    LIMIT_SWITCH_2 = 8
+    BRAKE_RELEASED = 9
+    ERROR_COUNTER_CLEAR = 10
+    ALM_A = 11
+    ALM_B = 12
+    ALM_C = 13
+    ALM_D = 14
+    MOVING = 15
+
+
+#: The bits INP may set (the simulated CN2 inputs).
+INPUT_BITS = frozenset(
+    {
+        IoBit.FWD_INHIBIT,
+        IoBit.REV_INHIBIT,
+        IoBit.ORIGIN_SENSOR,
+        IoBit.LIMIT_SWITCH_1,
+        IoBit.LIMIT_SWITCH_2,
+        IoBit.BRAKE_RELEASED,
+        IoBit.ERROR_COUNTER_CLEAR,
+    }
+)
+INPUT_MASK = sum(1 << b for b in INPUT_BITS)
+
+
+def alm_bits_from_io(mask: int) -> int:
+    """The 4-bit alarm code (bit 0 = ALM-A ... bit 3 = ALM-D) from an I/O mask."""
+    return (mask >> IoBit.ALM_A) & 0xF
+
+
+def io_with_alm_bits(mask: int, alm_bits: int) -> int:
+    """``mask`` with its ALM-A ... ALM-D bits set to ``alm_bits``."""
+    return (mask & ~(0xF << IoBit.ALM_A)) | ((alm_bits & 0xF) << IoBit.ALM_A)
+
+
+class TriggerKind(IntEnum):
+    """TTG values."""
+
+    IMMEDIATE = 0
+    RISING_LEVEL = 1
+    FALLING_LEVEL = 2
+    IO_BIT_RISES = 3
+    IO_BIT_FALLS = 4
+    ALARM = 5
+
+
+class TraceState(IntEnum):
+    """First value of the TST reply."""
+
+    IDLE = 0
+    ARMED = 1
+    CAPTURING = 2
+    DONE = 3
+
+
+def monitor_mask(items: Iterable[int]) -> int:
+    """MMR/TCH mask for monitor items 100-115; ValueError naming an item outside that range."""
+    mask = 0
+    for item in items:
+        if not MONITOR_MASK_BASE <= item < MONITOR_MASK_BASE + MONITOR_MASK_ITEMS:
+            raise ValueError(
+                f"monitor item {item} cannot be in a mask (items {MONITOR_MASK_BASE} ... "
+                f"{MONITOR_MASK_BASE + MONITOR_MASK_ITEMS - 1})"
+            )
+        mask |= 1 << (item - MONITOR_MASK_BASE)
+    return mask
+
+
+def mask_items(mask: int) -> list[int]:
+    """The monitor items of an MMR/TCH mask, in item order (the order of the reply's values)."""
+    return [MONITOR_MASK_BASE + k for k in range(MONITOR_MASK_ITEMS) if mask >> k & 1]

@@ -1,0 +1,52 @@
+"""Errors of the drive link (re-exported by fha_studio.hardware.client).
+
+Every error the client raises is a ``LinkError`` (one ``except`` for a caller that only reports).
+Two families below it say very different things:
+
+- ``LinkFailure``: the link did not work: ``LinkTimeout`` (no usable reply after the retries),
+  ``LinkLost`` (the port is gone, or too many failures in a row).
+- ``DriveRefused``: the link worked and the drive said no: ``ServoOnRefused`` (``s``: the servo
+  is on, not now), ``CommandRejected`` (``x``), ``CommandNotSupported`` (the drive lacks the
+  extension; nothing was sent). These are never retried and never count against the link.
+"""
+
+from __future__ import annotations
+
+
+class LinkError(Exception):
+    """Base of every error of the drive link."""
+
+
+class LinkFailure(LinkError):
+    """The link did not carry a usable exchange."""
+
+
+class LinkTimeout(LinkFailure):
+    """No complete, well-formed reply within the timeout, after all retries."""
+
+
+class LinkLost(LinkFailure):
+    """The port is gone (unplugged, peer closed) or failed too many times in a row.
+
+    ``port`` names it. The client stays unusable until it is opened again.
+    """
+
+    def __init__(self, message: str, port: str = ""):
+        super().__init__(message)
+        self.port = port
+
+
+class DriveRefused(LinkError):
+    """The drive answered and refused: the link itself is fine."""
+
+
+class ServoOnRefused(DriveRefused):
+    """The drive answered ``s``: the servo is on, the command was not processed (not a link fault)."""
+
+
+class CommandRejected(DriveRefused):
+    """The drive answered ``x``: unknown, malformed, not allowed now, or out of range."""
+
+
+class CommandNotSupported(DriveRefused):
+    """The drive does not have this extension command (from its CAP reply); nothing was sent."""

@@ -1,0 +1,300 @@
+"""Byte transports to a drive: pyserial URLs, and an in-process pipe pair for tests and the sim.
+
+``open_transport(url)`` opens anything ``serial.serial_for_url`` knows: a device (``/dev/ttyUSB0``,
+``COM3``), a pty path, ``socket://host:port``, ``loop://``, and ``sim://ACTUATOR-CODE?...`` (the
+embedded simulated drive; the handler module is ``fha_studio.hardware.sim.protocol_sim`` by
+pyserial's naming rule). What it returns is a ``GuardedTransport``: the same calls as a pyserial
+port, but a vanished port (unplugged adapter, closed pty or socket peer) raises ``LinkLost``
+naming the port instead of a bare ``SerialException`` / ``OSError``.
+
+``pipe_pair()`` gives two connected in-process ends with the same calls (the pymodbus NullModem
+idea): what one end writes the other reads. Writes can be split, delayed or corrupted on purpose
+through ``write_filter``, and ``unplug()`` makes both ends fail like a pulled cable.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+import time
+from collections.abc import Callable, Iterable
+from typing import Any, Protocol
+
+import serial
+
+from fha_studio.hardware.errors import LinkLost
+from fha_studio.hardware.protocol import BAUDRATE
+
+#: The package that holds ``protocol_sim`` for ``sim://`` URLs.
+SIM_HANDLER_PACKAGE = "fha_studio.hardware.sim"
+
+
+class Transport(Protocol):
+    """What the client needs of a port: the subset of pyserial's ``Serial`` it uses."""
+
+    port: str | None
+    timeout: float | None
+
+    def write(self, data: bytes) -> int | None: ...
+    def read(self, size: int = 1) -> bytes: ...
+    @property
+    def in_waiting(self) -> int: ...
+    def reset_input_buffer(self) -> None: ...
+    def close(self) -> None: ...
+    @property
+    def is_open(self) -> bool: ...
+
+
+def register_url_handlers() -> None:
+    """Let ``serial_for_url`` find ``sim://`` (idempotent)."""
+    if SIM_HANDLER_PACKAGE not in serial.protocol_handler_packages:
+        serial.protocol_handler_packages.append(SIM_HANDLER_PACKAGE)
+
+
+class GuardedTransport:
+    """A pyserial-like port whose failures come out as ``LinkLost`` naming the port.
+
+    Attributes not listed here are passed through to the wrapped port (``baudrate``, ...).
+    """
+
+    def __init__(self, inner: Any, name: str | None = None):
+        self.inner = inner
+        self.name = name or str(getattr(inner, "port", None) or "port")
+
+    def _lost(self, exc: BaseException) -> LinkLost:
+        return LinkLost(f"lost the link on {self.name}: {exc or type(exc).__name__}", port=self.name)
+
+    def write(self, data: bytes) -> int | None:
+        try:
+            return self.inner.write(data)
+        except (serial.SerialException, OSError) as exc:
+            raise self._lost(exc) from exc
+
+    def read(self, size: int = 1) -> bytes:
+        try:
+            return self.inner.read(size)
+        except (serial.SerialException, OSError) as exc:
+            raise self._lost(exc) from exc
+
+    @property
+    def in_waiting(self) -> int:
+        try:
+            return self.inner.in_waiting
+        except (serial.SerialException, OSError) as exc:
+            raise self._lost(exc) from exc
+
+    def reset_input_buffer(self) -> None:
+        try:
+            self.inner.reset_input_buffer()
+        except (serial.SerialException, OSError) as exc:
+            raise self._lost(exc) from exc
+
+    @property
+    def timeout(self) -> float | None:
+        return self.inner.timeout
+
+    @timeout.setter
+    def timeout(self, value: float | None) -> None:
+        try:
+            self.inner.timeout = value
+        except (serial.SerialException, OSError) as exc:
+            raise self._lost(exc) from exc
+
+    @property
+    def port(self) -> str:
+        return self.name
+
+    @property
+    def is_open(self) -> bool:
+        return bool(self.inner.is_open)
+
+    def close(self) -> None:
+        # closing a port that is already gone must not raise
+        with contextlib.suppress(serial.SerialException, OSError):
+            self.inner.close()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.inner, name)
+
+
+def open_transport(
+    url: str, baudrate: int = BAUDRATE, timeout: float | None = 0.05, **kwargs: Any
+) -> GuardedTransport:
+    """Open ``url`` at ``baudrate`` 8N1 (CN3's line) and return it guarded.
+
+    ``timeout`` is the read timeout of the port in seconds (the client sets its own per read).
+    Raises ``LinkLost`` naming the port when it cannot be opened (absent, busy, no permission),
+    ``ValueError`` for a URL scheme nobody handles.
+    """
+    register_url_handlers()
+    try:
+        port = serial.serial_for_url(
+            url,
+            baudrate=baudrate,
+            bytesize=serial.EIGHTBITS,
+            parity=serial.PARITY_NONE,
+            stopbits=serial.STOPBITS_ONE,
+            timeout=timeout,
+            **kwargs,
+        )
+    except ValueError as exc:
+        if "not known" in str(exc):
+            scheme = url.split("://", 1)[0]
+            raise ValueError(
+                f"cannot open {url!r}: unknown URL scheme {scheme!r} (use a device or pty path, "
+                "socket://host:port, loop:// or sim://ACTUATOR-CODE)"
+            ) from None
+        raise ValueError(f"cannot open {url!r}: {exc}") from None
+    except (serial.SerialException, OSError) as exc:
+        raise LinkLost(f"cannot open {url}: {exc}", port=url) from exc
+    return GuardedTransport(port, name=url)
+
+
+# ---------------------------------------------------------------------------------------------
+# In-process pipe pair
+# ---------------------------------------------------------------------------------------------
+
+WriteFilter = Callable[[bytes], Iterable[bytes]]
+
+
+class PipeEnd:
+    """One end of an in-process byte pipe with pyserial's calls (``read`` honours ``timeout``).
+
+    ``write_filter`` (optional) turns each written block into the chunks the peer receives: it
+    can split, drop or corrupt them on purpose. A chunk of type ``float`` is a pause in seconds
+    before the next chunk (to make a reply arrive in pieces over time).
+    """
+
+    def __init__(self, name: str):
+        self.port = name
+        self.timeout: float | None = None
+        self.write_filter: WriteFilter | None = None
+        self.peer: PipeEnd | None = None
+        self.written = bytearray()  # everything this end wrote, for tests
+        self._inbox = bytearray()
+        self._cond = threading.Condition()
+        self._open = True
+        self._unplugged = False
+        self._cancel = False
+
+    # pyserial-like API -------------------------------------------------------------------------
+
+    @property
+    def is_open(self) -> bool:
+        return self._open
+
+    @property
+    def in_waiting(self) -> int:
+        self._check()
+        with self._cond:
+            return len(self._inbox)
+
+    def write(self, data: bytes) -> int:
+        self._check()
+        peer = self.peer
+        if peer is None or not peer._open:
+            raise serial.SerialException(f"{self.port}: the other end is closed")
+        self.written += data
+        chunks = self.write_filter(bytes(data)) if self.write_filter else [bytes(data)]
+        for chunk in chunks:
+            if isinstance(chunk, float):
+                time.sleep(chunk)
+            else:
+                peer.inject(chunk)
+        return len(data)
+
+    def read(self, size: int = 1) -> bytes:
+        """Up to ``size`` bytes; fewer (maybe none) when ``timeout`` passes first."""
+        self._check()
+        deadline = None if self.timeout is None else time.monotonic() + self.timeout
+        with self._cond:
+            while len(self._inbox) < size and not self._cancel:
+                if self._unplugged:
+                    raise serial.SerialException(f"{self.port}: device disconnected")
+                if self.peer is not None and not self.peer._open:
+                    if self._inbox:
+                        break  # what the peer sent before closing
+                    raise serial.SerialException(f"{self.port}: the other end closed")
+                remaining = None if deadline is None else deadline - time.monotonic()
+                if remaining is not None and remaining <= 0:
+                    break
+                self._cond.wait(remaining)
+            self._cancel = False
+            data = bytes(self._inbox[:size])
+            del self._inbox[:size]
+            return data
+
+    def reset_input_buffer(self) -> None:
+        self._check()
+        with self._cond:
+            self._inbox.clear()
+
+    def reset_output_buffer(self) -> None:
+        self._check()
+
+    def flush(self) -> None:
+        self._check()
+
+    def cancel_read(self) -> None:
+        """Wake a blocked ``read`` (it returns what it has)."""
+        with self._cond:
+            self._cancel = True
+            self._cond.notify_all()
+
+    def close(self) -> None:
+        self._open = False
+        self._wake()
+        if self.peer is not None:
+            self.peer._wake()
+
+    # test controls -----------------------------------------------------------------------------
+
+    def inject(self, data: bytes) -> None:
+        """Make ``data`` arrive at this end as if the peer had sent it (garbage, half frames)."""
+        with self._cond:
+            self._inbox += data
+            self._cond.notify_all()
+
+    def unplug(self) -> None:
+        """Fail both ends from now on, like a pulled USB adapter."""
+        for end in (self, self.peer):
+            if end is not None:
+                end._unplugged = True
+                end._wake()
+
+    def _wake(self) -> None:
+        with self._cond:
+            self._cond.notify_all()
+
+    def _check(self) -> None:
+        if self._unplugged:
+            raise serial.SerialException(f"{self.port}: device disconnected")
+        if not self._open:
+            raise serial.PortNotOpenError()
+
+
+def pipe_pair(name: str = "pipe") -> tuple[PipeEnd, PipeEnd]:
+    """Two connected ends: ``(host_end, drive_end)``, named ``name:host`` and ``name:drive``."""
+    host, drive = PipeEnd(f"{name}:host"), PipeEnd(f"{name}:drive")
+    host.peer, drive.peer = drive, host
+    return host, drive
+
+
+def split_every(n: int) -> WriteFilter:
+    """A write filter that delivers writes in chunks of ``n`` bytes."""
+
+    def split(data: bytes) -> list[bytes]:
+        return [data[i : i + n] for i in range(0, len(data), n)]
+
+    return split
+
+
+def corrupt_at(index: int, byte: int) -> WriteFilter:
+    """A write filter that replaces byte ``index`` of every write (when it has one) by ``byte``."""
+
+    def corrupt(data: bytes) -> list[bytes]:
+        if index < len(data):
+            data = data[:index] + bytes([byte]) + data[index + 1 :]
+        return [data]
+
+    return corrupt

@@ -1,0 +1,109 @@
+"""Transports: pyserial URLs, the guarded port, the in-process pipe pair."""
+
+from __future__ import annotations
+
+import os
+import threading
+
+import pytest
+import serial
+
+from fha_studio.hardware.errors import LinkLost
+from fha_studio.hardware.transport import (
+    SIM_HANDLER_PACKAGE,
+    corrupt_at,
+    open_transport,
+    pipe_pair,
+    register_url_handlers,
+    split_every,
+)
+
+
+def test_loop_url_echoes_at_cn3_settings():
+    port = open_transport("loop://", timeout=0.2)
+    try:
+        assert (port.baudrate, port.bytesize, port.parity, port.stopbits) == (19200, 8, "N", 1)
+        port.write(b"DGR+00000\r")
+        assert port.read(10) == b"DGR+00000\r"
+    finally:
+        port.close()
+
+
+def test_sim_scheme_is_registered():
+    register_url_handlers()
+    register_url_handlers()
+    assert serial.protocol_handler_packages.count(SIM_HANDLER_PACKAGE) == 1
+
+
+def test_unknown_scheme_is_a_clear_value_error():
+    with pytest.raises(ValueError, match="unknown URL scheme 'nope'"):
+        open_transport("nope://x")
+
+
+def test_missing_device_is_link_lost_naming_it():
+    with pytest.raises(LinkLost, match="/dev/ttyNOPE0") as info:
+        open_transport("/dev/ttyNOPE0")
+    assert info.value.port == "/dev/ttyNOPE0"
+
+
+def test_pty_whose_other_side_closes_is_link_lost():
+    master, slave = os.openpty()
+    path = os.ttyname(slave)
+    port = open_transport(path, timeout=0.5)
+    try:
+        os.write(master, b"q\r")
+        assert port.read(2) == b"q\r"
+        os.close(master)
+        with pytest.raises(LinkLost, match=path):
+            port.read(1)
+    finally:
+        port.close()
+        os.close(slave)
+
+
+def test_pipe_carries_bytes_and_times_out():
+    host, drive = pipe_pair()
+    host.timeout = drive.timeout = 0.05
+    host.write(b"abc")
+    assert drive.in_waiting == 3
+    assert drive.read(5) == b"abc"  # fewer than asked: the timeout passed
+    assert drive.read(1) == b""
+    assert host.written == b"abc"
+
+
+def test_pipe_write_filters_split_and_corrupt():
+    host, drive = pipe_pair()
+    drive.timeout = 0
+    chunks = []
+    host.write_filter = lambda data: chunks.extend(split_every(2)(data)) or split_every(2)(data)
+    host.write(b"12345")
+    assert chunks == [b"12", b"34", b"5"]
+    assert drive.read(5) == b"12345"
+    host.write_filter = corrupt_at(1, 0xFF)
+    host.write(b"abc")
+    assert drive.read(3) == b"a\xffc"
+
+
+def test_pipe_read_wakes_when_data_arrives():
+    host, drive = pipe_pair()
+    drive.timeout = 5
+    got = []
+    reader = threading.Thread(target=lambda: got.append(drive.read(2)))
+    reader.start()
+    host.write(b"q\r")
+    reader.join(timeout=5)
+    assert got == [b"q\r"]
+
+
+def test_pipe_unplug_and_peer_close_raise_serial_exceptions():
+    host, drive = pipe_pair()
+    drive.close()
+    host.timeout = 1
+    with pytest.raises(serial.SerialException, match="other end"):
+        host.write(b"x")
+    with pytest.raises(serial.SerialException, match="other end closed"):
+        host.read(1)
+    host2, drive2 = pipe_pair()
+    host2.unplug()
+    with pytest.raises(serial.SerialException, match="disconnected"):
+        drive2.read(1)
