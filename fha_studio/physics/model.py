@@ -51,6 +51,7 @@ class AxisModel:
 
     ratio: motor turns per output turn (None for a custom axis without it: effects tied to the
     motor turn are then refused). output_resolution_ppr: encoder pulses per output turn.
+    max_current_a may be math.inf for an axis whose current limit is unknown (no saturation).
     max_torque_nm / friction_torque_nm (TM, TF of manual 2-4-4) are informative (defaults, checks).
     """
 
@@ -70,15 +71,16 @@ class AxisModel:
     effects: Effects = field(default_factory=Effects)
 
     def __post_init__(self) -> None:
-        def positive(name: str, allow_zero: bool = False) -> None:
+        def positive(name: str, allow_zero: bool = False, allow_inf: bool = False) -> None:
             v = getattr(self, name)
-            ok = isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+            ok = isinstance(v, int | float) and not isinstance(v, bool) and not math.isnan(v) \
+                and (allow_inf or math.isfinite(v))
             if not ok or v < 0 or (v == 0 and not allow_zero):
                 kind = "non-negative" if allow_zero else "positive"
                 raise ValueError(f"axis model: {name} must be a {kind} number, got {v!r}")
 
         positive("torque_constant_nm_per_a")
-        positive("max_current_a")
+        positive("max_current_a", allow_inf=True)
         positive("actuator_inertia_kgm2")
         positive("load_inertia_kgm2", allow_zero=True)
         positive("phase_resistance_ohm", allow_zero=True)
@@ -335,9 +337,9 @@ def _toml_value(value: Any) -> str:
     if isinstance(value, int):
         return str(value)
     if isinstance(value, float):
-        if not math.isfinite(value):
-            raise ValueError(f"cannot write {value!r} to a model file")
-        return repr(value)
+        if math.isnan(value):
+            raise ValueError("cannot write nan to a model file")
+        return repr(value) if math.isfinite(value) else ("inf" if value > 0 else "-inf")
     if isinstance(value, str):
         escaped = value.replace("\\", "\\\\").replace('"', '\\"')
         return f'"{escaped}"'

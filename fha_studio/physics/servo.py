@@ -32,6 +32,8 @@ from fha_studio.physics.motion import MotionGenerator
 from fha_studio.physics.stiffness import ARCSEC_PER_RAD
 
 MIN_SERVO_RATE_HZ = 5000.0
+# tuned_for(): the speed-loop bandwidth stays below this multiple of the load's anti-resonance
+ANTI_RESONANCE_BANDWIDTH_FACTOR = 1.5
 RAD_S_PER_RPM = 2.0 * math.pi / 60.0
 
 
@@ -46,6 +48,9 @@ class ServoSettings:
     current_limit_a: None = the actuator's maximum current.
     rotary_direction: parameter 8; 0 = FWD turns CW seen from the output flange, 1 = reversed.
     in_position_range_pulses: the IN-POS window, in output encoder pulses.
+    control_mode: parameter 0, "position" or "speed". In speed mode the command profile's speed
+    is the speed-loop reference (jog = the speed command), there is no position loop and the
+    error counter stays at zero.
     """
 
     position_loop_gain_per_s: float = 30.0
@@ -58,6 +63,7 @@ class ServoSettings:
     rotary_direction: int = 0
     in_position_range_pulses: int = 10
     servo_rate_hz: float = MIN_SERVO_RATE_HZ
+    control_mode: str = "position"
 
     def __post_init__(self) -> None:
         def check(name: str, ok: bool, what: str) -> None:
@@ -76,6 +82,7 @@ class ServoSettings:
         check("rotary_direction", self.rotary_direction in (0, 1), "0 (FWD = CW) or 1 (reversed)")
         check("in_position_range_pulses", self.in_position_range_pulses >= 0, "non-negative")
         check("servo_rate_hz", self.servo_rate_hz >= MIN_SERVO_RATE_HZ, f"at least {MIN_SERVO_RATE_HZ:g}")
+        check("control_mode", self.control_mode in ("position", "speed"), '"position" or "speed"')
 
     @classmethod
     def tuned_for(cls, model: AxisModel, speed_bandwidth_hz: float = 20.0,
@@ -83,9 +90,16 @@ class ServoSettings:
         """Gains from a speed-loop bandwidth on the rigid-body inertia of the model.
 
         Kv = 2 pi f J / Kt, Tv = 4 / (2 pi f), Kp = 2 pi f / 5: a conventional cascade with the
-        position loop well inside the speed loop.
+        position loop well inside the speed loop. With a catalogue stiffness curve, f is capped at
+        1.5 x the load's anti-resonance sqrt(K1 / J_load_side) / 2 pi (above it a heavy load on a
+        160:1 gear rings); the cap uses the catalogue curve whether or not torsional_compliance is
+        on, so a model and its nominal twin get the same gains.
         """
-        w = 2.0 * math.pi * speed_bandwidth_hz
+        f = speed_bandwidth_hz
+        if model.stiffness is not None:
+            f_anti = math.sqrt(model.stiffness.k1_nm_per_rad / model.load_side_inertia_kgm2) / (2.0 * math.pi)
+            f = min(f, ANTI_RESONANCE_BANDWIDTH_FACTOR * f_anti)
+        w = 2.0 * math.pi * f
         values: dict[str, object] = dict(
             position_loop_gain_per_s=w / 5.0,
             speed_loop_gain_a_s_per_rad=w * model.total_inertia_kgm2 / model.torque_constant_nm_per_a,
@@ -124,10 +138,12 @@ def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelPa
     tv = settings.speed_loop_integral_time_s
     ilim = model.max_current_a if settings.current_limit_a is None else min(settings.current_limit_a,
                                                                              model.max_current_a)
+    speed_mode = settings.control_mode == "speed"
     return _kernel.KernelParams(
         dt=dt, nsub=nsub, direction=settings.direction_sign,
-        kp=settings.position_loop_gain_per_s, kv=settings.speed_loop_gain_a_s_per_rad,
-        tv_inv=0.0 if math.isinf(tv) else 1.0 / tv, ff=settings.feed_forward_gain, ilim=ilim,
+        kp=0.0 if speed_mode else settings.position_loop_gain_per_s, kv=settings.speed_loop_gain_a_s_per_rad,
+        tv_inv=0.0 if math.isinf(tv) else 1.0 / tv, ff=1.0 if speed_mode else settings.feed_forward_gain,
+        ilim=ilim,
         kt=model.torque_constant_nm_per_a, jm=jm, jl=jl, j_total=jm + jl,
         compliant=compliant, k1=k1, k2=k2, k3=k3, t1=t1, t2=t2, th1=th1, th2=th2, damping=damping,
         fc=e.coulomb_friction.torque_nm if e.coulomb_friction else 0.0,
@@ -146,6 +162,7 @@ def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelPa
     )
 
 
+SMALL_STEP_COUNT = 16
 TRACE_CHANNELS = ("t", "cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd")
 
 
@@ -216,8 +233,12 @@ class ServoAxis:
         p = self._params
         if self._servo_on:
             k0 = self._state.step_index + 1
-            t = np.arange(k0, k0 + n) * p.dt
-            cmd = (self._generator.positions(t) + self._pulse_offset_rad).tolist()
+            off = self._pulse_offset_rad
+            if n <= SMALL_STEP_COUNT:  # numpy's call overhead dominates for a few periods
+                state_at = self._generator.state_at
+                cmd = [state_at((k0 + j) * p.dt)[0] + off for j in range(n)]
+            else:
+                cmd = (self._generator.positions(np.arange(k0, k0 + n) * p.dt) + off).tolist()
         else:
             cmd = None
         rec = self._trace
@@ -384,12 +405,18 @@ class ServoAxis:
         """Speed-loop reference (command frame, rad/s)."""
         return self._state.vref
 
+    def _speed_mode(self) -> bool:
+        return self._settings.control_mode == "speed"
+
     def _to_pulses(self, rad: float) -> int:
         return math.floor(rad / self._model.output_pulse_rad + 0.5)
 
     @property
     def command_pulses(self) -> int:
-        """Command position in output encoder pulses (command frame, after the electronic gear)."""
+        """Command position in output encoder pulses (command frame, after the electronic gear);
+        in speed mode it follows the feedback."""
+        if self._speed_mode():
+            return self.feedback_pulses
         return self._to_pulses(self._state.cprev)
 
     @property
@@ -431,8 +458,32 @@ class ServoAxis:
 
     @property
     def peak_error_pulses(self) -> float:
-        """Largest |position error| since reset_peaks(), in output pulses."""
+        """Largest |position error| since reset_peaks(), in output pulses (0 in speed mode)."""
+        if self._speed_mode():
+            return 0.0
         return self._state.peak_error / self._model.output_pulse_rad
+
+    def snapshot(self) -> dict[str, float | int | bool]:
+        """The present values a drive's monitors and alarms read, in one dict (units in the keys)."""
+        return {
+            "time_s": self.time_s,
+            "servo_on": self._servo_on,
+            "output_pos_rad": self.output_pos_rad,
+            "load_pos_rad": self.load_pos_rad,
+            "output_speed_rad_s": self.output_speed_rad_s,
+            "output_speed_rpm": self.output_speed_rpm,
+            "motor_speed_rpm": self.motor_speed_rpm,
+            "current_a": self.current_a,
+            "torque_nm": self.torque_nm,
+            "command_pos_rad": self.command_pos_rad,
+            "command_pulses": self.command_pulses,
+            "feedback_pulses": self.feedback_pulses,
+            "error_pulses": self.error_pulses,
+            "in_position": self.in_position,
+            "current_squared_integral_a2s": self.current_squared_integral_a2s,
+            "regenerated_energy_j": self.regenerated_energy_j,
+            "motor_work_j": self.motor_work_j,
+        }
 
     def reset_peaks(self) -> None:
         self._state.peak_speed = 0.0

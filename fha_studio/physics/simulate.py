@@ -49,7 +49,7 @@ class MonitorOptions:
     def typical(cls, model: AxisModel, seed: int | None = 0) -> MonitorOptions:
         """An assumption of a real drive's monitors: 10-bit current monitor over +-Imax with one
         step of noise, position in encoder pulses, load encoder at the same resolution."""
-        step = 2.0 * model.max_current_a / 1024.0
+        step = 2.0 * model.max_current_a / 1024.0 if math.isfinite(model.max_current_a) else 0.0
         return cls(True, model.output_resolution_ppr, step, step, 0.0, seed)
 
 

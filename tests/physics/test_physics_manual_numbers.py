@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from fha_studio.physics import (
     ARCMIN_PER_RAD,
@@ -145,3 +147,14 @@ def test_wind_up_formula_regions():
     assert g.theta2_rad == pytest.approx(19.2e-4, abs=0.1e-4)
     twist = np.linspace(-3e-3, 3e-3, 61)
     assert np.allclose(g.wind_up_rad(g.torque_nm(twist)), twist)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    t1=st.floats(1, 200), dt2=st.floats(0, 400), k1=st.floats(1e3, 5e5), f2=st.floats(1, 2),
+    f3=st.floats(1, 2), torque=st.floats(-2000, 2000),
+)
+def test_wind_up_and_torque_are_inverse(t1, dt2, k1, f2, f3, torque):
+    g = GearStiffness(t1_nm=t1, t2_nm=t1 + dt2, k1_nm_per_rad=k1, k2_nm_per_rad=k1 * f2,
+                      k3_nm_per_rad=k1 * f2 * f3)
+    assert g.torque_nm(g.wind_up_rad(torque)) == pytest.approx(torque, abs=1e-9 * max(1.0, abs(torque)))
