@@ -84,6 +84,16 @@ def _context(brake=True, absolute=False, sensor_set=True):
                 {"color": "Green", "signal": "CLR", "reference": "Clear Signal"},
             ],
         },
+        "environment": {
+            "temperature_min_c": 0.0,
+            "temperature_max_c": 40.0,
+            "humidity_min_pct": 20.0,
+            "humidity_max_pct": 80.0,
+            "vibration_max_m_s2": 24.5,
+            "altitude_max_m": 1000.0,
+            "cable_bending_radius_min_mm": 40.0,
+            "protection": "IP44",
+        },
         "sensor_set": {"ccw_limit_deg": -175.0, "cw_limit_deg": 175.0, "test_tolerance_deg": 2.0},
     }
 

@@ -30,13 +30,18 @@ def test_catalogue_context_matches_the_hand_written_one():
     )
     assert built["drivers"] == ["HA-655-2-200", "HA-675-2-200"]
     assert built["flags"] == {**built["flags"], "brake": True, "sensor_set": True, "incremental": True}
-    assert built["cables"]["motor"] == hand["cables"]["motor"]
+    assert [(r["color"], r["signal"]) for r in built["cables"]["motor"]] == [
+        (r["color"], r["signal"]) for r in hand["cables"]["motor"]
+    ]
+    assert len(built["cables"]["encoder_incremental_14"]) == 14 and built["cables"]["encoder_absolute"] == []
+    assert built["environment"]["cable_bending_radius_min_mm"] == 40
 
 
 def test_the_options_choose_the_tables():
     plain = build_context("FHA-17C-100-S248")
     assert "brake" not in plain and plain["flags"]["absolute"]
     assert [r["signal"] for r in plain["cables"]["motor"]][4:6] == ["No connection", "No connection"]
+    assert {"BAT+", "BAT-", "CLR"} <= {r["signal"] for r in plain["cables"]["encoder_absolute"]}
     assert plain["tightening"]["output_flange"]["screws"] == "6-M5 depth: 8"
     assert plain["sensor_set"]["cw_limit_deg"] == 170.0 and plain["sensor_set"]["certain"] is False
     big = build_context("FHA-40C-160-US250-B")

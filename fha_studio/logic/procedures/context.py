@@ -1,8 +1,9 @@
 """What a procedure may refer to for one actuator: ``build_context(code)`` (a plain nested dict).
 
 Values come from the catalogue (:func:`fha_studio.catalog.get_actuator`): identity, the
-combination table, tightening torques, the brake table; the cable colour tables of 1-14 and the
-movable range of the sensor set (4-7-3) from ``resources/procedures/``. Keys (see the procedure
+combination table, tightening torques, the brake table, the cable colour tables of 1-14, the
+environment limits of 3-3-1; the movable range of the sensor set (4-7-3) from
+``resources/procedures/sensor-set.toml``. Keys (see the procedure
 files for their use):
 
 - ``actuator``: ``model_code, frame, frame_name, ratio, encoder, encoder_code, options,
@@ -13,8 +14,11 @@ files for their use):
   torque_min_nm, torque_max_nm`` (the accepted band of the torque wrench setting)
 - ``brake`` (option B): ``supply_v, supply_tolerance_pct, supply_min_v, supply_max_v,
   activating_current_a, holding_current_a, holding_torque_nm``
-- ``cables``: ``motor`` (rows ``color, signal`` of the standard or the brake column),
-  ``motor_column``, ``encoder_incremental_14``, ``encoder_incremental_4``, ``encoder_absolute``
+- ``cables``: ``motor`` (the standard or the brake column), ``motor_column``,
+  ``encoder_incremental_14``, ``encoder_incremental_4``, ``encoder_absolute`` (rows
+  ``color, signal, reference``; empty when the encoder system has no such cable)
+- ``environment``: ``temperature_min_c, temperature_max_c, humidity_min_pct, humidity_max_pct,
+  vibration_max_m_s2, altitude_max_m, cable_bending_radius_min_mm, protection``
 - ``sensor_set`` (every actuator, used with option L): ``ccw_limit_deg, cw_limit_deg,
   test_tolerance_deg, certain, section``
 """
@@ -25,7 +29,7 @@ import tomllib
 from functools import cache
 from typing import Any
 
-from fha_studio.catalog import get_actuator
+from fha_studio.catalog import environment, get_actuator
 from fha_studio.catalog.tables import load_toml
 from fha_studio.paths import resource
 
@@ -70,6 +74,12 @@ def _tightening(part: Any, part_name: str, frame: str) -> dict[str, Any]:
     }
 
 
+def _rows(leads: Any) -> list[dict[str, str]]:
+    return [
+        {"color": lead.colour, "signal": lead.signal, "reference": lead.reference or "-"} for lead in leads
+    ]
+
+
 def build_context(code: str) -> dict[str, Any]:
     """The context of the actuator with model code ``code`` (ModelCodeError if the code is wrong)."""
     actuator = get_actuator(code)
@@ -77,8 +87,8 @@ def build_context(code: str) -> dict[str, Any]:
     absolute = actuator.encoder == "absolute"
     brake = actuator.brake is not None
     drivers = list(actuator.compatible_drivers)
-    cables = _toml("cables.toml")
-    column = "brake_option" if brake else "standard"
+    leads = actuator.cables
+    env = environment()
     sensor_set = _toml("sensor-set.toml")
     movable = sensor_set["movable_range"][actuator.frame]
     context: dict[str, Any] = {
@@ -108,10 +118,20 @@ def build_context(code: str) -> dict[str, Any]:
         },
         "cables": {
             "motor_column": "brake option" if brake else "standard",
-            "motor": [{"color": row["color"], "signal": row[column]} for row in cables["motor"]],
-            "encoder_incremental_14": list(cables["encoder_incremental_14"]),
-            "encoder_incremental_4": list(cables["encoder_incremental_4"]),
-            "encoder_absolute": list(cables["encoder_absolute"]),
+            "motor": _rows(leads.motor),
+            "encoder_incremental_14": _rows(leads.encoder.get("14-wire", ())),
+            "encoder_incremental_4": _rows(leads.encoder.get("4-wire", ())),
+            "encoder_absolute": _rows(leads.encoder.get("absolute", ())),
+        },
+        "environment": {
+            "temperature_min_c": env.service_temperature_min_c,
+            "temperature_max_c": env.service_temperature_max_c,
+            "humidity_min_pct": env.humidity_min_percent_rh,
+            "humidity_max_pct": env.humidity_max_percent_rh,
+            "vibration_max_m_s2": env.vibration_max_m_per_s2,
+            "altitude_max_m": env.altitude_max_m,
+            "cable_bending_radius_min_mm": round(env.min_cable_bending_radius_m * 1000, 3),
+            "protection": env.protection,
         },
         "sensor_set": {
             "ccw_limit_deg": float(movable["ccw_limit_deg"]),

@@ -67,6 +67,12 @@ class _Formatter(string.Formatter):
     def get_field(self, field_name, args, kwargs):
         return _lookup(field_name, self.context, self.where), field_name
 
+    def format_field(self, value, format_spec):
+        # Numbers in text as people write them: 40, 24.5, not 40.0.
+        if isinstance(value, float) and not format_spec:
+            return f"{value:g}"
+        return super().format_field(value, format_spec)
+
 
 def render(template: Any, context: Mapping[str, Any], where: str) -> Any:
     """Fill ``{path}`` fields of ``template`` from ``context``; non-strings and lists pass through."""
