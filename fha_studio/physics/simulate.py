@@ -77,7 +77,8 @@ def apply_monitor(result: dict[str, np.ndarray], model: AxisModel,
 
 
 def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, command_pos_rad: np.ndarray, *,
-             monitor: MonitorOptions | None = None, start_at_rest: bool = True) -> dict[str, np.ndarray]:
+             monitor: MonitorOptions | None = None, start_at_rest: bool = True,
+             current_average: bool = False) -> dict[str, np.ndarray]:
     """Run the closed loop through a recorded command and sample it at the recording's times.
 
     t_s: increasing sample times (s); command_pos_rad: the position command at those times (rad,
@@ -86,6 +87,9 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
     command, at rest, holding its static load (gravity, offset) as a servo that has been on.
     Returns {key: array} with the keys and units of SIMULATION_UNITS, sampled at t_s (the servo
     period ending at or just after each sample time, interpolated). monitor: quantisation/noise.
+    current_average: current and torque as their mean over each sample interval (t[k-1], t[k]]
+    (a sampled monitor with an anti-alias filter) instead of the instantaneous value; the first
+    sample stays instantaneous.
     """
     t = np.asarray(t_s, dtype=float)
     cmd = np.asarray(command_pos_rad, dtype=float)
@@ -120,6 +124,12 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
     out: dict[str, np.ndarray] = {"t": t.copy()}
     for key, values in series.items():
         out[key] = np.interp(t, ts, np.asarray(values))
+    if current_average:
+        # the current recorded at the end of a servo period was applied during all of it
+        cur = np.asarray(rec[5])
+        charge = np.concatenate(([0.0], np.cumsum(cur[1:]) * dt))  # integral of i dt at ts
+        q = np.interp(t, ts, charge)
+        out["current"][1:] = np.diff(q) / np.diff(t)
     out["torque"] = out["current"] * model.torque_constant_nm_per_a
     if monitor is not None:
         out = apply_monitor(out, model, monitor)

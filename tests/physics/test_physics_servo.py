@@ -279,3 +279,18 @@ def test_custom_axis_without_current_limit_round_trips(tmp_path):
     assert np.isfinite(r["current"]).all()
     with pytest.raises(ValueError, match="ratio is unknown"):
         model.with_effects(Effects().with_effect("kinematic_error", amplitude_arcsec=10.0))
+
+
+def test_simulate_can_average_the_current_over_each_sample(make_model):
+    # with ripple in the current (32 Hz here), the averaged 1 kHz monitor equals the mean of the
+    # 5 kHz servo current over each 1 ms interval
+    effects = Effects().with_effect("torque_ripple", amplitude_nm=3.0, cycles_per_motor_rev=2)
+    model = make_model(CODE, 0.5, effects)
+    t = np.arange(0, 1.0, 1e-3)
+    cmd = 2.0 * t
+    fine_t = np.arange(0, 0.999 + 1e-9, 2e-4)
+    fine = simulate(model, None, fine_t, 2.0 * fine_t)
+    avg = simulate(model, None, t, cmd, current_average=True)
+    expected = fine["current"][1:].reshape(-1, 5).mean(axis=1)
+    assert np.allclose(avg["current"][1:], expected, atol=1e-9)
+    assert np.allclose(avg["torque"], 22 * avg["current"])
