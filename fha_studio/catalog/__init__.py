@@ -2,7 +2,8 @@
 
 Public API: :func:`parse_model_code` -> :class:`ModelCode` (raises :class:`ModelCodeError`),
 :func:`get_actuator` -> :class:`Actuator`, :func:`compatible_drivers`, :func:`all_model_codes`,
-:func:`frames`, :func:`ratios`, :func:`options_allowed`, :func:`environment`; the raw tables are in
+:func:`frames`, :func:`ratios`, :func:`options_allowed`, :func:`environment`; the raw tables (incl.
+4-1 as printed, 1-7, 1-8, 1-14 cables, 4-7-1 sensors, 1-10 rotary direction) are in
 :mod:`fha_studio.catalog.tables`, the manual's contradictions in :func:`discrepancies`.
 """
 

@@ -570,3 +570,76 @@ def environment() -> Environment:
     e.pop("section")
     e["min_cable_bending_radius_m"] = e.pop("min_cable_bending_radius_mm") / 1000.0
     return Environment(**e)
+
+
+# --- 4-7-1 position sensors, 1-10 rotary direction ----------------------------------------------
+
+
+@dataclass(frozen=True)
+class OriginSensor:
+    """4-7-1 (1) origin sensor of option L (OMRON EE-SX672), SI."""
+
+    model: str
+    maker: str
+    output_status: str
+    supply_voltage_min_v: float
+    supply_voltage_max_v: float
+    supply_tolerance_percent: float
+    current_consumption_max_a: float
+    control_output_max_v: float
+    load_current_max_a: float
+    residual_voltage_max_v: float
+    ttl_load_current_max_a: float
+    ttl_residual_voltage_max_v: float
+
+
+@dataclass(frozen=True)
+class LimitSwitch:
+    """4-7-1 (2) stroke-end limit switches of option L (OMRON D2JW-01K21), SI."""
+
+    model: str
+    maker: str
+    count: int
+    rating_voltage_v: float
+    rating_current_a: float
+    mechanical_operations_per_min: float
+    electrical_operations_per_min: float
+    mechanical_life_operations: int
+    electrical_life_operations: int
+
+
+@dataclass(frozen=True)
+class PositionSensors:
+    """4-7-1: the option-L sensor set."""
+
+    origin_sensor: OriginSensor
+    limit_switch: LimitSwitch
+
+
+@cache
+def position_sensors() -> PositionSensors:
+    """The 4-7-1 specifications of the rotary position sensor set (option L)."""
+    s = load_toml("sensors")
+    return PositionSensors(
+        origin_sensor=OriginSensor(**s["origin_sensor"]), limit_switch=LimitSwitch(**s["limit_switch"])
+    )
+
+
+@dataclass(frozen=True)
+class RotaryDirectionSetting:
+    """1-10: one value of [parameter mode] -> [8: rotary direction] and what FWD/REV commands do."""
+
+    value: int
+    fwd_command: str
+    rev_command: str
+    default: bool
+
+
+@cache
+def rotary_direction() -> tuple[RotaryDirectionSetting, ...]:
+    """1-10 rotary direction table (value 0, the default, turns CW on a FWD command, seen from the flange)."""
+    r = load_toml("sensors")["rotary_direction"]
+    return tuple(
+        RotaryDirectionSetting(v["value"], v["fwd_command"], v["rev_command"], v["setting"] == "Default")
+        for v in r["values"]
+    )

@@ -158,3 +158,13 @@ def test_mechanical_accuracy_and_tightening_on_the_actuator():
     assert a.tightening.output_flange.screw_hole_depth_m == pytest.approx(0.015)
     b = get_actuator("FHA-32C-50-US250")
     assert (b.tightening.output_flange.screw_count, b.tightening.mounting_flange.screw_count) == (16, 12)
+
+
+def test_position_sensor_set_and_rotary_direction():
+    s = t.position_sensors()
+    assert s.origin_sensor.model == "EE-SX672" and s.origin_sensor.current_consumption_max_a == 0.035
+    assert s.limit_switch.model == "D2JW-01K21" and s.limit_switch.count == 2
+    assert s.limit_switch.electrical_life_operations < s.limit_switch.mechanical_life_operations
+    rd = t.rotary_direction()
+    assert [(r.value, r.default) for r in rd] == [(0, True), (1, False)]
+    assert rd[0].fwd_command == "FWD rotation" and rd[1].fwd_command == "REV rotation"

@@ -7,6 +7,7 @@ from conftest import KGF_N, RAD_PER_ARCMIN, agree_within_rounding, half_unit
 
 from fha_studio.catalog import discrepancies, get_actuator
 from fha_studio.catalog import tables as t
+from fha_studio.paths import resources_dir
 
 FRAME_RATIO = [(f, r) for f in t.FRAMES for r in t.RATIOS]
 KGF_CM_S2 = KGF_N / 100  # kg·m² per kgf·cm·s²
@@ -28,8 +29,29 @@ def test_every_table_loads_with_every_frame_and_ratio():
     assert [o.code for o in t.option_table()] == ["A", "B", "L", "C", "K", "W", "D", "F5", "E"]
     assert len(t.combination_table()) == 16
     assert len(t.discrepancies()) > 10
-    for name in ("specs", "stiffness", "selection", "brake", "options", "mechanical", "discrepancies"):
+    names = sorted(p.stem for p in resources_dir().joinpath("catalog").glob("*.toml"))
+    assert names == [
+        "ac100v",
+        "accuracy",
+        "brake",
+        "cables",
+        "discrepancies",
+        "mechanical",
+        "options",
+        "selection",
+        "sensors",
+        "specs",
+        "stiffness",
+    ]
+    for name in names:
         assert t.load_toml(name)
+    t.cable_tables()
+    t.environment()
+    t.position_sensors()
+    for frame in t.ac100v_frames():
+        t.ac100v_table(frame)
+    for encoder in t.ENCODERS:
+        t.encoder_resolution_table(encoder)
 
 
 def test_bad_table_shape_is_reported_with_where():
