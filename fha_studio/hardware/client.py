@@ -788,6 +788,22 @@ class DriveClient:
         self._require(Command.PWC)
         self._transact(Command.PWC)
 
+    def set_sensor_angle(self, which: str, angle_deg: float) -> None:
+        """Move the origin slit (``"origin"``) or the dog of limit switch 1 / 2 (``"ls1"``, ``"ls2"``)
+        to ``angle_deg`` (output flange, CW positive): SNO / SNA / SNB, simulated drive only."""
+        command = {"origin": Command.SNO, "ls1": Command.SNA, "ls2": Command.SNB}.get(which)
+        if command is None:
+            raise ValueError(f"sensor {which!r}: origin, ls1 or ls2")
+        self._require(command)
+        self._transact(command, _steps(angle_deg, p.ANGLE_STEP_DEG, "sensor angle", "deg"))
+
+    def sensor_angles(self) -> dict[str, float]:
+        """Where the origin slit and the two dogs are (SNQ, simulated drive only), deg:
+        ``{"origin": ..., "ls1": ..., "ls2": ...}``."""
+        self._require(Command.SNQ)
+        values = self._transact(Command.SNQ, parse=_values(3))
+        return {k: v * p.ANGLE_STEP_DEG for k, v in zip(("origin", "ls1", "ls2"), values, strict=True)}
+
     # --- the documented commands -----------------------------------------------------------------
 
     def absolute_position(self) -> int:

@@ -48,6 +48,7 @@ class Observation:
     value: Any
     passed: bool
     detail: str = ""
+    available: bool = True  # False: the drive cannot tell; the step is confirmed by hand instead
 
 
 def normalise_label(text: str) -> str:
@@ -195,9 +196,13 @@ class ProcedureRun:
             wanted = step.expect if isinstance(step.expect, list) else [step.expect]
             return choice, choice in [str(w) for w in wanted], ""
         if kind == "live":
+            if isinstance(value, bool):  # the drive cannot tell: a person checked it
+                return value, value, "confirmed by hand"
             if not isinstance(value, Observation):
-                raise StepInputError(f"live step '{step.id}' takes what the drive showed (an Observation)")
-            return value.value, bool(value.passed), value.detail
+                raise StepInputError(f"live step '{step.id}' takes what the drive showed, or yes/no by hand")
+            if not value.available:
+                raise StepInputError(f"live step '{step.id}': {value.detail}")
+            return _plain(value.value), bool(value.passed), value.detail
         if kind == "sensor_angle":
             seen = value if isinstance(value, Observation) else None
             angle = _number(seen.value if seen else value, step)
@@ -234,6 +239,17 @@ class ProcedureRun:
     def _save(self) -> None:
         if self.autosave and self.session.path is not None:
             self.session.save()
+
+
+def _plain(value: Any) -> Any:
+    # What JSON can hold: the session file must take every recorded value.
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if value is None or isinstance(value, bool | int | float | str):
+        return value
+    return str(value)
 
 
 def _number(value: Any, step: Step) -> float:
