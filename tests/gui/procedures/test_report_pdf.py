@@ -1,0 +1,45 @@
+"""The report printed to PDF by Qt holds what was checked (read back with pdftotext when there)."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+
+import pytest
+
+from fha_studio.gui.procedures.report_pdf import write_report
+from fha_studio.logic.procedures import ProcedureRun, Session, load_procedure
+from fha_studio.logic.procedures.context import build_context
+from fha_studio.logic.procedures.report import build_report
+from tests.procedures.walk import walk
+
+CODE = "FHA-32C-100-US250-B"
+
+
+def test_report_prints_to_pdf(qapp, tmp_path):
+    context = build_context(CODE)
+    session = Session(actuator_code=CODE, operator="T. Trainee", site="Hall 2")
+    session.driver = {"model": "HA-655-4-200", "adjusted_for": CODE, "version": "sim"}
+    for procedure_id in ("receiving-inspection", "installation"):
+        walk(ProcedureRun(session, load_procedure(procedure_id, context), autosave=False))
+    html_path, pdf_path = write_report(
+        build_report(session, context), tmp_path / "r.html", tmp_path / "r.pdf"
+    )
+    data = pdf_path.read_bytes()
+    assert data.startswith(b"%PDF") and len(data) > 5000
+    assert "16-M6 depth: 12" in html_path.read_text()
+    if shutil.which("pdftotext") is None:
+        pytest.skip("pdftotext is not installed: the PDF text is not checked")
+    text = subprocess.run(
+        ["pdftotext", "-layout", str(pdf_path), "-"], capture_output=True, text=True, check=True
+    ).stdout
+    for wanted in (
+        "Commissioning report",
+        CODE,
+        "HA-655-4-200",
+        "Receiving inspection",
+        "16-M6",
+        "T. Trainee",
+        "Not signed",
+    ):
+        assert wanted in text, wanted
