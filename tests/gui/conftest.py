@@ -1,17 +1,71 @@
-"""GUI fixtures: the user's settings are never read or written by a test."""
+"""GUI fixtures: the user's settings and data are never read or written by a test, and every
+window is built by a factory that tears it down without leaking widgets or threads."""
 
 from __future__ import annotations
 
+import gc
+
 import pytest
-from PySide6.QtCore import QCoreApplication, QSettings
+from PySide6.QtCore import QCoreApplication, QSettings, QStandardPaths
+from PySide6.QtWidgets import QApplication
 
 
 @pytest.fixture(autouse=True)
 def _isolated_settings(tmp_path, monkeypatch):
-    """QSettings go to a temporary directory, under a test organisation name."""
+    """QSettings go to a temporary directory, under a test organisation name; so do backups and
+    session logs (XDG_DATA_HOME)."""
     for fmt in (QSettings.Format.NativeFormat, QSettings.Format.IniFormat):
         QSettings.setPath(fmt, QSettings.Scope.UserScope, str(tmp_path / "settings"))
     QCoreApplication.setOrganizationName("FHA Studio Tests")
     QCoreApplication.setApplicationName("fha-studio-tests")
     monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    assert str(tmp_path) in QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation)
     yield
+    QSettings().clear()
+
+
+@pytest.fixture
+def make_window(qtbot):
+    """Factory: make_window(open_client=None, connect=url or None) -> a shown MainWindow.
+
+    `open_client(url, baud)` replaces the real DriveClient.open (a fake drive); by default the
+    real client (and the embedded simulated drive for sim:// URLs) is used. On teardown the link
+    thread is ended, the window closed and deleted, and no top-level widget may be left.
+    """
+    from fha_studio.gui.link import LinkController
+    from fha_studio.gui.main_window import MainWindow
+
+    app = QApplication.instance()
+    before = set(app.topLevelWidgets())
+    windows = []
+
+    def factory(open_client=None, connect: str | None = None, show: bool = True):
+        link = LinkController(open_client=open_client)
+        window = MainWindow(link)
+        link.setParent(window)
+        # not qtbot.addWidget: its teardown closes the window before ours can end the link
+        if show:
+            window.show()
+        windows.append(window)
+        if connect:
+            with qtbot.waitSignal(link.sigConnected, timeout=10000):
+                window.connect_to(connect)
+        return window
+
+    yield factory
+
+    for window in windows:
+        window._closing_confirmed = True
+        window.shutdown()
+        assert not window.link._thread.isRunning(), "the link thread is still running"
+        window.close()
+        window.deleteLater()
+    QApplication.processEvents()
+    QCoreApplication.sendPostedEvents(None, 0)  # DeferredDelete
+    QApplication.processEvents()
+    gc.collect()
+    leaked = [w for w in app.topLevelWidgets() if w not in before and w.isVisible()]
+    for w in leaked:
+        w.close()
+    assert not leaked, f"top-level widgets left open: {[type(w).__name__ for w in leaked]}"

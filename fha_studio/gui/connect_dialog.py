@@ -1,0 +1,165 @@
+"""The connect dialog: the embedded simulated drive (default), a serial port found on the machine,
+or an address typed by hand (pty path, socket://). Remembers the last choice."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QSettings, Slot
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QRadioButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from fha_studio.gui.forms import child, load_form
+from fha_studio.gui.session import DEFAULT_ACTUATOR
+
+BAUD_RATES = (9600, 19200, 38400, 57600, 115200)
+DEFAULT_BAUD = 19200
+
+
+def list_serial_ports() -> list[tuple[str, str]]:
+    """(device, description) of the serial ports found, e.g. ('/dev/ttyUSB0', 'FT232R USB UART')."""
+    try:
+        from serial.tools import list_ports
+    except ImportError:
+        return []
+    found = []
+    for port in sorted(list_ports.comports(), key=lambda p: p.device):
+        description = port.description if port.description and port.description != "n/a" else ""
+        found.append((port.device, description))
+    return found
+
+
+def catalogue_codes() -> list[str]:
+    """Model codes to offer: the catalogue's, when it can list them, else a few common ones."""
+    try:
+        from fha_studio import catalog
+
+        lister = getattr(catalog, "list_model_codes", None) or getattr(catalog, "all_model_codes", None)
+        if lister is not None:
+            return list(lister())
+    except Exception:
+        pass
+    return [
+        f"FHA-{frame}-{ratio}-{enc}"
+        for enc in ("US250", "S248")
+        for frame in ("17C", "25C", "32C", "40C")
+        for ratio in (50, 100, 160)
+    ]
+
+
+class ConnectDialog(QDialog):
+    """Asks where the drive is. `url()` and `baud_rate()` give the answer after exec()."""
+
+    def __init__(self, parent: QWidget | None = None, ports: list[tuple[str, str]] | None = None):
+        super().__init__(parent)
+        self.setWindowTitle("Connect to a drive")
+        self.form = load_form("connect_dialog.ui", self)
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.form)
+        self.buttons = QDialogButtonBox(
+            QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel
+        )
+        self.buttons.button(QDialogButtonBox.StandardButton.Ok).setText("C&onnect")
+        self.buttons.accepted.connect(self._accept)
+        self.buttons.rejected.connect(self.reject)
+        layout.addWidget(self.buttons)
+        self.sim_radio = child(self.form, QRadioButton, "simRadio")
+        self.serial_radio = child(self.form, QRadioButton, "serialRadio")
+        self.address_radio = child(self.form, QRadioButton, "addressRadio")
+        self.sim_actuator = child(self.form, QComboBox, "simActuatorCombo")
+        self.port_combo = child(self.form, QComboBox, "portCombo")
+        self.refresh_button = child(self.form, QPushButton, "refreshButton")
+        self.address_edit = child(self.form, QLineEdit, "addressEdit")
+        self.baud_combo = child(self.form, QComboBox, "baudCombo")
+        self.problem_label = child(self.form, QLabel, "problemLabel")
+        self.sim_actuator.addItems(catalogue_codes())
+        for rate in BAUD_RATES:
+            self.baud_combo.addItem(str(rate), rate)
+        self.refresh_button.clicked.connect(lambda: self.refresh_ports())
+        self.port_combo.activated.connect(lambda: self.serial_radio.setChecked(True))
+        self.address_edit.textEdited.connect(lambda: self.address_radio.setChecked(True))
+        self.sim_actuator.activated.connect(lambda: self.sim_radio.setChecked(True))
+        self.refresh_ports(ports)
+        self._restore()
+        self.resize(max(self.width(), 600), self.sizeHint().height())
+
+    @Slot()
+    def refresh_ports(self, ports: list[tuple[str, str]] | None = None) -> None:
+        ports = list_serial_ports() if ports is None else ports
+        current = self.port_combo.currentData()
+        self.port_combo.clear()
+        for device, description in ports:
+            self.port_combo.addItem(f"{device} — {description}" if description else device, device)
+        if not ports:
+            self.port_combo.addItem("(no serial port found)", None)
+        index = self.port_combo.findData(current)
+        if index >= 0:
+            self.port_combo.setCurrentIndex(index)
+
+    def _restore(self) -> None:
+        settings = QSettings()
+        kind = settings.value("connect/kind", "sim")
+        actuator = settings.value("connect/actuator", DEFAULT_ACTUATOR)
+        self.sim_actuator.setCurrentText(str(actuator))
+        port = settings.value("connect/port", "")
+        index = self.port_combo.findData(port)
+        if index >= 0:
+            self.port_combo.setCurrentIndex(index)
+        self.address_edit.setText(str(settings.value("connect/address", "")))
+        baud = int(settings.value("connect/baud", DEFAULT_BAUD))
+        self.baud_combo.setCurrentIndex(max(0, self.baud_combo.findData(baud)))
+        {"serial": self.serial_radio, "address": self.address_radio}.get(kind, self.sim_radio).setChecked(
+            True
+        )
+
+    def _save(self) -> None:
+        settings = QSettings()
+        kind = (
+            "serial"
+            if self.serial_radio.isChecked()
+            else "address"
+            if self.address_radio.isChecked()
+            else "sim"
+        )
+        settings.setValue("connect/kind", kind)
+        settings.setValue("connect/actuator", self.sim_actuator.currentText().strip())
+        if self.port_combo.currentData():
+            settings.setValue("connect/port", self.port_combo.currentData())
+        settings.setValue("connect/address", self.address_edit.text().strip())
+        settings.setValue("connect/baud", self.baud_rate())
+
+    def problem(self) -> str:
+        """What is wrong with the choice, or '' when it can be tried."""
+        if self.serial_radio.isChecked() and not self.port_combo.currentData():
+            return "No serial port is selected. Plug in the adapter and press Refresh, or type an address."
+        if self.address_radio.isChecked() and not self.address_edit.text().strip():
+            return "Type a device or pty path (/dev/pts/5) or a socket://host:port address."
+        if self.sim_radio.isChecked() and not self.sim_actuator.currentText().strip():
+            return "Choose the actuator the simulated drive should drive."
+        return ""
+
+    def url(self) -> str:
+        if self.serial_radio.isChecked():
+            return str(self.port_combo.currentData())
+        if self.address_radio.isChecked():
+            return self.address_edit.text().strip()
+        return f"sim://{self.sim_actuator.currentText().strip().upper()}"
+
+    def baud_rate(self) -> int:
+        return int(self.baud_combo.currentData() or DEFAULT_BAUD)
+
+    @Slot()
+    def _accept(self) -> None:
+        problem = self.problem()
+        self.problem_label.setText(problem)
+        if problem:
+            return
+        self._save()
+        self.accept()

@@ -1,0 +1,312 @@
+"""The main window: a toolbar with servo and the always-visible STOP, the pages as tabs, and a
+status bar with link, servo, alarm and what the drive supports."""
+
+from __future__ import annotations
+
+import logging
+
+from PySide6.QtCore import QSettings, Qt, Slot
+from PySide6.QtGui import QAction, QKeySequence, QShortcut
+from PySide6.QtWidgets import (
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QTabWidget,
+    QToolBar,
+    QWidget,
+)
+
+from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo
+from fha_studio.gui.session import DEFAULT_SIM_URL, Session
+from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton
+
+log = logging.getLogger(__name__)
+
+#: The key bound to STOP, everywhere in the main window (documented in the README and tooltip).
+STOP_KEY = Qt.Key.Key_Escape
+
+
+class MainWindow(QMainWindow):
+    """FHA Studio's main window."""
+
+    def __init__(self, link: LinkController | None = None, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.setWindowTitle("FHA Studio")
+        self.setObjectName("mainWindow")
+        self.link = link or LinkController(self)
+        self.session = Session(self.link, self)
+        self._closing_confirmed = False
+        self._shut_down = False
+        self._build_toolbar()
+        self._build_pages()
+        self._build_status_bar()
+        self.stop_shortcut = QShortcut(QKeySequence(STOP_KEY), self)
+        self.stop_shortcut.setContext(Qt.ShortcutContext.WindowShortcut)
+        self.stop_shortcut.activated.connect(self.stop_axis)
+        self.link.sigConnected.connect(self._on_connected)
+        self.link.sigDisconnected.connect(self._on_disconnected)
+        self.link.sigStatus.connect(self._on_status)
+        self.link.sigResult.connect(self._on_result)
+        self.session.sigMessage.connect(lambda text: self.statusBar().showMessage(text, 8000))
+        self.resize(1280, 720)
+        self._restore_layout()
+        self._on_disconnected("not connected", False)
+
+    # -- building -------------------------------------------------------------------------------
+    def _build_toolbar(self) -> None:
+        bar = QToolBar("Axis", self)
+        bar.setObjectName("axisToolbar")
+        bar.setMovable(False)
+        bar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, bar)
+        self.connect_action = QAction("&Connect…", self)
+        self.connect_action.setShortcut(QKeySequence("Ctrl+K"))
+        self.connect_action.setToolTip("Choose a drive to connect to (Ctrl+K)")
+        self.connect_action.triggered.connect(self.show_connect_dialog)
+        bar.addAction(self.connect_action)
+        self.disconnect_action = QAction("&Disconnect", self)
+        self.disconnect_action.triggered.connect(self.disconnect_drive)
+        bar.addAction(self.disconnect_action)
+        bar.addSeparator()
+        self.servo_action = QAction("Servo O&N", self)
+        self.servo_action.setCheckable(True)
+        self.servo_action.setToolTip("Switch the servo on or off (nothing moves without servo on)")
+        self.servo_action.triggered.connect(self._servo_clicked)
+        bar.addAction(self.servo_action)
+        spacer = QWidget()
+        spacer.setSizePolicy(
+            spacer.sizePolicy().horizontalPolicy().Expanding, spacer.sizePolicy().verticalPolicy().Preferred
+        )
+        bar.addWidget(spacer)
+        self.alarm_banner = QLabel("")
+        self.alarm_banner.setObjectName("alarmBanner")
+        self.alarm_banner_action = bar.addWidget(
+            self.alarm_banner
+        )  # a toolbar widget shows through its action
+        self.alarm_banner_action.setVisible(False)
+        self.stop_button = StopButton()
+        self.stop_button.clicked.connect(self.stop_axis)
+        bar.addWidget(self.stop_button)
+
+    def _build_pages(self) -> None:
+        from fha_studio.gui.pages.alarms import AlarmsPage
+        from fha_studio.gui.pages.connection import ConnectionPage
+        from fha_studio.gui.pages.direction import DirectionPage
+        from fha_studio.gui.pages.jog import JogPage
+        from fha_studio.gui.pages.parameters import ParametersPage
+        from fha_studio.gui.pages.sizing import SizingPage
+
+        self.tabs = QTabWidget(self)
+        self.tabs.setObjectName("pages")
+        self.tabs.setDocumentMode(True)
+        self.connection_page = ConnectionPage(self.session, self)
+        self.parameters_page = ParametersPage(self.session, self)
+        self.direction_page = DirectionPage(self.session, self)
+        self.alarms_page = AlarmsPage(self.session, self)
+        self.jog_page = JogPage(self.session, self)
+        self.sizing_page = SizingPage(self.session, self)
+        for page, title in (
+            (self.connection_page, "C&onnection"),
+            (self.parameters_page, "&Parameters"),
+            (self.direction_page, "&Rotary direction"),
+            (self.alarms_page, "&Alarms"),
+            (self.jog_page, "&Jog && test run"),
+            (self.sizing_page, "Si&zing"),
+        ):
+            self.tabs.addTab(page, title)
+        self.setCentralWidget(self.tabs)
+        self.alarms_page.sigAlarmAttention.connect(self._on_alarm_attention)
+
+    def _build_status_bar(self) -> None:
+        bar = self.statusBar()
+        self.link_lamp = Lamp("Link")
+        self.servo_lamp = Lamp("Servo", AMBER)
+        self.alarm_lamp = Lamp("Alarm", RED)
+        self.caps_label = QLabel("")
+        self.caps_label.setObjectName("capabilities")
+        for w in (self.link_lamp, self.servo_lamp, self.alarm_lamp):
+            bar.addPermanentWidget(w)
+        bar.addPermanentWidget(self.caps_label, 1)
+
+    # -- settings -------------------------------------------------------------------------------
+    def _restore_layout(self) -> None:
+        settings = QSettings()
+        geometry = settings.value("window/geometry")
+        if geometry is not None:
+            self.restoreGeometry(geometry)
+        state = settings.value("window/state")
+        if state is not None:
+            self.restoreState(state)
+        self.tabs.setCurrentIndex(int(settings.value("window/page", 0)))
+        for page in self._pages():
+            restore = getattr(page, "restore_settings", None)
+            if restore:
+                restore(settings)
+
+    def save_layout(self) -> None:
+        settings = QSettings()
+        settings.setValue("window/geometry", self.saveGeometry())
+        settings.setValue("window/state", self.saveState())
+        settings.setValue("window/page", self.tabs.currentIndex())
+        for page in self._pages():
+            save = getattr(page, "save_settings", None)
+            if save:
+                save(settings)
+
+    def _pages(self) -> list[QWidget]:
+        return [self.tabs.widget(i) for i in range(self.tabs.count())]
+
+    PAGE_NAMES = ("connection", "parameters", "direction", "alarms", "jog", "sizing")
+
+    def show_page(self, name: str) -> QWidget:
+        """Shows the page called `name` (one of PAGE_NAMES); ValueError naming them otherwise."""
+        if name not in self.PAGE_NAMES:
+            raise ValueError(f"no page {name!r}; pages: {', '.join(self.PAGE_NAMES)}")
+        self.tabs.setCurrentIndex(self.PAGE_NAMES.index(name))
+        return self.tabs.currentWidget()
+
+    # -- actions --------------------------------------------------------------------------------
+    @Slot()
+    def stop_axis(self) -> None:
+        """STOP: decelerate and hold. Sent even when the link looks idle."""
+        self.jog_page.release_jog()
+        self.link.stop_now()
+        self.statusBar().showMessage("STOP sent: the axis decelerates and holds (servo stays on).", 5000)
+
+    def connect_to(self, url: str = DEFAULT_SIM_URL, baud_rate: int = 19200) -> bool:
+        """Connects (after asking, when the axis is live); False when the user said no."""
+        if self.link.connected and not self.confirm_axis_release("switch to another drive"):
+            return False
+        self.link.open(url, baud_rate)
+        self.link_lamp.set_state(None)
+        self.caps_label.setText(f"connecting to {url} …")
+        return True
+
+    @Slot()
+    def show_connect_dialog(self) -> None:
+        from fha_studio.gui.connect_dialog import ConnectDialog
+
+        dialog = ConnectDialog(self)
+        if dialog.exec():
+            self.connect_to(dialog.url(), dialog.baud_rate())
+
+    @Slot()
+    def disconnect_drive(self) -> None:
+        if self.link.connected and self.confirm_axis_release("disconnect"):
+            self.link.close_link()
+
+    def confirm_axis_release(self, what: str) -> bool:
+        """Asks before the link goes away while the servo is on or the axis moves."""
+        if not (self.link.servo_on or self.link.moving):
+            return True
+        moving = self.link.moving
+        text = (
+            f"The servo is on{' and the axis is moving' if moving else ''}.\n\n"
+            f"If you {what} now, FHA Studio first sends STOP: the axis decelerates to standstill "
+            "and is held there by the servo, which stays ON. FHA Studio does not switch the servo "
+            "off by itself, because an axis without a brake under a load (a vertical axis) would "
+            "drop.\n\nSwitch the servo off yourself first if the axis should be free."
+        )
+        answer = QMessageBox.warning(
+            self,
+            f"{what.capitalize()} while the servo is on?",
+            text,
+            QMessageBox.StandardButton.Ok | QMessageBox.StandardButton.Cancel,
+            QMessageBox.StandardButton.Cancel,
+        )
+        return answer == QMessageBox.StandardButton.Ok
+
+    @Slot(bool)
+    def _servo_clicked(self, checked: bool) -> None:
+        self.link.send(Cmd.SERVO, checked)
+        self.servo_action.setChecked(self.link.servo_on)  # the drive's state decides, not the click
+
+    # -- from the link --------------------------------------------------------------------------
+    @Slot(object)
+    def _on_connected(self, info: LinkInfo) -> None:
+        self.link_lamp.set_state(True, GREEN)
+        where = "embedded simulated drive" if info.is_simulated else info.url
+        model = info.driver_model or "driver model unknown"
+        self.link_lamp.setToolTip(f"Link: connected to {where} ({model})")
+        self.caps_label.setText(f"{model} · {where} · {info.capabilities or 'capabilities unknown'}")
+        self.caps_label.setToolTip(info.capabilities)
+        self.disconnect_action.setEnabled(True)
+        self.servo_action.setEnabled(info.can_move)
+        self.setWindowTitle(f"FHA Studio — {model} — {where}")
+
+    @Slot(str, bool)
+    def _on_disconnected(self, reason: str, lost: bool) -> None:
+        self.link_lamp.set_state(False, GREEN)
+        self.servo_lamp.set_state(None)
+        self.alarm_lamp.set_state(None)
+        self.disconnect_action.setEnabled(False)
+        self.servo_action.setEnabled(False)
+        self.servo_action.setChecked(False)
+        self.setWindowTitle("FHA Studio — not connected")
+        if lost:
+            self.link_lamp.set_state(True, RED)
+            self.link_lamp.setToolTip(f"Link: LOST — {reason}")
+            self.caps_label.setText(f"LINK LOST: {reason}. Check the cable and power, then Connect… (Ctrl+K)")
+            self.caps_label.setStyleSheet("color: #b00020; font-weight: bold;")
+        else:
+            self.caps_label.setText(f"Not connected ({reason}). Connect… (Ctrl+K)")
+            self.caps_label.setStyleSheet("")
+
+    @Slot(object)
+    def _on_status(self, status: DriveStatus) -> None:
+        self.caps_label.setStyleSheet("")
+        if status.servo_on is not None:
+            self.servo_lamp.set_state(status.servo_on)
+            self.servo_action.setChecked(status.servo_on)
+            self.servo_action.setText("Servo O&N" if not status.servo_on else "Servo O&FF")
+        if status.alarm_code is not None:
+            self.alarm_lamp.set_state(status.alarm_code != 0)
+            self.alarm_lamp.setToolTip(f"Alarm {status.alarm_code}" if status.alarm_code else "Alarm: none")
+
+    @Slot(object)
+    def _on_result(self, result: CommandResult) -> None:
+        if result.ok:
+            return
+        if result.cmd is Cmd.OPEN:
+            self.caps_label.setText(f"Could not connect: {result.error}")
+            self.caps_label.setStyleSheet("color: #b00020; font-weight: bold;")
+            self.link_lamp.set_state(True, RED)
+        elif result.cmd is not Cmd.JOG_LEASE:
+            self.statusBar().showMessage(f"{_command_words(result.cmd)} failed: {result.error}", 8000)
+
+    @Slot(int, bool)
+    def _on_alarm_attention(self, code: int, attention: bool) -> None:
+        self.alarm_banner_action.setVisible(attention)
+        if attention:
+            self.alarm_banner.setText(f"  NEW ALARM {code} — see the Alarms page  ")
+            self.alarm_banner.setStyleSheet(
+                "background: #b00020; color: white; font-weight: bold; border-radius: 4px; padding: 4px;"
+            )
+
+    # -- closing --------------------------------------------------------------------------------
+    def closeEvent(self, event) -> None:
+        if self._shut_down:
+            event.accept()
+            return
+        if not self._closing_confirmed and not self.confirm_axis_release("close FHA Studio"):
+            event.ignore()
+            return
+        self._closing_confirmed = True
+        self.save_layout()
+        self.shutdown()
+        event.accept()
+
+    def shutdown(self) -> None:
+        """Stops the axis, closes the port and ends the link thread (idempotent)."""
+        if self._shut_down:
+            return
+        self._shut_down = True
+        for page in self._pages():
+            stop = getattr(page, "shutdown", None)
+            if stop:
+                stop()
+        self.link.shutdown()
+
+
+def _command_words(cmd: Cmd) -> str:
+    return cmd.name.replace("_", " ").lower().capitalize()

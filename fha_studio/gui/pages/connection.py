@@ -1,0 +1,215 @@
+"""Connection page: which drive, which actuator, and whether they belong together."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QSettings, Qt, Slot
+from PySide6.QtWidgets import (
+    QComboBox,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from fha_studio.gui.connect_dialog import catalogue_codes
+from fha_studio.gui.link import LinkInfo
+from fha_studio.gui.session import Session
+
+
+def _value_label() -> QLabel:
+    label = QLabel("—")
+    label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+    label.setWordWrap(True)
+    return label
+
+
+class ConnectionPage(QWidget):
+    """Drive identity, the actuator code and the pairing check."""
+
+    def __init__(self, session: Session, main_window=None):
+        super().__init__()
+        self.session = session
+        self.main_window = main_window
+        self.pairing = None
+        layout = QVBoxLayout(self)
+
+        drive_box = QGroupBox("Drive")
+        form = QFormLayout(drive_box)
+        self.link_label = _value_label()
+        self.driver_label = _value_label()
+        self.adjusted_label = _value_label()
+        self.firmware_label = _value_label()
+        self.caps_label = _value_label()
+        form.addRow("Link:", self.link_label)
+        form.addRow("Driver model (TYPE):", self.driver_label)
+        form.addRow("ADJUSTED FOR USE WITH:", self.adjusted_label)
+        form.addRow("Firmware:", self.firmware_label)
+        form.addRow("The drive supports:", self.caps_label)
+        buttons = QHBoxLayout()
+        self.connect_button = QPushButton("&Connect…")
+        self.connect_button.setToolTip(
+            "Choose the embedded simulated drive, a serial port or an address (Ctrl+K)"
+        )
+        self.disconnect_button = QPushButton("Dis&connect")
+        buttons.addWidget(self.connect_button)
+        buttons.addWidget(self.disconnect_button)
+        buttons.addStretch(1)
+        form.addRow(buttons)
+        layout.addWidget(drive_box)
+
+        actuator_box = QGroupBox("Actuator on the axis")
+        a_layout = QVBoxLayout(actuator_box)
+        row = QHBoxLayout()
+        label = QLabel("Model code from the actuator's &label:")
+        self.actuator_combo = QComboBox()
+        self.actuator_combo.setEditable(True)
+        self.actuator_combo.setInsertPolicy(QComboBox.InsertPolicy.NoInsert)
+        self.actuator_combo.addItems(catalogue_codes())
+        self.actuator_combo.setCurrentText("")
+        self.actuator_combo.lineEdit().setPlaceholderText(
+            "e.g. FHA-25C-50-US250-B (type it, or pick from the catalogue)"
+        )
+        self.actuator_combo.setMinimumWidth(320)
+        label.setBuddy(self.actuator_combo)
+        self.check_button = QPushButton("C&heck pairing")
+        row.addWidget(label)
+        row.addWidget(self.actuator_combo, 1)
+        row.addWidget(self.check_button)
+        a_layout.addLayout(row)
+        self.actuator_summary = QLabel("")
+        self.actuator_summary.setWordWrap(True)
+        self.actuator_summary.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        a_layout.addWidget(self.actuator_summary)
+        self.warning_label = QLabel("")
+        self.warning_label.setObjectName("pairingWarning")
+        self.warning_label.setWordWrap(True)
+        self.warning_label.setVisible(False)
+        a_layout.addWidget(self.warning_label)
+        ack_row = QHBoxLayout()
+        self.ack_button = QPushButton("I have checked the labels: &acknowledge this warning")
+        self.ack_button.setVisible(False)
+        ack_row.addWidget(self.ack_button)
+        ack_row.addStretch(1)
+        a_layout.addLayout(ack_row)
+        layout.addWidget(actuator_box)
+
+        hint = QLabel(
+            "<b>Commissioning order</b>: 1. connect · 2. check the actuator against the driver label · "
+            "3. <i>Parameters</i>: read all (a backup is saved before the first write) · "
+            "4. <i>Rotary direction</i>: set and check it · 5. <i>Jog &amp; test run</i> · "
+            "6. <i>Alarms</i>: clear what is left · 7. <i>Parameters</i>: save the parameter file."
+        )
+        hint.setWordWrap(True)
+        layout.addWidget(hint)
+        layout.addStretch(1)
+
+        if main_window is not None:
+            self.connect_button.clicked.connect(main_window.show_connect_dialog)
+            self.disconnect_button.clicked.connect(main_window.disconnect_drive)
+        self.check_button.clicked.connect(self.check_pairing)
+        self.actuator_combo.lineEdit().returnPressed.connect(self.check_pairing)
+        self.actuator_combo.activated.connect(lambda _i: self.check_pairing())
+        self.ack_button.clicked.connect(self.acknowledge)
+        session.link.sigConnected.connect(self._on_connected)
+        session.link.sigDisconnected.connect(self._on_disconnected)
+        session.sigActuatorChanged.connect(self._on_actuator_changed)
+        self._on_disconnected("not connected", False)
+
+    # -- settings ---------------------------------------------------------------------------------
+    def restore_settings(self, settings: QSettings) -> None:
+        code = settings.value("session/actuator", "")
+        if code and not self.session.actuator_code:
+            self.actuator_combo.setCurrentText(str(code))
+
+    def save_settings(self, settings: QSettings) -> None:
+        if self.session.actuator_code:
+            settings.setValue("session/actuator", self.session.actuator_code)
+
+    # -- behaviour --------------------------------------------------------------------------------
+    @Slot(object)
+    def _on_connected(self, info: LinkInfo) -> None:
+        self.link_label.setText(("embedded simulated drive — " if info.is_simulated else "") + info.url)
+        self.driver_label.setText(info.driver_model or "not reported by this drive")
+        self.adjusted_label.setText(info.adjusted_for or "not reported: read it from the driver's label")
+        self.firmware_label.setText(info.firmware or "—")
+        self.caps_label.setText(info.capabilities or "—")
+        self.disconnect_button.setEnabled(True)
+        if not self.actuator_combo.currentText().strip() and info.adjusted_for:
+            self.actuator_combo.setCurrentText(info.adjusted_for)
+        if self.actuator_combo.currentText().strip():
+            self.check_pairing()
+
+    @Slot(str, bool)
+    def _on_disconnected(self, reason: str, lost: bool) -> None:
+        self.link_label.setText(("LINK LOST: " if lost else "not connected: ") + reason)
+        self.link_label.setStyleSheet("color: #b00020; font-weight: bold;" if lost else "")
+        self.disconnect_button.setEnabled(False)
+
+    @Slot(str)
+    def _on_actuator_changed(self, code: str) -> None:
+        if self.actuator_combo.currentText().strip().upper() != code:
+            self.actuator_combo.setCurrentText(code)
+
+    @Slot()
+    def check_pairing(self) -> None:
+        from fha_studio.logic.pairing import check_pairing
+
+        code = self.actuator_combo.currentText().strip().upper()
+        info = self.session.link.info
+        if not code:
+            self._show_warning("")
+            return
+        try:
+            result = check_pairing(code, info.driver_model if info else "", info.adjusted_for if info else "")
+        except (ValueError, ImportError) as exc:
+            self.actuator_summary.setText("")
+            self._show_warning(f"<b>{code}</b> is not a model code the catalogue knows: {exc}", can_ack=False)
+            return
+        self.pairing = result
+        self.actuator_summary.setText(self._summary(code, result))
+        self.session.set_actuator(code, acknowledged=result.ok)
+        if result.ok:
+            self._show_warning("")
+        else:
+            self._show_warning("<br>".join(f"⚠ {w}" for w in result.warnings))
+
+    def _summary(self, code: str, result) -> str:
+        try:
+            from fha_studio.catalog import get_actuator
+
+            a = get_actuator(code)
+            text = (
+                f"<b>{code}</b>: max torque {a.max_torque_nm:g} N·m, max speed {a.max_speed_rpm:g} r/min, "
+                f"ratio {a.ratio}, output resolution {a.output_resolution_ppr:,} pulse/rev."
+            )
+        except Exception:
+            text = f"<b>{code}</b>"
+        if result.compatible_drivers:
+            text += f" Drivers for it (manual 1-3): {', '.join(result.compatible_drivers)}."
+        return text
+
+    def _show_warning(self, html: str, can_ack: bool = True) -> None:
+        self.warning_label.setText(html)
+        self.warning_label.setVisible(bool(html))
+        self.warning_label.setStyleSheet(
+            "background: #fff3cd; color: #5c3c00; border: 1px solid #e0a000; padding: 6px; "
+            "border-radius: 4px;"
+        )
+        self.ack_button.setVisible(bool(html) and can_ack)
+        self.ack_button.setEnabled(True)
+
+    @Slot()
+    def acknowledge(self) -> None:
+        self.session.set_actuator(self.actuator_combo.currentText(), acknowledged=True)
+        self.ack_button.setEnabled(False)
+        self.ack_button.setText("Acknowledged for this session")
+        self.warning_label.setStyleSheet(
+            "background: #f1f1f1; color: #5c3c00; border: 1px solid #bbb; padding: 6px; border-radius: 4px;"
+        )
+
+    @property
+    def warning_pending(self) -> bool:
+        return self.warning_label.isVisible() and self.ack_button.isVisible() and self.ack_button.isEnabled()

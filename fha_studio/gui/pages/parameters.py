@@ -1,0 +1,609 @@
+"""The parameter editor: one table of the tune and parameter (system) items of the driver."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtCore import QAbstractTableModel, QModelIndex, QPoint, QSettings, Qt, Signal, Slot
+from PySide6.QtGui import QBrush, QColor, QFont
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QComboBox,
+    QFileDialog,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QLineEdit,
+    QMessageBox,
+    QPlainTextEdit,
+    QPushButton,
+    QSplitter,
+    QStyledItemDelegate,
+    QTableView,
+    QToolTip,
+    QVBoxLayout,
+    QWidget,
+)
+
+from fha_studio.gui.link import Cmd, CommandResult, LinkInfo
+from fha_studio.gui.session import Session
+
+COLUMNS = ("Mode", "No.", "Name", "Value", "Unit", "Range", "Default", "State")
+COL_VALUE = 3
+EDITED_BRUSH = QBrush(QColor("#fff1b8"))
+DIFFERS_COLOUR = QColor("#0d47a1")
+MODE_WORDS = {"tune": "tune", "system": "parameter"}
+_ROOT = QModelIndex()
+
+
+def parse_value(item, text: str) -> int:
+    """The wire integer for what was typed: a choice number, or a value in the item's unit.
+    Raises ValueError saying the allowed range."""
+    text = text.strip()
+    if item.choices:
+        head = text.split(":", 1)[0].strip()
+        try:
+            wire = int(head)
+        except ValueError:
+            raise ValueError(f"{item.name}: choose one of {_choices(item)}") from None
+        if wire not in item.choices:
+            raise ValueError(f"{item.name}: {wire} is not allowed; choose one of {_choices(item)}")
+        return wire
+    try:
+        value = float(text.replace(",", "."))
+    except ValueError:
+        raise ValueError(f"{item.name}: '{text}' is not a number; allowed {range_text(item)}") from None
+    wire = round(value / item.scale)
+    if not item.minimum <= wire <= item.maximum or abs(wire * item.scale - value) > item.scale * 0.5 + 1e-9:
+        raise ValueError(f"{item.name}: {text} is outside the allowed range {range_text(item)}")
+    return wire
+
+
+def _choices(item) -> str:
+    return ", ".join(f"{k} ({v})" for k, v in item.choices.items())
+
+
+def _num(value: float) -> str:
+    return f"{value:g}"
+
+
+def range_text(item) -> str:
+    if item.choices:
+        return " / ".join(str(k) for k in item.choices)
+    return f"{_num(item.to_unit(item.minimum))} … {_num(item.to_unit(item.maximum))}"
+
+
+def value_text(item, wire: int | None) -> str:
+    if wire is None:
+        return ""
+    if item.choices:
+        return f"{wire}: {item.choices.get(wire, '?')}"
+    return _num(item.to_unit(wire))
+
+
+class ParameterTableModel(QAbstractTableModel):
+    """Items x (mode, number, name, value, unit, range, default, state). Edits stay here until
+    written; the drive's values come from the session."""
+
+    sigRefused = Signal(str, QModelIndex)  # why, where
+    sigEditsChanged = Signal(int)  # number of edited-not-written items
+
+    def __init__(self, session: Session, parent=None):
+        super().__init__(parent)
+        self.session = session
+        self.items: list = []
+        self.edits: dict[tuple[str, int], int] = {}
+        self.restart_pending: set[tuple[str, int]] = set()
+        self.reload_items()
+        session.sigValuesChanged.connect(self._values_changed)
+
+    def reload_items(self) -> None:
+        self.beginResetModel()
+        try:
+            self.items = self.session.editable_items()
+        except Exception:
+            self.items = []
+        self.endResetModel()
+
+    # -- Qt model API -------------------------------------------------------------------------------
+    def rowCount(self, parent=_ROOT) -> int:
+        return 0 if parent.isValid() else len(self.items)
+
+    def columnCount(self, parent=_ROOT) -> int:
+        return 0 if parent.isValid() else len(COLUMNS)
+
+    def headerData(self, section, orientation, role=Qt.ItemDataRole.DisplayRole):
+        if role == Qt.ItemDataRole.DisplayRole and orientation == Qt.Orientation.Horizontal:
+            return COLUMNS[section]
+        return None
+
+    def flags(self, index):
+        base = Qt.ItemFlag.ItemIsEnabled | Qt.ItemFlag.ItemIsSelectable
+        if index.column() == COL_VALUE:
+            base |= Qt.ItemFlag.ItemIsEditable
+        return base
+
+    def key(self, row: int) -> tuple[str, int]:
+        item = self.items[row]
+        return (item.mode, item.number)
+
+    def shown_value(self, row: int) -> int | None:
+        key = self.key(row)
+        return self.edits.get(key, self.session.drive_values.get(key))
+
+    def state_text(self, row: int) -> str:
+        item = self.items[row]
+        key = self.key(row)
+        drive = self.session.drive_values.get(key)
+        words = []
+        if key in self.edits:
+            words.append("edited, not written")
+        elif drive is None:
+            words.append("not read")
+        shown = self.shown_value(row)
+        if shown is not None and item.default is not None and shown != item.default:
+            words.append("≠ default")
+        if key in self.restart_pending:
+            words.append("power cycle needed")
+        elif item.restart_required:
+            words.append("needs restart")
+        return ", ".join(words)
+
+    def data(self, index, role=Qt.ItemDataRole.DisplayRole):
+        if not index.isValid():
+            return None
+        row, col = index.row(), index.column()
+        item = self.items[row]
+        key = self.key(row)
+        if role in (Qt.ItemDataRole.DisplayRole, Qt.ItemDataRole.EditRole):
+            if col == 0:
+                return MODE_WORDS.get(str(item.mode), str(item.mode))
+            if col == 1:
+                return item.number
+            if col == 2:
+                return item.name
+            if col == COL_VALUE:
+                return value_text(item, self.shown_value(row))
+            if col == 4:
+                return item.unit
+            if col == 5:
+                return range_text(item)
+            if col == 6:
+                return value_text(item, item.default)
+            if col == 7:
+                return self.state_text(row)
+        if role == Qt.ItemDataRole.ToolTipRole:
+            tip = f"<b>{MODE_WORDS.get(str(item.mode))} {item.number}: {item.name}</b><br>{item.description}"
+            tip += f"<br><i>Source: {item.source}</i>"
+            if not item.certain:
+                tip += f"<br><i>Uncertain ({', '.join(item.assumed)}): {item.note}</i>"
+            if item.restart_required:
+                tip += "<br><b>Takes effect after the driver's control power is cycled.</b>"
+            return tip
+        if role == Qt.ItemDataRole.BackgroundRole and key in self.edits:
+            return EDITED_BRUSH
+        if role == Qt.ItemDataRole.FontRole and key in self.edits and col in (COL_VALUE, 7):
+            font = QFont()
+            font.setBold(True)
+            return font
+        if role == Qt.ItemDataRole.ForegroundRole and col in (COL_VALUE, 7):
+            shown = self.shown_value(row)
+            if shown is not None and item.default is not None and shown != item.default:
+                return QBrush(DIFFERS_COLOUR)
+        if role == Qt.ItemDataRole.TextAlignmentRole and col in (1, COL_VALUE, 6):
+            return (
+                int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter) if not item.choices else None
+            )
+        if role == Qt.ItemDataRole.AccessibleDescriptionRole and col == COL_VALUE:
+            return self.state_text(row)
+        return None
+
+    def setData(self, index, value, role=Qt.ItemDataRole.EditRole) -> bool:
+        if role != Qt.ItemDataRole.EditRole or index.column() != COL_VALUE:
+            return False
+        item = self.items[index.row()]
+        try:
+            wire = (
+                value
+                if isinstance(value, int) and not isinstance(value, bool)
+                else parse_value(item, str(value))
+            )
+            item.check(wire)
+        except ValueError as exc:
+            self.sigRefused.emit(f"Refused: {exc}. Allowed: {range_text(item)} {item.unit}".rstrip(), index)
+            return False
+        self.set_edit(item.mode, item.number, wire)
+        return True
+
+    # -- edits --------------------------------------------------------------------------------------
+    def set_edit(self, mode: str, number: int, wire: int) -> None:
+        key = (mode, number)
+        if self.session.drive_values.get(key) == wire:
+            self.edits.pop(key, None)
+        else:
+            self.edits[key] = wire
+        self._row_changed(key)
+        self.sigEditsChanged.emit(len(self.edits))
+
+    def revert(self) -> None:
+        self.edits.clear()
+        self._all_changed()
+        self.sigEditsChanged.emit(0)
+
+    def row_of(self, key: str) -> int:
+        return next(r for r, i in enumerate(self.items) if i.key == key)
+
+    def _row_changed(self, key) -> None:
+        for row, item in enumerate(self.items):
+            if (item.mode, item.number) == key:
+                self.dataChanged.emit(self.index(row, 0), self.index(row, len(COLUMNS) - 1))
+
+    def _all_changed(self) -> None:
+        if self.items:
+            self.dataChanged.emit(self.index(0, 0), self.index(len(self.items) - 1, len(COLUMNS) - 1))
+
+    @Slot()
+    def _values_changed(self) -> None:
+        # an edit equal to what the drive now holds is no longer an edit
+        for key in [k for k, v in self.edits.items() if self.session.drive_values.get(k) == v]:
+            del self.edits[key]
+        self._all_changed()
+        self.sigEditsChanged.emit(len(self.edits))
+
+
+class ValueDelegate(QStyledItemDelegate):
+    """A combo box for choice items, a line edit showing the allowed range for numbers."""
+
+    def createEditor(self, parent, option, index):
+        item = index.model().items[index.row()]
+        if item.choices:
+            combo = QComboBox(parent)
+            for wire, meaning in item.choices.items():
+                combo.addItem(f"{wire}: {meaning}", wire)
+            return combo
+        edit = QLineEdit(parent)
+        edit.setPlaceholderText(f"{range_text(item)} {item.unit}".strip())
+        edit.setToolTip(f"Allowed: {range_text(item)} {item.unit}".strip())
+        return edit
+
+    def setEditorData(self, editor, index):
+        model = index.model()
+        wire = model.shown_value(index.row())
+        if isinstance(editor, QComboBox):
+            found = editor.findData(wire)
+            editor.setCurrentIndex(max(0, found))
+        else:
+            editor.setText(value_text(model.items[index.row()], wire))
+            editor.selectAll()
+
+    def setModelData(self, editor, model, index):
+        if isinstance(editor, QComboBox):
+            model.setData(index, int(editor.currentData()))
+        else:
+            model.setData(index, editor.text())
+
+
+class ParametersPage(QWidget):
+    """Read, edit, write (verified), save and load the driver's parameters."""
+
+    def __init__(self, session: Session, main_window=None):
+        super().__init__()
+        self.session = session
+        self.link = session.link
+        self.main_window = main_window
+        self.model = ParameterTableModel(session, self)
+        layout = QVBoxLayout(self)
+
+        buttons = QHBoxLayout()
+        self.read_button = QPushButton("&Read all")
+        self.read_button.setToolTip("Read every tune and parameter item from the drive")
+        self.write_changed_button = QPushButton("&Write changed")
+        self.write_changed_button.setToolTip(
+            "Write the edited items (yellow), each verified by reading it back"
+        )
+        self.write_all_button = QPushButton("Write a&ll")
+        self.write_all_button.setToolTip("Write every item as shown, each verified by reading it back")
+        self.revert_button = QPushButton("Re&vert edits")
+        self.save_button = QPushButton("&Save file…")
+        self.save_button.setToolTip("Save the drive's values (as last read) to a parameter file (TOML)")
+        self.load_button = QPushButton("L&oad file…")
+        self.load_button.setToolTip(
+            "Compare a parameter file with the drive and the defaults; choose what to apply"
+        )
+        for b in (self.read_button, self.write_changed_button, self.write_all_button, self.revert_button):
+            buttons.addWidget(b)
+        buttons.addStretch(1)
+        buttons.addWidget(self.save_button)
+        buttons.addWidget(self.load_button)
+        layout.addLayout(buttons)
+
+        self.restart_banner = QWidget()
+        rb = QHBoxLayout(self.restart_banner)
+        rb.setContentsMargins(6, 4, 6, 4)
+        self.restart_label = QLabel("")
+        self.restart_label.setWordWrap(True)
+        self.power_cycle_button = QPushButton("&Power cycle the drive now")
+        rb.addWidget(self.restart_label, 1)
+        rb.addWidget(self.power_cycle_button)
+        self.restart_banner.setStyleSheet(
+            "background: #fff3cd; border: 1px solid #e0a000; border-radius: 4px;"
+        )
+        self.restart_banner.setVisible(False)
+        layout.addWidget(self.restart_banner)
+
+        splitter = QSplitter(Qt.Orientation.Vertical)
+        splitter.setObjectName("parametersSplitter")
+        self.splitter = splitter
+        self.table = QTableView()
+        self.table.setObjectName("parameterTable")
+        self.table.setModel(self.model)
+        self.table.setItemDelegateForColumn(COL_VALUE, ValueDelegate(self.table))
+        self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
+        self.table.setEditTriggers(
+            QAbstractItemView.EditTrigger.DoubleClicked
+            | QAbstractItemView.EditTrigger.EditKeyPressed
+            | QAbstractItemView.EditTrigger.AnyKeyPressed
+        )
+        self.table.verticalHeader().setVisible(False)
+        self.table.setAlternatingRowColors(True)
+        header = self.table.horizontalHeader()
+        header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        header.setSectionResizeMode(2, QHeaderView.ResizeMode.Stretch)
+        header.setSectionResizeMode(COL_VALUE, QHeaderView.ResizeMode.Interactive)
+        splitter.addWidget(self.table)
+        log_box = QWidget()
+        lb = QVBoxLayout(log_box)
+        lb.setContentsMargins(0, 0, 0, 0)
+        lb.addWidget(QLabel("Session log (every write, verified by read-back):"))
+        self.log_view = QPlainTextEdit()
+        self.log_view.setReadOnly(True)
+        self.log_view.setObjectName("sessionLog")
+        lb.addWidget(self.log_view)
+        splitter.addWidget(log_box)
+        splitter.setStretchFactor(0, 4)
+        splitter.setStretchFactor(1, 1)
+        layout.addWidget(splitter, 1)
+        self.message = QLabel("Read the drive's parameters to begin (Read all).")
+        self.message.setObjectName("parameterMessage")
+        self.message.setWordWrap(True)
+        layout.addWidget(self.message)
+        legend = QLabel(
+            "<span style='background:#fff1b8'>&nbsp;yellow&nbsp;</span> edited, not written · "
+            "<span style='color:#0d47a1'>blue</span> differs from the default · "
+            "double-click or type on a value to edit · hover for the manual's description"
+        )
+        layout.addWidget(legend)
+
+        self.read_button.clicked.connect(self.read_all)
+        self.write_changed_button.clicked.connect(self.write_changed)
+        self.write_all_button.clicked.connect(self.write_all)
+        self.revert_button.clicked.connect(self.model.revert)
+        self.save_button.clicked.connect(lambda: self.save_file())
+        self.load_button.clicked.connect(lambda: self.load_file())
+        self.power_cycle_button.clicked.connect(self.power_cycle)
+        self.model.sigRefused.connect(self._refused)
+        self.model.sigEditsChanged.connect(self._edits_changed)
+        session.sigLogChanged.connect(self._log_changed)
+        session.sigWritesDone.connect(self._writes_done)
+        self.link.sigConnected.connect(self._on_connected)
+        self.link.sigDisconnected.connect(lambda *_: self._update_buttons())
+        self.link.sigResult.connect(self._on_result)
+        self.link.sigBusyChanged.connect(lambda _b: self._update_buttons())
+        self._update_buttons()
+
+    # -- settings -----------------------------------------------------------------------------------
+    def restore_settings(self, settings: QSettings) -> None:
+        state = settings.value("parameters/splitter")
+        if state is not None:
+            self.splitter.restoreState(state)
+
+    def save_settings(self, settings: QSettings) -> None:
+        settings.setValue("parameters/splitter", self.splitter.saveState())
+
+    # -- actions ------------------------------------------------------------------------------------
+    def _update_buttons(self) -> None:
+        connected = self.link.connected
+        for b in (self.read_button, self.write_all_button):
+            b.setEnabled(connected)
+        self.write_changed_button.setEnabled(connected and bool(self.model.edits))
+        self.revert_button.setEnabled(bool(self.model.edits))
+        self.save_button.setEnabled(bool(self.session.drive_values))
+
+    @Slot()
+    def read_all(self) -> None:
+        self.message.setText("Reading …")
+        self.session.read_all()
+
+    @Slot()
+    def write_changed(self) -> None:
+        writes = [(m, n, v) for (m, n), v in self.model.edits.items()]
+        self._write(writes)
+
+    @Slot()
+    def write_all(self) -> None:
+        writes = []
+        for row, item in enumerate(self.model.items):
+            value = self.model.shown_value(row)
+            if value is not None:
+                writes.append((item.mode, item.number, value))
+        if not writes:
+            self.message.setText("Nothing to write: read the drive first.")
+            return
+        self._write(writes)
+
+    def _write(self, writes) -> None:
+        if not writes:
+            return
+        if self.link.servo_on and any(m == "system" for m, _, _ in writes):
+            self.message.setText(
+                "Note: parameter (system) items cannot be written while the servo is on; "
+                "the drive will refuse them."
+            )
+        else:
+            self.message.setText(f"Writing {len(writes)} item(s) …")
+        self.session.write(writes)
+
+    @Slot(object)
+    def _writes_done(self, entries: list) -> None:
+        if not entries:
+            return
+        failed = [e for e in entries if not e.get("verified")]
+        restart = []
+        for e in entries:
+            if not e.get("verified"):
+                continue
+            try:
+                item = self.session.parameter_model.item(e["mode"], e["number"])
+            except KeyError:
+                continue
+            if item.restart_required and e.get("old") != e.get("new"):
+                restart.append(item)
+                self.model.restart_pending.add((item.mode, item.number))
+        ok = len(entries) - len(failed)
+        text = f"{ok} of {len(entries)} written and verified by read-back."
+        if failed:
+            text += " Failed: " + "; ".join(f"{e['mode']} {e['number']}: {e.get('error')}" for e in failed)
+        self.message.setText(text)
+        self.message.setStyleSheet("color: #b00020;" if failed else "")
+        if restart:
+            self.show_restart_needed(restart)
+        self.model._all_changed()
+
+    def show_restart_needed(self, items) -> None:
+        names = ", ".join(f"{i.name} ({MODE_WORDS.get(str(i.mode))} {i.number})" for i in items)
+        sim = bool(self.link.info and self.link.info.is_simulated)
+        how = (
+            "Power cycle the simulated drive with the button."
+            if sim
+            else "Switch the driver's control power off, wait until the display is dark, "
+            "and switch it on again."
+        )
+        self.restart_label.setText(f"<b>Takes effect after a power cycle:</b> {names}. {how}")
+        self.power_cycle_button.setVisible(sim)
+        self.restart_banner.setVisible(True)
+
+    @Slot()
+    def power_cycle(self) -> None:
+        if self.link.servo_on:
+            QMessageBox.information(self, "Servo is on", "Switch the servo off before the power cycle.")
+            return
+        self.link.send(Cmd.POWER_CYCLE)
+
+    @Slot(object)
+    def _on_result(self, result: CommandResult) -> None:
+        if result.cmd is Cmd.READ_PARAMETERS:
+            if result.ok:
+                errors = result.value["errors"]
+                n = len(result.value["values"])
+                text = f"Read {n} item(s) from the drive."
+                if errors:
+                    text += " Not read: " + "; ".join(f"{m} {k}: {e}" for (m, k), e in errors.items())
+                self.message.setText(text)
+                self.message.setStyleSheet("color: #b00020;" if errors else "")
+            else:
+                self.message.setText(f"Reading failed: {result.error}")
+            self._update_buttons()
+        elif result.cmd is Cmd.POWER_CYCLE:
+            if result.ok:
+                self.model.restart_pending.clear()
+                self.restart_banner.setVisible(False)
+                self.message.setText(
+                    "Power cycled: the restart-required items are now in effect. Reading back …"
+                )
+                self.session.read_all()
+            else:
+                self.message.setText(f"Power cycle failed: {result.error}")
+
+    @Slot(object)
+    def _on_connected(self, info: LinkInfo) -> None:
+        self.model.reload_items()
+        self.model.restart_pending.clear()
+        self.restart_banner.setVisible(False)
+        self.session.read_all()
+        self._update_buttons()
+
+    @Slot(str, QModelIndex)
+    def _refused(self, why: str, index: QModelIndex) -> None:
+        self.message.setText(why)
+        self.message.setStyleSheet("color: #b00020; font-weight: bold;")
+        rect = self.table.visualRect(index)
+        QToolTip.showText(
+            self.table.viewport().mapToGlobal(rect.bottomLeft() + QPoint(0, 2)), why, self.table
+        )
+
+    @Slot(int)
+    def _edits_changed(self, n: int) -> None:
+        if n:
+            self.message.setText(f"{n} item(s) edited, not written yet.")
+            self.message.setStyleSheet("")
+        self._update_buttons()
+
+    @Slot()
+    def _log_changed(self) -> None:
+        self.log_view.setPlainText("\n".join(r.line() for r in self.session.log.records))
+        self.log_view.verticalScrollBar().setValue(self.log_view.verticalScrollBar().maximum())
+
+    # -- files --------------------------------------------------------------------------------------
+    def _default_dir(self) -> str:
+        return str(QSettings().value("parameters/last_dir", str(Path.home())))
+
+    def save_file(self, path: str | None = None) -> Path | None:
+        if not self.session.drive_values:
+            self.message.setText("Nothing to save: read the drive first.")
+            return None
+        if path is None:
+            suggested = Path(self._default_dir()) / f"{self.session.actuator_code or 'parameters'}.toml"
+            path, _ = QFileDialog.getSaveFileName(
+                self, "Save parameter file", str(suggested), "Parameter files (*.toml);;All files (*)"
+            )
+            if not path:
+                return None
+        target = Path(path)
+        target.write_text(self.session.parameter_file_text(), encoding="utf-8")
+        QSettings().setValue("parameters/last_dir", str(target.parent))
+        self.message.setText(f"Saved the drive's values to {target}")
+        self.message.setStyleSheet("")
+        return target
+
+    def load_file(self, path: str | None = None, exec_dialog: bool = True):
+        """Reads a parameter file and shows the three-way comparison; nothing is applied until the
+        user confirms. Returns the dialog (tests drive it) or None when the file was refused."""
+        from fha_studio.gui.diff_dialog import ParameterDiffDialog
+        from fha_studio.logic.paramfile import ParameterFileError, read_parameter_file
+
+        if path is None:
+            path, _ = QFileDialog.getOpenFileName(
+                self, "Load parameter file", self._default_dir(), "Parameter files (*.toml);;All files (*)"
+            )
+            if not path:
+                return None
+        source = Path(path)
+        try:
+            text = source.read_text(encoding="utf-8")
+            loaded = read_parameter_file(text, self.session.parameter_model, name=source.name)
+        except (OSError, UnicodeDecodeError, ParameterFileError) as exc:
+            self.message.setText(f"File refused, nothing loaded: {exc}")
+            self.message.setStyleSheet("color: #b00020; font-weight: bold;")
+            if exec_dialog:
+                QMessageBox.warning(self, "Parameter file refused", f"Nothing was loaded.\n\n{exc}")
+            return None
+        QSettings().setValue("parameters/last_dir", str(source.parent))
+        dialog = ParameterDiffDialog(self.session, loaded, source.name, self)
+        dialog.accepted.connect(lambda: self.apply_choices(dialog.chosen_values()))
+        if exec_dialog:
+            dialog.open()
+        return dialog
+
+    def apply_choices(self, values: dict) -> None:
+        """Puts the chosen values as edits and writes the ones that differ from the drive."""
+        for (mode, number), wire in values.items():
+            self.model.set_edit(mode, number, wire)
+        if self.link.connected and self.model.edits:
+            self.write_changed()
+        elif self.model.edits:
+            self.message.setText(
+                f"{len(self.model.edits)} item(s) taken from the file; connect and write them."
+            )
+        else:
+            self.message.setText("The drive already holds the chosen values: nothing to write.")

@@ -1,0 +1,200 @@
+"""What one commissioning session knows, shared by the pages: the link, the actuator, the drive's
+parameter values, the automatic backup and the session log of every write."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import logging
+from pathlib import Path
+
+from PySide6.QtCore import QObject, QStandardPaths, Signal, Slot
+
+from fha_studio.gui.link import Cmd, CommandResult, LinkController, LinkInfo
+from fha_studio.logic.paramfile import dump_parameter_file
+from fha_studio.logic.session_log import SessionLog, WriteRecord
+
+log = logging.getLogger(__name__)
+
+DEFAULT_ACTUATOR = "FHA-25C-50-US250"
+DEFAULT_SIM_URL = f"sim://{DEFAULT_ACTUATOR}"
+
+
+def data_dir() -> Path:
+    """Where backups and session logs go (per user; tests redirect it through XDG_DATA_HOME)."""
+    base = QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation)
+    path = Path(base) if base else Path.home() / ".fha-studio"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def driver_family(driver_model: str) -> str:
+    """ "HA-655-2-200" -> "HA-655" (the parameter model to use); HA-655 when unknown."""
+    return "HA-675" if driver_model.upper().startswith("HA-675") else "HA-655"
+
+
+class Session(QObject):
+    """State of the session, on the GUI thread."""
+
+    sigActuatorChanged = Signal(str)
+    sigValuesChanged = Signal()  # the drive's parameter values (as last read or written) changed
+    sigLogChanged = Signal()  # a write went into the session log
+    sigWritesDone = Signal(object)  # list of write entries of one request
+    sigMessage = Signal(str)  # something for the status bar
+
+    def __init__(self, link: LinkController, parent: QObject | None = None):
+        super().__init__(parent)
+        self.link = link
+        self.actuator_code = ""
+        self.actuator_acknowledged = False
+        self.drive_values: dict[tuple[str, int], int] = {}
+        stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+        self.log = SessionLog(data_dir() / "sessions" / f"session-{stamp}.jsonl")
+        self.backup_path: Path | None = None
+        self._models: dict[str, object] = {}
+        self._pending_writes: list[tuple[str, int, int]] | None = None
+        self._backup_read_token: int | None = None
+        self._write_tokens: set[int] = set()
+        link.sigWrite.connect(self._on_write)
+        link.sigResult.connect(self._on_result)
+        link.sigConnected.connect(self._on_connected)
+
+    # -- the driver's parameter model ---------------------------------------------------------------
+    @property
+    def driver(self) -> str:
+        info = self.link.info
+        return driver_family(info.driver_model if info else "")
+
+    @property
+    def parameter_model(self):
+        """The parameter model of the connected driver family (HA-655 when unknown)."""
+        driver = self.driver
+        if driver not in self._models:
+            from fha_studio.hardware.parameters import load_parameter_model
+
+            self._models[driver] = load_parameter_model(driver)
+        return self._models[driver]
+
+    def editable_items(self) -> list:
+        """Writable tune and parameter (system) items, in panel order."""
+        return [i for i in self.parameter_model if i.mode in ("tune", "system") and i.writable]
+
+    def item(self, key: str):
+        return self.parameter_model.by_key(key)
+
+    # -- actuator -----------------------------------------------------------------------------------
+    def set_actuator(self, code: str, acknowledged: bool = False) -> None:
+        code = code.strip().upper()
+        changed = code != self.actuator_code
+        self.actuator_code = code
+        self.actuator_acknowledged = acknowledged
+        if changed:
+            self.sigActuatorChanged.emit(code)
+
+    # -- reading and writing ------------------------------------------------------------------------
+    def read_all(self) -> int:
+        return self.link.send(Cmd.READ_PARAMETERS, [(i.mode, i.number) for i in self.editable_items()])
+
+    def parameter_file_text(self, values: dict | None = None) -> str:
+        info = self.link.info
+        return dump_parameter_file(
+            self.parameter_model,
+            self.drive_values if values is None else values,
+            self.actuator_code,
+            info.driver_model if info else "",
+        )
+
+    def write(self, writes: list[tuple[str, int, int]]) -> None:
+        """Writes (mode, number, wire value) items, each verified by read-back. Before the first
+        write of a session the drive's values are read and saved as a backup."""
+        if not writes:
+            return
+        if self.backup_path is None:
+            self._pending_writes = list(writes)
+            self._backup_read_token = self.read_all()
+            self.sigMessage.emit("Reading the drive's parameters for the backup before the first write …")
+            return
+        self._write_tokens.add(self.link.send(Cmd.WRITE_PARAMETERS, list(writes)))
+
+    def write_backup(self) -> Path:
+        """Saves the drive's values as read before the first write of the session."""
+        stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+        directory = data_dir() / "backups"
+        directory.mkdir(parents=True, exist_ok=True)
+        base = f"backup-{self.actuator_code or 'unknown-actuator'}-{stamp}"
+        path = directory / f"{base}.toml"
+        n = 1
+        while path.exists():
+            n += 1
+            path = directory / f"{base}-{n}.toml"
+        path.write_text(self.parameter_file_text(), encoding="utf-8")
+        self.backup_path = path
+        self.sigMessage.emit(f"Backup of the drive's parameters saved before the first write: {path}")
+        return path
+
+    # -- from the link ------------------------------------------------------------------------------
+    @Slot(object)
+    def _on_connected(self, info: LinkInfo) -> None:
+        self.drive_values.clear()
+        self.backup_path = None  # a new drive: a new backup before its first write
+        self._pending_writes = None
+        if not self.actuator_code and info.adjusted_for:
+            self.set_actuator(info.adjusted_for)
+        self.sigValuesChanged.emit()
+
+    @Slot(object)
+    def _on_result(self, result: CommandResult) -> None:
+        if result.cmd is Cmd.READ_PARAMETERS and result.ok:
+            self.drive_values.update(result.value["values"])
+            self.sigValuesChanged.emit()
+        if result.token == self._backup_read_token:
+            self._backup_read_token = None
+            writes, self._pending_writes = self._pending_writes, None
+            if not result.ok or result.value["errors"]:
+                why = result.error or "; ".join(
+                    f"{m} {n}: {e}" for (m, n), e in result.value["errors"].items()
+                )
+                self.sigMessage.emit(f"Nothing written: the backup read failed ({why}).")
+                self.sigWritesDone.emit([])
+                return
+            try:
+                self.write_backup()
+            except OSError as exc:
+                self.sigMessage.emit(f"Nothing written: the backup could not be saved ({exc}).")
+                self.sigWritesDone.emit([])
+                return
+            if writes:
+                self._write_tokens.add(self.link.send(Cmd.WRITE_PARAMETERS, writes))
+        elif result.token in self._write_tokens:
+            self._write_tokens.discard(result.token)
+            self.sigWritesDone.emit(result.value if result.ok else [])
+
+    @Slot(object)
+    def _on_write(self, entry: dict) -> None:
+        key = (entry["mode"], entry["number"])
+        try:
+            item = self.parameter_model.item(*key)
+            item_key, name = item.key, item.name
+        except KeyError:
+            item_key, name = f"{key[0]}_{key[1]}", ""
+        record = WriteRecord(
+            time=SessionLog.now(),
+            mode=str(key[0]),
+            number=int(key[1]),
+            key=item_key,
+            name=name,
+            old=entry.get("old"),
+            new=int(entry["new"]),
+            read_back=entry.get("read_back"),
+            verified=bool(entry.get("verified")),
+            error=entry.get("error"),
+        )
+        try:
+            self.log.append(record)
+        except OSError as exc:  # the log file is a copy; the write itself happened
+            log.warning("session log file not written (the record is kept in memory): %s", exc)
+        if record.read_back is not None:
+            self.drive_values[key] = record.read_back
+        elif record.verified:
+            self.drive_values[key] = record.new
+        self.sigLogChanged.emit()
+        self.sigValuesChanged.emit()

@@ -1,0 +1,177 @@
+"""Small widgets shared by the pages: a lamp, the output-flange picture, the STOP button."""
+
+from __future__ import annotations
+
+import math
+
+from PySide6.QtCore import QPointF, QRectF, QSize, Qt
+from PySide6.QtGui import QBrush, QColor, QFont, QPainter, QPainterPath, QPen, QPolygonF
+from PySide6.QtWidgets import QLabel, QPushButton, QSizePolicy, QWidget
+
+GREEN = QColor("#2e9d3a")
+RED = QColor("#d12c2c")
+AMBER = QColor("#e0a000")
+GREY = QColor("#9a9a9a")
+
+
+class Lamp(QLabel):
+    """A round indicator with a caption: on (colour), off (grey) or unknown (outline)."""
+
+    def __init__(self, text: str, on_colour: QColor = GREEN, parent: QWidget | None = None):
+        super().__init__(parent)
+        self._caption = text
+        self._on_colour = on_colour
+        self._state: bool | None = None
+        self.setMinimumHeight(22)
+        self.setAccessibleName(text)
+        self.set_state(None)
+
+    @property
+    def state(self) -> bool | None:
+        return self._state
+
+    def set_state(self, state: bool | None, on_colour: QColor | None = None) -> None:
+        if on_colour is not None:
+            self._on_colour = on_colour
+        self._state = state
+        word = {True: "on", False: "off", None: "unknown"}[state]
+        self.setToolTip(f"{self._caption}: {word}")
+        self.setAccessibleDescription(word)
+        self.update()
+
+    def sizeHint(self) -> QSize:
+        width = self.fontMetrics().horizontalAdvance(self._caption) + 30
+        return QSize(width, max(22, self.fontMetrics().height() + 6))
+
+    def paintEvent(self, event) -> None:
+        painter = QPainter(self)
+        painter.setRenderHint(QPainter.RenderHint.Antialiasing)
+        d = min(14, self.height() - 6)
+        y = (self.height() - d) / 2
+        if self._state is None:
+            painter.setPen(QPen(GREY, 1.5, Qt.PenStyle.DashLine))
+            painter.setBrush(Qt.BrushStyle.NoBrush)
+        else:
+            painter.setPen(QPen(QColor("#444"), 1))
+            painter.setBrush(QBrush(self._on_colour if self._state else QColor("#d8d8d8")))
+        painter.drawEllipse(QRectF(3, y, d, d))
+        painter.setPen(self.palette().windowText().color())
+        painter.drawText(
+            QRectF(d + 9, 0, self.width() - d - 9, self.height()),
+            Qt.AlignmentFlag.AlignVCenter | Qt.AlignmentFlag.AlignLeft,
+            self._caption,
+        )
+        painter.end()
+
+
+class StopButton(QPushButton):
+    """The big red STOP. Always enabled: stopping is never refused."""
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__("STOP  (Esc)", parent)
+        self.setObjectName("stopButton")
+        self.setToolTip("Stop the axis now: decelerate and hold (the servo stays on). Key: Esc")
+        self.setMinimumSize(150, 40)
+        font = self.font()
+        font.setBold(True)
+        font.setPointSizeF(font.pointSizeF() * 1.3)
+        self.setFont(font)
+        self.setStyleSheet(
+            "QPushButton#stopButton { background: #c62828; color: white; border: 2px solid #7f0000;"
+            " border-radius: 6px; padding: 4px 14px; }"
+            "QPushButton#stopButton:pressed { background: #8e0000; }"
+            "QPushButton#stopButton:focus { border: 3px solid #ffd54f; }"
+        )
+
+
+class FlangeWidget(QWidget):
+    """The actuator seen from the output flange, with an arrow for the FWD command.
+
+    `clockwise=True` draws FWD as a clockwise arrow (rotary direction 0, the manual's default,
+    section 1-10); False draws it counter-clockwise (rotary direction 1).
+    """
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__(parent)
+        self._clockwise: bool | None = True
+        self._angle_deg = 0.0  # the output position, to show a mark turning with it
+        self.setMinimumSize(220, 220)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        self.setAccessibleName("Output flange, seen from the front")
+
+    def set_clockwise(self, clockwise: bool | None) -> None:
+        self._clockwise = clockwise
+        word = {True: "clockwise", False: "counter-clockwise", None: "unknown"}[clockwise]
+        self.setAccessibleDescription(f"FWD turns the output flange {word}")
+        self.update()
+
+    def set_angle_deg(self, angle_deg: float) -> None:
+        self._angle_deg = angle_deg
+        self.update()
+
+    def sizeHint(self) -> QSize:
+        return QSize(300, 300)
+
+    def paintEvent(self, event) -> None:
+        p = QPainter(self)
+        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+        side = min(self.width(), self.height())
+        p.translate(self.width() / 2, self.height() / 2)
+        scale = side / 300.0
+        p.scale(scale, scale)
+        # housing (square body seen from the front), flange, hollow shaft, bolt circle
+        p.setPen(QPen(QColor("#555"), 2))
+        p.setBrush(QColor("#cfd4da"))
+        p.drawRoundedRect(QRectF(-100, -100, 200, 200), 14, 14)
+        p.setBrush(QColor("#aab3bd"))
+        p.drawEllipse(QPointF(0, 0), 78, 78)
+        p.setBrush(self.palette().window())
+        p.drawEllipse(QPointF(0, 0), 26, 26)  # the hollow shaft
+        p.setBrush(QColor("#6b7680"))
+        for k in range(8):
+            a = math.radians(k * 45 + self._angle_deg)
+            p.drawEllipse(QPointF(52 * math.cos(a), 52 * math.sin(a)), 5, 5)
+        # a mark on the flange that turns with the output
+        a = math.radians(self._angle_deg - 90)
+        p.setPen(QPen(QColor("#1565c0"), 5, Qt.PenStyle.SolidLine, Qt.PenCapStyle.RoundCap))
+        p.drawLine(QPointF(32 * math.cos(a), 32 * math.sin(a)), QPointF(72 * math.cos(a), 72 * math.sin(a)))
+        if self._clockwise is not None:
+            self._draw_arrow(p, self._clockwise)
+        p.setPen(self.palette().windowText().color())
+        font = QFont(self.font())
+        font.setPointSizeF(font.pointSizeF() * 1.05)
+        p.setFont(font)
+        p.drawText(QRectF(-150, 120, 300, 28), Qt.AlignmentFlag.AlignCenter, "seen from the output flange")
+        p.end()
+
+    def _draw_arrow(self, p: QPainter, clockwise: bool) -> None:
+        colour = QColor("#2e7d32")
+        r = 118
+        # Qt angles: degrees counter-clockwise from 3 o'clock, y down on screen
+        start, span = (150, -120) if clockwise else (30, 120)
+        rect = QRectF(-r, -r, 2 * r, 2 * r)
+        path = QPainterPath()
+        path.arcMoveTo(rect, start)
+        path.arcTo(rect, start, span)
+        p.setPen(QPen(colour, 9, Qt.PenStyle.SolidLine, Qt.PenCapStyle.FlatCap))
+        p.setBrush(Qt.BrushStyle.NoBrush)
+        p.drawPath(path)
+        end_deg = start + span
+        end = QPointF(r * math.cos(math.radians(end_deg)), -r * math.sin(math.radians(end_deg)))
+        # tangent direction of travel at the end of the arc (screen coordinates)
+        sign = -1 if clockwise else 1
+        tangent_deg = end_deg + 90 * sign
+        t = QPointF(math.cos(math.radians(tangent_deg)), -math.sin(math.radians(tangent_deg)))
+        n = QPointF(-t.y(), t.x())
+        tip = end + t * 22
+        head = QPolygonF([tip, end + n * 14 - t * 4, end - n * 14 - t * 4])
+        p.setPen(Qt.PenStyle.NoPen)
+        p.setBrush(colour)
+        p.drawPolygon(head)
+        p.setPen(colour)
+        font = QFont(self.font())
+        font.setBold(True)
+        font.setPointSizeF(font.pointSizeF() * 1.4)
+        p.setFont(font)
+        label = "FWD = CW" if clockwise else "FWD = CCW"
+        p.drawText(QRectF(-150, -150, 300, 30), Qt.AlignmentFlag.AlignCenter, label)

@@ -1,0 +1,65 @@
+"""The session log: every parameter write of a commissioning session (time, item, old value, new
+value, verified or not), kept as JSON lines so the commissioning report can print it later."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+
+@dataclass(frozen=True)
+class WriteRecord:
+    """One write. Values are wire integers; `verified` means the read-back equals `new`."""
+
+    time: str  # ISO 8601, local time with offset
+    mode: str
+    number: int
+    key: str
+    name: str
+    old: int | None
+    new: int
+    read_back: int | None
+    verified: bool
+    error: str | None = None
+
+    def line(self) -> str:
+        """One line for people: ``17:05:02 system 8 rotary_direction: 0 -> 1 verified``."""
+        old = "?" if self.old is None else str(self.old)
+        outcome = "verified" if self.verified else f"NOT verified ({self.error or 'read-back differs'})"
+        clock = self.time[11:19] if len(self.time) >= 19 else self.time
+        return f"{clock} {self.mode} {self.number} {self.key}: {old} -> {self.new} {outcome}"
+
+
+class SessionLog:
+    """Appends WriteRecords to a JSON-lines file (when given one) and keeps them in memory."""
+
+    def __init__(self, path: Path | None = None):
+        self.path = path
+        self.records: list[WriteRecord] = []
+
+    def append(self, record: WriteRecord) -> None:
+        self.records.append(record)
+        if self.path is not None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with self.path.open("a", encoding="utf-8") as fh:
+                fh.write(json.dumps(asdict(record)) + "\n")
+
+    @staticmethod
+    def now() -> str:
+        return _dt.datetime.now().astimezone().isoformat(timespec="seconds")
+
+    @classmethod
+    def read(cls, path: Path) -> SessionLog:
+        """A log written before (one JSON object per line)."""
+        log = cls(None)
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            if not line.strip():
+                continue
+            try:
+                log.records.append(WriteRecord(**json.loads(line)))
+            except (ValueError, TypeError) as exc:
+                raise ValueError(f"{path}: line {number}: not a session-log record ({exc})") from None
+        log.path = path
+        return log

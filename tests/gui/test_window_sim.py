@@ -1,0 +1,178 @@
+"""The real window against the embedded simulated drive (sim://, unpaced), through the real
+DriveClient and the CN3 codec: what a newcomer does in the README, driven by the tests."""
+
+from __future__ import annotations
+
+import pytest
+from PySide6.QtCore import Qt
+
+from fha_studio.gui.link import Cmd
+
+SIM_URL = "sim://FHA-25C-50-US250?paced=0"
+
+
+def sim_drive(window):
+    """The SimDrive behind the link (for injecting what a technician would do at the machine)."""
+    return window.link._worker._client._transport.inner.sim_drive
+
+
+@pytest.fixture
+def window(make_window, qtbot):
+    w = make_window(connect=SIM_URL)
+    qtbot.waitUntil(lambda: len(w.session.drive_values) >= 14, timeout=10000)
+    return w
+
+
+def servo_on(window, qtbot):
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO, timeout=5000):
+        window.jog_page.servo_on_button.click()
+    qtbot.waitUntil(lambda: window.link.servo_on, timeout=3000)
+
+
+def test_connects_identifies_and_status_bar_says_what_the_drive_supports(window, qtbot):
+    info = window.link.info
+    assert info.driver_model == "HA-655-2-200"
+    assert info.adjusted_for == "FHA-25C-50-US250"
+    assert info.is_simulated
+    assert "HA-655-2-200" in window.caps_label.text() and "traces" in window.caps_label.text()
+    assert window.connection_page.adjusted_label.text() == "FHA-25C-50-US250"
+    qtbot.waitUntil(lambda: window.alarm_lamp.state is False, timeout=3000)
+    assert window.servo_lamp.state is False
+
+
+def test_rotary_direction_written_power_cycled_and_read_back(window, qtbot):
+    page = window.show_page("direction")
+    assert page.drive_value() == 0
+    page.ccw_radio.setChecked(True)
+    with qtbot.waitSignal(window.session.sigWritesDone, timeout=5000) as done:
+        page.write_button.click()
+    assert done.args[0][-1]["verified"]
+    assert "power cycle" in page.status_label.text()
+    assert page.power_cycle_button.isVisible()
+    with qtbot.waitSignal(
+        window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.POWER_CYCLE, timeout=8000
+    ):
+        page.power_cycle_button.click()
+    # read back from the drive after the power cycle: the value is still there (EEPROM)
+    window.session.drive_values.clear()
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.READ_PARAMETERS):
+        window.session.read_all()
+    assert page.drive_value() == 1
+    assert "counter-clockwise" in page.drive_label.text()
+    log = window.session.log.records
+    assert log[-1].key == "rotary_direction" and log[-1].old == 0 and log[-1].new == 1 and log[-1].verified
+
+
+def test_refuses_a_bad_value_at_the_field(window, qtbot):
+    model = window.parameters_page.model
+    index = model.index(model.row_of("speed_loop_gain"), 3)
+    with qtbot.waitSignal(model.sigRefused):
+        assert not model.setData(index, "5000")
+    assert "1 … 500" in window.parameters_page.message.text()
+    assert not model.edits
+
+
+def test_save_load_and_diff_a_parameter_file(window, qtbot, tmp_path):
+    page = window.show_page("parameters")
+    saved = page.save_file(str(tmp_path / "axis.toml"))
+    text = saved.read_text()
+    assert 'actuator = "FHA-25C-50-US250"' in text and 'driver_model = "HA-655-2-200"' in text
+    edited = text.replace("in_position_range", "in_position_range_x", 0)
+    edited = edited.replace("speed_loop_gain", "speed_loop_gain", 1)
+    lines = [
+        ln if not ln.startswith("in_position_range ") else "in_position_range = 33"
+        for ln in edited.splitlines()
+    ]
+    lines.append("notch_filter = 2")  # [system] is last: an item this driver does not have
+    (tmp_path / "edited.toml").write_text("\n".join(lines) + "\n")
+    dialog = page.load_file(str(tmp_path / "edited.toml"), exec_dialog=False)
+    assert dialog.differing >= 1
+    assert "notch_filter" in dialog.not_mapped_view.toPlainText()
+    assert dialog.chosen_values() == {("tune", 4): 33}
+    dialog.set_choice("in_position_range", "default")
+    assert dialog.chosen_values() == {}  # the default (10) is what the drive holds
+    dialog.set_choice("in_position_range", "file")
+    with qtbot.waitSignal(window.session.sigWritesDone, timeout=5000):
+        dialog.accept()
+    assert window.session.drive_values[("tune", 4)] == 33
+    assert window.session.backup_path.exists()
+    dialog.deleteLater()
+
+
+def test_corrupt_file_is_refused_with_the_line(window, tmp_path):
+    page = window.parameters_page
+    bad = tmp_path / "bad.toml"
+    bad.write_text('format = "fha-parameters/1"\n[tune]\nspeed_loop_gain = fast\n')
+    assert page.load_file(str(bad), exec_dialog=False) is None
+    assert "line 3" in page.message.text() and "nothing loaded" in page.message.text()
+
+
+def test_jog_moves_the_axis_and_release_stops_it(window, qtbot):
+    page = window.show_page("jog")
+    servo_on(window, qtbot)
+    start = window.link.status.position_pulse
+    page.speed_spin.setValue(10.0)
+    qtbot.mousePress(page.fwd_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: (window.link.status.speed_rpm or 0) > 5.0, timeout=5000)
+    qtbot.mouseRelease(page.fwd_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: abs(window.link.status.speed_rpm or 0) < 0.01, timeout=5000)
+    assert window.link.status.position_pulse > start  # FWD counts up
+    assert window.link.servo_on  # release stops and holds; the servo stays on
+
+
+def test_stop_key_stops_a_move(window, qtbot):
+    page = window.show_page("jog")
+    servo_on(window, qtbot)
+    page.angle_spin.setValue(900.0)
+    page.move_speed_spin.setValue(20.0)
+    page.move_button.click()
+    qtbot.waitUntil(lambda: (window.link.status.speed_rpm or 0) > 1.0, timeout=5000)
+    qtbot.keyClick(window, Qt.Key.Key_Escape)
+    qtbot.waitUntil(lambda: abs(window.link.status.speed_rpm or 0) < 0.01, timeout=5000)
+    assert not window.link.status.moving
+
+
+def test_inputs_shown_live(window, qtbot):
+    page = window.show_page("jog")
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SET_INPUTS):
+        window.link.send(Cmd.SET_INPUTS, {"fwd_inhibit": True})
+    from fha_studio.gui.link import IO_FWD_INHIBIT
+
+    qtbot.waitUntil(lambda: page.signal_lamps[IO_FWD_INHIBIT].state is True, timeout=3000)
+
+
+def test_alarm_raised_highlighted_acknowledged_cleared(window, qtbot):
+    page = window.show_page("alarms")
+    sim_drive(window).raise_alarm(20)
+    qtbot.waitUntil(lambda: page.current_code == 20, timeout=3000)
+    qtbot.waitUntil(window.alarm_banner.isVisible, timeout=1000)
+    assert "Overload" in page.code_label.text()
+    assert "Remedy" in page.cause_label.text()
+    qtbot.waitUntil(lambda: page.history_table.rowCount() >= 1, timeout=3000)
+    assert page.history_table.item(0, 0).text() == "20"
+    page.ack_button.click()
+    qtbot.waitUntil(lambda: not window.alarm_banner.isVisible(), timeout=1000)
+    assert window.alarm_lamp.state is True  # acknowledged is not cleared
+    page.clear_button.click()
+    qtbot.waitUntil(lambda: page.current_code == 0, timeout=3000)
+    assert window.alarm_lamp.state is False
+
+
+def test_alarm_that_needs_a_power_cycle_says_so(window, qtbot):
+    page = window.show_page("alarms")
+    sim_drive(window).raise_alarm(50)
+    qtbot.waitUntil(lambda: page.current_code == 50, timeout=3000)
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.CLEAR_ALARM):
+        page.clear_button.click()
+    assert "power cycle" in page.result_label.text()
+    assert page.current_code == 50
+
+
+def test_lost_link_shown_within_a_second(window, qtbot):
+    window.link._worker._client._transport.inner.close()  # the cable is pulled
+    with qtbot.waitSignal(window.link.sigDisconnected, timeout=1000) as lost:
+        pass
+    assert lost.args[1] is True
+    assert "LINK LOST" in window.caps_label.text()
+    assert window.link_lamp.state is True  # red lamp: lost, not merely disconnected
+    assert not window.jog_page.fwd_button.isEnabled()
