@@ -305,6 +305,18 @@ def _brake(code: ModelCode, index: int) -> Brake:
     )
 
 
+def _checked(mc: ModelCode) -> ModelCode:
+    """A ModelCode built by hand passes the parser's rules too (frame, ratio, encoder, options)."""
+    parsed = parse_model_code(mc.code)
+    if parsed != mc:
+        raise ModelCodeError(
+            mc,
+            f"encoder {mc.encoder!r} does not match encoder code {mc.encoder_code!r}",
+            "build it with parse_model_code",
+        )
+    return parsed
+
+
 def _cables(mc: ModelCode) -> CableLeads:
     c = cable_tables()
     if mc.encoder == "incremental":
@@ -327,7 +339,7 @@ def compatible_drivers(code: str | ModelCode, supply_voltage: int | None = None)
     ``supply_voltage`` (V) defaults to the code's (100 with option A, else 200); giving the other one
     is a mistake (the winding differs) and raises ValueError. Empty list: no driver exists.
     """
-    mc = code if isinstance(code, ModelCode) else parse_model_code(code)
+    mc = _checked(code) if isinstance(code, ModelCode) else parse_model_code(code)
     if supply_voltage is None:
         supply_voltage = mc.supply_voltage
     if supply_voltage not in (100, 200):
@@ -419,7 +431,7 @@ def get_actuator(code: str | ModelCode) -> Actuator:
     Raises :class:`ModelCodeError` (a ValueError) for a code the manual does not allow.
     """
     if isinstance(code, ModelCode):
-        return _get_actuator(code)
+        return _get_actuator(_checked(code))
     if not isinstance(code, str):
         raise ModelCodeError(
             code, f"expected a string or ModelCode, got {type(code).__name__}", "e.g. FHA-25C-50-US250"

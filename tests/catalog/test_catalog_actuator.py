@@ -176,3 +176,15 @@ def test_get_actuator_rejects_a_non_code():
         get_actuator(25)  # type: ignore[arg-type]
     with pytest.raises(ModelCodeError, match="option A"):
         get_actuator("FHA-40C-50-S248-A")
+
+
+def test_a_hand_built_model_code_is_checked_like_a_parsed_one():
+    from fha_studio.catalog import ModelCode
+
+    assert get_actuator(ModelCode("25C", 50, "incremental", "US250")) is get_actuator("FHA-25C-50-US250")
+    with pytest.raises(ModelCodeError, match="frame '99C'"):
+        get_actuator(ModelCode("99C", 50, "incremental", "US250"))
+    with pytest.raises(ModelCodeError, match="option A"):
+        compatible_drivers(ModelCode("40C", 50, "incremental", "US250", frozenset({"A"})))
+    with pytest.raises(ModelCodeError, match="does not match"):
+        get_actuator(ModelCode("25C", 50, "absolute", "US250"))
