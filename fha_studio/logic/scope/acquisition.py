@@ -253,6 +253,11 @@ class PollingAcquisition:
 
     # -- state ----------------------------------------------------------------------------------
     @property
+    def answering(self) -> bool:
+        """True when the last read got a sample (False after a refusal, a timeout, a lost link)."""
+        return self._live
+
+    @property
     def rate_hz(self) -> float:
         """Samples per second over the recent samples (host time)."""
         r = self._recent

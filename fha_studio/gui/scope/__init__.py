@@ -1,0 +1,1 @@
+"""The scope: live view, trace capture, built-in tests, recording (Qt, pyqtgraph)."""

@@ -1,0 +1,299 @@
+"""The scope's acquisition driver: a QObject that lives in the link thread and uses its client.
+
+It never opens a port. It is moved to the thread of the link worker that owns the
+``DriveClient`` and is given that client (``ScopeController.attach``), so every exchange runs
+in the link thread, interleaved with the worker's own commands (a STOP waits at most one
+polling pass, ``PASS_BUDGET_S``). Requests come in through one queued signal carrying a
+``ScopeRequest``; results go out through signals. Samples go into the acquisition's
+``RingBuffer``, which the GUI timer drains (friture's pattern).
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+import time
+from dataclasses import dataclass
+from typing import Any
+
+from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
+
+from fha_studio.hardware.errors import LinkError
+from fha_studio.logic.scope.acquisition import (
+    LiveMode,
+    LiveStatus,
+    MoveTest,
+    PollingAcquisition,
+    ScopeConfig,
+    TraceAcquisition,
+    TraceSettings,
+    load_scope_config,
+)
+
+log = logging.getLogger(__name__)
+
+#: Longest time one polling pass holds the link thread [s].
+PASS_BUDGET_S = 0.03
+#: How often the state goes out to the GUI [s].
+STATUS_INTERVAL_S = 0.2
+#: Period of the trace-status and move-test steps [ms].
+STEP_INTERVAL_MS = 20
+
+
+class ScopeCmd(enum.Enum):
+    SET_CLIENT = enum.auto()  # args: client or None, ratio (int | None)
+    START = enum.auto()  # args: channels (sequence of ScopeChannel), capacity
+    STOP = enum.auto()
+    ARM_TRACE = enum.auto()  # args: TraceSettings
+    CANCEL_TRACE = enum.auto()
+    RUN_TEST = enum.auto()  # args: MoveTest keyword arguments (dict)
+    ABORT_TEST = enum.auto()
+    CALL = enum.auto()  # args: callable(client) -> value, for a one-off exchange (e.g. jog in tests)
+    SHUTDOWN = enum.auto()  # args: quit_thread (bool): stop everything, delete the driver in its thread
+
+
+@dataclass(frozen=True)
+class ScopeRequest:
+    cmd: ScopeCmd
+    args: tuple = ()
+
+
+@dataclass(frozen=True)
+class LiveStarted:
+    """A live acquisition started: its channels (what each ring column is) and the ring."""
+
+    mode: LiveMode
+    channels: tuple
+    ring: Any  # RingBuffer: rows [t_s, values...]
+    t0: float  # host clock (time.monotonic) of t_s = 0
+
+
+class ScopeDriver(QObject):
+    """Runs polling, trace capture and the move test in the thread it lives in."""
+
+    sigLiveStarted = Signal(object)  # LiveStarted
+    sigStatus = Signal(object)  # LiveStatus
+    sigTraceState = Signal(str)  # a sentence: armed, capturing n, reading out ..., done
+    sigTraceDone = Signal(object)  # TraceResult
+    sigTestDone = Signal(object)  # MoveTestResult
+    sigError = Signal(str)
+    sigCallDone = Signal(object)  # the value of a CALL
+
+    def __init__(self, config: ScopeConfig | None = None):
+        super().__init__()
+        self.config = config or load_scope_config()
+        self._client = None
+        self._ratio: int | None = None
+        self._poller: PollingAcquisition | None = None
+        self._trace: TraceAcquisition | None = None
+        self._test: MoveTest | None = None
+        self._poll_timer: QTimer | None = None
+        self._step_timer: QTimer | None = None
+        self._last_status = 0.0
+        self._paused_for_test = False
+
+    def _timers(self) -> None:
+        # Timers are made on first use, so they belong to the thread the driver lives in.
+        if self._poll_timer is None:
+            self._poll_timer = QTimer(self)
+            self._poll_timer.setSingleShot(True)
+            self._poll_timer.timeout.connect(self._poll)
+            self._step_timer = QTimer(self)
+            self._step_timer.setInterval(STEP_INTERVAL_MS)
+            self._step_timer.timeout.connect(self._step)
+
+    @Slot(object)
+    def handle(self, request: ScopeRequest) -> None:
+        self._timers()
+        try:
+            getattr(self, f"_do_{request.cmd.name.lower()}")(*request.args)
+        except (LinkError, ValueError) as exc:
+            self.sigError.emit(str(exc))
+
+    # -- commands -------------------------------------------------------------------------------
+    def _do_set_client(self, client, ratio: int | None = None) -> None:
+        self._do_stop()
+        self._abort_test("the drive was disconnected")
+        self._trace = None
+        self._client, self._ratio = client, ratio
+
+    def _do_start(self, channels, capacity: int = 65536) -> None:
+        if self._client is None:
+            raise ValueError("not connected to a drive")
+        self._poller = PollingAcquisition(self._client, channels, ratio=self._ratio, capacity=capacity,
+                                          config=self.config)
+        p = self._poller
+        self.sigLiveStarted.emit(LiveStarted(p.mode, tuple(p.channels), p.ring, p.t0))
+        self._last_status = 0.0
+        self._poll_timer.start(0)
+
+    def _do_stop(self) -> None:
+        if self._poll_timer is not None:
+            self._poll_timer.stop()
+        self._poller = None
+
+    def _do_arm_trace(self, settings: TraceSettings) -> None:
+        if self._client is None:
+            raise ValueError("not connected to a drive")
+        trace = TraceAcquisition(self._client, self.config)
+        ok, why = trace.available()
+        if not ok:
+            raise ValueError(why)
+        trace.configure(settings)
+        trace.arm()
+        self._trace = trace
+        self.sigTraceState.emit(f"armed: {settings.trigger.describe()}, {settings.samples} samples at "
+                                f"{trace.actual_rate_hz(settings):g} Hz")
+        self._step_timer.start()
+
+    def _do_cancel_trace(self) -> None:
+        if self._trace is not None:
+            self._trace = None
+            self.sigTraceState.emit("cancelled")
+
+    def _do_run_test(self, kwargs: dict) -> None:
+        if self._client is None:
+            raise ValueError("not connected to a drive")
+        if self._test is not None:
+            raise ValueError("a test is already running")
+        self._test = MoveTest(self._client, config=self.config, **kwargs)
+        if not self._test.use_trace and self._poller is not None:
+            self._paused_for_test = True  # the test polls itself: give it the whole line
+            self._poll_timer.stop()
+        self._step_timer.start()
+
+    def _do_abort_test(self) -> None:
+        self._abort_test("stopped by the user")
+
+    def _do_shutdown(self, quit_thread: bool) -> None:
+        self._do_set_client(None)
+        for timer in (self._poll_timer, self._step_timer):
+            timer.stop()
+        self.deleteLater()  # timers die in the thread they belong to
+        if quit_thread:
+            self.thread().quit()
+
+    def _do_call(self, function) -> None:
+        self.sigCallDone.emit(function(self._client))
+
+    def _abort_test(self, why: str) -> None:
+        test = self._test
+        if test is not None:
+            test.abort(why)
+            self._test_finished()
+
+    # -- timers ---------------------------------------------------------------------------------
+    @Slot()
+    def _poll(self) -> None:
+        p = self._poller
+        if p is None:
+            return
+        p.step(PASS_BUDGET_S)
+        now = time.monotonic()
+        status = p.status(now)
+        if now - self._last_status >= STATUS_INTERVAL_S:
+            self._last_status = now
+            self.sigStatus.emit(status)
+        if p.mode is LiveMode.NONE or p.lost:
+            self.sigStatus.emit(status)
+            return
+        # back to back while samples come; a slow retry while the drive refuses or is silent
+        self._poll_timer.start(0 if p.answering else int(p.retry_interval_s * 1000))
+
+    @Slot()
+    def _step(self) -> None:
+        try:
+            if self._test is not None and self._test.step():
+                self._test_finished()
+            if self._trace is not None:
+                self._step_trace()
+        except LinkError as exc:
+            self._trace = None
+            self.sigError.emit(str(exc))
+        if self._test is None and self._trace is None:
+            self._step_timer.stop()
+
+    def _step_trace(self) -> None:
+        trace = self._trace
+        status = trace.status()
+        if status.state.name == "DONE":
+            settings = trace.settings
+            chars = status.count * (len(settings.items()) * 8) + status.count
+            self.sigTraceState.emit(f"reading out {status.count} samples (about "
+                                    f"{chars / 1920:.0f} s at 19200 bit/s)")
+            result = trace.read()
+            self._trace = None
+            self.sigTraceDone.emit(result)
+            self.sigTraceState.emit(f"done: {len(result.t_s)} samples at {result.sample_rate_hz:g} Hz")
+        elif status.state.name == "ARMED" and trace.ready_for_trigger(status):
+            self.sigTraceState.emit(f"armed, waiting for the trigger ({status.count} pre-trigger samples)")
+        else:
+            self.sigTraceState.emit(f"{status.state.name.lower()}: {status.count} samples")
+
+    def _test_finished(self) -> None:
+        test, self._test = self._test, None
+        if self._paused_for_test and self._poller is not None:
+            self._poll_timer.start(0)
+        self._paused_for_test = False
+        self.sigTestDone.emit(test.result)
+
+
+class ScopeController(QObject):
+    """The GUI-thread face of the driver: sends requests, re-emits results; never blocks.
+
+    ``thread``: the link worker's QThread (the driver is moved there). Without one, the
+    controller starts its own (tests, or before the main window provides its link thread).
+    """
+
+    sigRequest = Signal(object)
+    # the driver's signals, re-emitted in the GUI thread
+    sigLiveStarted = Signal(object)
+    sigStatus = Signal(object)
+    sigTraceState = Signal(str)
+    sigTraceDone = Signal(object)
+    sigTestDone = Signal(object)
+    sigError = Signal(str)
+    sigCallDone = Signal(object)
+
+    def __init__(self, thread: QThread | None = None, parent: QObject | None = None,
+                 config: ScopeConfig | None = None):
+        super().__init__(parent)
+        self._own_thread = thread is None
+        if thread is None:
+            thread = QThread()
+            thread.setObjectName("fha-scope")
+            thread.start()
+        self.thread = thread
+        self.driver = ScopeDriver(config)
+        self.driver.moveToThread(thread)
+        self.sigRequest.connect(self.driver.handle)
+        for name in ("sigLiveStarted", "sigStatus", "sigTraceState", "sigTraceDone", "sigTestDone",
+                     "sigError", "sigCallDone"):
+            getattr(self.driver, name).connect(getattr(self, name))  # queued: into this thread
+        self.connected = False
+        self._shut = False
+
+    def send(self, cmd: ScopeCmd, *args) -> None:
+        self.sigRequest.emit(ScopeRequest(cmd, tuple(args)))
+
+    def attach(self, client, ratio: int | None = None) -> None:
+        """Hand the driver a client (it uses it only in its thread); None detaches."""
+        self.connected = client is not None
+        self.send(ScopeCmd.SET_CLIENT, client, ratio)
+
+    def shutdown(self, timeout_ms: int = 3000) -> bool:
+        """Stop acquiring and delete the driver in its thread; end the thread when it is the
+        controller's own (True when it ended in time)."""
+        if self._shut:
+            return True
+        self._shut = True
+        self.send(ScopeCmd.SHUTDOWN, self._own_thread)
+        if not self._own_thread:
+            return True
+        ended = self.thread.wait(timeout_ms)
+        if not ended:
+            log.error("the scope thread did not end within %d ms", timeout_ms)
+        return ended
+
+
+__all__ = ["LiveStarted", "LiveStatus", "ScopeCmd", "ScopeController", "ScopeDriver", "ScopeRequest"]

@@ -1,0 +1,198 @@
+"""The scope against the embedded simulated drive (and a drive of the manual's command set).
+
+The driver runs in its own thread with the client, as it would in the link worker's thread;
+the test talks to the drive only through the driver (CALL), never from the GUI thread.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QTimer
+
+from fha_studio.gui.scope.driver import ScopeCmd, ScopeController
+from fha_studio.gui.scope.view import ScopeContext, ScopeView
+from fha_studio.hardware import protocol as p
+from fha_studio.hardware.client import DriveClient
+from fha_studio.hardware.scripted import ScriptedDrive
+from fha_studio.hardware.transport import pipe_pair
+from fha_studio.recording import read_recording
+
+ACTUATOR = "FHA-25C-50-US250"
+SIM_URL = f"sim://{ACTUATOR}?paced=0"
+
+
+@pytest.fixture
+def scope(qtbot):
+    """Factory: scope(client) -> ScopeView with its driver in a thread, holding ``client``."""
+    made = []
+
+    def make(client, ratio=50):
+        controller = ScopeController()
+        view = ScopeView(controller, ScopeContext(ACTUATOR, load_inertia_kgm2=0.5))
+        qtbot.addWidget(view)
+        view.resize(1200, 700)
+        controller.attach(client, ratio)
+        made.append((view, controller, client))
+        return view
+
+    yield make
+    for view, controller, client in made:
+        view.shutdown()
+        assert controller.shutdown()
+        client.close()
+
+
+@pytest.fixture
+def sim_client():
+    return DriveClient.open(SIM_URL)
+
+
+def call(view, function):
+    """Run ``function(client)`` in the driver's thread (as the link worker would)."""
+    view.controller.send(ScopeCmd.CALL, function)
+
+
+def latest(view, key):
+    live = view._live
+    j = [c.key for c in live.channels].index(key) + 1
+    return live.ring.window()[:, j]
+
+
+def test_jog_shows_position_speed_and_current_live(qtbot, scope, sim_client):
+    view = scope(sim_client)
+    view.start_live()
+    qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=5000)
+    call(view, lambda c: c.servo(True))
+    jog = QTimer()
+    jog.timeout.connect(lambda: call(view, lambda c: c.jog(20.0)))  # the button held: JOG every 40 ms
+    jog.start(40)
+    try:
+        qtbot.waitUntil(lambda: abs(latest(view, "output_speed")[-1] - 20.0) < 0.5, timeout=10000)
+    finally:
+        jog.stop()
+    position = latest(view, "feedback_position")
+    assert position[-1] - position[0] > 1.0  # deg: the axis turned and the view saw it
+    assert np.abs(latest(view, "motor_current")).max() > 0.01  # A: accelerating takes current
+    assert view.frames > 0 and view._status.rate_hz > 50  # unpaced sim: far above the real line
+    view.set_paused(True)
+    assert view.indicator_text().startswith("PAUSED")
+    view.set_paused(False)
+    call(view, lambda c: c.servo(False))
+
+
+def test_a_stuck_link_is_not_shown_as_live(qtbot, scope, sim_client):
+    view = scope(sim_client)
+    view.start_live()
+    qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=5000)
+    release = threading.Event()
+    call(view, lambda c: release.wait(5))  # the link thread is busy: no samples come
+    try:
+        qtbot.waitUntil(lambda: view.indicator_text().startswith("NOT LIVE: no new sample"), timeout=3000)
+    finally:
+        release.set()
+    qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=5000)
+
+
+def test_triggered_move_is_captured_saved_and_loads_everywhere(qtbot, scope, sim_client, tmp_path):
+    view = scope(sim_client)
+    call(view, lambda c: (c.servo(True), c.set_move_speed(30.0)))
+    view.trigger_kind.setCurrentIndex(view.trigger_kind.findData(p.TriggerKind.IO_BIT_RISES))
+    view.trigger_channel.setCurrentIndex(view.trigger_channel.findData("moving"))
+    view.trace_samples.setValue(1024)
+    view.trace_rate.setValue(1000)
+    view.trace_pre.setValue(10)
+    view.arm_trace()
+    qtbot.waitUntil(lambda: "waiting for the trigger" in view.trace_state.text(), timeout=5000)
+    with qtbot.waitSignal(view.sigTraceDone, timeout=15000) as done:
+        call(view, lambda c: c.move_by(20.0))
+    result = done.args[0]
+    assert len(result.t_s) == 1024 and result.t_s[102] == 0.0
+    cmd = result.column("command_position")
+    assert np.ptp(cmd[:100]) == 0  # still before the trigger
+    assert cmd[-1] - cmd[0] == pytest.approx(20.0, abs=0.01)
+    assert view.indicator_text().startswith("NOT LIVE: showing the trace")
+    path = view.save_capture(tmp_path / "move.csv")
+    recording = read_recording(path)
+    assert recording.metadata.sample_rate_hz == pytest.approx(1000)
+    assert recording.pos_deg[-1] - recording.pos_deg[0] == pytest.approx(20.0, abs=0.05)
+    assert recording.cmd_pos_deg is not None and recording.vel_rpm is not None
+    plain = np.genfromtxt(path, delimiter=",", comments="#")[1:]
+    assert plain.shape == (1024, 5) and not np.isnan(plain).any()
+    # the spectrum of a captured channel, and the file opened back into the scope
+    view.spectrum_channel.setCurrentIndex(view.spectrum_channel.findData("output_speed"))
+    view.compute_spectrum()
+    assert view.spectrum_label.text().startswith("Peaks:")
+    view.open_recording(path)
+    assert view.indicator_text() == "NOT LIVE: showing the recording move.csv"
+    view.set_cursors(0.0, 0.5)
+    readout = view.cursor_readout()
+    assert readout["command_position"][0] == pytest.approx(0.5)
+    assert view.export_png(tmp_path / "view.png").stat().st_size > 1000
+    csv = np.loadtxt(view.export_csv(tmp_path / "view.csv"), delimiter=",", skiprows=1)
+    assert csv.shape == (1024, 5)
+
+
+def test_move_and_step_tests_report_overshoot_settling_and_in_position(qtbot, scope, sim_client):
+    view = scope(sim_client)
+    call(view, lambda c: c.servo(True))
+    view.test_angle.setValue(30.0)
+    view.test_speed.setValue(30.0)
+    with qtbot.waitSignal(view.sigTestDone, timeout=20000) as done:
+        view.run_test("move")
+    result = done.args[0]
+    assert result.error == "", result.error
+    m = result.metrics
+    assert m.target - m.start == pytest.approx(30.0, abs=0.01)
+    assert m.in_position_time_s is not None and m.settling_time_s is not None
+    assert abs(m.final_error) < 0.05
+    assert result.capture.method == "trace"
+    assert view.result_labels["overshoot"].text().endswith("deg)")
+    with qtbot.waitSignal(view.sigTestDone, timeout=20000) as done:
+        view.run_test("step")
+    step = done.args[0]
+    assert step.error == "", step.error
+    assert step.metrics.rise_time_s is not None and step.metrics.rise_time_s < 0.2
+    # the JOG acceleration is back where it was
+    with qtbot.waitSignal(view.controller.sigCallDone, timeout=5000) as got:
+        call(view, lambda c: c.read_parameter("test", 1))
+    assert got.args[0] == 200
+
+
+def test_recording_while_plotting_loads_in_numpy(qtbot, scope, sim_client, tmp_path):
+    view = scope(sim_client)
+    view.start_live()
+    qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=5000)
+    view.start_recording(tmp_path / "live.csv")
+    start = view._recorder.rows_written
+    qtbot.waitUntil(lambda: view._recorder.rows_written > start + 50, timeout=5000)
+    path = view.stop_recording()
+    recording = read_recording(path)
+    assert len(recording) > 50 and np.all(np.diff(recording.t_s) > 0)
+    assert set(recording.channels) >= {"t", "pos", "current", "cmd_pos", "vel"}
+
+
+def test_a_documented_only_drive_says_not_live_and_why(qtbot, scope):
+    servo = {"on": False}
+
+    def documented(request):
+        if isinstance(request, p.Request) and request.command is p.Command.DGR:
+            return p.Reply((), p.Status.SERVO_ON) if servo["on"] else p.Reply(("204800",))
+        return p.Reply((), p.Status.REJECTED)
+
+    host, end = pipe_pair("documented")
+    drive = ScriptedDrive(end, documented)
+    try:
+        client = DriveClient.attach(host)
+        view = scope(client)
+        view.start_live()
+        qtbot.waitUntil(lambda: "only the documented commands" in view.indicator_text(), timeout=5000)
+        assert view._live.channels[0].key == "feedback_position"
+        qtbot.waitUntil(lambda: len(view._live.ring) > 0, timeout=5000)
+        assert view._live.ring.window(1)[0, 1] == pytest.approx(204800 * 360 / (8192 * 50))
+        servo["on"] = True
+        qtbot.waitUntil(lambda: view.indicator_text().startswith("NOT LIVE: the servo is on"), timeout=5000)
+    finally:
+        drive.close()
