@@ -95,6 +95,7 @@ class MainWindow(QMainWindow):
         from fha_studio.gui.pages.jog import JogPage
         from fha_studio.gui.pages.parameters import ParametersPage
         from fha_studio.gui.pages.sizing import SizingPage
+        from fha_studio.gui.scope.page import ScopePage
 
         self.tabs = QTabWidget(self)
         self.tabs.setObjectName("pages")
@@ -105,6 +106,7 @@ class MainWindow(QMainWindow):
         self.alarms_page = AlarmsPage(self.session, self)
         self.jog_page = JogPage(self.session, self)
         self.sizing_page = SizingPage(self.session, self)
+        self.scope_page = ScopePage(self.session, self)
         for page, title in (
             (self.connection_page, "C&onnection"),
             (self.parameters_page, "&Parameters"),
@@ -112,6 +114,7 @@ class MainWindow(QMainWindow):
             (self.alarms_page, "&Alarms"),
             (self.jog_page, "&Jog && test run"),
             (self.sizing_page, "Si&zing"),
+            (self.scope_page, "&Scope"),
         ):
             self.tabs.addTab(page, title)
         self.setCentralWidget(self.tabs)
@@ -156,7 +159,7 @@ class MainWindow(QMainWindow):
     def _pages(self) -> list[QWidget]:
         return [self.tabs.widget(i) for i in range(self.tabs.count())]
 
-    PAGE_NAMES = ("connection", "parameters", "direction", "alarms", "jog", "sizing")
+    PAGE_NAMES = ("connection", "parameters", "direction", "alarms", "jog", "sizing", "scope")
 
     def show_page(self, name: str) -> QWidget:
         """Shows the page called `name` (one of PAGE_NAMES); ValueError naming them otherwise."""

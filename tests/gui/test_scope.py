@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QTimer
 
+from fha_studio.gui.link import Cmd
 from fha_studio.gui.scope.driver import ScopeCmd, ScopeController
 from fha_studio.gui.scope.view import ScopeContext, ScopeView
 from fha_studio.hardware import protocol as p
@@ -196,3 +197,24 @@ def test_a_documented_only_drive_says_not_live_and_why(qtbot, scope):
         qtbot.waitUntil(lambda: view.indicator_text().startswith("NOT LIVE: the servo is on"), timeout=5000)
     finally:
         drive.close()
+
+
+def test_the_main_window_scope_runs_in_the_link_thread(make_window, qtbot):
+    window = make_window(connect=SIM_URL)
+    page = window.show_page("scope")
+    view = page.view
+    assert page.controller.driver.thread() is window.link._thread  # no port of its own
+    qtbot.waitUntil(lambda: view.controller.connected, timeout=5000)
+    qtbot.waitUntil(lambda: view.indicator_text() == "NOT LIVE: not started", timeout=5000)
+    view.start_live()
+    qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=10000)
+    window.link.send(Cmd.SERVO, True)
+    qtbot.waitUntil(lambda: window.link.servo_on, timeout=5000)
+    window.link.jog_press(20.0)
+    try:
+        qtbot.waitUntil(lambda: abs(latest(view, "output_speed")[-1] - 20.0) < 0.5, timeout=10000)
+    finally:
+        window.link.jog_release()
+    with qtbot.waitSignal(window.link.sigDisconnected, timeout=5000):
+        window.link.close_link()
+    qtbot.waitUntil(lambda: view.indicator_text().startswith("NOT LIVE"), timeout=3000)

@@ -373,6 +373,19 @@ class ScopeView(QWidget):
             self.result_labels[key] = label
             res.addRow(text, label)
         lay.addWidget(box)
+        files = QGroupBox("Recordings")
+        ff = QFormLayout(files)
+        self.actuator_label = QLabel(self.context.actuator)
+        ff.addRow("Actuator", self.actuator_label)
+        self.load_inertia = QDoubleSpinBox()
+        self.load_inertia.setObjectName("scopeLoadInertia")
+        self.load_inertia.setRange(0.0, 1e4)
+        self.load_inertia.setDecimals(4)
+        self.load_inertia.setValue(self.context.load_inertia_kgm2)
+        self.load_inertia.setSuffix(" kg m²")
+        self.load_inertia.setToolTip("The load inertia written into recordings (the model check needs it)")
+        ff.addRow("Load inertia", self.load_inertia)
+        lay.addWidget(files)
         self.test_message = QLabel("The servo must be on. The axis moves.")
         self.test_message.setWordWrap(True)
         lay.addWidget(self.test_message)
@@ -711,8 +724,26 @@ class ScopeView(QWidget):
 
     def _metadata(self, sample_rate_hz: float | None, extra: dict | None = None) -> RecordingMetadata:
         c = self.context
-        return RecordingMetadata(c.actuator, c.load_inertia_kgm2, c.supply_voltage, sample_rate_hz,
+        return RecordingMetadata(c.actuator, self.load_inertia.value(), c.supply_voltage, sample_rate_hz,
                                  extra=dict(extra or {}))
+
+    def set_context(self, context: ScopeContext) -> None:
+        """Another actuator (resolution, ratio, speed range): channels are rebuilt, live stops."""
+        if context == self.context:
+            return
+        self.stop_live()
+        self.context = context
+        self._actuator = context.actuator_data()
+        self.all_channels = scope_channels(load_parameter_model(context.driver),
+                                           self._actuator.output_resolution_ppr)
+        self.actuator_label.setText(context.actuator)
+        self.test_speed.setMaximum(float(self._actuator.max_speed_rpm))
+        self._static = None
+        self._fill_channel_table()
+
+    @property
+    def ratio(self) -> int:
+        return int(self._actuator.ratio)
 
     def _record_clicked(self, checked: bool) -> None:
         if checked:

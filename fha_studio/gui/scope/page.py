@@ -1,0 +1,63 @@
+"""The scope as a page of the main window, wired to the link worker's thread.
+
+The driver is moved to the link thread and gets the worker's ``DriveClient`` through the
+worker's CALL command (the function runs in the link thread, where the driver lives), so
+the scope never opens a port and every exchange is serialised with the worker's own.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+from PySide6.QtWidgets import QVBoxLayout, QWidget
+
+from fha_studio.catalog import get_actuator
+from fha_studio.gui.link import Cmd, LinkInfo
+
+from .driver import ScopeCmd, ScopeController, ScopeRequest
+from .view import ScopeContext, ScopeView
+
+DEFAULT_ACTUATOR = "FHA-25C-50-US250"
+
+
+def _attach_in_link_thread(controller: ScopeController, ratio: int | None, client) -> None:
+    """Runs in the link thread (worker CALL): give the driver the worker's client."""
+    controller.driver.handle(ScopeRequest(ScopeCmd.SET_CLIENT, (client, ratio)))
+
+
+class ScopePage(QWidget):
+    """Page "Scope": live view, trace, built-in tests, recording."""
+
+    def __init__(self, session, main_window=None):
+        super().__init__(main_window)
+        self.session = session
+        link = session.link
+        self.controller = ScopeController(thread=link._thread, parent=self)
+        self.view = ScopeView(self.controller, self._context())
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.view)
+        link.sigConnected.connect(self._on_connected)
+        link.sigDisconnected.connect(self._on_disconnected)
+        session.sigActuatorChanged.connect(lambda _code: self.view.set_context(self._context()))
+
+    def _context(self) -> ScopeContext:
+        code = self.session.actuator_code
+        try:
+            get_actuator(code)
+        except (ValueError, KeyError):
+            code = DEFAULT_ACTUATOR
+        return ScopeContext(code, load_inertia_kgm2=0.0, driver=self.session.driver)
+
+    def _on_connected(self, info: LinkInfo) -> None:
+        self.view.set_context(self._context())
+        self.controller.connected = True
+        self.session.link.send(Cmd.CALL, partial(_attach_in_link_thread, self.controller, self.view.ratio))
+
+    def _on_disconnected(self, reason: str, lost: bool) -> None:
+        self.view.stop_live()
+        self.controller.attach(None)
+
+    def shutdown(self) -> None:
+        self.view.shutdown()
+        self.controller.shutdown()
