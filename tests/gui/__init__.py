@@ -1,0 +1,1 @@
+"""GUI tests (a package, so that tests/gui/procedures and tests/procedures do not collide)."""
