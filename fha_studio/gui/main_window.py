@@ -95,6 +95,7 @@ class MainWindow(QMainWindow):
         from fha_studio.gui.pages.jog import JogPage
         from fha_studio.gui.pages.parameters import ParametersPage
         from fha_studio.gui.pages.sizing import SizingPage
+        from fha_studio.gui.procedures.page import ProceduresPage
         from fha_studio.gui.scope.page import ScopePage
 
         self.tabs = QTabWidget(self)
@@ -107,6 +108,7 @@ class MainWindow(QMainWindow):
         self.jog_page = JogPage(self.session, self)
         self.sizing_page = SizingPage(self.session, self)
         self.scope_page = ScopePage(self.session, self)
+        self.procedures_page = ProceduresPage(self.session, self)
         for page, title in (
             (self.connection_page, "C&onnection"),
             (self.parameters_page, "&Parameters"),
@@ -115,6 +117,7 @@ class MainWindow(QMainWindow):
             (self.jog_page, "&Jog && test run"),
             (self.sizing_page, "Si&zing"),
             (self.scope_page, "&Scope"),
+            (self.procedures_page, "Proced&ures"),
         ):
             self.tabs.addTab(page, title)
         self.setCentralWidget(self.tabs)
@@ -159,7 +162,7 @@ class MainWindow(QMainWindow):
     def _pages(self) -> list[QWidget]:
         return [self.tabs.widget(i) for i in range(self.tabs.count())]
 
-    PAGE_NAMES = ("connection", "parameters", "direction", "alarms", "jog", "sizing", "scope")
+    PAGE_NAMES = ("connection", "parameters", "direction", "alarms", "jog", "sizing", "scope", "procedures")
 
     def show_page(self, name: str) -> QWidget:
         """Shows the page called `name` (one of PAGE_NAMES); ValueError naming them otherwise."""

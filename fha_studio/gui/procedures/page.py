@@ -1,0 +1,573 @@
+"""The Procedures page: the manual's procedures step by step (a stepper in the main window).
+
+It drives :class:`fha_studio.logic.procedures.ProcedureRun`: one step at a time, each answer
+recorded with the operator's name and the time in the session file (saved at every answer, so a
+procedure can be left and resumed after a restart). Live checks run in the link thread through
+the worker's CALL command; the page never touches the port. A failed check stops the procedure
+with the manual's warning until someone says it was put right.
+"""
+
+from __future__ import annotations
+
+import logging
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QObject, Signal, Slot
+from PySide6.QtWidgets import (
+    QComboBox,
+    QFileDialog,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QListWidget,
+    QListWidgetItem,
+    QMessageBox,
+    QPushButton,
+    QSplitter,
+    QStackedWidget,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from fha_studio.gui.link import CommandResult
+from fha_studio.gui.procedures.dog_panel import SensorDogPanel
+from fha_studio.logic.procedures import (
+    Observation,
+    Procedure,
+    ProcedureError,
+    ProcedureRun,
+    Session,
+    SessionError,
+    Step,
+    StepInputError,
+    load_all,
+)
+from fha_studio.logic.procedures.report import SignError, build_report, sign
+
+log = logging.getLogger(__name__)
+
+_STATUS_WORDS = {
+    "not_started": "not started",
+    "running": "in progress",
+    "paused": "paused",
+    "stopped": "STOPPED",
+    "completed": "done ✓",
+}
+
+
+class _SampleRelay(QObject):
+    """Carries samples of a live check's move from the link thread to the GUI thread."""
+
+    sigSample = Signal(float, int)
+
+
+def _live_check_in_link_thread(step: Step, context, angles: dict, relay: _SampleRelay, client) -> Observation:
+    """Runs in the link thread (worker CALL)."""
+    from fha_studio.logic.procedures.live import LiveEnv, run_live_check
+
+    env = LiveEnv(context, angles, on_sample=lambda angle, io: relay.sigSample.emit(angle, io.raw))
+    return run_live_check(client, step, env)
+
+
+class ProceduresPage(QWidget):
+    """Receiving inspection, installation, wiring, sensor set, rotary direction; the report."""
+
+    sigStepChanged = Signal()  # the current step or the run's state changed
+    sigLiveDone = Signal(object)  # Observation of a live check (after it was recorded or shown)
+
+    def __init__(self, gui_session, main_window=None):
+        super().__init__()
+        self.gui_session = gui_session
+        self.link = gui_session.link
+        self.main_window = main_window
+        self.session: Session | None = None
+        self.context: dict | None = None
+        self.procedures: list[Procedure] = []
+        self.run: ProcedureRun | None = None
+        self._live_token: int | None = None
+        self._relay = _SampleRelay(self)
+        self._build()
+        self.link.sigResult.connect(self._on_result)
+        self.link.sigConnected.connect(lambda _info: self._refresh())
+        self._relay.sigSample.connect(
+            lambda angle, bits: self.dog_panel.observe(angle, bits) if self.dog_panel.wizard else None
+        )
+        self._refresh()
+
+    # -- layout -------------------------------------------------------------------------------
+    def _build(self) -> None:
+        layout = QVBoxLayout(self)
+        top = QHBoxLayout()
+        self.actuator_edit = QLineEdit()
+        self.actuator_edit.setPlaceholderText("model code on the order, e.g. FHA-25C-50-US250-B-L")
+        self.operator_edit = QLineEdit()
+        self.operator_edit.setPlaceholderText("your name (every check records it)")
+        self.new_button = QPushButton("&New session…")
+        self.open_button = QPushButton("&Open session…")
+        self.new_button.clicked.connect(self._new_clicked)
+        self.open_button.clicked.connect(self._open_clicked)
+        for w in (
+            QLabel("Actuator:"),
+            self.actuator_edit,
+            QLabel("Operator:"),
+            self.operator_edit,
+            self.new_button,
+            self.open_button,
+        ):
+            top.addWidget(w)
+        layout.addLayout(top)
+        self.session_label = QLabel("No session: start one with New session (actuator and your name first).")
+        self.session_label.setWordWrap(True)
+        layout.addWidget(self.session_label)
+
+        split = QSplitter(self)
+        layout.addWidget(split, 1)
+        self.procedure_list = QListWidget()
+        self.procedure_list.setObjectName("procedure_list")
+        self.procedure_list.currentItemChanged.connect(self._procedure_chosen)
+        split.addWidget(self.procedure_list)
+
+        middle = QWidget()
+        m = QVBoxLayout(middle)
+        self.step_box = QGroupBox("Step")
+        s = QVBoxLayout(self.step_box)
+        self.section_label = QLabel("")
+        self.section_label.setObjectName("step_section")
+        self.step_text = QLabel("")
+        self.step_text.setObjectName("step_text")
+        self.step_text.setWordWrap(True)
+        self.progress_label = QLabel("")
+        s.addWidget(self.section_label)
+        s.addWidget(self.step_text, 1)
+        s.addWidget(self.progress_label)
+
+        self.inputs = QStackedWidget()
+        # confirm
+        confirm = QWidget()
+        c = QHBoxLayout(confirm)
+        self.yes_button = QPushButton("&Yes, done / checked")
+        self.no_button = QPushButton("N&o")
+        self.yes_button.clicked.connect(lambda: self.answer(True))
+        self.no_button.clicked.connect(lambda: self.answer(False))
+        c.addWidget(self.yes_button)
+        c.addWidget(self.no_button)
+        # value (measure, text)
+        value = QWidget()
+        v = QHBoxLayout(value)
+        self.value_edit = QLineEdit()
+        self.value_edit.setObjectName("value_edit")
+        self.unit_label = QLabel("")
+        self.value_button = QPushButton("&Record")
+        self.value_button.clicked.connect(lambda: self.answer(self.value_edit.text()))
+        self.value_edit.returnPressed.connect(self.value_button.click)
+        v.addWidget(self.value_edit, 1)
+        v.addWidget(self.unit_label)
+        v.addWidget(self.value_button)
+        # choose
+        choose = QWidget()
+        ch = QHBoxLayout(choose)
+        self.choice_combo = QComboBox()
+        self.choice_button = QPushButton("&Record")
+        self.choice_button.clicked.connect(lambda: self.answer(self.choice_combo.currentText()))
+        ch.addWidget(self.choice_combo, 1)
+        ch.addWidget(self.choice_button)
+        # live
+        live = QWidget()
+        lv = QVBoxLayout(live)
+        row = QHBoxLayout()
+        self.live_button = QPushButton("&Check on the drive")
+        self.live_button.clicked.connect(self.run_live_check)
+        self.by_hand_button = QPushButton("Checked &by hand: OK")
+        self.by_hand_button.clicked.connect(lambda: self.answer(True))
+        self.by_hand_button.setVisible(False)
+        row.addWidget(self.live_button)
+        row.addWidget(self.by_hand_button)
+        lv.addLayout(row)
+        self.live_label = QLabel("")
+        self.live_label.setObjectName("live_result")
+        self.live_label.setWordWrap(True)
+        lv.addWidget(self.live_label)
+        # sensor angle
+        self.dog_panel = SensorDogPanel(self.link)
+        self.dog_panel.sigRecord.connect(self.answer)
+        self.dog_panel.sigMessage.connect(self._message)
+        self._pages = {}
+        for name, widget in (
+            ("confirm", confirm),
+            ("value", value),
+            ("choose", choose),
+            ("live", live),
+            ("sensor_angle", self.dog_panel),
+            ("none", QWidget()),
+        ):
+            self._pages[name] = self.inputs.addWidget(widget)
+        s.addWidget(self.inputs)
+        m.addWidget(self.step_box, 1)
+
+        self.stop_box = QGroupBox("Stopped")
+        st = QVBoxLayout(self.stop_box)
+        self.warning_label = QLabel("")
+        self.warning_label.setObjectName("stop_warning")
+        self.warning_label.setWordWrap(True)
+        self.warning_label.setStyleSheet("color: #b00000; font-weight: bold;")
+        self.note_edit = QLineEdit()
+        self.note_edit.setPlaceholderText("what was put right (goes into the report)")
+        self.retry_button = QPushButton("Put right — check a&gain")
+        self.retry_button.clicked.connect(lambda: self.retry(self.note_edit.text()))
+        st.addWidget(self.warning_label)
+        st.addWidget(self.note_edit)
+        st.addWidget(self.retry_button)
+        m.addWidget(self.stop_box)
+
+        buttons = QHBoxLayout()
+        self.pause_button = QPushButton("&Pause (saved)")
+        self.pause_button.clicked.connect(self.pause)
+        self.report_button = QPushButton("Commissioning &report…")
+        self.report_button.clicked.connect(self._report_clicked)
+        self.sign_button = QPushButton("&Sign the report")
+        self.sign_button.clicked.connect(self._sign_clicked)
+        self.message_label = QLabel("")
+        self.message_label.setObjectName("procedure_message")
+        self.message_label.setWordWrap(True)
+        buttons.addWidget(self.pause_button)
+        buttons.addWidget(self.report_button)
+        buttons.addWidget(self.sign_button)
+        m.addLayout(buttons)
+        m.addWidget(self.message_label)
+        split.addWidget(middle)
+
+        self.history = QTableWidget(0, 5)
+        self.history.setObjectName("history")
+        self.history.setHorizontalHeaderLabels(["Step", "Value", "Result", "Who", "When (UTC)"])
+        split.addWidget(self.history)
+        split.setSizes([220, 520, 360])
+
+    # -- sessions -----------------------------------------------------------------------------
+    def _identity(self) -> dict[str, str]:
+        info = self.link.info
+        if info is None:
+            return {}
+        return {
+            "model": info.driver_model,
+            "adjusted_for": info.adjusted_for,
+            "version": info.firmware,
+            "url": info.url,
+        }
+
+    def new_session(self, path: str | Path, actuator_code: str = "", operator: str = "") -> None:
+        """Start a commissioning session for ``actuator_code`` (the ordered model) saved at ``path``."""
+        from fha_studio.logic.procedures.context import build_context
+
+        code = (actuator_code or self.actuator_edit.text() or self.gui_session.actuator_code).strip().upper()
+        operator = (operator or self.operator_edit.text()).strip()
+        if not code:
+            raise ProcedureError("the actuator model code (from the order) is needed to start a session")
+        context = build_context(code)  # ModelCodeError (a ValueError) says what is wrong with the code
+        session = Session(actuator_code=code, operator=operator, driver=self._identity())
+        session.save(path)
+        self._use(session, context)
+
+    def open_session(self, path: str | Path) -> None:
+        """Open a saved session (resume where it was left)."""
+        from fha_studio.logic.procedures.context import build_context
+
+        session = Session.load(path)
+        self._use(session, build_context(session.actuator_code))
+
+    def _use(self, session: Session, context: dict) -> None:
+        self.session, self.context = session, context
+        self.procedures = load_all(context)
+        self.run = None
+        self.actuator_edit.setText(session.actuator_code)
+        if session.operator and not self.operator_edit.text():
+            self.operator_edit.setText(session.operator)
+        self.procedure_list.blockSignals(True)
+        self.procedure_list.clear()
+        for procedure in self.procedures:
+            item = QListWidgetItem()
+            item.setData(256, procedure.id)
+            self.procedure_list.addItem(item)
+        self.procedure_list.blockSignals(False)
+        first = next((i for i, p in enumerate(self.procedures) if p.applies and not self._done(p)), 0)
+        self.procedure_list.setCurrentRow(first)
+        self._refresh()
+
+    def _done(self, procedure: Procedure) -> bool:
+        state = self.session.runs.get(procedure.id) if self.session else None
+        return bool(state and state.status == "completed")
+
+    # -- walking ------------------------------------------------------------------------------
+    def select_procedure(self, procedure_id: str) -> None:
+        for row, procedure in enumerate(self.procedures):
+            if procedure.id == procedure_id:
+                self.procedure_list.setCurrentRow(row)
+                return
+        raise ValueError(f"no procedure '{procedure_id}'")
+
+    @Slot(object, object)
+    def _procedure_chosen(self, current, _previous) -> None:
+        self.dog_panel.release()
+        self.run = None
+        if current is None or self.session is None:
+            self._refresh()
+            return
+        procedure = next(p for p in self.procedures if p.id == current.data(256))
+        if procedure.applies:
+            try:
+                self.run = ProcedureRun(self.session, procedure)
+            except ProcedureError as exc:
+                self._message(str(exc))
+        self._refresh()
+
+    @property
+    def who(self) -> str:
+        return self.operator_edit.text().strip() or (self.session.operator if self.session else "")
+
+    def current_step(self) -> Step | None:
+        return self.run.current() if self.run else None
+
+    def answer(self, value: Any) -> bool:
+        """Answer the current step (what the buttons do). False with a message when not accepted."""
+        if self.run is None:
+            return False
+        step = self.run.current()
+        if step is None:
+            return False
+        if step.kind == "live" and not isinstance(value, bool | Observation):
+            return False
+        try:
+            record = self.run.submit(value, who=self.who)
+        except StepInputError as exc:
+            self._message(str(exc))
+            return False
+        self._message("" if record.passed else "The check failed: the procedure stops here.")
+        self.value_edit.clear()
+        self.live_label.setText("")
+        self._refresh()
+        return True
+
+    def run_live_check(self) -> None:
+        """Ask the drive (in the link thread); the answer is recorded when it comes."""
+        from fha_studio.gui.link import Cmd
+
+        step = self.current_step()
+        if step is None or step.kind != "live" or self._live_token is not None:
+            return
+        if not self.link.connected:
+            self._message("No drive connected: connect first, or confirm by hand.")
+            self.by_hand_button.setVisible(True)
+            return
+        self.live_label.setText("Asking the drive …")
+        self.live_button.setEnabled(False)
+        function = partial(
+            _live_check_in_link_thread, step, self.context, dict(self.session.sensor_angles_deg), self._relay
+        )
+        self._live_token = self.link.send(Cmd.CALL, function)
+
+    @Slot(object)
+    def _on_result(self, result: CommandResult) -> None:
+        if result.token != self._live_token:
+            return
+        self._live_token = None
+        self.live_button.setEnabled(True)
+        if not result.ok:
+            self.live_label.setText(f"The check could not run: {result.error}")
+            self.sigLiveDone.emit(None)
+            return
+        observation: Observation = result.value
+        self.live_label.setText(observation.detail)
+        if observation.available:
+            self.answer(observation)
+            self.live_label.setText(observation.detail)
+        else:
+            self.by_hand_button.setVisible(True)
+        self.sigLiveDone.emit(observation)
+
+    def retry(self, note: str = "") -> None:
+        if self.run is not None and self.run.stopped:
+            self.run.retry(self.who, note)
+            self.note_edit.clear()
+            self._message("")
+            self._refresh()
+
+    def pause(self) -> None:
+        if self.run is not None:
+            self.run.pause()
+            self._message("Paused and saved: open the session again to go on.")
+            self._refresh()
+
+    # -- report -------------------------------------------------------------------------------
+    def _collect_for_report(self) -> None:
+        """Bring the drive's identity and parameter values into the session before a report."""
+        if self.session is None:
+            return
+        identity = self._identity()
+        if identity:
+            self.session.driver = identity
+        values = getattr(self.gui_session, "drive_values", {}) or {}
+        if values:
+            model = self.gui_session.parameter_model
+            by_key = {}
+            for (mode, number), wire in values.items():
+                try:
+                    by_key[model.item(mode, number).key] = int(wire)
+                except (KeyError, ValueError, TypeError):
+                    continue
+            path = self.session.path.with_suffix(".params") if self.session.path else None
+            if path is not None:
+                try:
+                    path.write_text(self.gui_session.parameter_file_text(), encoding="utf-8")
+                except Exception as exc:  # the report still goes out, saying the file is missing
+                    log.warning("parameter file not written: %s", exc)
+                    path = None
+            self.session.parameters = {"file": str(path or ""), "values": by_key}
+        if self.session.path:
+            self.session.save()
+
+    def add_plot(self, title: str, png_path: str | Path) -> None:
+        if self.session is not None:
+            self.session.add_plot(title, png_path)
+            self.session.save()
+
+    def write_report(self, html_path: str | Path, pdf_path: str | Path | None = None):
+        """Write the commissioning report (HTML, and PDF when a path is given)."""
+        from fha_studio.gui.procedures.report_pdf import write_report
+
+        if self.session is None:
+            raise SessionError("no session: nothing to report")
+        self._collect_for_report()
+        return write_report(build_report(self.session, self.context), html_path, pdf_path)
+
+    def sign(self, who: str = "") -> bool:
+        if self.session is None:
+            return False
+        self._collect_for_report()
+        try:
+            sign(self.session, who or self.who, self.context)
+        except SignError as exc:
+            self._message(str(exc))
+            return False
+        self._message(f"Signed by {self.session.signature['who']}.")
+        self._refresh()
+        return True
+
+    # -- dialogs ------------------------------------------------------------------------------
+    def _new_clicked(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(
+            self, "New commissioning session", "axis1.fha-session.json", "FHA sessions (*.json)"
+        )
+        if path:
+            try:
+                self.new_session(path)
+            except (ValueError, OSError) as exc:
+                QMessageBox.warning(self, "New session", str(exc))
+
+    def _open_clicked(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Open commissioning session", "", "FHA sessions (*.json)")
+        if path:
+            try:
+                self.open_session(path)
+            except (ValueError, OSError) as exc:
+                QMessageBox.warning(self, "Open session", str(exc))
+
+    def _report_clicked(self) -> None:
+        if self.session is None:
+            return
+        base = self.session.path.with_suffix("") if self.session.path else Path("report")
+        path, _ = QFileDialog.getSaveFileName(
+            self, "Commissioning report (PDF)", str(base) + ".pdf", "PDF (*.pdf)"
+        )
+        if path:
+            html, pdf = self.write_report(Path(path).with_suffix(".html"), path)
+            self._message(f"Report written: {pdf} and {html}")
+
+    def _sign_clicked(self) -> None:
+        self.sign()
+
+    # -- view ---------------------------------------------------------------------------------
+    def _message(self, text: str) -> None:
+        self.message_label.setText(text)
+
+    def _refresh(self) -> None:
+        has_session = self.session is not None
+        for row, procedure in enumerate(self.procedures):
+            item = self.procedure_list.item(row)
+            if not procedure.applies:
+                status = "does not apply"
+            else:
+                state = self.session.runs.get(procedure.id)
+                status = _STATUS_WORDS.get(state.status if state else "not_started", "")
+            item.setText(f"{procedure.title} ({procedure.section}) — {status}")
+        if has_session:
+            signed = self.session.signature
+            self.session_label.setText(
+                f"Session {self.session.path} — {self.session.actuator_code}"
+                + (f" — signed by {signed['who']}" if signed else "")
+            )
+        step = self.current_step()
+        run = self.run
+        self.stop_box.setVisible(bool(run and run.stopped))
+        if run and run.stopped:
+            self.warning_label.setText(run.state.stop_warning)
+        self.pause_button.setEnabled(bool(run))
+        self.report_button.setEnabled(has_session)
+        self.sign_button.setEnabled(has_session)
+        self.by_hand_button.setVisible(False)
+        self.step_box.setEnabled(True)
+        if run is None:
+            selected = self.procedure_list.currentItem()
+            if has_session and selected is not None:
+                self.step_text.setText("This procedure does not apply to this actuator.")
+            self.section_label.setText("")
+            self.progress_label.setText("")
+            self.inputs.setCurrentIndex(self._pages["none"])
+        elif step is None:
+            self.section_label.setText(run.procedure.section)
+            self.step_text.setText(f"{run.procedure.title}: done.")
+            self.progress_label.setText("")
+            self.inputs.setCurrentIndex(self._pages["none"])
+        else:
+            done, total = run.progress()
+            self.section_label.setText(f"§ {step.section}")
+            self.step_text.setText(step.text)
+            self.progress_label.setText(f"Step {done + 1} of {total}")
+            self._show_input(step)
+            self.step_box.setEnabled(not run.stopped)
+        self._fill_history()
+        self.sigStepChanged.emit()
+
+    def _show_input(self, step: Step) -> None:
+        if step.kind == "confirm":
+            self.inputs.setCurrentIndex(self._pages["confirm"])
+        elif step.kind in ("measure", "text"):
+            self.unit_label.setText(step.unit)
+            self.value_edit.setPlaceholderText(step.expected_text() if step.kind == "measure" else "")
+            self.inputs.setCurrentIndex(self._pages["value"])
+        elif step.kind == "choose":
+            self.choice_combo.clear()
+            self.choice_combo.addItems(list(step.choices))
+            self.inputs.setCurrentIndex(self._pages["choose"])
+        elif step.kind == "live":
+            self.inputs.setCurrentIndex(self._pages["live"])
+        elif step.kind == "sensor_angle":
+            if self.dog_panel.sensor != step.sensor or self.dog_panel.wizard is None:
+                self.dog_panel.start(step.sensor, self.context)
+            self.inputs.setCurrentIndex(self._pages["sensor_angle"])
+
+    def _fill_history(self) -> None:
+        records = self.run.state.records if self.run else []
+        self.history.setRowCount(len(records))
+        for row, r in enumerate(records):
+            value = ("yes" if r.value else "no") if r.kind == "confirm" else f"{r.value} {r.unit}".strip()
+            for column, text in enumerate(
+                (r.step_id, value, "pass" if r.passed else "FAIL", r.who, r.at_utc)
+            ):
+                self.history.setItem(row, column, QTableWidgetItem(text))
+
+    def shutdown(self) -> None:
+        self.dog_panel.shutdown()

@@ -1,0 +1,150 @@
+"""The Procedures page in the real window against the embedded simulated drive: a trainee walks the
+procedures, a check fails and is put right, the app is restarted and resumes, the report prints."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+
+import pytest
+
+from fha_studio.gui.link import Cmd
+from fha_studio.logic.procedures import Session
+from tests.procedures.walk import good_answer
+
+CODE = "FHA-25C-50-US250-B-L"
+SIM_URL = f"sim://{CODE}?paced=0&ls1_deg=-30&ls2_deg=30&origin_deg=0"
+
+
+@pytest.fixture
+def window(make_window, qtbot):
+    w = make_window(connect=SIM_URL)
+    qtbot.waitUntil(lambda: len(w.session.drive_values) >= 14, timeout=10000)
+    return w
+
+
+def _answer_by_hand(page):
+    """What a trainee types or clicks for the step on the screen (live steps: the button)."""
+    step = page.current_step()
+    if step.kind == "confirm":
+        page.yes_button.click()
+    elif step.kind in ("measure", "text"):
+        page.value_edit.setText(str(good_answer(step)))
+        page.value_button.click()
+    elif step.kind == "choose":
+        page.choice_combo.setCurrentText(str(good_answer(step)))
+        page.choice_button.click()
+    else:
+        raise AssertionError(step.kind)
+
+
+def _walk(page, qtbot, procedure_id, before=None, limit=80):
+    page.select_procedure(procedure_id)
+    for _ in range(limit):
+        step = page.current_step()
+        if step is None or page.run.stopped:
+            return
+        if before:
+            before(step)
+        if step.kind == "live":
+            with qtbot.waitSignal(page.sigLiveDone, timeout=20000):
+                page.live_button.click()
+        else:
+            _answer_by_hand(page)
+    raise AssertionError("procedure did not end")
+
+
+def test_trainee_walks_inspection_and_wiring_with_a_failed_check_and_a_resume(window, qtbot, tmp_path):
+    page = window.show_page("procedures")
+    page.operator_edit.setText("T. Trainee")
+    path = tmp_path / "axis1.json"
+    page.new_session(path, CODE)
+    assert page.procedure_list.count() == 5
+    assert page.session.driver["adjusted_for"] == CODE
+    # receiving inspection: the trainee misreads the driver label; the manual's warning stops it
+    page.select_procedure("receiving-inspection")
+    page.yes_button.click()
+    page.value_edit.setText(CODE)
+    page.value_button.click()
+    page.value_edit.setText("FHA-32C-50-US250")
+    page.value_button.click()
+    assert page.run.stopped and page.stop_box.isVisibleTo(page)
+    assert "Only connect the actuator specified on the driver label" in page.warning_label.text()
+    assert not page.step_box.isEnabled()
+    page.note_edit.setText("read the label again: 25C")
+    page.retry_button.click()
+    assert not page.run.stopped
+    _walk(page, qtbot, "receiving-inspection")
+    assert page.session.runs["receiving-inspection"].status == "completed"
+    records = page.session.runs["receiving-inspection"].records
+    assert records[-1].step_id == "drive-identity" and records[-1].value == CODE and records[-1].passed
+
+    # wiring: half way, the app is closed
+    page.select_procedure("wiring")
+    for _ in range(4):
+        _answer_by_hand(page)
+    here = page.current_step().id
+    page.pause_button.click()
+    assert Session.load(path).runs["wiring"].status == "paused"
+
+    page.open_session(path)  # as after a restart
+    page.select_procedure("wiring")
+    assert page.current_step().id == here
+
+    def trainee(step):  # switches the brake's 24 V as the step asks (on the simulated drive: INP)
+        if step.id in ("brake-releases", "brake-holds"):
+            with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SET_INPUTS):
+                window.link.send(Cmd.SET_INPUTS, {"brake_released": step.id == "brake-releases"})
+
+    _walk(page, qtbot, "wiring", before=trainee)
+    wiring = Session.load(path).runs["wiring"]
+    assert wiring.status == "completed", page.warning_label.text()
+    assert {r.who for r in wiring.records} == {"T. Trainee"}
+    assert "done" in page.procedure_list.item(2).text()
+
+
+@pytest.mark.slow
+def test_sensor_dogs_set_on_the_simulated_drive_and_the_report_prints(window, qtbot, tmp_path):
+    page = window.show_page("procedures")
+    page.new_session(tmp_path / "axis1.json", CODE, operator="T. Trainee")
+    page.select_procedure("sensor-adjustment")
+    page.yes_button.click()
+    page.yes_button.click()
+    panel = page.dog_panel
+    assert page.inputs.currentWidget() is panel and panel.sim_box.isVisibleTo(panel)
+    qtbot.waitUntil(lambda: panel.wizard.angle_deg is not None, timeout=3000)
+    # moves past the movable range are refused before anything is sent
+    assert not panel.move_to(179.0)
+    assert "movable range" in page.message_label.text()
+
+    def go_to(angle):
+        assert panel.move_to(angle)
+        qtbot.waitUntil(
+            lambda: abs(panel.wizard.angle_deg - angle) < 0.3 and not window.link.moving, timeout=15000
+        )
+
+    for sensor, angle in (("limit_switch_2", 25.0), ("limit_switch_1", -20.0), ("origin_sensor", 2.0)):
+        assert page.current_step().sensor == sensor
+        go_to(angle)
+        panel.set_dog_button.click()  # the trainee turns the dog until its switch actuates here
+        qtbot.waitUntil(lambda s=sensor: panel.wizard.states[s], timeout=3000)
+        panel.record_button.click()
+        assert page.session.sensor_angles_deg[sensor] == pytest.approx(angle, abs=0.6)
+    page.yes_button.click()  # screws tightened
+    with qtbot.waitSignal(page.sigLiveDone, timeout=60000) as done:
+        page.live_button.click()
+    assert done.args[0].passed, done.args[0].detail
+    assert page.session.runs["sensor-adjustment"].status == "completed"
+
+    html, pdf = page.write_report(tmp_path / "report.html", tmp_path / "report.pdf")
+    text = html.read_text()
+    assert "limit switch 2 (CW end)" in text and "HA-655-2-200" in text and "Not signed" in text
+    assert "Changed from the defaults" in text or "items differ from the defaults" in text
+    assert pdf.read_bytes().startswith(b"%PDF")
+    if shutil.which("pdftotext"):
+        pdf_text = subprocess.run(
+            ["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True
+        ).stdout
+        assert "Rotary position sensor set adjustment" in pdf_text and CODE in pdf_text
+    assert not page.sign()  # the other procedures are still open
+    assert "cannot sign while these are open" in page.message_label.text()
