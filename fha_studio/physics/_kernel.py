@@ -56,6 +56,8 @@ class KernelParams:
     ke_phase: float
     lm_half: float
     resistance: float
+    pulse_rad: float = 0.0  # > 0: feedback quantised to encoder pulses of this size
+    speed_filter_alpha: float = 1.0  # first-order filter of the pulse-difference speed (1 = none)
 
 
 @dataclass
@@ -79,6 +81,8 @@ class KernelState:
     brake_torque: float = 0.0  # N m, extra stiction on the motor side while the brake holds
     step_index: int = 0  # servo periods done
     rec_count: int = 0  # periods since the last recorded sample
+    fb_prev: float | None = None  # quantised feedback of the previous period (rad, physical)
+    v_filt: float = 0.0  # filtered pulse-difference speed (rad/s, physical)
 
 
 def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_on: bool,
@@ -104,6 +108,13 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     compliant = p.compliant
     k1, k2, k3, t1, t2, th1, th2, damp = p.k1, p.k2, p.k3, p.t1, p.t2, p.th1, p.th2, p.damping
     sin = math.sin
+    floor = math.floor
+    pq = p.pulse_rad
+    quant = pq > 0.0
+    alpha = p.speed_filter_alpha
+    if quant and s.fb_prev is None:
+        s.fb_prev = floor(s.xm / pq + 0.5) * pq
+    fb_prev, v_filt = s.fb_prev, s.v_filt
 
     xm, vm, xl, vl = s.xm, s.vm, s.xl, s.vl
     integ, cprev, cur, vref = s.integ, s.cprev, s.current, s.vref
@@ -130,9 +141,17 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
             c = cmd[k] if cmd is not None else cprev
             vc = (c - cprev) * rate
             cprev = c
-            err = c - d * xm
-            vref = kp * err + ff * vc
-            ev = vref - d * vm
+            if quant:
+                fbp = floor(xm / pq + 0.5) * pq
+                v_filt += alpha * ((fbp - fb_prev) * rate - v_filt)
+                fb_prev = fbp
+                err = c - d * fbp
+                vref = kp * err + ff * vc
+                ev = vref - d * v_filt
+            else:
+                err = c - d * xm
+                vref = kp * err + ff * vc
+                ev = vref - d * vm
             integ_new = integ + ev * dt * tv_inv
             ic = kv * (ev + integ_new)
             if ic > ilim:
@@ -232,6 +251,10 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
 
         if not servo_on:
             c = cprev = d * xm  # the error counter follows the feedback while the servo is off
+            if quant:  # the drive keeps counting pulses
+                fbp = floor(xm / pq + 0.5) * pq
+                v_filt += alpha * ((fbp - fb_prev) * rate - v_filt)
+                fb_prev = fbp
 
         # ---------------- accounting ----------------
         i2 += cur * cur
@@ -262,6 +285,7 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     s.regen_j += regen * dt
     s.peak_speed, s.peak_error = pk_v, pk_e
     s.step_index += n
+    s.fb_prev, s.v_filt = fb_prev, v_filt
     s.rec_count = rec_count
 
 

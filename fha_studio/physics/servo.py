@@ -51,6 +51,9 @@ class ServoSettings:
     control_mode: parameter 0, "position" or "speed". In speed mode the command profile's speed
     is the speed-loop reference (jog = the speed command), there is no position loop and the
     error counter stays at zero.
+    quantised_feedback: the loops see the encoder in whole pulses and the speed as the pulse
+    difference per period, low-passed at speed_filter_hz (0 = unfiltered), as a real drive; the
+    current then carries the quantisation noise a real drive's current has. Off: ideal feedback.
     """
 
     position_loop_gain_per_s: float = 30.0
@@ -64,6 +67,8 @@ class ServoSettings:
     in_position_range_pulses: int = 10
     servo_rate_hz: float = MIN_SERVO_RATE_HZ
     control_mode: str = "position"
+    quantised_feedback: bool = False
+    speed_filter_hz: float = 500.0
 
     def __post_init__(self) -> None:
         def check(name: str, ok: bool, what: str) -> None:
@@ -83,6 +88,7 @@ class ServoSettings:
         check("in_position_range_pulses", self.in_position_range_pulses >= 0, "non-negative")
         check("servo_rate_hz", self.servo_rate_hz >= MIN_SERVO_RATE_HZ, f"at least {MIN_SERVO_RATE_HZ:g}")
         check("control_mode", self.control_mode in ("position", "speed"), '"position" or "speed"')
+        check("speed_filter_hz", self.speed_filter_hz >= 0, "non-negative")
 
     @classmethod
     def tuned_for(cls, model: AxisModel, speed_bandwidth_hz: float = 20.0,
@@ -159,6 +165,9 @@ def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelPa
         ke_phase=math.radians(e.kinematic_error.phase_deg) if e.kinematic_error else 0.0,
         lm_half=0.5 * e.lost_motion.width_arcsec / ARCSEC_PER_RAD if e.lost_motion else 0.0,
         resistance=model.phase_resistance_ohm,
+        pulse_rad=model.output_pulse_rad if settings.quantised_feedback else 0.0,
+        speed_filter_alpha=(1.0 - math.exp(-2.0 * math.pi * settings.speed_filter_hz * dt)
+                            if settings.speed_filter_hz > 0 else 1.0),
     )
 
 
@@ -340,9 +349,12 @@ class ServoAxis:
 
     def _rebase_command(self) -> None:
         d = self._settings.direction_sign
-        self._generator.hold(self.time_s, d * self._state.xm)
+        x = self._state.xm
+        if self._settings.quantised_feedback:  # the drive only knows whole pulses
+            x = self._to_pulses(x) * self._model.output_pulse_rad
+        self._generator.hold(self.time_s, d * x)
         self._pulse_offset_rad = 0.0
-        self._state.cprev = d * self._state.xm
+        self._state.cprev = d * x
 
     def _load_rest_position(self, xm: float) -> float:
         p = self._params

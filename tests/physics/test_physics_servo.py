@@ -294,3 +294,26 @@ def test_simulate_can_average_the_current_over_each_sample(make_model):
     expected = fine["current"][1:].reshape(-1, 5).mean(axis=1)
     assert np.allclose(avg["current"][1:], expected, atol=1e-9)
     assert np.allclose(avg["torque"], 22 * avg["current"])
+
+
+def test_quantised_feedback_holds_within_a_pulse_and_makes_current_noise(make_model):
+    model = make_model(CODE, 1.5, Effects().with_effect("viscous_friction", coefficient_nm_s_per_rad=1.0))
+    ideal = ServoSettings.tuned_for(model)
+    real = ideal.replace(quantised_feedback=True, speed_filter_hz=300.0)
+    traces = {}
+    for name, settings in (("ideal", ideal), ("real", real)):
+        axis = ServoAxis(model, settings)
+        axis.servo_on()
+        axis.jog(10 * RPM)
+        axis.advance(1.0)
+        axis.start_trace()
+        axis.advance(1.0)
+        traces[name] = axis.read_trace()
+        axis.stop()
+        axis.advance(1.0)
+        assert abs(axis.error_pulses) <= 1
+    # same mean torque (viscous x speed), but the pulse-difference speed makes the current noisy
+    for tr in traces.values():
+        assert np.mean(tr["current"]) * 22 == pytest.approx(10 * RPM, rel=0.02)
+    assert np.std(traces["ideal"]["current"]) < 1e-6
+    assert 0.01 < np.std(traces["real"]["current"]) < 0.5
