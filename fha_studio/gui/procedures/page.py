@@ -16,6 +16,7 @@ from typing import Any
 
 from PySide6.QtCore import QObject, Signal, Slot
 from PySide6.QtWidgets import (
+    QCheckBox,
     QComboBox,
     QFileDialog,
     QGroupBox,
@@ -34,7 +35,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui.link import CommandResult
+from fha_studio.gui.link import IO_BRAKE_RELEASED, Cmd, CommandResult, DriveStatus
 from fha_studio.gui.procedures.dog_panel import SensorDogPanel
 from fha_studio.logic.procedures import (
     Observation,
@@ -94,6 +95,7 @@ class ProceduresPage(QWidget):
         self._build()
         self.link.sigResult.connect(self._on_result)
         self.link.sigConnected.connect(lambda _info: self._refresh())
+        self.link.sigStatus.connect(self._on_status)
         self._relay.sigSample.connect(
             lambda angle, bits: self.dog_panel.observe(angle, bits) if self.dog_panel.wizard else None
         )
@@ -188,6 +190,13 @@ class ProceduresPage(QWidget):
         row.addWidget(self.live_button)
         row.addWidget(self.by_hand_button)
         lv.addLayout(row)
+        # On the simulated drive the trainee switches the brake's 24 V here (INP), as at the machine.
+        self.sim_brake_check = QCheckBox("Simulated drive: brake supply 24 V on")
+        self.sim_brake_check.setObjectName("sim_brake")
+        self.sim_brake_check.toggled.connect(
+            lambda on: self.link.send(Cmd.SET_INPUTS, {"brake_released": on}) if self.link.connected else None
+        )
+        lv.addWidget(self.sim_brake_check)
         self.live_label = QLabel("")
         self.live_label.setObjectName("live_result")
         self.live_label.setWordWrap(True)
@@ -229,12 +238,16 @@ class ProceduresPage(QWidget):
         self.pause_button.clicked.connect(self.pause)
         self.report_button = QPushButton("Commissioning &report…")
         self.report_button.clicked.connect(self._report_clicked)
+        self.capture_button = QPushButton("Capture the scope &plot")
+        self.capture_button.setToolTip("Save what the Scope page shows as a PNG for the report")
+        self.capture_button.clicked.connect(self._capture_clicked)
         self.sign_button = QPushButton("&Sign the report")
         self.sign_button.clicked.connect(self._sign_clicked)
         self.message_label = QLabel("")
         self.message_label.setObjectName("procedure_message")
         self.message_label.setWordWrap(True)
         buttons.addWidget(self.pause_button)
+        buttons.addWidget(self.capture_button)
         buttons.addWidget(self.report_button)
         buttons.addWidget(self.sign_button)
         m.addLayout(buttons)
@@ -353,8 +366,6 @@ class ProceduresPage(QWidget):
 
     def run_live_check(self) -> None:
         """Ask the drive (in the link thread); the answer is recorded when it comes."""
-        from fha_studio.gui.link import Cmd
-
         step = self.current_step()
         if step is None or step.kind != "live" or self._live_token is not None:
             return
@@ -387,6 +398,14 @@ class ProceduresPage(QWidget):
         else:
             self.by_hand_button.setVisible(True)
         self.sigLiveDone.emit(observation)
+
+    @Slot(object)
+    def _on_status(self, status: DriveStatus) -> None:
+        released = status.bit(IO_BRAKE_RELEASED)
+        if released is not None and self.sim_brake_check.isVisible():
+            self.sim_brake_check.blockSignals(True)
+            self.sim_brake_check.setChecked(released)
+            self.sim_brake_check.blockSignals(False)
 
     def retry(self, note: str = "") -> None:
         if self.run is not None and self.run.stopped:
@@ -433,6 +452,18 @@ class ProceduresPage(QWidget):
         if self.session is not None:
             self.session.add_plot(title, png_path)
             self.session.save()
+
+    def capture_scope_plot(self, title: str = "") -> Path | None:
+        """Save the Scope page's plot as a PNG beside the session and add it to the report."""
+        scope = getattr(self.main_window, "scope_page", None)
+        if self.session is None or self.session.path is None or scope is None:
+            return None
+        number = len(self.session.plots) + 1
+        path = self.session.path.with_name(f"{self.session.path.stem}-plot{number}.png")
+        scope.view.export_png(path)
+        self.add_plot(title or f"Scope plot {number}", path)
+        self._message(f"Plot saved for the report: {path}")
+        return path
 
     def write_report(self, html_path: str | Path, pdf_path: str | Path | None = None):
         """Write the commissioning report (HTML, and PDF when a path is given)."""
@@ -486,6 +517,12 @@ class ProceduresPage(QWidget):
             html, pdf = self.write_report(Path(path).with_suffix(".html"), path)
             self._message(f"Report written: {pdf} and {html}")
 
+    def _capture_clicked(self) -> None:
+        try:
+            self.capture_scope_plot()
+        except Exception as exc:  # an empty plot, a full disk: say so, the session goes on
+            self._message(f"The plot could not be saved: {exc}")
+
     def _sign_clicked(self) -> None:
         self.sign()
 
@@ -516,6 +553,11 @@ class ProceduresPage(QWidget):
             self.warning_label.setText(run.state.stop_warning)
         self.pause_button.setEnabled(bool(run))
         self.report_button.setEnabled(has_session)
+        self.capture_button.setEnabled(has_session)
+        info = self.link.info
+        self.sim_brake_check.setVisible(
+            bool(info and info.is_simulated and self.context and self.context["flags"].get("brake"))
+        )
         self.sign_button.setEnabled(has_session)
         self.by_hand_button.setVisible(False)
         self.step_box.setEnabled(True)

@@ -148,3 +148,49 @@ def test_sensor_dogs_set_on_the_simulated_drive_and_the_report_prints(window, qt
         assert "Rotary position sensor set adjustment" in pdf_text and CODE in pdf_text
     assert not page.sign()  # the other procedures are still open
     assert "cannot sign while these are open" in page.message_label.text()
+
+
+@pytest.mark.slow
+def test_from_boxed_actuator_to_signed_report(make_window, qtbot, tmp_path):
+    """Every procedure that applies, in the app only, then the signed report (brake, no sensor set)."""
+    code = "FHA-25C-50-US250-B"
+    window = make_window(connect=f"sim://{code}?paced=0")
+    qtbot.waitUntil(lambda: len(window.session.drive_values) >= 14, timeout=10000)
+    page = window.show_page("procedures")
+    page.actuator_edit.setText(code)
+    page.operator_edit.setText("T. Trainee")
+    page.new_session(tmp_path / "axis1.json")
+    assert "does not apply" in page.procedure_list.item(3).text()
+
+    def trainee(step):  # the brake supply switch, on the page (simulated drive)
+        if step.id in ("brake-releases", "brake-holds"):
+            assert page.sim_brake_check.isVisibleTo(page)
+            want = step.id == "brake-releases"
+            with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SET_INPUTS):
+                page.sim_brake_check.setChecked(want)
+
+    for procedure_id in ("receiving-inspection", "installation", "wiring", "rotary-direction"):
+        _walk(page, qtbot, procedure_id, before=trainee)
+        assert page.session.runs[procedure_id].status == "completed", (
+            procedure_id,
+            page.warning_label.text(),
+        )
+    jog = page.session.runs["rotary-direction"].records[2]
+    assert jog.step_id == "jog-fwd" and jog.value == pytest.approx(5.0, abs=0.3) and "CW" in jog.detail
+    plot = page.capture_scope_plot("Scope after the direction check")
+    assert plot is not None and plot.is_file()
+    assert page.sign(), page.message_label.text()
+    html, pdf = page.write_report(tmp_path / "report.html", tmp_path / "report.pdf")
+    text = html.read_text()
+    for wanted in (
+        "Signed by T. Trainee",
+        "None.",
+        "HA-655-2-200",
+        "Scope after the direction check",
+        "rotary direction",
+        "21.6",
+        "8-M6 depth: 10",
+    ):
+        assert wanted in text, wanted
+    assert pdf.stat().st_size > 5000
+    assert Session.load(tmp_path / "axis1.json").signature["who"] == "T. Trainee"
