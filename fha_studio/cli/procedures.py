@@ -1,0 +1,239 @@
+"""``fha-studio procedures ...``: the guided procedures on the command line (no Qt).
+
+- ``procedures list --actuator CODE [--session FILE]``: the procedures, whether they apply, status.
+- ``procedures show ID --actuator CODE``: the checklist filled in for the actuator (to print).
+- ``procedures run ID --session FILE [--actuator CODE] [--operator NAME] [--drive URL]``: walk it
+  in the terminal; live steps ask the drive when ``--drive`` is given, else they are confirmed by
+  hand. Ctrl-D pauses (the session file keeps the place).
+- ``procedures report SESSION [-o OUT.html] [--sign NAME]``: the commissioning report as HTML
+  (PDF from the GUI).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from fha_studio.catalog import ModelCodeError
+from fha_studio.cli import CliError
+
+ORDER = 60
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "procedures",
+        help="guided procedures of the manual and the commissioning report",
+        description="The FHA-C manual's procedures (receiving inspection 3-1, installation 3-3, wiring "
+        "1-14/4-2, sensor set 4-7-2, rotary direction 1-10) as checklists for one actuator, "
+        "recorded in a session file, and the commissioning report.",
+    )
+    sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
+    ls = sub.add_parser("list", help="the procedures for an actuator and their status")
+    ls.add_argument("--actuator", help="model code, e.g. FHA-25C-50-US250-B-L (or from --session)")
+    ls.add_argument("--session", type=Path, help="a session file: show each procedure's status")
+    ls.set_defaults(func=_list)
+    show = sub.add_parser("show", help="print a checklist filled in for an actuator")
+    show.add_argument("procedure", metavar="ID")
+    show.add_argument("--actuator", required=True)
+    show.set_defaults(func=_show)
+    run = sub.add_parser("run", help="walk a procedure in the terminal, recorded in the session file")
+    run.add_argument("procedure", metavar="ID")
+    run.add_argument("--session", type=Path, required=True, help="session file (created when missing)")
+    run.add_argument("--actuator", help="model code (needed to create a session)")
+    run.add_argument("--operator", default="", help="your name: every check records it")
+    run.add_argument(
+        "--drive", metavar="URL", help="drive for live checks, e.g. sim://FHA-25C-50-US250?paced=0"
+    )
+    run.set_defaults(func=_run)
+    report = sub.add_parser("report", help="write the commissioning report of a session as HTML")
+    report.add_argument("session", type=Path)
+    report.add_argument("-o", "--output", type=Path, help="HTML file (default: beside the session)")
+    report.add_argument("--sign", metavar="NAME", help="sign it (refused while checks are open)")
+    report.set_defaults(func=_report)
+
+
+def _context(code: str):
+    from fha_studio.logic.procedures.context import build_context
+
+    try:
+        return build_context(code)
+    except ModelCodeError as exc:
+        raise CliError(str(exc)) from None
+
+
+def _load_session(path: Path):
+    from fha_studio.logic.procedures import Session, SessionError
+
+    try:
+        return Session.load(path)
+    except SessionError as exc:
+        raise CliError(str(exc)) from None
+
+
+def _list(args) -> int:
+    from fha_studio.logic.procedures import load_all
+
+    session = _load_session(args.session) if args.session else None
+    code = args.actuator or (session.actuator_code if session else None)
+    if not code:
+        raise CliError("give --actuator CODE or --session FILE")
+    for procedure in load_all(_context(code)):
+        state = session.runs.get(procedure.id) if session else None
+        status = "does not apply" if not procedure.applies else (state.status if state else "not started")
+        print(f"{procedure.id:22} {procedure.section:10} {procedure.title}  [{status.replace('_', ' ')}]")
+    return 0
+
+
+def _show(args) -> int:
+    from fha_studio.logic.procedures import ProcedureError, load_procedure
+
+    try:
+        procedure = load_procedure(args.procedure, _context(args.actuator))
+    except ProcedureError as exc:
+        raise CliError(str(exc)) from None
+    print(f"{procedure.title} ({procedure.section}) — {args.actuator.upper()}")
+    if not procedure.applies:
+        print("Does not apply to this actuator.")
+        return 0
+    for number, definition in enumerate(procedure.steps, start=1):
+        step = definition.resolve(procedure.context, _AnyAnswer())
+        condition = (
+            f"  (when {', '.join(definition.when)})" if any("answer:" in c for c in definition.when) else ""
+        )
+        print(f"{number:3}. [{step.section}] {step.text}{condition}")
+        if step.expected_text() and step.kind != "confirm":
+            print(f"       passes: {step.expected_text()}")
+    return 0
+
+
+class _AnyAnswer(dict):
+    def __contains__(self, key: object) -> bool:
+        return True
+
+    def __missing__(self, key: str) -> str:
+        return f"<{key}>"
+
+
+def _ask(prompt: str) -> str:
+    try:
+        return input(prompt)
+    except EOFError:
+        raise _Pause from None
+
+
+class _Pause(Exception):
+    pass
+
+
+def _run(args) -> int:
+    from fha_studio.logic.procedures import (
+        ProcedureError,
+        ProcedureRun,
+        Session,
+        StepInputError,
+        load_procedure,
+    )
+
+    if args.session.exists():
+        session = _load_session(args.session)
+        if args.actuator and args.actuator.strip().upper() != session.actuator_code:
+            raise CliError(f"{args.session} is a session for {session.actuator_code}, not {args.actuator}")
+    else:
+        if not args.actuator:
+            raise CliError(f"{args.session} does not exist: give --actuator CODE to start a new session")
+        _context(args.actuator)
+        session = Session(actuator_code=args.actuator.strip().upper(), operator=args.operator)
+        session.save(args.session)
+    context = _context(session.actuator_code)
+    try:
+        run = ProcedureRun(session, load_procedure(args.procedure, context))
+    except ProcedureError as exc:
+        raise CliError(str(exc)) from None
+    client = None
+    if args.drive:
+        from fha_studio.hardware.client import DriveClient
+        from fha_studio.hardware.errors import LinkError
+
+        try:
+            client = DriveClient.open(args.drive)
+        except (LinkError, ValueError) as exc:
+            raise CliError(f"drive {args.drive}: {exc}") from None
+        identity = client.identify()
+        if identity is not None and not session.driver:
+            session.driver = {
+                "model": identity.driver_model,
+                "adjusted_for": identity.adjusted_for,
+                "version": identity.firmware,
+            }
+    who = args.operator or session.operator
+    print(f"{run.procedure.title} ({run.procedure.section}) for {session.actuator_code}; Ctrl-D pauses.")
+    try:
+        while (step := run.current()) is not None:
+            if run.stopped:
+                print(f"STOPPED: {run.state.stop_warning}")
+                note = _ask("Put right? Type what was done to check again (empty: stay stopped): ").strip()
+                if not note:
+                    return 1
+                run.retry(who, note)
+                continue
+            done, total = run.progress()
+            print(f"\n[{done + 1}/{total}] § {step.section}\n{step.text}")
+            try:
+                value = _answer_in_terminal(step, client, context, session)
+                record = run.submit(value, who=who)
+            except StepInputError as exc:
+                print(f"  {exc}")
+                continue
+            print("  pass" if record.passed else "  FAIL" + (f": {record.detail}" if record.detail else ""))
+    except (_Pause, KeyboardInterrupt):
+        run.pause()
+        print(f"\nPaused; {args.session} keeps the place.")
+        return 0
+    finally:
+        if client is not None:
+            client.close()
+    print(f"{run.procedure.title}: done.")
+    return 0
+
+
+def _answer_in_terminal(step, client, context, session):
+    if step.kind == "confirm":
+        return _ask("  done / checked? [y/n] ").strip().lower() in ("y", "yes")
+    if step.kind in ("measure", "text"):
+        hint = f" ({step.expected_text()})" if step.kind == "measure" else ""
+        return _ask(f"  value{hint}: ")
+    if step.kind == "choose":
+        return _ask(f"  one of {', '.join(step.choices)}: ").strip()
+    if step.kind == "live":
+        if client is not None:
+            from fha_studio.logic.procedures.live import LiveEnv, run_live_check
+
+            _ask("  press Enter to check on the drive ")
+            seen = run_live_check(client, step, LiveEnv(context, dict(session.sensor_angles_deg)))
+            print(f"  drive: {seen.detail}")
+            if seen.available:
+                return seen
+        return _ask("  checked by hand, OK? [y/n] ").strip().lower() in ("y", "yes")
+    if step.kind == "sensor_angle":
+        return _ask("  output angle where it switched (deg): ")
+    raise CliError(f"step kind {step.kind} cannot be answered here")
+
+
+def _report(args) -> int:
+    from fha_studio.logic.procedures.report import SignError, build_report, render_html, sign
+
+    session = _load_session(args.session)
+    if args.sign:
+        try:
+            sign(session, args.sign)
+        except SignError as exc:
+            raise CliError(str(exc)) from None
+    report = build_report(session)
+    output = args.output or args.session.with_suffix(".html")
+    output.write_text(render_html(report), encoding="utf-8")
+    print(f"{output}  ({len(report.warnings)} open warning(s))")
+    for warning in report.warnings:
+        print(f"  - {warning}", file=sys.stderr)
+    return 0
