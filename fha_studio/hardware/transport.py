@@ -25,6 +25,13 @@ import serial
 from fha_studio.hardware.errors import LinkLost
 from fha_studio.hardware.protocol import BAUDRATE
 
+try:  # pyserial's POSIX port lets termios.error (not an OSError) out of tcflush on a closed pty
+    import termios
+
+    _PORT_ERRORS: tuple[type[BaseException], ...] = (serial.SerialException, OSError, termios.error)
+except ImportError:  # pragma: no cover - Windows
+    _PORT_ERRORS = (serial.SerialException, OSError)
+
 #: The package that holds ``protocol_sim`` for ``sim://`` URLs.
 SIM_HANDLER_PACKAGE = "fha_studio.hardware.sim"
 
@@ -67,26 +74,26 @@ class GuardedTransport:
     def write(self, data: bytes) -> int | None:
         try:
             return self.inner.write(data)
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             raise self._lost(exc) from exc
 
     def read(self, size: int = 1) -> bytes:
         try:
             return self.inner.read(size)
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             raise self._lost(exc) from exc
 
     @property
     def in_waiting(self) -> int:
         try:
             return self.inner.in_waiting
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             raise self._lost(exc) from exc
 
     def reset_input_buffer(self) -> None:
         try:
             self.inner.reset_input_buffer()
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             raise self._lost(exc) from exc
 
     @property
@@ -97,7 +104,7 @@ class GuardedTransport:
     def timeout(self, value: float | None) -> None:
         try:
             self.inner.timeout = value
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             raise self._lost(exc) from exc
 
     @property
@@ -110,7 +117,7 @@ class GuardedTransport:
 
     def close(self) -> None:
         # closing a port that is already gone must not raise
-        with contextlib.suppress(serial.SerialException, OSError):
+        with contextlib.suppress(*_PORT_ERRORS):
             self.inner.close()
 
     def __getattr__(self, name: str) -> Any:
@@ -145,7 +152,7 @@ def open_transport(
                 "socket://host:port, loop:// or sim://ACTUATOR-CODE)"
             ) from None
         raise ValueError(f"cannot open {url!r}: {exc}") from None
-    except (serial.SerialException, OSError) as exc:
+    except _PORT_ERRORS as exc:
         raise LinkLost(f"cannot open {url}: {exc}", port=url) from exc
     return GuardedTransport(port, name=url)
 
