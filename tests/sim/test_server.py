@@ -126,3 +126,16 @@ def test_bad_sim_url_is_a_serial_exception_naming_the_option():
     register_url_handler()
     with pytest.raises(serial.SerialException, match="unknown option"):
         serial.serial_for_url("sim://FHA-25C-50-US250?colour=red")
+
+
+def test_oww_acknowledges_later_through_the_url_in_real_time(tmp_path):
+    register_url_handler()
+    url = f"sim://FHA-25C-50-S248?paced=0&oww_clear_s=0.2&eeprom={tmp_path / 'e.json'}"
+    with serial.serial_for_url(url, timeout=0.05) as port:
+        assert port.sim_drive.running
+        port.write(b"OWW+00000\r")
+        assert port.read(2) == b""  # nothing yet: the multi-turn data is being cleared
+        port.write(b"OWW+00000\r")
+        assert port.read(2) == b"x\r"  # repeated before the first q
+        port.timeout = 2.0
+        assert port.read(2) == b"q\r"

@@ -807,7 +807,12 @@ class SimDrive:
 
     # ------------------------------------------------------------------ monitors
     def monitor(self, item: int) -> int:
-        """Wire value of monitor item ``item`` (docs/protocol.md, monitor table)."""
+        """Wire value of monitor item ``item`` (docs/protocol.md, monitor table); SimRefused
+        (``x``) for an item the drive does not have."""
+        with self._lock:
+            return self._monitor(item)
+
+    def _monitor(self, item: int) -> int:
         axis = self._axis
         d = self._direction
         if item == 100:

@@ -1,0 +1,150 @@
+"""End to end: ``fha-studio sim --pty --unpaced`` in its own process, DriveClient over the pty.
+
+The jog loops repeat JOG every 50 ms like a held jog button; that pacing is the behaviour under
+test (the drive's 100 ms watchdog), not a wait for a condition.
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from fha_studio.hardware.client import DriveClient, LinkSettings
+from fha_studio.hardware.errors import CommandRejected, LinkLost, LinkTimeout
+from fha_studio.hardware.parameters import Mode
+
+pytestmark = pytest.mark.e2e
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def start_sim(tmp_path: Path, *extra: str) -> tuple[subprocess.Popen, str]:
+    """Start the sim in a process; returns it and the pty path it printed (within 30 s)."""
+    cmd = [sys.executable, "-m", "fha_studio", "sim", "--pty", "--unpaced",
+           "--eeprom", str(tmp_path / "eeprom.json"), *extra]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    assert proc.stdout is not None
+    ready, _, _ = select.select([proc.stdout], [], [], 30.0)
+    if not ready:
+        proc.kill()
+        proc.wait(5)
+        pytest.fail("the sim printed no pty path within 30 s")
+    line = proc.stdout.readline().decode().strip()
+    if not line.startswith("/dev/"):
+        proc.kill()
+        _, err = proc.communicate(timeout=5)
+        pytest.fail(f"the sim did not start: {line!r} {err.decode()!r}")
+    return proc, line
+
+
+def stop_sim(proc: subprocess.Popen) -> None:
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(5)
+    for stream in (proc.stdout, proc.stderr):
+        if stream is not None:
+            stream.close()
+
+
+@pytest.fixture(scope="module")
+def sim(tmp_path_factory):
+    proc, path = start_sim(tmp_path_factory.mktemp("sim"))
+    client = DriveClient.open(path)
+    yield client
+    client.close()
+    stop_sim(proc)
+    assert proc.returncode == 0  # SIGTERM ends it cleanly (EEPROM saved, threads stopped)
+
+
+def jog(client: DriveClient, speed_rpm: float, seconds: float) -> None:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        client.jog(speed_rpm)
+        time.sleep(0.05)
+
+
+def test_reads_every_parameter_and_monitor(sim):
+    ident = sim.identify()
+    assert ident is not None and ident.driver_model == "HA-655-2-200"
+    for mode in (Mode.TUNE, Mode.SYSTEM, Mode.TEST):
+        values = sim.read_all_parameters(mode)
+        expected = {item.number: item.default for item in sim.model.in_mode(mode)}
+        assert values == expected, mode
+    for item in sim.model.in_mode(Mode.MONITOR):
+        assert isinstance(sim.read_monitor(item.number), int)
+
+
+def test_writes_rotary_direction_and_reads_it_back(sim):
+    result = sim.write_parameter(Mode.SYSTEM, 8, 1)
+    assert result.verified and result.needs_restart
+    assert sim.read_parameter(Mode.SYSTEM, 8) == 1
+    assert sim.write_parameter(Mode.SYSTEM, 8, 0).verified
+    assert sim.read_parameter(Mode.SYSTEM, 8) == 0
+
+
+def test_jog_turns_the_way_the_rotary_direction_says(sim):
+    sim.servo(True)
+    start = sim.read_monitor(107)  # the load encoder: CW seen from the flange counts up
+    jog(sim, 10.0, 0.4)
+    assert sim.read_monitor(107) > start + 1000
+    sim.servo(False)
+    sim.write_parameter(Mode.SYSTEM, 8, 1)
+    sim.power_cycle()
+    sim.servo(True)
+    start = sim.read_monitor(107)
+    jog(sim, 10.0, 0.4)
+    assert sim.read_monitor(107) < start - 1000
+    sim.servo(False)
+    sim.write_parameter(Mode.SYSTEM, 8, 0)
+    sim.power_cycle()
+
+
+def test_raises_and_clears_an_alarm(sim):
+    previous = sim.read_parameter(Mode.SYSTEM, 6)
+    sim.write_parameter(Mode.SYSTEM, 6, 1)  # error allowance 100 pulses
+    sim.servo(True)
+    deadline = time.monotonic() + 3.0
+    while sim.alarm() == 0 and time.monotonic() < deadline:
+        try:
+            sim.jog(40.0)
+        except CommandRejected:
+            break
+        time.sleep(0.05)
+    assert sim.alarm() == 60
+    assert sim.io_state().alm_bits == 0b0010
+    sim.clear_alarm()
+    assert sim.alarm() == 0
+    assert sim.alarm_history()[0].code == 60
+    sim.write_parameter(Mode.SYSTEM, 6, previous)
+
+
+def test_killing_the_sim_gives_a_clean_link_error(tmp_path):
+    proc, path = start_sim(tmp_path)
+    client = DriveClient.open(path, LinkSettings(response_timeout_s=0.3, retries=1))
+    try:
+        assert sim_alive(client)
+        proc.kill()
+        proc.wait(5)
+        started = time.monotonic()
+        with pytest.raises((LinkLost, LinkTimeout)):
+            for _ in range(5):
+                client.read_monitor(100)
+        assert time.monotonic() - started < 5.0
+    finally:
+        client.close()
+        stop_sim(proc)
+
+
+def sim_alive(client: DriveClient) -> bool:
+    return client.alarm() == 0
