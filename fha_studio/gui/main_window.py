@@ -234,7 +234,8 @@ class MainWindow(QMainWindow):
         where = "embedded simulated drive" if info.is_simulated else info.url
         model = info.driver_model or "driver model unknown"
         self.link_lamp.setToolTip(f"Link: connected to {where} ({model})")
-        self.caps_label.setText(f"{model} · {where} · {info.capabilities or 'capabilities unknown'}")
+        first = (info.capabilities or "capabilities unknown").split(". ")[0].rstrip(".")
+        self.caps_label.setText(f"{model} · {where} · {first}.")
         self.caps_label.setToolTip(info.capabilities)
         self.disconnect_action.setEnabled(True)
         self.servo_action.setEnabled(info.can_move)

@@ -23,6 +23,7 @@ class Lamp(QLabel):
         self._on_colour = on_colour
         self._state: bool | None = None
         self.setMinimumHeight(22)
+        self.setMinimumWidth(self.sizeHint().width())
         self.setAccessibleName(text)
         self.set_state(None)
 

@@ -200,6 +200,7 @@ class ConnectionPage(QWidget):
         )
         self.ack_button.setVisible(bool(html) and can_ack)
         self.ack_button.setEnabled(True)
+        self.ack_button.setText("I have checked the labels: &acknowledge this warning")
 
     @Slot()
     def acknowledge(self) -> None:

@@ -174,6 +174,8 @@ class ParameterTableModel(QAbstractTableModel):
                 return self.state_text(row)
         if role == Qt.ItemDataRole.ToolTipRole:
             tip = f"<b>{MODE_WORDS.get(str(item.mode))} {item.number}: {item.name}</b><br>{item.description}"
+            if item.choices:
+                tip += "<br>" + "<br>".join(f"{k}: {v}" for k, v in item.choices.items())
             tip += f"<br><i>Source: {item.source}</i>"
             if not item.certain:
                 tip += f"<br><i>Uncertain ({', '.join(item.assumed)}): {item.note}</i>"
@@ -346,15 +348,26 @@ class ParametersPage(QWidget):
             | QAbstractItemView.EditTrigger.AnyKeyPressed
         )
         self.table.verticalHeader().setVisible(False)
+        self.table.verticalHeader().setDefaultSectionSize(self.table.fontMetrics().height() + 8)
+        self.table.setWordWrap(False)
+        self.table.setTextElideMode(Qt.TextElideMode.ElideRight)
         self.table.setAlternatingRowColors(True)
         header = self.table.horizontalHeader()
         header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         header.setSectionResizeMode(2, QHeaderView.ResizeMode.Stretch)
-        header.setSectionResizeMode(COL_VALUE, QHeaderView.ResizeMode.Interactive)
+        for col, chars in ((COL_VALUE, 30), (6, 26)):  # long choice texts elide; the tooltip has them
+            header.setSectionResizeMode(col, QHeaderView.ResizeMode.Interactive)
+            header.resizeSection(col, self.table.fontMetrics().averageCharWidth() * chars)
         splitter.addWidget(self.table)
         log_box = QWidget()
         lb = QVBoxLayout(log_box)
         lb.setContentsMargins(0, 0, 0, 0)
+        self.details = QLabel("Select an item to see the manual's description here.")
+        self.details.setObjectName("parameterDetails")
+        self.details.setWordWrap(True)
+        self.details.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.details.setStyleSheet("background: palette(base); border: 1px solid palette(mid); padding: 4px;")
+        lb.addWidget(self.details)
         lb.addWidget(QLabel("Session log (every write, verified by read-back):"))
         self.log_view = QPlainTextEdit()
         self.log_view.setReadOnly(True)
@@ -375,6 +388,7 @@ class ParametersPage(QWidget):
         )
         layout.addWidget(legend)
 
+        self.table.selectionModel().currentRowChanged.connect(self._show_details)
         self.read_button.clicked.connect(self.read_all)
         self.write_changed_button.clicked.connect(self.write_changed)
         self.write_all_button.clicked.connect(self.write_all)
@@ -517,11 +531,16 @@ class ParametersPage(QWidget):
 
     @Slot(object)
     def _on_connected(self, info: LinkInfo) -> None:
-        self.model.reload_items()
+        self.model.reload_items()  # a model reset: the selection model stays the same object
         self.model.restart_pending.clear()
         self.restart_banner.setVisible(False)
         self.session.read_all()
         self._update_buttons()
+
+    @Slot(QModelIndex, QModelIndex)
+    def _show_details(self, current: QModelIndex, _previous: QModelIndex) -> None:
+        if current.isValid():
+            self.details.setText(self.model.data(current.siblingAtColumn(2), Qt.ItemDataRole.ToolTipRole))
 
     @Slot(str, QModelIndex)
     def _refused(self, why: str, index: QModelIndex) -> None:

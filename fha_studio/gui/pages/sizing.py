@@ -1,16 +1,390 @@
-"""Sizing: the selection calculator of Chapter 2 as a page (filled in when the calculator lands)."""
+"""Sizing: the selection calculator of FHA-C manual Chapter 2 as a page.
+
+Load parts from the Appendix 2 shapes and materials add up to the load inertia; the duty cycle
+goes through the calculator (fha_studio.logic.sizing); the checks are listed with the manual's
+section, the duty is drawn on the torque-speed plane against the actuator's continuous and
+maximum ranges, and the catalogue actuators the duty passes on are suggested.
+"""
 
 from __future__ import annotations
 
-from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
+import inspect
 
-from fha_studio.gui.session import Session
+import pyqtgraph as pg
+from PySide6.QtCore import QSettings, Qt, Slot
+from PySide6.QtGui import QColor
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QListWidget,
+    QPushButton,
+    QScrollArea,
+    QSplitter,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from fha_studio.gui.connect_dialog import catalogue_codes
+from fha_studio.gui.session import DEFAULT_ACTUATOR, Session
+
+PASS_COLOUR = QColor("#2e7d32")
+FAIL_COLOUR = QColor("#b00020")
+
+
+def _spin(value: float, minimum: float, maximum: float, decimals: int, suffix: str) -> QDoubleSpinBox:
+    spin = QDoubleSpinBox()
+    spin.setRange(minimum, maximum)
+    spin.setDecimals(decimals)
+    spin.setValue(value)
+    spin.setSuffix(suffix)
+    spin.setKeyboardTracking(False)
+    return spin
+
+
+def _words(name: str) -> str:
+    return name.replace("_", " ").capitalize()
 
 
 class SizingPage(QWidget):
+    """Load inertia, duty cycle, checks, torque-speed picture, suggestion."""
+
     def __init__(self, session: Session, main_window=None):
         super().__init__()
+        from fha_studio.logic.sizing.inertia import SHAPES, materials
+
         self.session = session
-        layout = QVBoxLayout(self)
-        layout.addWidget(QLabel("The selection calculator (Chapter 2) appears here."))
-        layout.addStretch(1)
+        self.shapes = SHAPES
+        self.materials = materials()
+        self.parts: list[tuple[str, float]] = []  # (description, inertia about the output axis)
+        self.result = None
+        self.suggested: list[str] = []
+        outer = QHBoxLayout(self)
+        splitter = QSplitter(Qt.Orientation.Horizontal)
+        splitter.setObjectName("sizingSplitter")
+        self.splitter = splitter
+        outer.addWidget(splitter)
+
+        # -- left: inputs ------------------------------------------------------------------------
+        scroll = QScrollArea()
+        scroll.setWidgetResizable(True)
+        scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        scroll.setMinimumWidth(440)
+        left = QWidget()
+        scroll.setWidget(left)
+        l_layout = QVBoxLayout(left)
+
+        load_box = QGroupBox("Load inertia from shapes (Appendix 2)")
+        form = QFormLayout(load_box)
+        self.shape_combo = QComboBox()
+        for name in SHAPES:
+            self.shape_combo.addItem(_words(name), name)
+        self.material_combo = QComboBox()
+        for m in self.materials:
+            self.material_combo.addItem(f"{m.name} (SG {m.specific_gravity:g})", m.density_kg_m3)
+        self.material_combo.setCurrentIndex(max(0, self.material_combo.findText("Aluminum", Qt.MatchFlag.MatchStartsWith)))
+        form.addRow("&Shape:", self.shape_combo)
+        form.addRow("&Material:", self.material_combo)
+        self.dims_widget = QWidget()
+        self.dims_form = QFormLayout(self.dims_widget)
+        self.dims_form.setContentsMargins(0, 0, 0, 0)
+        form.addRow(self.dims_widget)
+        self.axis_combo = QComboBox()
+        self.offset_spin = _spin(0.0, 0.0, 10000.0, 1, " mm")
+        self.offset_spin.setToolTip("Distance F from the part's centre of gravity to the output axis: I = Ig + m F²")
+        form.addRow("&Axis of rotation:", self.axis_combo)
+        form.addRow("&Offset F from the output axis:", self.offset_spin)
+        self.part_label = QLabel("")
+        form.addRow(self.part_label)
+        buttons = QHBoxLayout()
+        self.add_part_button = QPushButton("&Add part to the load")
+        self.remove_part_button = QPushButton("Remo&ve part")
+        buttons.addWidget(self.add_part_button)
+        buttons.addWidget(self.remove_part_button)
+        form.addRow(buttons)
+        self.parts_list = QListWidget()
+        self.parts_list.setMaximumHeight(90)
+        form.addRow(self.parts_list)
+        l_layout.addWidget(load_box)
+
+        duty_box = QGroupBox("Duty cycle (2-4)")
+        d_form = QFormLayout(duty_box)
+        self.actuator_combo = QComboBox()
+        self.actuator_combo.setEditable(True)
+        self.actuator_combo.addItems(catalogue_codes())
+        self.actuator_combo.setCurrentText(DEFAULT_ACTUATOR)
+        self.inertia_spin = _spin(1.0, 0.0, 10000.0, 4, " kg·m²")
+        self.inertia_spin.setToolTip("Load inertia JL about the output axis (the parts above add up here)")
+        self.speed_spin = _spin(30.0, 0.1, 1000.0, 1, " r/min")
+        self.angle_spin = _spin(90.0, 0.1, 100000.0, 1, " °")
+        self.cycle_spin = _spin(2.0, 0.01, 100000.0, 2, " s")
+        self.torque_spin = _spin(0.0, -10000.0, 10000.0, 1, " N·m")
+        self.torque_spin.setToolTip("Load torque TL, positive when it opposes the rotation (friction, a load to lift)")
+        d_form.addRow("Ac&tuator:", self.actuator_combo)
+        d_form.addRow("Load &inertia JL:", self.inertia_spin)
+        d_form.addRow("Spee&d N:", self.speed_spin)
+        d_form.addRow("Move an&gle θ:", self.angle_spin)
+        d_form.addRow("C&ycle time t:", self.cycle_spin)
+        d_form.addRow("Load tor&que TL:", self.torque_spin)
+        self.calculate_button = QPushButton("&Calculate")
+        d_form.addRow(self.calculate_button)
+        l_layout.addWidget(duty_box)
+        l_layout.addStretch(1)
+        splitter.addWidget(scroll)
+
+        # -- right: results ----------------------------------------------------------------------
+        right = QWidget()
+        r_layout = QVBoxLayout(right)
+        r_layout.setContentsMargins(0, 0, 0, 0)
+        self.verdict = QLabel("")
+        self.verdict.setWordWrap(True)
+        self.verdict.setObjectName("sizingVerdict")
+        r_layout.addWidget(self.verdict)
+        self.plot = pg.PlotWidget(background="w")
+        self.plot.setObjectName("torqueSpeedPlot")
+        self.plot.setLabel("bottom", "Output speed", units="r/min")
+        self.plot.setLabel("left", "Output torque", units="N·m")
+        self.plot.showGrid(x=True, y=True, alpha=0.25)
+        self.plot.addLegend(offset=(-10, 10))
+        self.plot.setMenuEnabled(False)
+        self.plot.setMinimumHeight(220)
+        r_layout.addWidget(self.plot, 3)
+        self.checks_table = QTableWidget(0, 5)
+        self.checks_table.setObjectName("checksTable")
+        self.checks_table.setHorizontalHeaderLabels(["Check", "Value", "Limit", "", "Section"])
+        self.checks_table.verticalHeader().setVisible(False)
+        self.checks_table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
+        header = self.checks_table.horizontalHeader()
+        header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        header.setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
+        r_layout.addWidget(self.checks_table, 2)
+        self.suggestion = QLabel("")
+        self.suggestion.setWordWrap(True)
+        self.suggestion.setObjectName("sizingSuggestion")
+        r_layout.addWidget(self.suggestion)
+        splitter.addWidget(right)
+        splitter.setStretchFactor(0, 2)
+        splitter.setStretchFactor(1, 3)
+
+        self.dim_spins: dict[str, QDoubleSpinBox] = {}
+        self.shape_combo.currentIndexChanged.connect(self._build_dimensions)
+        self.material_combo.currentIndexChanged.connect(self._update_part)
+        self.axis_combo.currentIndexChanged.connect(self._update_part)
+        self.offset_spin.valueChanged.connect(self._update_part)
+        self.add_part_button.clicked.connect(self.add_part)
+        self.remove_part_button.clicked.connect(self.remove_part)
+        self.calculate_button.clicked.connect(self.calculate)
+        for spin in (self.inertia_spin, self.speed_spin, self.angle_spin, self.cycle_spin, self.torque_spin):
+            spin.editingFinished.connect(self.calculate)
+        self.actuator_combo.activated.connect(lambda _i: self.calculate())
+        session.sigActuatorChanged.connect(self._actuator_changed)
+        self._build_dimensions()
+        self._calculated_once = False
+
+    def showEvent(self, event) -> None:
+        # the first calculation (all catalogue actuators for the suggestion) waits until the page
+        # is looked at, so that it costs nothing at start-up
+        if not self._calculated_once:
+            self._calculated_once = True
+            self.calculate()
+        super().showEvent(event)
+
+    # -- settings ------------------------------------------------------------------------------------
+    def restore_settings(self, settings: QSettings) -> None:
+        state = settings.value("sizing/splitter")
+        if state is not None:
+            self.splitter.restoreState(state)
+        for key, spin in self._duty_spins().items():
+            value = settings.value(f"sizing/{key}")
+            if value is not None:
+                spin.setValue(float(value))
+
+    def save_settings(self, settings: QSettings) -> None:
+        settings.setValue("sizing/splitter", self.splitter.saveState())
+        for key, spin in self._duty_spins().items():
+            settings.setValue(f"sizing/{key}", spin.value())
+
+    def _duty_spins(self) -> dict[str, QDoubleSpinBox]:
+        return {
+            "load_inertia_kgm2": self.inertia_spin,
+            "speed_rpm": self.speed_spin,
+            "angle_deg": self.angle_spin,
+            "cycle_time_s": self.cycle_spin,
+            "load_torque_nm": self.torque_spin,
+        }
+
+    # -- load inertia ----------------------------------------------------------------------------------
+    @Slot()
+    def _build_dimensions(self) -> None:
+        while self.dims_form.rowCount():
+            self.dims_form.removeRow(0)
+        self.dim_spins.clear()
+        function = self.shapes[self.shape_combo.currentData()]
+        for name in inspect.signature(function).parameters:
+            if name == "density_kg_m3":
+                continue
+            if name.endswith("_deg"):
+                spin = _spin(30.0, 0.0, 90.0, 1, " °")
+                label = _words(name[:-4])
+            else:
+                spin = _spin(100.0, 0.1, 100000.0, 1, " mm")
+                label = _words(name[:-2] if name.endswith("_m") else name)
+            if "inner" in name or "wall" in name:
+                spin.setValue(20.0)
+            spin.valueChanged.connect(self._update_part)
+            self.dims_form.addRow(f"{label}:", spin)
+            self.dim_spins[name] = spin
+        self._update_part()
+
+    def current_part(self):
+        """(ShapeInertia, inertia about the output axis in kg m^2) of the part being entered."""
+        from fha_studio.logic.sizing.inertia import off_axis_inertia_kgm2
+
+        function = self.shapes[self.shape_combo.currentData()]
+        kwargs = {
+            name: spin.value() if name.endswith("_deg") else spin.value() / 1000.0
+            for name, spin in self.dim_spins.items()
+        }
+        shape = function(density_kg_m3=float(self.material_combo.currentData()), **kwargs)
+        axes = {a: getattr(shape, f"i{a}_kgm2") for a in "xyz" if getattr(shape, f"i{a}_kgm2") is not None}
+        if [self.axis_combo.itemData(i) for i in range(self.axis_combo.count())] != list(axes):
+            self.axis_combo.blockSignals(True)
+            self.axis_combo.clear()
+            for a in axes:
+                self.axis_combo.addItem({"x": "x (long axis)", "y": "y (across)", "z": "z (across)"}[a], a)
+            self.axis_combo.blockSignals(False)
+        ig = axes[self.axis_combo.currentData() or next(iter(axes))]
+        total = off_axis_inertia_kgm2(ig, shape.mass_kg, self.offset_spin.value() / 1000.0)
+        return shape, total
+
+    @Slot()
+    def _update_part(self) -> None:
+        try:
+            shape, total = self.current_part()
+        except ValueError as exc:
+            self.part_label.setText(f"<span style='color:#b00020'>{exc}</span>")
+            self.add_part_button.setEnabled(False)
+            return
+        self.add_part_button.setEnabled(True)
+        note = f"<br><i>{shape.note}</i>" if shape.note else ""
+        self.part_label.setText(f"mass {shape.mass_kg:.3g} kg, I = <b>{total:.4g} kg·m²</b> about the output axis{note}")
+        self.part_label.setWordWrap(True)
+
+    @Slot()
+    def add_part(self) -> None:
+        shape, total = self.current_part()
+        text = (f"{self.shape_combo.currentText()}, {self.material_combo.currentText().split(' (')[0]}: "
+                f"{shape.mass_kg:.3g} kg, {total:.4g} kg·m²")
+        self.parts.append((text, total))
+        self.parts_list.addItem(text)
+        self._parts_changed()
+
+    @Slot()
+    def remove_part(self) -> None:
+        row = self.parts_list.currentRow()
+        if row < 0 and self.parts:
+            row = len(self.parts) - 1
+        if row >= 0:
+            self.parts.pop(row)
+            self.parts_list.takeItem(row)
+            self._parts_changed()
+
+    def _parts_changed(self) -> None:
+        if self.parts:
+            self.inertia_spin.setValue(sum(i for _, i in self.parts))
+        self.calculate()
+
+    # -- the calculation --------------------------------------------------------------------------------
+    @Slot(str)
+    def _actuator_changed(self, code: str) -> None:
+        if code:
+            self.actuator_combo.setCurrentText(code)
+
+    def duty(self):
+        from fha_studio.logic.sizing import DutyCycle
+
+        return DutyCycle(
+            load_inertia_kgm2=self.inertia_spin.value(),
+            speed_rpm=self.speed_spin.value(),
+            angle_deg=self.angle_spin.value(),
+            cycle_time_s=self.cycle_spin.value(),
+            load_torque_nm=self.torque_spin.value(),
+        )
+
+    @Slot()
+    def calculate(self) -> None:
+        from fha_studio.logic.sizing import SizingError, size_axis, suggest_actuators
+
+        code = self.actuator_combo.currentText().strip().upper()
+        try:
+            duty = self.duty()
+            result = size_axis(code, duty)
+        except (SizingError, ValueError) as exc:
+            self.result = None
+            self.verdict.setText(f"<span style='color:#b00020'>Cannot size: {exc}</span>")
+            self.checks_table.setRowCount(0)
+            self.plot.clear()
+            return
+        self.result = result
+        failed = result.failed
+        if result.ok:
+            self.verdict.setText(f"<b style='color:#2e7d32'>{code} passes every check</b> of Chapter 2 for this duty.")
+        else:
+            names = ", ".join(c.name for c in failed)
+            self.verdict.setText(f"<b style='color:#b00020'>{code} fails {len(failed)} check(s)</b>: {names}.")
+        self._fill_checks(result)
+        self._draw(result)
+        try:
+            self.suggested = [r.actuator_code for r in suggest_actuators(duty)]
+        except (SizingError, ValueError):
+            self.suggested = []
+        if self.suggested:
+            self.suggestion.setText("<b>Actuators this duty passes on</b> (200 V, incremental; smallest first): "
+                                    + ", ".join(self.suggested[:8]) + (" …" if len(self.suggested) > 8 else ""))
+        else:
+            self.suggestion.setText("<b style='color:#b00020'>No catalogue actuator passes this duty.</b> "
+                                    "Lengthen the cycle, lower the speed or the load inertia.")
+
+    def _fill_checks(self, result) -> None:
+        checks = list(result.checks)
+        self.checks_table.setRowCount(len(checks))
+        for row, check in enumerate(checks):
+            unit = f" {check.unit}" if check.unit else ""
+            cells = [check.name, f"{check.value:.4g}{unit}", f"{check.comparison} {check.limit:.4g}{unit}",
+                     "pass" if check.ok else "FAIL", check.section]
+            for col, text in enumerate(cells):
+                item = QTableWidgetItem(text)
+                item.setToolTip(check.note)
+                if col == 3:
+                    item.setForeground(PASS_COLOUR if check.ok else FAIL_COLOUR)
+                    font = item.font()
+                    font.setBold(True)
+                    item.setFont(font)
+                self.checks_table.setItem(row, col, item)
+
+    def _draw(self, result) -> None:
+        env = result.envelope()
+        self.plot.clear()
+        tm, nm = env["max_torque_nm"], env["max_speed_rpm"]
+        tc, nc = env["continuous_torque_nm"], env["continuous_speed_rpm"]
+        self.plot.plot([0, nm, nm, 0], [tm, tm, -tm, -tm], pen=pg.mkPen("#c62828", width=2, style=Qt.PenStyle.DashLine),
+                       name="maximum range")
+        self.plot.plot([0, nc, nc, 0], [tc, tc, -tc, -tc], pen=pg.mkPen("#1565c0", width=2), name="continuous range")
+        points = result.operating_points()
+        duty = [p for p in points if p.phase != "effective"]
+        self.plot.plot([p.speed_rpm for p in duty], [p.torque_nm for p in duty],
+                       pen=pg.mkPen("#555", width=1.5), symbol="o", symbolSize=7, symbolBrush="#555",
+                       name="duty: accelerate, run, brake")
+        eff = [p for p in points if p.phase == "effective"]
+        if eff:
+            ok = result.effective_torque_nm <= tc and result.average_speed_rpm <= nc
+            self.plot.plot([eff[0].speed_rpm], [eff[0].torque_nm], pen=None, symbol="star", symbolSize=16,
+                           symbolBrush="#2e7d32" if ok else "#b00020", name="effective torque at average speed")
+        self.plot.setXRange(0, max(nm, self.speed_spin.value()) * 1.1, padding=0)
+        self.plot.setYRange(-tm * 1.15, tm * 1.15, padding=0)

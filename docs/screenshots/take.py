@@ -1,0 +1,133 @@
+"""Takes the README's screenshots of every page on the embedded simulated drive.
+
+    xvfb-run -a -s "-screen 0 1366x768x24" python docs/screenshots/take.py [OUTDIR]
+
+A scripted commissioning session: connect, read, set the rotary direction to reversed (not
+written), servo on and jog, raise alarm 20 on the simulated drive, a sizing duty. Settings and
+data go to a temporary directory, never the user's.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+TMP = tempfile.mkdtemp(prefix="fha-shots-")
+os.environ["XDG_CONFIG_HOME"] = f"{TMP}/config"
+os.environ["XDG_DATA_HOME"] = f"{TMP}/data"
+
+from PySide6.QtCore import QCoreApplication, QTimer  # noqa: E402
+from PySide6.QtWidgets import QApplication  # noqa: E402
+
+OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
+
+
+def main() -> int:
+    app = QApplication(sys.argv[:1])
+    QCoreApplication.setOrganizationName("FHA Studio Screenshots")
+    QCoreApplication.setApplicationName("fha-studio-screenshots")
+    from fha_studio.gui.link import Cmd
+    from fha_studio.gui.main_window import MainWindow
+
+    window = MainWindow()
+    window.resize(1366, 740)
+    window.show()
+    window.connect_to("sim://FHA-25C-50-US250?paced=0")
+    steps = []
+
+    def step(delay_ms: int):
+        def wrap(fn):
+            steps.append((delay_ms, fn))
+            return fn
+        return wrap
+
+    def shot(name: str):
+        app.processEvents()
+        path = OUT / f"{name}.png"
+        window.grab().save(str(path))
+        print("saved", path)
+
+    @step(1500)
+    def connection():
+        window.show_page("connection")
+        shot("connection")
+
+    @step(300)
+    def parameters():
+        page = window.show_page("parameters")
+        model = page.model
+        model.setData(model.index(model.row_of("position_loop_gain"), 3), "60")
+        shot("parameters")
+
+    @step(100)
+    def direction():
+        page = window.show_page("direction")
+        page.ccw_radio.setChecked(True)
+        shot("rotary-direction")
+        page.cw_radio.setChecked(True)
+        window.link.send(Cmd.SERVO, True)
+
+    @step(600)
+    def jog():
+        page = window.show_page("jog")
+        window.link.jog_press(8.0)
+
+    @step(700)
+    def jog_shot():
+        shot("jog")
+        window.link.jog_release()
+        window.link._worker._client._transport.inner.sim_drive.raise_alarm(20)
+
+    @step(800)
+    def alarms():
+        window.show_page("alarms")
+        shot("alarms")
+
+    @step(300)
+    def sizing():
+        page = window.show_page("sizing")
+        page.inertia_spin.setValue(1.2)
+        page.speed_spin.setValue(40.0)
+        page.angle_spin.setValue(120.0)
+        page.cycle_spin.setValue(1.5)
+        page.calculate()
+
+    @step(500)
+    def sizing_shot():
+        shot("sizing")
+
+    @step(100)
+    def connect_dialog():
+        from fha_studio.gui.connect_dialog import ConnectDialog
+
+        dialog = ConnectDialog(window, ports=[("/dev/ttyUSB0", "FT232R USB UART"), ("/dev/ttyS0", "")])
+        dialog.show()
+        app.processEvents()
+        dialog.grab().save(str(OUT / "connect-dialog.png"))
+        print("saved", OUT / "connect-dialog.png")
+        dialog.close()
+        window._closing_confirmed = True
+        window.close()
+        app.quit()
+
+    def run(index: int = 0):
+        if index < len(steps):
+            delay, fn = steps[index]
+
+            def go():
+                fn()
+                run(index + 1)
+            QTimer.singleShot(delay, go)
+
+    run()
+    app.exec()
+    window.shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,73 @@
+"""Pages that work without a drive: sizing, the connect dialog, layout memory, pairing warning."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QSettings
+
+from fha_studio.gui.connect_dialog import ConnectDialog
+
+
+def test_sizing_page_adds_parts_checks_and_suggests(make_window, qtbot):
+    window = make_window()
+    page = window.show_page("sizing")
+    qtbot.waitUntil(lambda: page.result is not None, timeout=5000)
+    page.shape_combo.setCurrentIndex(page.shape_combo.findData("cylinder"))
+    page.dim_spins["radius_m"].setValue(150.0)
+    page.dim_spins["length_m"].setValue(20.0)
+    shape, inertia = page.current_part()
+    assert abs(inertia - shape.mass_kg * 0.15**2 / 2) < 1e-9  # about its own axis, no offset
+    page.add_part()
+    assert abs(page.inertia_spin.value() - inertia) < 1e-4
+    assert page.checks_table.rowCount() == len(page.result.checks)
+    assert page.suggested and "passes" in page.verdict.text()
+    page.cycle_spin.setValue(0.2)  # far too short a cycle for the effective torque
+    page.calculate()
+    assert "fails" in page.verdict.text()
+    texts = [page.checks_table.item(r, 3).text() for r in range(page.checks_table.rowCount())]
+    assert "FAIL" in texts
+
+
+def test_connect_dialog_defaults_to_the_simulated_drive_and_remembers(qtbot):
+    dialog = ConnectDialog(ports=[("/dev/ttyUSB0", "FT232R USB UART")])
+    qtbot.addWidget(dialog)
+    assert dialog.sim_radio.isChecked()
+    assert dialog.url().startswith("sim://FHA-25C-50-US250")
+    assert dialog.baud_rate() == 19200
+    assert dialog.port_combo.itemText(0) == "/dev/ttyUSB0 — FT232R USB UART"
+    dialog.address_radio.setChecked(True)
+    dialog._accept()
+    assert "Type a device" in dialog.problem_label.text()  # nothing typed: refused, stays open
+    dialog.address_edit.setText("socket://127.0.0.1:5020")
+    dialog._accept()
+    assert dialog.result() == ConnectDialog.DialogCode.Accepted
+    again = ConnectDialog(ports=[])
+    qtbot.addWidget(again)
+    assert again.address_radio.isChecked() and again.url() == "socket://127.0.0.1:5020"
+
+
+def test_window_layout_and_page_are_remembered(make_window):
+    window = make_window()
+    window.resize(1024, 600)  # narrower than its minimum width would be clamped
+    window.show_page("alarms")
+    window.save_layout()
+    assert QSettings().value("window/page") == 3
+    second = make_window()
+    assert second.tabs.currentIndex() == 3
+    assert second.size().height() == 600  # not the default 720
+
+
+def test_pairing_warning_must_be_acknowledged(make_window, qtbot):
+    from tests.gui.fake_drive import FakeDriveClient
+
+    fake = FakeDriveClient()  # driver HA-655-2-200, ADJUSTED FOR USE WITH FHA-25C-50-US250
+    window = make_window(open_client=lambda url, baud: fake, connect="fake://")
+    page = window.connection_page
+    assert not page.warning_pending  # the label's actuator was taken over: no warning
+    page.actuator_combo.setCurrentText("FHA-32C-50-US250")
+    page.check_pairing()
+    assert page.warning_pending
+    text = page.warning_label.text()
+    assert "ADJUSTED FOR USE WITH FHA-25C-50-US250" in text and "HA-655-4-200" in text
+    assert not window.session.actuator_acknowledged
+    page.acknowledge()
+    assert not page.warning_pending and window.session.actuator_acknowledged
