@@ -67,8 +67,9 @@ def main() -> int:
     env["XDG_DATA_HOME"] = f"{tmp}/data"
     results = []
     for _ in range(runs):
-        done = subprocess.run([sys.executable, "-c", CHILD, str(ROOT)], capture_output=True, text=True,
-                              env=env, timeout=60)
+        done = subprocess.run(
+            [sys.executable, "-c", CHILD, str(ROOT)], capture_output=True, text=True, env=env, timeout=60
+        )
         line = [ln for ln in done.stdout.splitlines() if ln.startswith("{")]
         if done.returncode or not line:
             print(done.stdout, done.stderr, file=sys.stderr)

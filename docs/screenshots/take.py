@@ -43,6 +43,7 @@ def main() -> int:
         def wrap(fn):
             steps.append((delay_ms, fn))
             return fn
+
         return wrap
 
     def shot(name: str):
@@ -73,7 +74,7 @@ def main() -> int:
 
     @step(600)
     def jog():
-        page = window.show_page("jog")
+        window.show_page("jog")
         window.link.jog_press(8.0)
 
     @step(700)
@@ -121,6 +122,7 @@ def main() -> int:
             def go():
                 fn()
                 run(index + 1)
+
             QTimer.singleShot(delay, go)
 
     run()

@@ -13,6 +13,7 @@ from PySide6.QtWidgets import (
     QMessageBox,
     QTabWidget,
     QToolBar,
+    QVBoxLayout,
     QWidget,
 )
 
@@ -94,9 +95,6 @@ class MainWindow(QMainWindow):
         from fha_studio.gui.pages.direction import DirectionPage
         from fha_studio.gui.pages.jog import JogPage
         from fha_studio.gui.pages.parameters import ParametersPage
-        from fha_studio.gui.pages.sizing import SizingPage
-        from fha_studio.gui.procedures.page import ProceduresPage
-        from fha_studio.gui.scope.page import ScopePage
 
         self.tabs = QTabWidget(self)
         self.tabs.setObjectName("pages")
@@ -106,22 +104,37 @@ class MainWindow(QMainWindow):
         self.direction_page = DirectionPage(self.session, self)
         self.alarms_page = AlarmsPage(self.session, self)
         self.jog_page = JogPage(self.session, self)
-        self.sizing_page = SizingPage(self.session, self)
-        self.scope_page = ScopePage(self.session, self)
-        self.procedures_page = ProceduresPage(self.session, self)
+        # pages with plots (pyqtgraph, numpy) are built when first shown: start-up stays short
+        self._lazy: dict[str, LazyPage] = {
+            "sizing": LazyPage(self, _sizing_page),
+            "scope": LazyPage(self, _scope_page),
+            "procedures": LazyPage(self, _procedures_page),
+        }
         for page, title in (
             (self.connection_page, "C&onnection"),
             (self.parameters_page, "&Parameters"),
             (self.direction_page, "&Rotary direction"),
             (self.alarms_page, "&Alarms"),
             (self.jog_page, "&Jog && test run"),
-            (self.sizing_page, "Si&zing"),
-            (self.scope_page, "&Scope"),
-            (self.procedures_page, "Proced&ures"),
+            (self._lazy["sizing"], "Si&zing"),
+            (self._lazy["scope"], "&Scope"),
+            (self._lazy["procedures"], "Proced&ures"),
         ):
             self.tabs.addTab(page, title)
         self.setCentralWidget(self.tabs)
         self.alarms_page.sigAlarmAttention.connect(self._on_alarm_attention)
+
+    @property
+    def sizing_page(self):
+        return self._lazy["sizing"].page
+
+    @property
+    def scope_page(self):
+        return self._lazy["scope"].page
+
+    @property
+    def procedures_page(self):
+        return self._lazy["procedures"].page
 
     def _build_status_bar(self) -> None:
         bar = self.statusBar()
@@ -160,7 +173,15 @@ class MainWindow(QMainWindow):
                 save(settings)
 
     def _pages(self) -> list[QWidget]:
-        return [self.tabs.widget(i) for i in range(self.tabs.count())]
+        """The pages built so far (a lazy page not yet shown has nothing to save or stop)."""
+        pages = []
+        for i in range(self.tabs.count()):
+            widget = self.tabs.widget(i)
+            if isinstance(widget, LazyPage):
+                widget = widget.built
+            if widget is not None:
+                pages.append(widget)
+        return pages
 
     PAGE_NAMES = ("connection", "parameters", "direction", "alarms", "jog", "sizing", "scope", "procedures")
 
@@ -169,7 +190,8 @@ class MainWindow(QMainWindow):
         if name not in self.PAGE_NAMES:
             raise ValueError(f"no page {name!r}; pages: {', '.join(self.PAGE_NAMES)}")
         self.tabs.setCurrentIndex(self.PAGE_NAMES.index(name))
-        return self.tabs.currentWidget()
+        widget = self.tabs.currentWidget()
+        return widget.page if isinstance(widget, LazyPage) else widget
 
     # -- actions --------------------------------------------------------------------------------
     @Slot()
@@ -313,6 +335,58 @@ class MainWindow(QMainWindow):
             if stop:
                 stop()
         self.link.shutdown()
+
+
+class LazyPage(QWidget):
+    """A tab whose page is built the first time it is shown (or asked for through `page`).
+
+    A page built after the link came up learns of it through its `_on_connected(info)` (the
+    slot it connects to the link's sigConnected), and gets its saved settings restored."""
+
+    def __init__(self, window: MainWindow, factory):
+        super().__init__()
+        self._window = window
+        self._factory = factory
+        self.built: QWidget | None = None
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+
+    @property
+    def page(self) -> QWidget:
+        if self.built is None:
+            page = self._factory(self._window)
+            self.built = page
+            self.layout().addWidget(page)
+            restore = getattr(page, "restore_settings", None)
+            if restore:
+                restore(QSettings())
+            link = self._window.link
+            on_connected = getattr(page, "_on_connected", None)
+            if link.connected and on_connected is not None:
+                on_connected(link.info)
+        return self.built
+
+    def showEvent(self, event) -> None:
+        _ = self.page
+        super().showEvent(event)
+
+
+def _sizing_page(window: MainWindow) -> QWidget:
+    from fha_studio.gui.pages.sizing import SizingPage
+
+    return SizingPage(window.session, window)
+
+
+def _scope_page(window: MainWindow) -> QWidget:
+    from fha_studio.gui.scope.page import ScopePage
+
+    return ScopePage(window.session, window)
+
+
+def _procedures_page(window: MainWindow) -> QWidget:
+    from fha_studio.gui.procedures.page import ProceduresPage
+
+    return ProceduresPage(window.session, window)
 
 
 def _command_words(cmd: Cmd) -> str:

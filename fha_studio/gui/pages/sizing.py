@@ -88,7 +88,9 @@ class SizingPage(QWidget):
         self.material_combo = QComboBox()
         for m in self.materials:
             self.material_combo.addItem(f"{m.name} (SG {m.specific_gravity:g})", m.density_kg_m3)
-        self.material_combo.setCurrentIndex(max(0, self.material_combo.findText("Aluminum", Qt.MatchFlag.MatchStartsWith)))
+        self.material_combo.setCurrentIndex(
+            max(0, self.material_combo.findText("Aluminum", Qt.MatchFlag.MatchStartsWith))
+        )
         form.addRow("&Shape:", self.shape_combo)
         form.addRow("&Material:", self.material_combo)
         self.dims_widget = QWidget()
@@ -97,7 +99,9 @@ class SizingPage(QWidget):
         form.addRow(self.dims_widget)
         self.axis_combo = QComboBox()
         self.offset_spin = _spin(0.0, 0.0, 10000.0, 1, " mm")
-        self.offset_spin.setToolTip("Distance F from the part's centre of gravity to the output axis: I = Ig + m F²")
+        self.offset_spin.setToolTip(
+            "Distance F from the part's centre of gravity to the output axis: I = Ig + m F²"
+        )
         form.addRow("&Axis of rotation:", self.axis_combo)
         form.addRow("&Offset F from the output axis:", self.offset_spin)
         self.part_label = QLabel("")
@@ -125,7 +129,9 @@ class SizingPage(QWidget):
         self.angle_spin = _spin(90.0, 0.1, 100000.0, 1, " °")
         self.cycle_spin = _spin(2.0, 0.01, 100000.0, 2, " s")
         self.torque_spin = _spin(0.0, -10000.0, 10000.0, 1, " N·m")
-        self.torque_spin.setToolTip("Load torque TL, positive when it opposes the rotation (friction, a load to lift)")
+        self.torque_spin.setToolTip(
+            "Load torque TL, positive when it opposes the rotation (friction, a load to lift)"
+        )
         d_form.addRow("Ac&tuator:", self.actuator_combo)
         d_form.addRow("Load &inertia JL:", self.inertia_spin)
         d_form.addRow("Spee&d N:", self.speed_spin)
@@ -273,14 +279,18 @@ class SizingPage(QWidget):
             return
         self.add_part_button.setEnabled(True)
         note = f"<br><i>{shape.note}</i>" if shape.note else ""
-        self.part_label.setText(f"mass {shape.mass_kg:.3g} kg, I = <b>{total:.4g} kg·m²</b> about the output axis{note}")
+        self.part_label.setText(
+            f"mass {shape.mass_kg:.3g} kg, I = <b>{total:.4g} kg·m²</b> about the output axis{note}"
+        )
         self.part_label.setWordWrap(True)
 
     @Slot()
     def add_part(self) -> None:
         shape, total = self.current_part()
-        text = (f"{self.shape_combo.currentText()}, {self.material_combo.currentText().split(' (')[0]}: "
-                f"{shape.mass_kg:.3g} kg, {total:.4g} kg·m²")
+        text = (
+            f"{self.shape_combo.currentText()}, {self.material_combo.currentText().split(' (')[0]}: "
+            f"{shape.mass_kg:.3g} kg, {total:.4g} kg·m²"
+        )
         self.parts.append((text, total))
         self.parts_list.addItem(text)
         self._parts_changed()
@@ -334,10 +344,14 @@ class SizingPage(QWidget):
         self.result = result
         failed = result.failed
         if result.ok:
-            self.verdict.setText(f"<b style='color:#2e7d32'>{code} passes every check</b> of Chapter 2 for this duty.")
+            self.verdict.setText(
+                f"<b style='color:#2e7d32'>{code} passes every check</b> of Chapter 2 for this duty."
+            )
         else:
             names = ", ".join(c.name for c in failed)
-            self.verdict.setText(f"<b style='color:#b00020'>{code} fails {len(failed)} check(s)</b>: {names}.")
+            self.verdict.setText(
+                f"<b style='color:#b00020'>{code} fails {len(failed)} check(s)</b>: {names}."
+            )
         self._fill_checks(result)
         self._draw(result)
         try:
@@ -345,19 +359,29 @@ class SizingPage(QWidget):
         except (SizingError, ValueError):
             self.suggested = []
         if self.suggested:
-            self.suggestion.setText("<b>Actuators this duty passes on</b> (200 V, incremental; smallest first): "
-                                    + ", ".join(self.suggested[:8]) + (" …" if len(self.suggested) > 8 else ""))
+            self.suggestion.setText(
+                "<b>Actuators this duty passes on</b> (200 V, incremental; smallest first): "
+                + ", ".join(self.suggested[:8])
+                + (" …" if len(self.suggested) > 8 else "")
+            )
         else:
-            self.suggestion.setText("<b style='color:#b00020'>No catalogue actuator passes this duty.</b> "
-                                    "Lengthen the cycle, lower the speed or the load inertia.")
+            self.suggestion.setText(
+                "<b style='color:#b00020'>No catalogue actuator passes this duty.</b> "
+                "Lengthen the cycle, lower the speed or the load inertia."
+            )
 
     def _fill_checks(self, result) -> None:
         checks = list(result.checks)
         self.checks_table.setRowCount(len(checks))
         for row, check in enumerate(checks):
             unit = f" {check.unit}" if check.unit else ""
-            cells = [check.name, f"{check.value:.4g}{unit}", f"{check.comparison} {check.limit:.4g}{unit}",
-                     "pass" if check.ok else "FAIL", check.section]
+            cells = [
+                check.name,
+                f"{check.value:.4g}{unit}",
+                f"{check.comparison} {check.limit:.4g}{unit}",
+                "pass" if check.ok else "FAIL",
+                check.section,
+            ]
             for col, text in enumerate(cells):
                 item = QTableWidgetItem(text)
                 item.setToolTip(check.note)
@@ -373,18 +397,37 @@ class SizingPage(QWidget):
         self.plot.clear()
         tm, nm = env["max_torque_nm"], env["max_speed_rpm"]
         tc, nc = env["continuous_torque_nm"], env["continuous_speed_rpm"]
-        self.plot.plot([0, nm, nm, 0], [tm, tm, -tm, -tm], pen=pg.mkPen("#c62828", width=2, style=Qt.PenStyle.DashLine),
-                       name="maximum range")
-        self.plot.plot([0, nc, nc, 0], [tc, tc, -tc, -tc], pen=pg.mkPen("#1565c0", width=2), name="continuous range")
+        self.plot.plot(
+            [0, nm, nm, 0],
+            [tm, tm, -tm, -tm],
+            pen=pg.mkPen("#c62828", width=2, style=Qt.PenStyle.DashLine),
+            name="maximum range",
+        )
+        self.plot.plot(
+            [0, nc, nc, 0], [tc, tc, -tc, -tc], pen=pg.mkPen("#1565c0", width=2), name="continuous range"
+        )
         points = result.operating_points()
         duty = [p for p in points if p.phase != "effective"]
-        self.plot.plot([p.speed_rpm for p in duty], [p.torque_nm for p in duty],
-                       pen=pg.mkPen("#555", width=1.5), symbol="o", symbolSize=7, symbolBrush="#555",
-                       name="duty: accelerate, run, brake")
+        self.plot.plot(
+            [p.speed_rpm for p in duty],
+            [p.torque_nm for p in duty],
+            pen=pg.mkPen("#555", width=1.5),
+            symbol="o",
+            symbolSize=7,
+            symbolBrush="#555",
+            name="duty: accelerate, run, brake",
+        )
         eff = [p for p in points if p.phase == "effective"]
         if eff:
             ok = result.effective_torque_nm <= tc and result.average_speed_rpm <= nc
-            self.plot.plot([eff[0].speed_rpm], [eff[0].torque_nm], pen=None, symbol="star", symbolSize=16,
-                           symbolBrush="#2e7d32" if ok else "#b00020", name="effective torque at average speed")
+            self.plot.plot(
+                [eff[0].speed_rpm],
+                [eff[0].torque_nm],
+                pen=None,
+                symbol="star",
+                symbolSize=16,
+                symbolBrush="#2e7d32" if ok else "#b00020",
+                name="effective torque at average speed",
+            )
         self.plot.setXRange(0, max(nm, self.speed_spin.value()) * 1.1, padding=0)
         self.plot.setYRange(-tm * 1.15, tm * 1.15, padding=0)
