@@ -788,6 +788,11 @@ class DriveClient:
         self._require(Command.PWC)
         self._transact(Command.PWC)
 
+    def inject_alarm(self, code: int) -> None:
+        """Raise alarm ``code`` as the drive's supervision would (FLT, simulated drive only)."""
+        self._require(Command.FLT)
+        self._transact(Command.FLT, code)
+
     def set_sensor_angle(self, which: str, angle_deg: float) -> None:
         """Move the origin slit (``"origin"``) or the dog of limit switch 1 / 2 (``"ls1"``, ``"ls2"``)
         to ``angle_deg`` (output flange, CW positive): SNO / SNA / SNB, simulated drive only."""

@@ -84,6 +84,11 @@ class MiniDrive:
             return OK
         if c in (Command.JOG, Command.SPD, Command.STP, Command.ACL, Command.PWC):
             return OK
+        if c in (Command.FLT, Command.SNO, Command.SNA, Command.SNB):
+            self.moves.append((c.value, v))
+            return OK
+        if c is Command.SNQ:
+            return Reply(("0,-9000,9000",))
         if c is Command.MOV:
             self.moves.append(v)
             return OK

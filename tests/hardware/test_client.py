@@ -161,6 +161,14 @@ def test_alarms_and_io(client_for, mini):
         client.set_inputs(warp_drive=True)
 
 
+def test_sim_only_training_commands(client_for, mini):
+    client, _drive = client_for(mini)
+    client.inject_alarm(50)
+    client.set_sensor_angle("ls1", -95.5)
+    assert client.sensor_angles() == pytest.approx({"origin": 0.0, "ls1": -90.0, "ls2": 90.0})
+    assert mini.moves == [("FLT", 50), ("SNA", -9550)]
+
+
 def test_trace_capture_reads_all_blocks(client_for, mini):
     client, _ = client_for(mini)
     assert client.configure_trace([103, 100], divider=2) == (100, 103)

@@ -234,3 +234,25 @@ def test_value_formats():
         p.parse_int("12a")
     assert p.split_absolute_position(p.join_absolute_position(-3, 100)) == (-3, 100)
     assert p.character_time_s() == pytest.approx(1 / 1920)
+
+
+def test_protocol_doc_examples_are_what_the_codec_says():
+    doc = (paths.resources_dir().parent / "docs" / "protocol.md").read_text()
+    examples = doc[doc.index("## Examples, byte by byte") : doc.index("## Transports")]
+    hex_lines = re.findall(r"^([<>]) ((?:[0-9A-F]{2} )+)\s*(\S.*)?$", examples, flags=re.M)
+    assert len(hex_lines) > 20
+    for direction, hexes, _text in hex_lines:
+        data = bytes.fromhex(hexes)
+        if direction == ">" and len(data) == p.FRAME_LENGTH:
+            used, request = decode_request(data)
+            assert used == p.FRAME_LENGTH and isinstance(request, Request | UnknownRequest), data
+            assert encode_or_none(request) in (data, None)
+        elif direction == "<":
+            messages, pending = feed_all(decode_reply, [data])
+            assert pending == b"" and isinstance(messages[-1], Reply), data
+            if data.startswith(b"5\xff"):
+                assert messages[-1].corrupt
+
+
+def encode_or_none(request):
+    return request.encode() if isinstance(request, Request) else None
