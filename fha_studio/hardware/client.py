@@ -604,10 +604,17 @@ class DriveClient:
             return self._capabilities
 
     def identify(self) -> Identity | None:
-        """Driver model, adjusted-for actuator, firmware; None on a drive without IDN."""
+        """Driver model, adjusted-for actuator, firmware; None on a drive without IDN.
+
+        An HA-675 switches ``model`` to the HA-675 parameter model (same items, all uncertain).
+        """
         if Command.IDN not in self._capabilities.commands:
             return None
-        return self._transact(Command.IDN, parse=_identity)
+        identity = self._transact(Command.IDN, parse=_identity)
+        driver = "HA-675" if identity.driver_model.upper().startswith("HA-675") else "HA-655"
+        if driver != self.model.driver:
+            self.model = load_parameter_model(driver)
+        return identity
 
     # --- parameters -------------------------------------------------------------------------------
 

@@ -52,6 +52,14 @@ def test_capabilities_and_identity_of_a_full_drive(client_for, mini):
     assert drive.commands()[:2] == ["CAP", "DGR"]
 
 
+def test_an_ha675_gets_its_parameter_model(client_for, mini):
+    mini.override["IDN"] = lambda r: Reply(("HA-675-4-200", "FHA-32C-100-S248", "fw 2"))
+    client, _ = client_for(mini)
+    assert client.model.driver == "HA-655"
+    client.identify()
+    assert client.model.driver == "HA-675" and not client.model.by_key("rotary_direction").certain
+
+
 def test_read_and_verified_write_of_rotary_direction(client_for, mini):
     client, _ = client_for(mini)
     assert client.read_parameter("system", 8) == 0
