@@ -318,3 +318,29 @@ def test_trace_level_trigger_keeps_pretrigger_samples(make_drive):
     assert drive.execute("TST", 0).lines == ("3,60",)
     speeds = [int(line) for line in drive.execute("TRB", 0).lines]
     assert speeds[19] < 500 <= speeds[20]
+
+
+def test_speed_mode_after_a_power_cycle_has_no_error_counter(make_drive):
+    drive = make_drive()
+    drive.write_parameter(Mode.SYSTEM, 0, 1)  # control mode: speed (restart required)
+    drive.write_parameter(Mode.SYSTEM, 6, 1)  # an allowance that position mode would overflow
+    assert not drive.speed_mode
+    drive.power_cycle()
+    assert drive.speed_mode
+    drive.set_servo(True)
+    jog_for(drive, 40.0, 0.4)
+    assert drive.alarm == 0 and drive.error_pulses == 0
+    assert speed_rpm(drive) == pytest.approx(40.0, abs=1.0)
+
+
+def test_quantised_feedback_gives_a_real_drives_current_noise_while_moving(make_drive):
+    drive = make_drive()
+    drive.set_servo(True)
+    jog_for(drive, 30.0, 0.4)
+    currents = []
+    for _ in range(40):
+        drive.jog(30.0)
+        drive.advance(0.002)
+        currents.append(drive.monitor(104))
+    assert len(set(currents)) > 5  # not a constant: the pulse-difference speed is noisy
+    assert abs(sum(currents) / len(currents)) < 500  # ... around zero without friction

@@ -91,9 +91,12 @@ def build_model(resolved: ResolvedActuator, config: SimConfig) -> AxisModel:
         raise SimConfigError(f"simulated drive: {exc}") from None
 
 
-def servo_settings(model: AxisModel, values: dict[str, int], servo_rate_hz: float) -> ServoSettings:
+def servo_settings(model: AxisModel, values: dict[str, int], servo_rate_hz: float,
+                   quantised_feedback: bool = True) -> ServoSettings:
     """The HA-655 items (wire values by key) as physics ServoSettings.
 
+    Control mode (system 0): 0 position, 1 speed (JOG is then the speed command). With
+    ``quantised_feedback`` the loops see whole encoder pulses, as a real drive does.
     The speed loop gain is a bandwidth in Hz (tune 0): Kv = 2 pi f J / Kt on the rigid-body
     inertia of the axis (actuator + load), as the physics' own ``tuned_for`` does.
     """
@@ -108,6 +111,8 @@ def servo_settings(model: AxisModel, values: dict[str, int], servo_rate_hz: floa
         rotary_direction=int(values["rotary_direction"]),
         in_position_range_pulses=int(values["in_position_range"]),
         servo_rate_hz=servo_rate_hz,
+        control_mode="speed" if values["control_mode"] == 1 else "position",
+        quantised_feedback=quantised_feedback,
     )
 
 

@@ -276,7 +276,7 @@ class SimDrive:
     # ------------------------------------------------------------------ power
     def _settings(self, values: dict[tuple[Mode, int], int]) -> ServoSettings:
         by_key = {self.parameters.item(mode, number).key: v for (mode, number), v in values.items()}
-        return servo_settings(self.model, by_key, self.servo_rate_hz)
+        return servo_settings(self.model, by_key, self.servo_rate_hz, self.config.quantised)
 
     def _power_on(self) -> None:
         """Control power on: active items from the EEPROM, counters from zero, no alarm."""
@@ -391,8 +391,15 @@ class SimDrive:
         return self._pulses(self._direction * (self._axis.output_pos_rad - self._feedback_zero_rad))
 
     @property
+    def speed_mode(self) -> bool:
+        """Control mode (system 0) is speed: no position loop, the error counter stays at zero."""
+        return self._axis.settings.control_mode == "speed"
+
+    @property
     def command_pulses(self) -> int:
         """Monitor 101: command position in output pulses, command sense."""
+        if self.speed_mode:
+            return self.feedback_pulses
         return self._pulses(self._direction * (self._axis.command_pos_rad - self._feedback_zero_rad))
 
     @property
@@ -731,7 +738,7 @@ class SimDrive:
         if self._regen_j > c.regeneration_energy_capacity_j:
             self.raise_alarm(41)
         # 60 error counter overflow against parameter 6
-        if self.servo_on:
+        if self.servo_on and not self.speed_mode:
             item = self.parameters.by_key("position_error_allowance")
             allowance_pulses = self._param("position_error_allowance") * item.scale
             if axis.peak_error_pulses > allowance_pulses:

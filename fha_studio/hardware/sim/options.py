@@ -20,6 +20,8 @@ Options (all optional):
 ``eeprom``         EEPROM file; ``user`` = the user data directory; default: a temporary file
                    removed when the drive closes
 ``paced``          1 (default): replies paced like a 19200 baud line; 0: at memory speed
+``quantised``      1 (default): the servo loops see whole encoder pulses (a real drive's current
+                   noise); 0: ideal feedback
 ``oww_clear_s``    how long OWW takes to clear the multi-turn data [s] (default 5)
 =================  ==========================================================================
 """
@@ -51,6 +53,7 @@ class SimConfig:
     effects: dict[str, dict[str, float]] = field(default_factory=dict)
     eeprom: str | None = None
     paced: bool = True
+    quantised: bool = True
     oww_clear_s: float | None = None
 
     def __post_init__(self) -> None:
@@ -117,7 +120,7 @@ def parse_effects(specs: list[str]) -> dict[str, dict[str, float]]:
 
 _URL_KEYS = {
     "driver", "load_inertia", "load_inertia_kgm2", "brake", "sensors", "origin_deg", "ls1_deg",
-    "ls2_deg", "effects", "effect", "eeprom", "paced", "oww_clear_s",
+    "ls2_deg", "effects", "effect", "eeprom", "paced", "quantised", "oww_clear_s",
 }
 
 
@@ -145,7 +148,7 @@ def config_from_url(url: str) -> SimConfig:
     inertia = last("load_inertia_kgm2") if last("load_inertia_kgm2") is not None else last("load_inertia")
     if inertia is not None:
         values["load_inertia_kgm2"] = _finite("load_inertia", inertia, minimum=0.0)
-    for key in ("brake", "sensors", "paced"):
+    for key in ("brake", "sensors", "paced", "quantised"):
         if last(key) is not None:
             values[key] = _flag(key, last(key))
     for key in ("origin_deg", "ls1_deg", "ls2_deg", "oww_clear_s"):
