@@ -102,6 +102,19 @@ class SensorDogPanel(QWidget):
         record_row.addWidget(self.found_label, 1)
         record_row.addWidget(self.record_button)
         layout.addLayout(record_row)
+        # A drive that reports no position (a real HA-655 with the servo on answers nothing on CN3):
+        # the angle read elsewhere (the controller, a scale on the flange) is typed in.
+        typed_row = QHBoxLayout()
+        self.typed_spin = QDoubleSpinBox()
+        self.typed_spin.setRange(-360.0, 360.0)
+        self.typed_spin.setDecimals(2)
+        self.typed_spin.setSuffix(" °")
+        self.typed_button = QPushButton("Record the typed angle")
+        self.typed_button.clicked.connect(lambda: self.sigRecord.emit(self.typed_spin.value()))
+        typed_row.addWidget(QLabel("Angle read elsewhere:"))
+        typed_row.addWidget(self.typed_spin)
+        typed_row.addWidget(self.typed_button)
+        layout.addLayout(typed_row)
         layout.addStretch(1)
         link.sigStatus.connect(self.on_status)
 

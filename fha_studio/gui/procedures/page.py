@@ -611,5 +611,23 @@ class ProceduresPage(QWidget):
             ):
                 self.history.setItem(row, column, QTableWidgetItem(text))
 
+    # -- settings (called by the main window) --------------------------------------------------
+    def save_settings(self, settings) -> None:
+        settings.setValue("procedures/operator", self.operator_edit.text())
+        if self.session is not None and self.session.path is not None:
+            settings.setValue("procedures/session", str(self.session.path))
+
+    def restore_settings(self, settings) -> None:
+        """Reopen the last session, where it was left (a restart resumes the commissioning)."""
+        operator = settings.value("procedures/operator", "")
+        if operator and not self.operator_edit.text():
+            self.operator_edit.setText(str(operator))
+        path = settings.value("procedures/session", "")
+        if path and self.session is None and Path(str(path)).is_file():
+            try:
+                self.open_session(str(path))
+            except (ValueError, OSError) as exc:
+                self._message(f"The last session could not be reopened: {exc}")
+
     def shutdown(self) -> None:
         self.dog_panel.shutdown()

@@ -194,3 +194,22 @@ def test_from_boxed_actuator_to_signed_report(make_window, qtbot, tmp_path):
         assert wanted in text, wanted
     assert pdf.stat().st_size > 5000
     assert Session.load(tmp_path / "axis1.json").signature["who"] == "T. Trainee"
+
+
+def test_a_restarted_app_reopens_the_session_where_it_was_left(make_window, tmp_path):
+    first = make_window()
+    page = first.show_page("procedures")
+    page.operator_edit.setText("T. Trainee")
+    page.new_session(tmp_path / "axis1.json", "FHA-17C-100-US250")
+    page.select_procedure("installation")
+    page.value_edit.setText("23.5")
+    page.value_button.click()
+    here = page.current_step().id
+    first.save_layout()  # what closing the window does
+    second = make_window()  # the app started again
+    again = second.procedures_page
+    assert again.session is not None and again.session.path == tmp_path / "axis1.json"
+    assert again.operator_edit.text() == "T. Trainee"
+    again.select_procedure("installation")
+    assert again.current_step().id == here
+    assert again.run.state.records[0].value == 23.5

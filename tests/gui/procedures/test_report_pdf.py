@@ -20,6 +20,12 @@ def test_report_prints_to_pdf(qapp, tmp_path):
     context = build_context(CODE)
     session = Session(actuator_code=CODE, operator="T. Trainee", site="Hall 2")
     session.driver = {"model": "HA-655-4-200", "adjusted_for": CODE, "version": "sim"}
+    from PySide6.QtGui import QColor, QImage
+
+    image = QImage(400, 300, QImage.Format.Format_RGB32)
+    image.fill(QColor(200, 30, 30))
+    image.save(str(tmp_path / "plot.png"))
+    session.add_plot("A plot", tmp_path / "plot.png")
     for procedure_id in ("receiving-inspection", "installation"):
         walk(ProcedureRun(session, load_procedure(procedure_id, context), autosave=False))
     html_path, pdf_path = write_report(
@@ -27,6 +33,7 @@ def test_report_prints_to_pdf(qapp, tmp_path):
     )
     data = pdf_path.read_bytes()
     assert data.startswith(b"%PDF") and len(data) > 5000
+    assert b"/Image" in data  # the plot is in the PDF, not only named
     assert "16-M6 depth: 12" in html_path.read_text()
     if shutil.which("pdftotext") is None:
         pytest.skip("pdftotext is not installed: the PDF text is not checked")
