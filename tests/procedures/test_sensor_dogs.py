@@ -19,6 +19,7 @@ def test_edges_are_recorded_where_a_sensor_switches_on(context):
     wizard.observe(140.0, {**OFF, "limit_switch_2": True})
     assert wizard.found("origin_sensor") == 10.0 and wizard.found("limit_switch_2") == 140.0
     assert wizard.edge_direction["limit_switch_2"] == 1
+    assert wizard.edge_intervals_deg["limit_switch_2"] == (11.0, 140.0)
     assert wizard.found("limit_switch_1") is None
 
 
@@ -54,5 +55,11 @@ def test_test_run_is_judged_against_the_recorded_angles(context):
     assert ok and "limit switch 1 (CCW end) at -139.50°" in detail
     ok, detail = wizard.test_run_result(recorded, {"limit_switch_1": [-130.0], "limit_switch_2": [140.0]})
     assert not ok and "never switched on" in detail and "more than 2° apart" in detail
+    # polled slowly: the switch happened between two samples 5° apart, and that interval holds it
+    ok, _ = wizard.test_run_result(
+        recorded,
+        {"limit_switch_1": [(-144.0, -139.0)], "limit_switch_2": [(137.0, 142.0)], "origin_sensor": [0.0]},
+    )
+    assert ok
     with pytest.raises(MoveRefused, match="no test run before"):
         wizard.test_run_plan({"limit_switch_1": -140.0})

@@ -204,14 +204,14 @@ def _check_sensor_test_run(client: DriveClient, step: Step, env: LiveEnv) -> Obs
         )
     wizard = SensorDogWizard.for_context(env.context)
     targets = wizard.test_run_plan(env.sensor_angles_deg)
-    seen: dict[str, list[float]] = {s: [] for s in SENSORS}
+    seen: dict[str, list[tuple[float, float]]] = {s: [] for s in SENSORS}
     angle, io = output_angle_deg(client, env.output_ppr)
     wizard.observe(angle, _sensor_states(io))
     speed = float(step.params.get("speed_rpm", LOW_SPEED_RPM))
 
     def sample(a: float, state: IoState) -> None:
         for sensor in wizard.observe(a, _sensor_states(state)):
-            seen[sensor].append(a)
+            seen[sensor].append(wizard.edge_intervals_deg[sensor])
         if env.on_sample:
             env.on_sample(a, state)
 
@@ -223,7 +223,8 @@ def _check_sensor_test_run(client: DriveClient, step: Step, env: LiveEnv) -> Obs
         if env.cancelled():
             return Observation(None, False, "test run cancelled")
     passed, detail = wizard.test_run_result(env.sensor_angles_deg, seen)
-    return Observation({k: v for k, v in seen.items()}, passed, detail)
+    # recorded: where each sensor switched on, per pass (the angle of the first sample it was on)
+    return Observation({k: [round(e[1], 3) for e in v] for k, v in seen.items()}, passed, detail)
 
 
 def _sensor_states(io: IoState) -> dict[str, bool]:

@@ -61,6 +61,8 @@ class SensorDogWizard:
     # Angle where each sensor last switched on, and the direction of travel then (+1 CW, -1 CCW).
     edges_deg: dict[str, float] = field(default_factory=dict)
     edge_direction: dict[str, int] = field(default_factory=dict)
+    # The sensor was off at the previous sample: it switched somewhere between the two angles.
+    edge_intervals_deg: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     @classmethod
     def for_context(cls, context: Mapping[str, Any]) -> SensorDogWizard:
@@ -76,6 +78,11 @@ class SensorDogWizard:
             now = bool(states.get(sensor, False))
             if now and not self.states[sensor]:
                 self.edges_deg[sensor] = angle_deg
+                low = angle_deg if previous is None else min(previous, angle_deg)
+                self.edge_intervals_deg[sensor] = (
+                    low,
+                    angle_deg if previous is None else max(previous, angle_deg),
+                )
                 self.edge_direction[sensor] = 0 if previous is None else (1 if angle_deg >= previous else -1)
                 switched_on.append(sensor)
             self.states[sensor] = now
@@ -123,19 +130,29 @@ class SensorDogWizard:
     def test_run_result(self, recorded: Mapping[str, float], seen: Mapping[str, list[float]]):
         """Compare the switching angles seen during the test run with the recorded ones.
 
-        ``seen[sensor]`` lists the angles where the sensor switched on during the run. Returns
-        ``(passed, detail)``.
+        ``seen[sensor]`` lists where the sensor switched on during the run: an angle, or the
+        interval ``(low, high)`` between the sample where it was still off and the one where it was
+        on (so a slow poll does not count as a misplaced sensor). Returns ``(passed, detail)``.
         """
         problems, lines = [], []
+
+        def distance(edge, want: float) -> float:
+            low, high = edge if isinstance(edge, tuple | list) else (edge, edge)
+            return 0.0 if low <= want <= high else min(abs(low - want), abs(high - want))
+
+        def where(edge) -> float:
+            return edge[-1] if isinstance(edge, tuple | list) else edge
+
         for sensor in SENSORS:
-            angles = seen.get(sensor, [])
+            edges = seen.get(sensor, [])
             want = recorded[sensor]
-            if not angles:
+            if not edges:
                 problems.append(f"{SENSOR_NAMES[sensor]} never switched on (recorded at {want:+.2f}°)")
                 continue
-            nearest = min(angles, key=lambda a: abs(a - want))
+            best = min(edges, key=lambda e: distance(e, want))
+            nearest = where(best)
             lines.append(f"{SENSOR_NAMES[sensor]} at {nearest:+.2f}° (recorded {want:+.2f}°)")
-            if abs(nearest - want) > self.tolerance_deg:
+            if distance(best, want) > self.tolerance_deg:
                 problems.append(
                     f"{SENSOR_NAMES[sensor]} switched at {nearest:+.2f}°, recorded {want:+.2f}° "
                     f"(more than {self.tolerance_deg:g}° apart)"
