@@ -8,7 +8,7 @@ import subprocess
 
 import pytest
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import IO_BRAKE_RELEASED, Cmd
 from fha_studio.logic.procedures import Session
 from tests.procedures.walk import good_answer
 
@@ -93,8 +93,9 @@ def test_trainee_walks_inspection_and_wiring_with_a_failed_check_and_a_resume(wi
 
     def trainee(step):  # switches the brake's 24 V as the step asks (on the simulated drive: INP)
         if step.id in ("brake-releases", "brake-holds"):
-            with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SET_INPUTS):
-                window.link.send(Cmd.SET_INPUTS, {"brake_released": step.id == "brake-releases"})
+            want = step.id == "brake-releases"
+            window.link.send(Cmd.SET_INPUTS, {"brake_released": want})
+            qtbot.waitUntil(lambda: window.link.status.bit(IO_BRAKE_RELEASED) is want, timeout=15000)
 
     _walk(page, qtbot, "wiring", before=trainee)
     wiring = Session.load(path).runs["wiring"]
@@ -112,7 +113,7 @@ def test_sensor_dogs_set_on_the_simulated_drive_and_the_report_prints(window, qt
     page.yes_button.click()
     panel = page.dog_panel
     assert page.inputs.currentWidget() is panel and panel.sim_box.isVisibleTo(panel)
-    qtbot.waitUntil(lambda: panel.wizard.angle_deg is not None, timeout=3000)
+    qtbot.waitUntil(lambda: panel.wizard.angle_deg is not None, timeout=15000)
     # moves past the movable range are refused before anything is sent
     assert not panel.move_to(179.0)
     assert "movable range" in page.message_label.text()
@@ -127,7 +128,7 @@ def test_sensor_dogs_set_on_the_simulated_drive_and_the_report_prints(window, qt
         assert page.current_step().sensor == sensor
         go_to(angle)
         panel.set_dog_button.click()  # the trainee turns the dog until its switch actuates here
-        qtbot.waitUntil(lambda s=sensor: panel.wizard.states[s], timeout=3000)
+        qtbot.waitUntil(lambda s=sensor: panel.wizard.states[s], timeout=15000)
         panel.record_button.click()
         assert page.session.sensor_angles_deg[sensor] == pytest.approx(angle, abs=0.6)
     page.yes_button.click()  # screws tightened
@@ -166,8 +167,8 @@ def test_from_boxed_actuator_to_signed_report(make_window, qtbot, tmp_path):
         if step.id in ("brake-releases", "brake-holds"):
             assert page.sim_brake_check.isVisibleTo(page)
             want = step.id == "brake-releases"
-            with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SET_INPUTS):
-                page.sim_brake_check.setChecked(want)
+            page.sim_brake_check.setChecked(want)
+            qtbot.waitUntil(lambda: window.link.status.bit(IO_BRAKE_RELEASED) is want, timeout=15000)
 
     for procedure_id in ("receiving-inspection", "installation", "wiring", "rotary-direction"):
         _walk(page, qtbot, procedure_id, before=trainee)
