@@ -1,0 +1,80 @@
+"""``fha-studio discrepancy``: find where a recording and the catalogue model disagree (issue 4).
+
+Prints a human summary (each missing effect with its fitted parameters and the gap on held-out
+data), optionally writes the JSON report and the updated model file (fha-axis-model/1 TOML).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+from fha_studio.cli import CliError
+
+ORDER = 40
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "discrepancy",
+        help="name the effect missing from the model of a recorded axis and show the gap shrink",
+        description="Compare an fha-recording/1 file with the catalogue model of its declared actuator: "
+        "where they disagree, which effect is missing (Coulomb/viscous friction, gravity, offset, inertia "
+        "error, torque ripple; with load_pos: kinematic error, wind-up, lost motion), its parameters, and "
+        "the RMS gap before and after on held-out data.",
+    )
+    p.add_argument("recording", metavar="RECORDING.csv", help="the recording (fha-recording/1)")
+    p.add_argument("--json", metavar="REPORT.json", help="write the report as JSON")
+    p.add_argument(
+        "--model-out", metavar="MODEL.toml", help="write the updated axis model (fha-axis-model/1)"
+    )
+    p.add_argument(
+        "--window",
+        type=int,
+        metavar="SAMPLES",
+        help="Savitzky-Golay window in samples (default: chosen from the noise)",
+    )
+    p.add_argument("--no-resim", action="store_true", help="skip the closed-loop re-simulation")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from fha_studio.logic.modelcheck import ModelCheckError, run_modelcheck
+    from fha_studio.recording import RecordingError, read_recording
+
+    if args.window is not None and args.window < 11:
+        raise CliError("--window must be at least 11 samples")
+    try:
+        rec = read_recording(args.recording)
+    except RecordingError as exc:
+        raise CliError(str(exc)) from None
+    try:
+        result = run_modelcheck(rec, window=args.window, resimulate=not args.no_resim)
+    except ModelCheckError as exc:
+        raise CliError(f"{args.recording}: {exc}") from None
+    print(
+        f"{args.recording}: {result.actuator}, {len(rec)} samples over {rec.duration_s:.3g} s "
+        f"(Savitzky-Golay window {result.window_samples} samples = {1000 * result.window_s:.0f} ms)"
+    )
+    for line in result.summary_lines():
+        print(line)
+    if args.json:
+        Path(args.json).write_text(json.dumps(_finite(result.to_json()), indent=2) + "\n", encoding="utf-8")
+        print(f"report written to {args.json}")
+    if args.model_out:
+        result.write_model(args.model_out)
+        print(f"updated model written to {args.model_out}")
+    return 0
+
+
+def _finite(obj):
+    """JSON has no infinity or NaN: write them as null."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_finite(v) for v in obj]
+    return obj

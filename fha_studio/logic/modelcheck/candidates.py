@@ -1,0 +1,389 @@
+"""The candidate effects: how each one shows in a residual channel (its regressor columns).
+
+Ids and parameter names are the contract of issue 4 (the same as fha_studio.physics.Effects).
+Torque channel (N m): what the motor supplied (Kt x current) minus what the nominal model needs
+((J_actuator + J_load_declared) x acceleration). Position channel (arcsec): load_pos - pos.
+
+Every regressor is computed on the whole uniformly sampled record and smoothed with the analysis
+filter (see signals.py), so measured and modelled sides carry the same bandwidth.
+Each candidate turns its fitted linear coefficients (and shape parameters) into contract
+parameters with one-sigma uncertainties (delta method) and gives its *size*: the effect's typical
+magnitude in the channel's unit, which the practical-significance floor is compared with.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fha_studio.logic.modelcheck.signals import ARCSEC_PER_RAD, Signals
+
+TORQUE = "torque"
+POSITION = "position"
+CHANNEL_UNITS = {TORQUE: "N m", POSITION: "arcsec"}
+
+
+@dataclass
+class ChannelContext:
+    """What candidates need to build their columns for one channel."""
+
+    sig: Signals
+    channel: str
+    # torque carried by the gear (N m, smoothed), for the position channel
+    gear_torque_nm: np.ndarray | None = None
+    # torque breakpoints of the wind-up curve (catalogue T1, T2) the data reaches beyond
+    breakpoints_nm: tuple[float, ...] = ()
+    cache: dict = field(default_factory=dict)
+
+    def full_sign_speed(self, memory: bool = False) -> np.ndarray:
+        """Direction of motion on the whole record: 0 while standing, or (memory) the last direction."""
+        key = ("dir", memory)
+        if key not in self.cache:
+            v = self.sig.full_speed_rad_s
+            threshold = 3.0 * max(self.sig.pos_noise_rad, 1e-9) / (self.sig.filt.window * self.sig.filt.dt_s)
+            d = np.where(v > threshold, 1.0, np.where(v < -threshold, -1.0, np.nan if memory else 0.0))
+            self.cache[key] = _hold_last(d) if memory else d
+        return self.cache[key]
+
+
+def _hold_last(d: np.ndarray) -> np.ndarray:
+    """Fill NaN with the last valid value (0 before the first)."""
+    valid = ~np.isnan(d)
+    idx = np.where(valid, np.arange(len(d)), 0)
+    np.maximum.accumulate(idx, out=idx)
+    out = d[idx]
+    out[np.isnan(out)] = 0.0
+    if valid.any():
+        out[: int(np.argmax(valid))] = 0.0
+    return out
+
+
+@dataclass(frozen=True)
+class Param:
+    """One fitted contract parameter."""
+
+    name: str
+    value: float
+    std: float
+    unit: str
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A candidate effect and how to see it."""
+
+    id: str
+    channel: str
+    label: str  # human name
+    n_linear: int
+    build: Callable[[ChannelContext, tuple[float, ...]], np.ndarray]  # smoothed columns (n, n_linear)
+    to_params: Callable[[np.ndarray, np.ndarray, tuple[float, ...], np.ndarray, ChannelContext], list[Param]]
+    size: Callable[[np.ndarray, ChannelContext], float]
+    shape_grid: Sequence[tuple[float, ...]] = ((),)
+    shape_refine: bool = False  # refine the (continuous) shape by least squares
+    shape_names: tuple[str, ...] = ()
+    sign: int = 0  # +1/-1: the first coefficient must have this sign to be physical (0 = any)
+    primary: str = ""  # parameter the detection limit is stated in
+    needs_ratio: bool = False
+
+
+def _amp_phase(beta: np.ndarray, cov: np.ndarray) -> tuple[float, float, float, float]:
+    """A sin(x + phi) = a sin x + b cos x: amplitude, phase (deg) and their sigmas from (a, b)."""
+    a, b = float(beta[0]), float(beta[1])
+    amp = math.hypot(a, b)
+    phase = math.degrees(math.atan2(b, a))
+    if amp == 0:
+        return 0.0, 0.0, math.sqrt(max(cov[0, 0], 0.0)), 180.0
+    g_amp = np.array([a / amp, b / amp])
+    g_ph = np.degrees(np.array([-b / amp**2, a / amp**2]))
+    s_amp = math.sqrt(max(float(g_amp @ cov[:2, :2] @ g_amp), 0.0))
+    s_ph = math.sqrt(max(float(g_ph @ cov[:2, :2] @ g_ph), 0.0))
+    return amp, phase, s_amp, s_ph
+
+
+def _sd(cov: np.ndarray, i: int) -> float:
+    return math.sqrt(max(float(cov[i, i]), 0.0))
+
+
+def _rms(x: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(x)))) if len(x) else 0.0
+
+
+# ------------------------------------------------------------------------------------ torque channel
+
+
+def _coulomb_cols(ctx, shape):
+    # a stuck axis keeps the friction it last slid against (the servo's integrator holds it)
+    return ctx.sig.regressor(ctx.full_sign_speed(memory=True))[:, None]
+
+
+def _viscous_cols(ctx, shape):
+    return ctx.sig.speed_f_rad_s[:, None]
+
+
+def _gravity_cols(ctx, shape):
+    p = ctx.sig.raw_pos_rad
+    return np.column_stack([ctx.sig.regressor(np.sin(p)), ctx.sig.regressor(np.cos(p))])
+
+
+def _offset_cols(ctx, shape):
+    return np.ones((len(ctx.sig.t_s), 1))
+
+
+def _inertia_cols(ctx, shape):
+    return ctx.sig.accel_rad_s2[:, None]
+
+
+def _periodic_motor_cols(ctx, shape):
+    (cycles,) = shape
+    angle = cycles * ctx.sig.ratio * ctx.sig.raw_pos_rad
+    return np.column_stack([ctx.sig.regressor(np.sin(angle)), ctx.sig.regressor(np.cos(angle))])
+
+
+def _one(name: str, unit: str, scale: float = 1.0):
+    def convert(beta, cov, shape, shape_cov, ctx):
+        return [Param(name, float(beta[0]) * scale, _sd(cov, 0) * abs(scale), unit)]
+
+    return convert
+
+
+def _gravity_params(beta, cov, shape, shape_cov, ctx):
+    amp, ph, s_amp, s_ph = _amp_phase(beta, cov)
+    return [Param("amplitude_nm", amp, s_amp, "N m"), Param("phase_deg", ph, s_ph, "deg")]
+
+
+def _periodic_params(amp_name: str, unit: str):
+    def convert(beta, cov, shape, shape_cov, ctx):
+        amp, ph, s_amp, s_ph = _amp_phase(beta, cov)
+        s_c = math.sqrt(max(float(shape_cov[0, 0]), 0.0)) if shape_cov.size else 0.0
+        return [
+            Param(amp_name, amp, s_amp, unit),
+            Param("cycles_per_motor_rev", float(shape[0]), s_c, "1/rev"),
+            Param("phase_deg", ph, s_ph, "deg"),
+        ]
+
+    return convert
+
+
+def _amp_size(beta, ctx):
+    return math.hypot(float(beta[0]), float(beta[1]))
+
+
+RIPPLE_CYCLES = (1.0, 2.0, 3.0, 4.0, 6.0, 8.0)
+KINEMATIC_CYCLES = (2.0, 1.0, 4.0)
+
+TORQUE_CANDIDATES: tuple[Candidate, ...] = (
+    Candidate(
+        "inertia_error",
+        TORQUE,
+        "Inertia error",
+        1,
+        _inertia_cols,
+        _one("inertia_kgm2", "kg m^2"),
+        lambda b, c: abs(float(b[0])) * _rms(c.sig.accel_rad_s2),
+        primary="inertia_kgm2",
+    ),
+    Candidate(
+        "coulomb_friction",
+        TORQUE,
+        "Coulomb friction",
+        1,
+        _coulomb_cols,
+        _one("torque_nm", "N m"),
+        lambda b, c: abs(float(b[0])),
+        sign=1,
+        primary="torque_nm",
+    ),
+    Candidate(
+        "viscous_friction",
+        TORQUE,
+        "Viscous friction",
+        1,
+        _viscous_cols,
+        _one("coefficient_nm_s_per_rad", "N m s/rad"),
+        lambda b, c: abs(float(b[0])) * _rms(c.sig.speed_rad_s),
+        sign=1,
+        primary="coefficient_nm_s_per_rad",
+    ),
+    Candidate(
+        "gravity_load",
+        TORQUE,
+        "Gravity load (unbalance)",
+        2,
+        _gravity_cols,
+        _gravity_params,
+        _amp_size,
+        primary="amplitude_nm",
+    ),
+    Candidate(
+        "load_torque_offset",
+        TORQUE,
+        "Load torque offset",
+        1,
+        _offset_cols,
+        _one("torque_nm", "N m"),
+        lambda b, c: abs(float(b[0])),
+        primary="torque_nm",
+    ),
+    Candidate(
+        "torque_ripple",
+        TORQUE,
+        "Torque ripple",
+        2,
+        _periodic_motor_cols,
+        _periodic_params("amplitude_nm", "N m"),
+        _amp_size,
+        shape_grid=tuple((c,) for c in RIPPLE_CYCLES),
+        shape_refine=True,
+        shape_names=("cycles_per_motor_rev",),
+        primary="amplitude_nm",
+        needs_ratio=True,
+    ),
+)
+
+
+# ---------------------------------------------------------------------------------- position channel
+
+
+def _kinematic_cols(ctx, shape):
+    return _periodic_motor_cols(ctx, shape)
+
+
+def _compliance_cols(ctx, shape):
+    # wind-up = tau/K1 below T1, then a change of slope at each breakpoint reached (manual 1-9-2)
+    tau = ctx.gear_torque_nm
+    cols = [tau]
+    regions = int(shape[0]) if shape else 0
+    for t_break in ctx.breakpoints_nm[:regions]:
+        cols.append(np.sign(tau) * np.maximum(np.abs(tau) - t_break, 0.0))
+    return np.column_stack(cols)
+
+
+def _compliance_params(beta, cov, shape, shape_cov, ctx):
+    # load_pos - pos = c tau (arcsec per N m) with c = -1/K in each region (slopes add up)
+    out = []
+    names = ("stiffness_nm_per_rad", "k2_nm_per_rad", "k3_nm_per_rad")
+    for i in range(len(beta)):
+        g = np.zeros(len(beta))
+        g[: i + 1] = 1.0
+        c = float(g @ beta)
+        var = float(g @ cov @ g)
+        k = -ARCSEC_PER_RAD / c if c != 0 else math.inf
+        out.append(
+            Param(names[i], k, abs(k) * math.sqrt(max(var, 0.0)) / abs(c) if c else math.inf, "N m/rad")
+        )
+    return out
+
+
+def _lost_motion_cols(ctx, shape):
+    # the load lags by half the dead band in the direction of motion (or of the gear torque)
+    if shape and shape[0] > 0 and ctx.gear_torque_nm is not None:
+        key = "torque_dir"
+        if key not in ctx.cache:
+            tau = ctx.gear_torque_nm
+            thr = 0.05 * max(_rms(tau), 1e-9)
+            ctx.cache[key] = _hold_last(np.where(tau > thr, 1.0, np.where(tau < -thr, -1.0, np.nan)))
+        return -ctx.cache[key][:, None]
+    return -ctx.sig.regressor(ctx.full_sign_speed(memory=True))[:, None]
+
+
+def _lost_motion_params(beta, cov, shape, shape_cov, ctx):
+    return [Param("width_arcsec", 2.0 * float(beta[0]), 2.0 * _sd(cov, 0), "arcsec")]
+
+
+POSITION_CANDIDATES: tuple[Candidate, ...] = (
+    Candidate(
+        "kinematic_error",
+        POSITION,
+        "Kinematic error of the gear",
+        2,
+        _kinematic_cols,
+        _periodic_params("amplitude_arcsec", "arcsec"),
+        _amp_size,
+        shape_grid=tuple((c,) for c in KINEMATIC_CYCLES),
+        shape_refine=True,
+        shape_names=("cycles_per_motor_rev",),
+        primary="amplitude_arcsec",
+        needs_ratio=True,
+    ),
+    Candidate(
+        "torsional_compliance",
+        POSITION,
+        "Torsional compliance (wind-up)",
+        1,
+        _compliance_cols,
+        _compliance_params,
+        lambda b, c: abs(float(b[0])) * _rms(c.gear_torque_nm),
+        sign=-1,
+        shape_grid=((0.0,), (1.0,), (2.0,)),
+        primary="stiffness_nm_per_rad",
+    ),
+    Candidate(
+        "lost_motion",
+        POSITION,
+        "Lost motion (dead band)",
+        1,
+        _lost_motion_cols,
+        _lost_motion_params,
+        lambda b, c: abs(float(b[0])),
+        sign=1,
+        shape_grid=((0.0,), (1.0,)),
+        primary="width_arcsec",
+    ),
+)
+
+LABELS = {c.id: c.label for c in TORQUE_CANDIDATES + POSITION_CANDIDATES}
+
+# Which recording would tell two look-alikes apart.
+SEPARATING_TESTS: dict[frozenset[str], str] = {
+    frozenset(
+        {"gravity_load", "load_torque_offset"}
+    ): "move over at least half an output turn: gravity changes with position, an offset does not",
+    frozenset(
+        {"gravity_load", "torque_ripple"}
+    ): "record a full output turn at two loads (or with the load removed): gravity scales with the "
+    "load's unbalance, ripple follows the motor turn",
+    frozenset(
+        {"coulomb_friction", "viscous_friction"}
+    ): "record constant-speed runs at several speeds: Coulomb friction stays the same, "
+    "viscous grows with speed",
+    frozenset(
+        {"coulomb_friction", "load_torque_offset"}
+    ): "move in both directions: friction changes sign with the direction, an offset does not",
+    frozenset(
+        {"coulomb_friction", "inertia_error"}
+    ): "record a move with a long constant-speed part: friction stays while accelerating stops",
+    frozenset(
+        {"viscous_friction", "inertia_error"}
+    ): "record moves with different accelerations to the same speed: inertia follows acceleration, "
+    "viscous friction follows speed",
+    frozenset({"inertia_error", "load_torque_offset"}): "record moves accelerating in both directions",
+    frozenset(
+        {"inertia_error", "gravity_load"}
+    ): "record moves with different accelerations over the same positions",
+    frozenset(
+        {"viscous_friction", "gravity_load"}
+    ): "record the same positions at different speeds and in both directions",
+    frozenset({"viscous_friction", "load_torque_offset"}): "record at several speeds in both directions",
+    frozenset(
+        {"torsional_compliance", "lost_motion"}
+    ): "record slow reversals at low torque and a hold under steady torque: lost motion is a step at "
+    "reversals, wind-up grows with the torque",
+    frozenset(
+        {"kinematic_error", "torsional_compliance"}
+    ): "record the same positions at two loads: kinematic error follows the motor angle, wind-up the torque",
+    frozenset(
+        {"kinematic_error", "lost_motion"}
+    ): "record slow moves over several motor turns in both directions",
+}
+DEFAULT_SEPARATING_TEST = (
+    "record a longer motion covering more speeds, positions and accelerations, in both directions"
+)
+
+
+def separating_test(a: str, b: str) -> str:
+    """The recording that would separate effect a from effect b."""
+    return SEPARATING_TESTS.get(frozenset({a, b}), DEFAULT_SEPARATING_TEST)

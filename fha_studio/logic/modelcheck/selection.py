@@ -1,0 +1,535 @@
+"""Step 3 of the model check: name the effect(s) that explain a residual, without naming noise.
+
+The criterion (each gate must pass for an effect to be named):
+
+1. Whitened BIC. Residuals of a closed-loop axis (and of any smoothed signal) are strongly
+   autocorrelated, so an information criterion on raw samples would count thousands of
+   "independent" samples and name noise. The residual of the current model is fitted with an
+   autoregressive model AR(p) (p by BIC, up to MAX_AR_ORDER); the residual and every regressor are
+   passed through the same whitening filter, and the BIC of the whitened least-squares fit must
+   fall by at least BIC_MIN (10: "very strong" evidence) when the effect is added.
+2. Contiguous-block cross-validation: the record is cut into CV_BLOCKS contiguous blocks (never
+   shuffled samples: neighbouring samples are nearly copies of each other); each block is predicted
+   from a fit on the others. The held-out RMS must fall.
+3. Practical significance: the effect's size (its typical magnitude in N m or arcsec) must exceed a
+   floor, so that a statistically clear but practically irrelevant (or noise-level) term is not
+   named. It must also have the physical sign (friction opposes motion, a spring winds up under load).
+
+Parameters are estimated by ordinary least squares on the (unwhitened) residual: whitening
+emphasises the highest frequencies, where the rigid-body and timing approximations are weakest,
+so it serves the criterion only (the BIC of the least-squares fit on whitened data).
+Uncertainties come from a delete-one-block jackknife over JACKKNIFE_BLOCKS contiguous blocks,
+which stays honest under autocorrelation. The shape of a candidate (cycles per motor turn, the
+number of wind-up regions) is chosen by contiguous-block CV.
+
+Forward selection (best whitened-BIC gain first), the nominal parameters (the total inertia) first,
+then a backward pass. Shape parameters (cycles per motor turn) are picked on a grid and refined by
+least squares; the final fit refines all parameters together (scipy.optimize.least_squares).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from fha_studio.logic.modelcheck.candidates import Candidate, ChannelContext, Param
+
+BIC_MIN = 10.0
+CV_BLOCKS = 5
+CV_MIN_GAIN = 0.005  # the held-out RMS must fall by at least 0.5 %
+MAX_AR_ORDER = 12
+MAX_EFFECTS = 4
+JACKKNIFE_BLOCKS = 10
+
+
+# ------------------------------------------------------------------------------- linear algebra
+
+
+def fit_ar(e: np.ndarray, max_order: int = MAX_AR_ORDER) -> np.ndarray:
+    """AR coefficients phi (e[t] ~ sum phi_k e[t-k]) by Yule-Walker (Levinson-Durbin), order by BIC."""
+    n = len(e)
+    top = max(0, min(max_order, n // 10))
+    x = e - np.mean(e)
+    r = np.array([float(x[: n - k] @ x[k:]) / n for k in range(top + 1)])
+    if r[0] <= 0:
+        return np.empty(0)
+    best_bic, best = n * math.log(r[0]), np.empty(0)
+    phi = np.empty(0)
+    err = r[0]
+    for p in range(1, top + 1):
+        k = (r[p] - float(phi @ r[p - 1 : 0 : -1])) / err if p > 1 else r[1] / err
+        phi = np.concatenate([phi - k * phi[::-1], [k]]) if p > 1 else np.array([k])
+        err *= max(1.0 - k * k, 1e-12)
+        value = n * math.log(max(err, 1e-300)) + p * math.log(n)
+        if value < best_bic:
+            best_bic, best = value, phi.copy()
+    return best
+
+
+def whiten(x: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """Apply the AR whitening filter w[t] = x[t] - sum phi_k x[t-k] (drops the first p samples)."""
+    p = len(phi)
+    if p == 0:
+        return x
+    out = x[p:].copy()
+    for k in range(p):
+        out = out - phi[k] * x[p - k - 1 : len(x) - k - 1]
+    return out
+
+
+def ols(y: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least squares (normal equations on scaled columns, pseudo-inverse): coefficients and RSS."""
+    if x.shape[1] == 0:
+        return np.empty(0), float(y @ y)
+    scale = np.sqrt(np.sum(x * x, axis=0))
+    scale[scale == 0] = 1.0
+    xs = x / scale
+    gram = xs.T @ xs
+    beta = (np.linalg.pinv(gram, rcond=1e-10, hermitian=True) @ (xs.T @ y)) / scale
+    r = y - x @ beta
+    return beta, float(r @ r)
+
+
+def bic(rss: float, n: int, k: int) -> float:
+    """Bayesian information criterion of a Gaussian least-squares fit."""
+    return n * math.log(max(rss / n, 1e-300)) + k * math.log(n)
+
+
+def block_edges(n: int, blocks: int = CV_BLOCKS) -> list[tuple[int, int]]:
+    """Contiguous blocks covering 0..n."""
+    cuts = np.linspace(0, n, blocks + 1).round().astype(int)
+    return [(int(a), int(b)) for a, b in itertools.pairwise(cuts)]
+
+
+def block_cv(y: np.ndarray, x: np.ndarray, blocks: int = CV_BLOCKS) -> tuple[float, np.ndarray]:
+    """Held-out RMS and the held-out prediction: each block predicted from a fit on the others."""
+    n = len(y)
+    pred = np.zeros(n)
+    if x.shape[1]:
+        for a, b in block_edges(n, blocks):
+            train = np.ones(n, bool)
+            train[a:b] = False
+            beta, _ = ols(y[train], x[train])
+            pred[a:b] = x[a:b] @ beta
+    r = y - pred
+    return float(np.sqrt(np.mean(r**2))), pred
+
+
+# ----------------------------------------------------------------------------------- data types
+
+
+@dataclass
+class Term:
+    """One candidate in a model, with its shape (e.g. cycles per motor turn)."""
+
+    cand: Candidate
+    shape: tuple[float, ...]
+    cols: np.ndarray  # decimated columns (n, n_linear)
+
+    @property
+    def id(self) -> str:
+        return self.cand.id
+
+
+@dataclass
+class Trial:
+    """One candidate tried at one selection step (for the GUI's table of each step)."""
+
+    id: str
+    shape: tuple[float, ...]
+    delta_bic: float
+    cv_rms_before: float
+    cv_rms_after: float
+    size: float
+    physical: bool
+    accepted: bool
+    reason: str
+
+
+@dataclass
+class Step:
+    """One forward (or backward) selection step."""
+
+    kind: str  # "nominal", "forward", "backward"
+    ar_order: int
+    trials: list[Trial]
+    chosen: str | None
+
+
+@dataclass
+class FittedTerm:
+    """A named effect with its contract parameters."""
+
+    id: str
+    channel: str
+    label: str
+    params: list[Param]
+    size: float
+    shape: tuple[float, ...]
+    beta: np.ndarray
+    contribution: np.ndarray  # its part of the fitted residual (decimated samples)
+
+
+@dataclass
+class ChannelResult:
+    """The outcome of selection on one channel."""
+
+    channel: str
+    unit: str
+    floor: float
+    n: int
+    terms: list[FittedTerm]
+    steps: list[Step]
+    ar_order: int
+    fitted: np.ndarray  # fitted residual (decimated)
+    y: np.ndarray  # the residual (decimated)
+    base_beta: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+
+# --------------------------------------------------------------------------------------- engine
+
+
+class ChannelSelector:
+    """Forward/backward selection on one channel's residual (decimated samples)."""
+
+    def __init__(
+        self,
+        ctx: ChannelContext,
+        y: np.ndarray,
+        candidates: tuple[Candidate, ...],
+        index: np.ndarray,
+        floor: float,
+        unit: str,
+        base: np.ndarray | None = None,
+    ):
+        self.ctx = ctx
+        self.y = y
+        self.index = index  # decimation: rows of the analysis-rate arrays used
+        self.floor = floor
+        self.unit = unit
+        self.base = base if base is not None else np.empty((len(y), 0))
+        self.candidates = [c for c in candidates if not (c.needs_ratio and ctx.sig.ratio is None)]
+        self.n = len(y)
+        self._cols_cache: dict[tuple[str, tuple[float, ...]], np.ndarray] = {}
+
+    # --- columns
+    def cols(self, cand: Candidate, shape: tuple[float, ...]) -> np.ndarray:
+        key = (cand.id, tuple(round(s, 9) for s in shape))
+        if key not in self._cols_cache:
+            full = cand.build(self.ctx, shape)
+            self._cols_cache[key] = np.asarray(full, dtype=float)[self.index]
+        return self._cols_cache[key]
+
+    def design(self, terms: list[Term]) -> np.ndarray:
+        parts = [self.base] + [t.cols for t in terms]
+        return np.column_stack(parts) if sum(p.shape[1] for p in parts) else np.empty((self.n, 0))
+
+    def residual(self, terms: list[Term]) -> np.ndarray:
+        x = self.design(terms)
+        beta, _ = ols(self.y, x)
+        return self.y - x @ beta if x.shape[1] else self.y.copy()
+
+    # --- scoring
+    def _ar_for(self, x: np.ndarray) -> np.ndarray:
+        """AR whitening estimated on the residual of the model with columns x (the alternative)."""
+        beta, _ = ols(self.y, x)
+        return fit_ar(self.y - x @ beta if x.shape[1] else self.y)
+
+    def _wrss(self, x: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, float, int]:
+        """The criterion's fit: least squares on the whitened residual and columns (GLS); its RSS."""
+        yw = whiten(self.y, phi)
+        xw = whiten(x, phi) if x.shape[1] else np.empty((len(yw), 0))
+        beta, rss = ols(yw, xw)
+        return beta, rss, len(yw)
+
+    def score(self, terms: list[Term], phi: np.ndarray) -> float:
+        x = self.design(terms)
+        _, rss, nw = self._wrss(x, phi)
+        return bic(rss, nw, x.shape[1])
+
+    def best_shape(self, cand: Candidate, terms: list[Term]) -> tuple[float, ...]:
+        if len(cand.shape_grid) == 1 and not cand.shape_refine:
+            return cand.shape_grid[0]
+        x0 = self.design(terms)
+        # shapes by contiguous-block CV: honest for shapes of different dimension (wind-up regions),
+        # and it does not weigh the highest frequencies as whitening does
+        scores = [
+            block_cv(self.y, np.column_stack([x0, self.cols(cand, shape)]))[0] for shape in cand.shape_grid
+        ]
+        shape = cand.shape_grid[int(np.argmin(scores))]
+        if not cand.shape_refine:
+            return shape
+
+        def resid(s):
+            x1 = np.column_stack([x0, self.cols(cand, (float(s[0]),))])
+            beta, _ = ols(self.y, x1)
+            return self.y - x1 @ beta
+
+        c0 = shape[0]
+        try:
+            sol = least_squares(resid, [c0], bounds=([c0 - 0.25], [c0 + 0.25]), diff_step=1e-4, max_nfev=30)
+            return (float(sol.x[0]),)
+        except (ValueError, np.linalg.LinAlgError):  # pragma: no cover - degenerate data
+            return shape
+
+    def try_add(self, cand: Candidate, terms: list[Term]) -> tuple[Trial, Term]:
+        """Score cand added to terms: whitened BIC gain (AR from the larger model), block CV, size."""
+        shape = self.best_shape(cand, terms)
+        term = Term(cand, shape, self.cols(cand, shape))
+        x0 = self.design(terms)
+        x1 = self.design([*terms, term])
+        phi = self._ar_for(x1)
+        _, rss1, nw = self._wrss(x1, phi)
+        _, rss0, _ = self._wrss(x0, phi)
+        beta1, _ = ols(self.y, x1)  # size and sign from the plain least-squares estimate
+        bic0, bic1 = bic(rss0, nw, x0.shape[1]), bic(rss1, nw, x1.shape[1])
+        cv0, _ = block_cv(self.y, x0)
+        cv1, _ = block_cv(self.y, x1)
+        beta_c = beta1[-term.cols.shape[1] :]
+        size = float(cand.size(beta_c, self.ctx))
+        physical = self._physical(cand, beta_c)
+        reasons = []
+        if bic1 - bic0 > -BIC_MIN:
+            reasons.append(f"whitened BIC gain {bic0 - bic1:.1f} < {BIC_MIN:g}")
+        if cv1 > cv0 * (1.0 - CV_MIN_GAIN):
+            reasons.append("held-out RMS does not fall")
+        if size < self.floor:
+            reasons.append(f"size {size:.3g} {self.unit} below the floor {self.floor:.3g}")
+        if not physical:
+            reasons.append("unphysical sign")
+        trial = Trial(
+            cand.id,
+            shape,
+            bic1 - bic0,
+            cv0,
+            cv1,
+            size,
+            bool(physical),
+            not reasons,
+            "; ".join(reasons) or "named",
+        )
+        return trial, term
+
+    @staticmethod
+    def _physical(cand: Candidate, beta: np.ndarray) -> bool:
+        if cand.sign == 0:
+            return True
+        # cumulative: every region of a piecewise term (wind-up slopes) must keep the sign
+        return bool(np.all(np.sign(np.cumsum(beta)) == cand.sign))
+
+    # --- selection
+    def select(self, nominal_first: tuple[str, ...] = ()) -> tuple[list[Term], list[Step]]:
+        terms: list[Term] = []
+        steps: list[Step] = []
+        # re-fit the nominal parameters before blaming a missing effect
+        for cid in nominal_first:
+            cand = next((c for c in self.candidates if c.id == cid), None)
+            if cand is None:
+                continue
+            trial, term = self.try_add(cand, terms)
+            steps.append(
+                Step(
+                    "nominal",
+                    len(self._ar_for(self.design([*terms, term]))),
+                    [trial],
+                    cid if trial.accepted else None,
+                )
+            )
+            if trial.accepted:
+                terms.append(term)
+        while len(terms) < MAX_EFFECTS:
+            phi = fit_ar(self.residual(terms))
+            chosen = [t.id for t in terms]
+            trials = [self.try_add(cand, terms) for cand in self.candidates if cand.id not in chosen]
+            good = [(tr, tm) for tr, tm in trials if tr.accepted]
+            best = min(good, key=lambda p: p[0].delta_bic) if good else None
+            steps.append(Step("forward", len(phi), [tr for tr, _ in trials], best[0].id if best else None))
+            if best is None:
+                break
+            terms.append(best[1])
+        # backward: drop a term the others have made redundant
+        changed = True
+        while changed and len(terms) > 1:
+            changed = False
+            phi = self._ar_for(self.design(terms))
+            full = self.score(terms, phi)
+            cv_full, _ = block_cv(self.y, self.design(terms))
+            trials = []
+            for term in terms:
+                rest = [t for t in terms if t is not term]
+                drop_bic = self.score(rest, phi)
+                cv_rest, _ = block_cv(self.y, self.design(rest))
+                keep = drop_bic - full >= BIC_MIN and cv_full < cv_rest * (1.0 - CV_MIN_GAIN)
+                trials.append(
+                    Trial(
+                        term.id,
+                        term.shape,
+                        full - drop_bic,
+                        cv_rest,
+                        cv_full,
+                        0.0,
+                        True,
+                        keep,
+                        "kept" if keep else "redundant given the others",
+                    )
+                )
+            weakest = min(trials, key=lambda tr: -tr.delta_bic if not tr.accepted else math.inf)
+            if not weakest.accepted:
+                terms = [t for t in terms if t.id != weakest.id]
+                steps.append(Step("backward", len(phi), trials, weakest.id))
+                changed = True
+        return terms, steps
+
+    # --- final fit with uncertainty
+    def _fit_all(
+        self, terms: list[Term], rows: np.ndarray | None, start: np.ndarray | None = None, max_nfev: int = 50
+    ) -> tuple[np.ndarray, dict[int, tuple[float, ...]]]:
+        """All coefficients (base, then terms) and refined shapes, on rows (None = all)."""
+        shaped = [i for i, t in enumerate(terms) if t.cand.shape_refine]
+        sel = slice(None) if rows is None else rows
+        y = self.y[sel]
+
+        def design_for(shapes):
+            cols = [self.base[sel]]
+            for i, t in enumerate(terms):
+                cols.append(self.cols(t.cand, shapes[i])[sel] if i in shaped else t.cols[sel])
+            return np.column_stack(cols) if sum(c.shape[1] for c in cols) else np.empty((len(y), 0))
+
+        shapes0 = {i: terms[i].shape for i in shaped}
+        x = design_for(shapes0)
+        beta0, _ = ols(y, x)
+        if not shaped:
+            return beta0, {}
+        n_lin = x.shape[1]
+
+        def resid(p):
+            shapes = {i: (float(p[n_lin + j]),) for j, i in enumerate(shaped)}
+            return y - design_for(shapes) @ p[:n_lin]
+
+        p0 = start if start is not None else np.concatenate([beta0, [terms[i].shape[0] for i in shaped]])
+        sol = least_squares(resid, p0, diff_step=1e-6, x_scale="jac", max_nfev=max_nfev)
+        return sol.x[:n_lin], {i: (float(sol.x[n_lin + j]),) for j, i in enumerate(shaped)}
+
+    def final_fit(self, terms: list[Term]) -> tuple[list[FittedTerm], np.ndarray, np.ndarray, int]:
+        """Refine every parameter together (least squares); uncertainties by block jackknife."""
+        beta, shapes = self._fit_all(terms, None)
+        shaped = sorted(shapes)
+        nb = self.base.shape[1]
+        for i, shape in shapes.items():
+            terms[i].shape = shape
+            terms[i].cols = self.cols(terms[i].cand, shape)
+        x = self.design(terms)
+        full_params = self._term_values(terms, beta)
+        # delete-one-block jackknife of every reported number
+        start = np.concatenate([beta, [shapes[i][0] for i in shaped]])
+        reps = []
+        for a, b in block_edges(self.n, JACKKNIFE_BLOCKS):
+            rows = np.ones(self.n, bool)
+            rows[a:b] = False
+            bj, sj = self._fit_all(terms, rows, start=start, max_nfev=10)
+            saved = [(t.shape, t.cols) for t in terms]
+            for i, shape in sj.items():
+                terms[i].shape, terms[i].cols = shape, self.cols(terms[i].cand, shape)
+            reps.append(self._term_values(terms, bj))
+            for t, (sh, co) in zip(terms, saved, strict=True):
+                t.shape, t.cols = sh, co
+        g = len(reps)
+        fitted_terms = []
+        col = nb
+        for ti, t in enumerate(terms):
+            k = t.cols.shape[1]
+            b_t = beta[col : col + k]
+            params = []
+            for pi, prm in enumerate(full_params[ti]):
+                vals = np.array([r[ti][pi].value for r in reps])
+                if prm.name == "phase_deg":  # wrap around the full-data value
+                    vals = prm.value + (vals - prm.value + 180.0) % 360.0 - 180.0
+                var = (g - 1) / g * float(np.sum((vals - vals.mean()) ** 2))
+                params.append(Param(prm.name, prm.value, math.sqrt(var), prm.unit))
+            fitted_terms.append(
+                FittedTerm(
+                    t.id,
+                    t.cand.channel,
+                    t.cand.label,
+                    params,
+                    float(t.cand.size(b_t, self.ctx)),
+                    t.shape,
+                    b_t,
+                    x[:, col : col + k] @ b_t,
+                )
+            )
+            col += k
+        fitted = x @ beta if x.shape[1] else np.zeros(self.n)
+        phi = fit_ar(self.y - fitted)
+        return fitted_terms, fitted, beta[:nb], len(phi)
+
+    def _term_values(self, terms: list[Term], beta: np.ndarray) -> list[list[Param]]:
+        out = []
+        col = self.base.shape[1]
+        none = np.zeros((0, 0))
+        for t in terms:
+            k = t.cols.shape[1]
+            out.append(t.cand.to_params(beta[col : col + k], np.zeros((k, k)), t.shape, none, self.ctx))
+            col += k
+        return out
+
+    # --- after selection
+    def detection_limit(self, terms: list[Term], cand: Candidate) -> tuple[float, tuple[float, ...]]:
+        """Smallest size of cand this record would have revealed next to terms (channel unit).
+
+        The jackknife spread of cand's coefficient(s) when fitted next to the chosen terms, times
+        the whitened-BIC gate's own threshold sqrt(BIC_MIN + k ln n), never below the floor.
+        """
+        shape = cand.shape_grid[0]
+        x = np.column_stack([self.design(terms), self.cols(cand, shape)])
+        k = x.shape[1] - self.design(terms).shape[1]
+        reps = []
+        for a, b in block_edges(self.n, JACKKNIFE_BLOCKS):
+            rows = np.ones(self.n, bool)
+            rows[a:b] = False
+            bj, _ = ols(self.y[rows], x[rows])
+            reps.append(bj[-k:])
+        reps_arr = np.array(reps)
+        g = len(reps)
+        var = (g - 1) / g * np.sum((reps_arr - reps_arr.mean(axis=0)) ** 2, axis=0)
+        sigma = math.sqrt(float(np.mean(var)))
+        unit_size = cand.size(np.full(k, 1.0 / math.sqrt(k)) if k > 1 else np.ones(1), self.ctx)
+        z = math.sqrt(BIC_MIN + k * math.log(self.n))
+        return max(self.floor, z * sigma * unit_size), shape
+
+    def substitutes(self, terms: list[Term]) -> list[tuple[str, str, float]]:
+        """(chosen, alternative, BIC difference) for alternatives that explain the data as well.
+
+        An alternative (swapped in for one chosen term, passing every gate itself) is not separable
+        when the whitened BIC does not prefer the chosen set by BIC_MIN, or when the two fits differ
+        by less than the practical floor anywhere it matters (RMS of their difference): the data
+        then cannot tell which is the cause, however precise it is.
+        """
+        if not terms:
+            return []
+        x_full = self.design(terms)
+        phi = self._ar_for(x_full)
+        full = self.score(terms, phi)
+        beta, _ = ols(self.y, x_full)
+        fit_full = x_full @ beta
+        out = []
+        chosen = {t.id for t in terms}
+        for term in terms:
+            rest = [t for t in terms if t is not term]
+            for cand in self.candidates:
+                if cand.id in chosen:
+                    continue
+                trial, alt = self.try_add(cand, rest)
+                if not trial.accepted:
+                    continue
+                x_alt = self.design([*rest, alt])
+                alt_bic = self.score([*rest, alt], phi)
+                b_alt, _ = ols(self.y, x_alt)
+                differ = float(np.sqrt(np.mean((x_alt @ b_alt - fit_full) ** 2)))
+                if alt_bic - full < BIC_MIN or differ < 0.5 * self.floor:
+                    out.append((term.id, cand.id, alt_bic - full))
+        return out

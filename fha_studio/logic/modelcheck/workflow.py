@@ -1,0 +1,697 @@
+"""The model-check workflow: residuals -> where -> name -> add -> gap. Results are arrays per step."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.signal import savgol_filter
+
+from fha_studio.logic.modelcheck.axis import (
+    DeclaredAxis,
+    ModelCheckError,
+    check_plausible,
+    declared_axis,
+    rms,
+)
+from fha_studio.logic.modelcheck.candidates import (
+    CHANNEL_UNITS,
+    LABELS,
+    POSITION,
+    POSITION_CANDIDATES,
+    TORQUE,
+    TORQUE_CANDIDATES,
+    ChannelContext,
+    Param,
+    separating_test,
+)
+from fha_studio.logic.modelcheck.selection import (
+    BIC_MIN,
+    ChannelSelector,
+    FittedTerm,
+    Step,
+    block_cv,
+    block_edges,
+)
+from fha_studio.logic.modelcheck.signals import ARCSEC_PER_RAD, POLYORDER, Signals, build_signals
+from fha_studio.physics import AxisModel, Effects, ServoSettings, simulate
+from fha_studio.recording import Recording
+
+# Practical-significance floors (assumptions, stated in the report).
+TORQUE_FLOOR_FRACTION_OF_MAX = 0.005  # 0.5 % of the actuator's maximum torque
+TORQUE_FLOOR_MIN_NM = 0.02
+POSITION_FLOOR_ARCSEC = 2.0
+STRUCTURE_MIN_FRACTION = 0.15  # a structured residual explains >= 15 % of the residual's variance
+RESIM_BANDWIDTH_HZ = 60.0  # speed-loop bandwidth of the stiff servo that follows the measured motion
+TARGET_DECIMATED = 2500  # samples the selection works on (speed); never below 4 per window
+
+
+# ------------------------------------------------------------------------------------ result types
+
+
+@dataclass
+class Binned:
+    """A residual binned against one variable (what a person plots to see the effect)."""
+
+    variable: str
+    unit: str
+    centers: np.ndarray
+    mean: np.ndarray  # mean residual per bin (channel unit)
+    sem: np.ndarray  # standard error of the mean per bin
+    count: np.ndarray
+
+
+@dataclass
+class ChannelWhere:
+    """Step 2 for one channel: the residual against time and the state variables, before and after."""
+
+    channel: str
+    unit: str
+    t_s: np.ndarray  # decimated times
+    residual_before: np.ndarray  # nominal model
+    residual_after: np.ndarray  # updated model (in-sample)
+    variables: dict[str, np.ndarray]  # decimated variable values (for scatter plots)
+    variable_units: dict[str, str]
+    before: dict[str, Binned]
+    after: dict[str, Binned]
+
+
+@dataclass
+class Effect:
+    """A named missing effect (step 3/4)."""
+
+    id: str
+    channel: str
+    label: str
+    params: dict[str, float]
+    uncertainty: dict[str, float]  # one sigma, same keys
+    units: dict[str, str]
+    size: float  # typical magnitude in the channel unit
+    alternatives: list[str] = field(default_factory=list)  # not separable from these
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "id": self.id,
+            "params": dict(self.params),
+            "channel": self.channel,
+            "uncertainty": dict(self.uncertainty),
+            "units": dict(self.units),
+            "label": self.label,
+            "size": self.size,
+            "not_separable_from": list(self.alternatives),
+        }
+
+
+@dataclass
+class Ambiguity:
+    """Two effects the data cannot tell apart, and the test that would."""
+
+    channel: str
+    chosen: str
+    alternative: str
+    delta_bic: float
+    separating_test: str
+
+
+@dataclass
+class Structure:
+    """A structured residual that no candidate explains."""
+
+    channel: str
+    variable: str
+    rms: float  # of the part explained by the variable, held-out
+    fraction: float  # of the residual variance
+    unit: str
+
+
+@dataclass
+class DetectionLimit:
+    """Smallest effect of one kind this recording could have revealed."""
+
+    id: str
+    channel: str
+    size: float  # channel unit
+    unit: str
+    param: str
+    value: float  # in the param's unit
+    param_unit: str
+
+
+@dataclass
+class Gap:
+    """Step 5: RMS gap on held-out contiguous segments (each predicted from a fit on the others)."""
+
+    channel: str
+    unit: str
+    rms_before: float
+    rms_after: float
+    t_s: np.ndarray
+    measured: np.ndarray  # residual of the nominal model (what the updated model must explain)
+    predicted_heldout: np.ndarray  # the updated model's held-out prediction of it
+    blocks: list[tuple[float, float]]  # time spans of the held-out blocks
+
+
+@dataclass
+class Resimulation:
+    """The recorded command re-simulated with the nominal and the updated model, over the measurement."""
+
+    t_s: np.ndarray
+    torque_measured_nm: np.ndarray  # Kt x current (smoothed like the analysis)
+    torque_nominal_nm: np.ndarray
+    torque_updated_nm: np.ndarray
+    pos_measured_deg: np.ndarray
+    pos_nominal_deg: np.ndarray
+    pos_updated_deg: np.ndarray
+    rms_nominal_nm: float
+    rms_updated_nm: float
+    load_diff_measured_arcsec: np.ndarray | None = None
+    load_diff_nominal_arcsec: np.ndarray | None = None
+    load_diff_updated_arcsec: np.ndarray | None = None
+    command: str = "cmd_pos"  # which column drove it ("cmd_pos", or "pos" when no command was recorded)
+
+
+@dataclass
+class ChannelReport:
+    """Steps 3-5 of one channel."""
+
+    channel: str
+    unit: str
+    floor: float
+    steps: list[Step]
+    ar_order: int
+    n_samples: int
+
+
+@dataclass
+class ModelCheckResult:
+    """Everything the model check found, per step, as arrays a GUI can plot."""
+
+    source: str
+    actuator: str
+    window_samples: int
+    window_s: float
+    bandwidth_hz: float
+    residual: dict[str, np.ndarray]  # step 1, analysis rate: t_s, torque_measured_nm, torque_nominal_nm, ...
+    where: dict[str, ChannelWhere]  # step 2
+    channels: dict[str, ChannelReport]  # step 3 (selection steps)
+    effects: list[Effect]  # steps 3-4
+    ambiguities: list[Ambiguity]
+    structures: list[Structure]
+    detection_limits: list[DetectionLimit]
+    gap: dict[str, Gap]  # step 5
+    nominal_model: AxisModel
+    updated_model: AxisModel  # step 4
+    resimulation: Resimulation | None
+    notes: list[str]
+
+    @property
+    def found(self) -> bool:
+        return bool(self.effects)
+
+    def summary_lines(self) -> list[str]:
+        """The human summary (one finding per line)."""
+        lines = []
+        by_channel: dict[str, Effect] = {}
+        for e in self.effects:
+            by_channel.setdefault(e.channel, e)
+        for e in self.effects:
+            p = next(iter(e.params))
+            main = _fmt_pm(e.params[p], e.uncertainty[p], e.units[p])
+            others = ", ".join(
+                f"{k} {_fmt_pm(v, e.uncertainty[k], e.units[k])}" for k, v in e.params.items() if k != p
+            )
+            text = f"{e.label} missing: {main}" + (f" ({others})" if others else "")
+            if e.alternatives:
+                alts = " or ".join(LABELS[a] for a in e.alternatives)
+                text = f"{e.label} or {alts} — not separable from this data; as {e.id}: {main}"
+            gap = self.gap.get(e.channel)
+            if gap is not None and by_channel.get(e.channel) is e:
+                text += (
+                    f"; {e.channel} gap {_fmt(gap.rms_before)} -> {_fmt(gap.rms_after)} {gap.unit} rms "
+                    "on held-out data"
+                )
+            lines.append(text)
+        for a in self.ambiguities:
+            lines.append(
+                f"  {LABELS[a.chosen]} or {LABELS[a.alternative]} — not separable from this data; "
+                f"to separate them: {a.separating_test}"
+            )
+        for s in self.structures:
+            lines.append(
+                f"Structured residual in the {s.channel} channel that no candidate explains: "
+                f"{_fmt(s.rms)} {s.unit} rms organised by {s.variable} ({100 * s.fraction:.0f} % of the "
+                "residual); not forced onto a named effect"
+            )
+        if not self.effects:
+            lines.append("No missing effect found.")
+            for ch, gap in self.gap.items():
+                lines.append(
+                    f"  {ch} gap {_fmt(gap.rms_before)} -> {_fmt(gap.rms_after)} {gap.unit} rms "
+                    "on held-out data"
+                )
+        if self.detection_limits:
+            limits = ", ".join(
+                f"{LABELS[d.id]} {_fmt(d.value)} {d.param_unit}" for d in self.detection_limits
+            )
+            lines.append(f"Detection limit (smallest effect this recording could have revealed): {limits}")
+        if self.resimulation is not None:
+            r = self.resimulation
+            lines.append(
+                f"Re-simulation of the recorded {r.command}: torque {_fmt(r.rms_nominal_nm)} -> "
+                f"{_fmt(r.rms_updated_nm)} N m rms (nominal -> updated model)"
+            )
+        lines.extend(self.notes)
+        return lines
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON report (issue 4 contract: effects [{id, params, channel}], gap {channel: {...}})."""
+        return {
+            "format": "fha-modelcheck-report/1",
+            "recording": self.source,
+            "actuator": self.actuator,
+            "effects": [e.to_json() for e in self.effects],
+            "gap": {
+                ch: {"rms_before": g.rms_before, "rms_after": g.rms_after, "unit": g.unit}
+                for ch, g in self.gap.items()
+            },
+            "not_separable": [
+                {"channel": a.channel, "ids": [a.chosen, a.alternative], "separating_test": a.separating_test}
+                for a in self.ambiguities
+            ],
+            "structured_residual": [
+                {
+                    "channel": s.channel,
+                    "variable": s.variable,
+                    "rms": s.rms,
+                    "fraction": s.fraction,
+                    "unit": s.unit,
+                }
+                for s in self.structures
+            ],
+            "detection_limits": [
+                {
+                    "id": d.id,
+                    "channel": d.channel,
+                    "param": d.param,
+                    "value": d.value,
+                    "unit": d.param_unit,
+                    "size": d.size,
+                    "size_unit": d.unit,
+                }
+                for d in self.detection_limits
+            ],
+            "analysis": {
+                "savgol_window_samples": self.window_samples,
+                "savgol_window_s": self.window_s,
+                "bandwidth_hz": self.bandwidth_hz,
+                "floors": {ch: {"value": c.floor, "unit": c.unit} for ch, c in self.channels.items()},
+                "criterion": f"AR-whitened BIC gain >= {BIC_MIN:g}, contiguous-block CV, floor",
+            },
+            "resimulation": None
+            if self.resimulation is None
+            else {
+                "command": self.resimulation.command,
+                "torque_rms_nominal_nm": self.resimulation.rms_nominal_nm,
+                "torque_rms_updated_nm": self.resimulation.rms_updated_nm,
+            },
+            "notes": list(self.notes),
+        }
+
+    def write_model(self, path: str | Path) -> None:
+        """Write the updated model file (fha-axis-model/1 TOML, loadable by the sim and later checks)."""
+        self.updated_model.save(path)
+
+
+def _fmt(x: float) -> str:
+    if x == 0 or not math.isfinite(x):
+        return f"{x:g}"
+    digits = max(0, 2 - math.floor(math.log10(abs(x))))
+    return f"{x:.{min(digits, 6)}f}" if abs(x) < 1e5 else f"{x:.3g}"
+
+
+def _fmt_pm(value: float, sigma: float, unit: str) -> str:
+    if not math.isfinite(sigma) or sigma <= 0:
+        return f"{_fmt(value)} {unit}"
+    digits = max(0, -math.floor(math.log10(sigma)))
+    if abs(value) >= 1e5:
+        return f"{value:.4g} {unit} ± {sigma:.2g}"
+    return f"{value:.{min(digits, 8)}f} {unit} ± {sigma:.{min(digits, 8)}f}"
+
+
+# ------------------------------------------------------------------------------------------ workflow
+
+
+def run_modelcheck(
+    rec: Recording, *, window: int | None = None, resimulate: bool = True, servo: ServoSettings | None = None
+) -> ModelCheckResult:
+    """Run the whole workflow on a recording. Raises ModelCheckError when it cannot be checked.
+
+    window: Savitzky-Golay window in samples (None: chosen from the noise, see signals.py).
+    servo: the drive's loop settings, when known; the re-simulation then drives the recorded
+    cmd_pos through them. Without them (the usual case: a recording does not carry the gains) the
+    re-simulation follows the measured motion (smoothed) with a stiff servo and feed-forward, so the
+    overlay compares the models rather than a guess of the gains.
+    """
+    axis = declared_axis(rec)
+    notes = check_plausible(rec, axis)
+    model = axis.model
+    sig = build_signals(
+        rec.t_s,
+        np.radians(rec.pos_deg),
+        rec.current_a,
+        kt_nm_per_a=axis.kt_nm_per_a,
+        inertia_kgm2=axis.nominal_inertia_kgm2,
+        ratio=axis.ratio,
+        load_pos_rad=None if rec.load_pos_deg is None else np.radians(rec.load_pos_deg),
+        cmd_pos_rad=None if rec.cmd_pos_deg is None else np.radians(rec.cmd_pos_deg),
+        window=window,
+    )
+    if sig.resampled:
+        notes.append("Note: the sampling was not uniform; the signals were resampled onto a uniform grid.")
+    n = len(sig.t_s)
+    step = max(1, min(n // TARGET_DECIMATED, (sig.filt.window - 2) // 4)) if n > TARGET_DECIMATED else 1
+    step = max(step, 1)
+    index = np.arange(0, n, step)
+
+    # ---- step 1: residuals
+    torque_nominal = axis.nominal_inertia_kgm2 * sig.accel_rad_s2
+    y_torque = sig.torque_f_nm - torque_nominal
+    residual: dict[str, np.ndarray] = {
+        "t_s": sig.t_s,
+        "torque_measured_nm": sig.torque_f_nm,
+        "torque_nominal_nm": torque_nominal,
+        "torque_residual_nm": y_torque,
+        "speed_rad_s": sig.speed_rad_s,
+        "accel_rad_s2": sig.accel_rad_s2,
+        "pos_rad": sig.pos_rad,
+    }
+
+    # ---- step 3 on the torque channel
+    floor_t = max(
+        TORQUE_FLOOR_MIN_NM,
+        TORQUE_FLOOR_FRACTION_OF_MAX * (model.max_torque_nm or 3.0 * float(np.max(np.abs(sig.torque_f_nm)))),
+    )
+    ctx_t = ChannelContext(sig, TORQUE)
+    # Nuisance, always fitted: a time offset between the current monitor and the encoder (sampling
+    # instants, monitor delay) shows as -delay x J x jerk. It belongs to the recorder, not to the axis.
+    jerk_col = (axis.nominal_inertia_kgm2 * sig.jerk_rad_s3)[index][:, None]
+    sel_t = ChannelSelector(
+        ctx_t, y_torque[index], TORQUE_CANDIDATES, index, floor_t, CHANNEL_UNITS[TORQUE], base=jerk_col
+    )
+    terms_t, steps_t = sel_t.select(nominal_first=("inertia_error",))
+    fitted_t, fit_t, base_t, ar_t = sel_t.final_fit(terms_t)
+    delay_ms = -1000.0 * float(base_t[0])
+    if abs(delay_ms) > 0.05:
+        notes.append(
+            f"Note: the current is {'late' if delay_ms > 0 else 'early'} against the position by "
+            f"{abs(delay_ms):.2f} ms (fitted as a recorder property, not an effect of the axis)."
+        )
+    channels = {TORQUE: ChannelReport(TORQUE, "N m", floor_t, steps_t, ar_t, len(index))}
+    selectors = {TORQUE: (sel_t, terms_t, fitted_t, fit_t)}
+
+    # ---- position channel (needs load_pos)
+    if sig.load_diff_f_rad is not None:
+        motor_side = np.zeros(n)
+        for ft in fitted_t:
+            if ft.id in ("coulomb_friction", "viscous_friction", "torque_ripple"):
+                cand = next(c for c in TORQUE_CANDIDATES if c.id == ft.id)
+                motor_side += cand.build(ctx_t, ft.shape) @ ft.beta
+        gear_torque = sig.torque_f_nm - model.motor_side_inertia_kgm2 * sig.accel_rad_s2 - motor_side
+        residual["gear_torque_nm"] = gear_torque
+        breaks: list[float] = []
+        if model.stiffness is not None:
+            for t_break in (model.stiffness.t1_nm, model.stiffness.t2_nm):
+                if np.mean(np.abs(gear_torque) > t_break) < 0.05:
+                    break  # too little data beyond it to see another region
+                breaks.append(t_break)
+        ctx_p = ChannelContext(sig, POSITION, gear_torque_nm=gear_torque, breakpoints_nm=tuple(breaks))
+        y_pos = sig.load_diff_f_rad * ARCSEC_PER_RAD
+        residual["load_diff_arcsec"] = y_pos
+        base = np.ones((len(index), 1))  # the external encoder's zero is not an effect
+        sel_p = ChannelSelector(
+            ctx_p,
+            y_pos[index],
+            POSITION_CANDIDATES,
+            index,
+            POSITION_FLOOR_ARCSEC,
+            CHANNEL_UNITS[POSITION],
+            base=base,
+        )
+        terms_p, steps_p = sel_p.select()
+        fitted_p, fit_p, _base_beta, ar_p = sel_p.final_fit(terms_p)
+        channels[POSITION] = ChannelReport(
+            POSITION, "arcsec", POSITION_FLOOR_ARCSEC, steps_p, ar_p, len(index)
+        )
+        selectors[POSITION] = (sel_p, terms_p, fitted_p, fit_p)
+
+    # ---- name: effects, look-alikes, structure, detection limits
+    effects: list[Effect] = []
+    ambiguities: list[Ambiguity] = []
+    structures: list[Structure] = []
+    limits: list[DetectionLimit] = []
+    gaps: dict[str, Gap] = {}
+    where: dict[str, ChannelWhere] = {}
+    for ch, (sel, terms, fitted, fit) in selectors.items():
+        unit = CHANNEL_UNITS[ch]
+        for a, b, dbic in sel.substitutes(terms):
+            ambiguities.append(Ambiguity(ch, a, b, dbic, separating_test(a, b)))
+        for ft in fitted:
+            effects.append(_effect(ft, [amb.alternative for amb in ambiguities if amb.chosen == ft.id]))
+        chosen = {t.id for t in terms}
+        for cand in sel.candidates:
+            if cand.id in chosen or any(a.alternative == cand.id for a in ambiguities):
+                continue
+            size, _ = sel.detection_limit(terms, cand)
+            limits.append(_limit(cand, ch, size, unit, sel))
+        variables, var_units = _where_variables(sig, index, ch, residual)
+        after = sel.y - fit
+        # in the torque channel the measured torque contains the residual itself: not a cause
+        candidates_vars = {k: v for k, v in variables.items() if not (ch == TORQUE and k == "torque")}
+        block_len = max(30, 4 * sig.filt.window // step)
+        s = _structure(after, candidates_vars, sel.floor, block_len)
+        if s is not None:
+            structures.append(Structure(ch, s[0], s[1], s[2], unit))
+        where[ch] = ChannelWhere(
+            ch,
+            unit,
+            sig.t_s[index],
+            sel.y if ch == TORQUE else sel.y - np.median(sel.y),
+            after,
+            variables,
+            var_units,
+            {
+                k: _bin(v, sel.y - (np.median(sel.y) if ch == POSITION else 0.0), k, var_units[k])
+                for k, v in variables.items()
+            },
+            {k: _bin(v, after, k, var_units[k]) for k, v in variables.items()},
+        )
+        gaps[ch] = _gap(sel, terms, ch, unit, sig.t_s[index])
+
+    # ---- add: the updated model
+    updated = _updated_model(model, effects)
+    resim = None
+    if resimulate:
+        resim = _resimulate(sig, axis, model, updated, servo)
+    filt = sig.filt
+    return ModelCheckResult(
+        source=rec.source,
+        actuator=axis.code,
+        window_samples=filt.window,
+        window_s=filt.window * filt.dt_s,
+        bandwidth_hz=filt.bandwidth_hz,
+        residual=residual,
+        where=where,
+        channels=channels,
+        effects=effects,
+        ambiguities=ambiguities,
+        structures=structures,
+        detection_limits=limits,
+        gap=gaps,
+        nominal_model=model,
+        updated_model=updated,
+        resimulation=resim,
+        notes=notes,
+    )
+
+
+def _effect(ft: FittedTerm, alternatives: list[str]) -> Effect:
+    params = {p.name: p.value for p in ft.params}
+    sig = {p.name: p.std for p in ft.params}
+    units = {p.name: p.unit for p in ft.params}
+    return Effect(ft.id, ft.channel, ft.label, params, sig, units, ft.size, alternatives)
+
+
+def _limit(cand, ch: str, size: float, unit: str, sel: ChannelSelector) -> DetectionLimit:
+    ctx = sel.ctx
+    sig = ctx.sig
+    primary = cand.primary
+    if cand.id == "viscous_friction":
+        value, punit = size / max(rms(sig.speed_rad_s), 1e-12), "N m s/rad"
+    elif cand.id == "inertia_error":
+        value, punit = size / max(rms(sig.accel_rad_s2), 1e-12), "kg m^2"
+    elif cand.id == "torsional_compliance":
+        # wind-up smaller than this (in arcsec) would not show: the stiffest spring still visible
+        value, punit = rms(ctx.gear_torque_nm) * ARCSEC_PER_RAD / max(size, 1e-12), "N m/rad"
+    elif cand.id == "lost_motion":
+        value, punit = 2.0 * size, "arcsec"
+    else:
+        value, punit = size, unit
+    return DetectionLimit(cand.id, ch, size, unit, primary, value, punit)
+
+
+def _where_variables(sig: Signals, index: np.ndarray, ch: str, residual: dict[str, np.ndarray]):
+    variables = {
+        "time": sig.t_s[index],
+        "speed": sig.speed_rad_s[index] * 30.0 / math.pi,
+        "position": np.degrees(sig.pos_rad[index]),
+        "acceleration": sig.accel_rad_s2[index],
+        "torque": (residual["gear_torque_nm"] if ch == POSITION else sig.torque_f_nm)[index],
+    }
+    units = {"time": "s", "speed": "r/min", "position": "deg", "acceleration": "rad/s^2", "torque": "N m"}
+    if sig.ratio is not None:
+        variables["motor_angle"] = np.degrees(np.mod(sig.ratio * sig.pos_rad[index], 2.0 * math.pi))
+        units["motor_angle"] = "deg"
+    return variables, units
+
+
+def _bin(x: np.ndarray, y: np.ndarray, name: str, unit: str, bins: int = 24) -> Binned:
+    lo, hi = np.percentile(x, [0.5, 99.5]) if name != "motor_angle" else (0.0, 360.0)
+    if hi <= lo:
+        hi = lo + 1e-9
+    edges = np.linspace(lo, hi, bins + 1)
+    which = np.clip(np.digitize(x, edges) - 1, 0, bins - 1)
+    count = np.bincount(which, minlength=bins).astype(float)
+    s = np.bincount(which, weights=y, minlength=bins)
+    s2 = np.bincount(which, weights=y * y, minlength=bins)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(count > 0, s / np.maximum(count, 1), np.nan)
+        var = np.where(count > 1, (s2 - count * mean**2) / np.maximum(count - 1, 1), np.nan)
+        sem = np.sqrt(np.maximum(var, 0) / np.maximum(count, 1))
+    return Binned(name, unit, 0.5 * (edges[:-1] + edges[1:]), mean, sem, count)
+
+
+def _structure(
+    e: np.ndarray, variables: dict[str, np.ndarray], floor: float, block_len: int = 50
+) -> tuple[str, float, float] | None:
+    """Residual organised by a state variable, confirmed on held-out blocks.
+
+    Leave-one-block-out over contiguous blocks a few filter windows long (neighbours within a block
+    are near copies): each block is predicted by the residual's bin means (against the variable)
+    over all other blocks. The held-out prediction must explain at least STRUCTURE_MIN_FRACTION of
+    the residual variance and reach the practical floor somewhere (the largest bin mean): a local
+    bump matters even when its RMS over the whole record is small.
+    """
+    n = len(e)
+    nbins = 32
+    total = float(np.mean(e**2))
+    if total <= 0:
+        return None
+    edges = block_edges(n, max(4, n // block_len))
+    block_of = np.zeros(n, int)
+    for k, (a, b) in enumerate(edges):
+        block_of[a:b] = k
+    best = None
+    for name, x in variables.items():
+        if name == "time":
+            continue
+        lo, hi = np.percentile(x, [1, 99])
+        if hi <= lo:
+            continue
+        bin_edges = np.linspace(lo, hi, nbins + 1)
+        centers = 0.5 * (bin_edges[:-1] + bin_edges[1:])
+        which = np.clip(np.digitize(x, bin_edges) - 1, 0, nbins - 1)
+        cell = block_of * nbins + which
+        cnt_kb = np.bincount(cell, minlength=len(edges) * nbins).reshape(len(edges), nbins)
+        sum_kb = np.bincount(cell, weights=e, minlength=len(edges) * nbins).reshape(len(edges), nbins)
+        cnt_all, sum_all = cnt_kb.sum(axis=0), sum_kb.sum(axis=0)
+        pred = np.zeros(n)
+        for k, (a, b) in enumerate(edges):
+            cnt_out = cnt_all - cnt_kb[k]  # every bin without block k
+            ok = cnt_out >= 5
+            if ok.sum() >= 2:  # piecewise linear between the bin means of the other blocks
+                pred[a:b] = np.interp(x[a:b], centers[ok], (sum_all[ok] - sum_kb[k][ok]) / cnt_out[ok])
+        frac = max(total - float(np.mean((e - pred) ** 2)), 0.0) / total
+        means_all = sum_all / np.maximum(cnt_all, 1)
+        peak = float(np.max(np.abs(means_all[cnt_all >= 10]), initial=0.0))
+        explained = math.sqrt(frac * total)
+        if frac >= STRUCTURE_MIN_FRACTION and peak >= floor and (best is None or frac > best[2]):
+            best = (name, explained, frac)
+    return best
+
+
+def _gap(sel: ChannelSelector, terms, ch: str, unit: str, t: np.ndarray) -> Gap:
+    y = sel.y
+    base = sel.design([])
+    before, pred0 = block_cv(y, base)
+    after, pred = block_cv(y, sel.design(terms))
+    measured = y - pred0 if base.shape[1] else y
+    edges = block_edges(len(y))
+    return Gap(
+        ch, unit, before, after, t, measured, pred - pred0, [(float(t[a]), float(t[b - 1])) for a, b in edges]
+    )
+
+
+def _updated_model(model: AxisModel, effects: list[Effect]) -> AxisModel:
+    e = Effects()
+    for eff in effects:
+        params = dict(eff.params)
+        if eff.id in ("coulomb_friction", "viscous_friction", "lost_motion"):
+            key = next(iter(params))
+            params[key] = max(params[key], 0.0)
+        if eff.id == "torsional_compliance":
+            params = {k: v for k, v in params.items() if math.isfinite(v) and v > 0}
+            if "stiffness_nm_per_rad" not in params:
+                continue
+        if eff.id == "inertia_error" and model.load_side_inertia_kgm2 + params["inertia_kgm2"] <= 0:
+            continue
+        e = e.with_effect(eff.id, **params)
+    return model.with_effects(e)
+
+
+def _resimulate(
+    sig: Signals, axis: DeclaredAxis, nominal: AxisModel, updated: AxisModel, servo: ServoSettings | None
+) -> Resimulation:
+    t = sig.raw_t_s
+    f = sig.filt
+    if servo is not None and sig.cmd_pos_rad is not None:
+        command, cmd = "cmd_pos", sig.cmd_pos_rad
+    else:
+        command = "motion (measured pos, smoothed, stiff servo)"
+        cmd = savgol_filter(sig.raw_pos_rad, f.window, POLYORDER)
+        servo = ServoSettings.tuned_for(nominal, speed_bandwidth_hz=RESIM_BANDWIDTH_HZ, feed_forward_gain=1.0)
+    h = f.half
+    kt = axis.kt_nm_per_a
+    out = {}
+    for name, m in (("nominal", nominal), ("updated", updated)):
+        try:
+            r = simulate(m, servo, t, cmd)
+        except ValueError as exc:
+            raise ModelCheckError(f"re-simulation with the {name} model failed: {exc}") from None
+        out[name] = r
+    meas = sig.torque_f_nm
+    tn = kt * f.apply(out["nominal"]["current"])
+    tu = kt * f.apply(out["updated"]["current"])
+    res = Resimulation(
+        t_s=sig.t_s,
+        torque_measured_nm=meas,
+        torque_nominal_nm=tn,
+        torque_updated_nm=tu,
+        pos_measured_deg=np.degrees(sig.pos_rad),
+        pos_nominal_deg=np.degrees(out["nominal"]["pos"][h:-h]),
+        pos_updated_deg=np.degrees(out["updated"]["pos"][h:-h]),
+        rms_nominal_nm=rms(meas - tn),
+        rms_updated_nm=rms(meas - tu),
+        command=command,
+    )
+    if sig.load_diff_f_rad is not None:
+        res.load_diff_measured_arcsec = sig.load_diff_f_rad * ARCSEC_PER_RAD
+        for name in ("nominal", "updated"):
+            d = f.apply(out[name]["load_pos"] - out[name]["pos"]) * ARCSEC_PER_RAD
+            setattr(res, f"load_diff_{name}_arcsec", d)
+    return res
+
+
+__all__ = ["ModelCheckError", "ModelCheckResult", "Param", "run_modelcheck"]
