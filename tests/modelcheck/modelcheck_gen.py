@@ -95,7 +95,10 @@ def record(
     monitor = MonitorOptions(
         True, model.output_resolution_ppr if with_load_pos else None, step, noise_steps * step, 0.0, seed
     )
-    settings = servo or ServoSettings.tuned_for(model, speed_bandwidth_hz=30.0, feed_forward_gain=0.8)
+    # the loops see whole encoder pulses, so the current carries a real drive's quantisation noise
+    settings = servo or ServoSettings.tuned_for(
+        model, speed_bandwidth_hz=30.0, feed_forward_gain=0.8, quantised_feedback=True
+    )
     # Simulate at the servo rate and let the current monitor average over each recording interval
     # (the anti-alias filter of a sampled monitor: an instantaneous sample of the servo's current,
     # which steps every servo period, would miss what the position integrates). Positions are
