@@ -175,3 +175,24 @@ def test_a_drive_that_cannot_tell_is_confirmed_by_hand(drive):
         )
     record = run.submit(True, who="T. Trainee")
     assert record.passed and record.detail == "confirmed by hand"
+
+
+def test_a_servo_on_refusal_is_not_a_failed_check():
+    from fha_studio.hardware.errors import CommandNotSupported, ServoOnRefused
+
+    class RealDriveServoOn:  # a real HA-655 answers "s" to everything while the servo is on
+        def io_state(self):
+            raise ServoOnRefused("s: the servo is on")
+
+        def alarm(self):
+            raise CommandNotSupported("ALM: not an HA-655 command")
+
+    context = build_context(CODE)
+    wiring = load_procedure("wiring", context)
+    step = wiring.step("brake-releases").resolve(context, {})
+    seen = run_live_check(RealDriveServoOn(), step, LiveEnv(context))
+    assert not seen.available and "switch it off" in seen.detail
+    seen = run_live_check(
+        RealDriveServoOn(), wiring.step("encoder-signals").resolve(context, {}), LiveEnv(context)
+    )
+    assert not seen.available and "confirm by hand" in seen.detail

@@ -258,5 +258,7 @@ def run_live_check(client: DriveClient, step: Step, env: LiveEnv) -> Observation
         return check(client, step, env)
     except CommandNotSupported as exc:
         return unavailable(str(exc))
+    except ServoOnRefused:  # a real HA-655 answers nothing on CN3 while the servo is on
+        return unavailable("the servo is on (CN3 answers only with the servo off): switch it off")
     except DriveRefused as exc:  # the link works and the drive said no: the check fails, saying why
         return Observation(None, False, f"the drive refused: {exc}")
