@@ -344,3 +344,19 @@ def test_quantised_feedback_gives_a_real_drives_current_noise_while_moving(make_
         currents.append(drive.monitor(104))
     assert len(set(currents)) > 5  # not a constant: the pulse-difference speed is noisy
     assert abs(sum(currents) / len(currents)) < 500  # ... around zero without friction
+
+
+def test_driver_from_the_combination_table_and_supply_voltage(make_drive):
+    assert make_drive("FHA-25C-50-US250-A").driver == "HA-655-4-100"  # 100 V (option A), 1-3
+    assert make_drive("FHA-32C-100-S248").driver == "HA-655-4A-200"
+    drive = make_drive("FHA-17C-50-US250", driver="HA-675-2-200")
+    assert drive.execute("IDN", 0).lines[0] == "HA-675-2-200"
+    assert drive.parameters.driver == "HA-675"
+
+
+def test_user_eeprom_lives_in_the_user_data_directory(make_drive, tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    drive = make_drive(eeprom="user")
+    drive.write_parameter(Mode.TUNE, 4, 33)
+    expected = tmp_path / "data" / "fha-studio" / "sim" / "HA-655-2-200_FHA-25C-50-US250.json"
+    assert drive.eeprom.path == expected and expected.exists()
