@@ -210,6 +210,7 @@ def test_named_effect_report_shape(results):
     assert report["effects"][0]["id"] == "coulomb_friction"
     assert set(report["effects"][0]) >= {"id", "params", "channel"}
     assert report["effects"][0]["channel"] == "torque"
+    assert 0.0 < report["analysis"]["current_delay_ms"] < 1.5  # the monitor averages over 1 ms: ~0.5 ms
     gap = report["gap"]["torque"]
     assert gap["unit"] == "N m" and gap["rms_after"] < gap["rms_before"]
     line = result.summary_lines()[0]

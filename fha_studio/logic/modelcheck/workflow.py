@@ -46,7 +46,7 @@ TORQUE_FLOOR_MIN_NM = 0.02
 POSITION_FLOOR_ARCSEC = 2.0
 STRUCTURE_MIN_FRACTION = 0.15  # a structured residual explains >= 15 % of the residual's variance
 RESIM_BANDWIDTH_HZ = 60.0  # speed-loop bandwidth of the stiff servo that follows the measured motion
-TARGET_DECIMATED = 2500  # samples the selection works on (speed); never below 4 per window
+TARGET_DECIMATED = 2500  # about this many samples for the selection (speed), see run_modelcheck
 
 
 # ------------------------------------------------------------------------------------ result types
@@ -206,6 +206,7 @@ class ModelCheckResult:
     updated_model: AxisModel  # step 4
     resimulation: Resimulation | None
     notes: list[str]
+    current_delay_ms: float = 0.0  # fitted time offset of the current against the position (recorder)
 
     @property
     def found(self) -> bool:
@@ -309,6 +310,7 @@ class ModelCheckResult:
                 "bandwidth_hz": self.bandwidth_hz,
                 "floors": {ch: {"value": c.floor, "unit": c.unit} for ch, c in self.channels.items()},
                 "criterion": f"AR-whitened BIC gain >= {BIC_MIN:g}, contiguous-block CV, floor",
+                "current_delay_ms": self.current_delay_ms,
             },
             "resimulation": None
             if self.resimulation is None
@@ -372,8 +374,9 @@ def run_modelcheck(
     if sig.resampled:
         notes.append("Note: the sampling was not uniform; the signals were resampled onto a uniform grid.")
     n = len(sig.t_s)
-    step = max(1, min(n // TARGET_DECIMATED, (sig.filt.window - 2) // 4)) if n > TARGET_DECIMATED else 1
-    step = max(step, 1)
+    # decimate the smoothed signals for the selection: about TARGET_DECIMATED samples, never below
+    # two per smoothing window half-width (the smoothed band stays below the new Nyquist frequency)
+    step = max(1, min(n // TARGET_DECIMATED, (sig.filt.window - 2) // 2))
     index = np.arange(0, n, step)
 
     # ---- step 1: residuals
@@ -514,6 +517,7 @@ def run_modelcheck(
         updated_model=updated,
         resimulation=resim,
         notes=notes,
+        current_delay_ms=delay_ms,
     )
 
 
