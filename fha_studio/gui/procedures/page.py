@@ -14,7 +14,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QObject, Signal, Slot
+from PySide6.QtCore import QObject, Qt, Signal, Slot
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -131,6 +131,7 @@ class ProceduresPage(QWidget):
         layout.addWidget(split, 1)
         self.procedure_list = QListWidget()
         self.procedure_list.setObjectName("procedure_list")
+        self.procedure_list.setWordWrap(True)
         self.procedure_list.currentItemChanged.connect(self._procedure_chosen)
         split.addWidget(self.procedure_list)
 
@@ -143,6 +144,7 @@ class ProceduresPage(QWidget):
         self.step_text = QLabel("")
         self.step_text.setObjectName("step_text")
         self.step_text.setWordWrap(True)
+        self.step_text.setAlignment(Qt.AlignmentFlag.AlignTop | Qt.AlignmentFlag.AlignLeft)
         self.progress_label = QLabel("")
         s.addWidget(self.section_label)
         s.addWidget(self.step_text, 1)
@@ -258,7 +260,7 @@ class ProceduresPage(QWidget):
         self.history.setObjectName("history")
         self.history.setHorizontalHeaderLabels(["Step", "Value", "Result", "Who", "When (UTC)"])
         split.addWidget(self.history)
-        split.setSizes([220, 520, 360])
+        split.setSizes([260, 640, 360])
 
     # -- sessions -----------------------------------------------------------------------------
     def _identity(self) -> dict[str, str]:
