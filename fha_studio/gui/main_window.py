@@ -109,6 +109,7 @@ class MainWindow(QMainWindow):
             "sizing": LazyPage(self, _sizing_page),
             "scope": LazyPage(self, _scope_page),
             "procedures": LazyPage(self, _procedures_page),
+            "modelcheck": LazyPage(self, _modelcheck_page),
         }
         for page, title in (
             (self.connection_page, "C&onnection"),
@@ -119,6 +120,7 @@ class MainWindow(QMainWindow):
             (self._lazy["sizing"], "Si&zing"),
             (self._lazy["scope"], "&Scope"),
             (self._lazy["procedures"], "Proced&ures"),
+            (self._lazy["modelcheck"], "Model chec&k"),
         ):
             self.tabs.addTab(page, title)
         self.setCentralWidget(self.tabs)
@@ -127,6 +129,10 @@ class MainWindow(QMainWindow):
     @property
     def sizing_page(self):
         return self._lazy["sizing"].page
+
+    @property
+    def modelcheck_page(self):
+        return self._lazy["modelcheck"].page
 
     @property
     def scope_page(self):
@@ -183,7 +189,8 @@ class MainWindow(QMainWindow):
                 pages.append(widget)
         return pages
 
-    PAGE_NAMES = ("connection", "parameters", "direction", "alarms", "jog", "sizing", "scope", "procedures")
+    PAGE_NAMES = ("connection", "parameters", "direction", "alarms", "jog", "sizing", "scope", "procedures",
+                  "modelcheck")
 
     def show_page(self, name: str) -> QWidget:
         """Shows the page called `name` (one of PAGE_NAMES); ValueError naming them otherwise."""
@@ -381,6 +388,12 @@ def _scope_page(window: MainWindow) -> QWidget:
     from fha_studio.gui.scope.page import ScopePage
 
     return ScopePage(window.session, window)
+
+
+def _modelcheck_page(window: MainWindow) -> QWidget:
+    from fha_studio.gui.modelcheck.page import ModelCheckPage
+
+    return ModelCheckPage(window.session, window)
 
 
 def _procedures_page(window: MainWindow) -> QWidget:

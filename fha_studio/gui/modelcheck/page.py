@@ -1,0 +1,511 @@
+"""Page "Model check": load a recording (or take the scope's capture), run the discrepancy
+workflow off the GUI thread, and show each step: residuals, where they sit, the effects named
+with their parameters, the gap on held-out data, and the re-simulation with the updated model.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6.QtCore import QObject, QStandardPaths, QThread, Signal, Slot
+from PySide6.QtGui import QFont
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDoubleSpinBox,
+    QFileDialog,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QPlainTextEdit,
+    QPushButton,
+    QSplitter,
+    QTableWidget,
+    QTableWidgetItem,
+    QTabWidget,
+    QVBoxLayout,
+    QWidget,
+)
+
+from fha_studio.logic.modelcheck import ModelCheckError, ModelCheckResult, run_modelcheck
+from fha_studio.recording import Recording, RecordingError, read_recording
+
+COLORS = {"measured": "#1f77b4", "nominal": "#d62728", "updated": "#2ca02c", "residual": "#555555"}
+VARIABLE_LABELS = {
+    "time": "time",
+    "speed": "output speed",
+    "position": "output position",
+    "acceleration": "acceleration",
+    "motor_angle": "motor angle",
+    "torque": "torque",
+}
+
+
+class _Worker(QObject):
+    """Runs the workflow in its own thread; the GUI thread never waits for it."""
+
+    sigDone = Signal(object, float)  # ModelCheckResult, seconds
+    sigFailed = Signal(str)
+
+    @Slot(object)
+    def run(self, recording: Recording) -> None:
+        started = time.perf_counter()
+        try:
+            result = run_modelcheck(recording)
+        except (ModelCheckError, RecordingError, ValueError) as exc:
+            self.sigFailed.emit(str(exc))
+            return
+        except Exception as exc:  # an analysis bug must not kill the thread silently
+            self.sigFailed.emit(f"the model check failed: {type(exc).__name__}: {exc}")
+            return
+        self.sigDone.emit(result, time.perf_counter() - started)
+
+
+def _plot(title: str, left: str, bottom: str = "time (s)") -> pg.PlotWidget:
+    widget = pg.PlotWidget(background="w")
+    item = widget.getPlotItem()
+    item.setTitle(title, color="#222", size="10pt")
+    item.setLabel("left", left)
+    item.setLabel("bottom", bottom)
+    item.showGrid(x=True, y=True, alpha=0.25)
+    item.addLegend(offset=(10, 5), labelTextColor="#222")
+    item.setClipToView(True)
+    item.setDownsampling(auto=True, mode="peak")
+    return widget
+
+
+class ModelCheckPage(QWidget):
+    """Loads a recording, runs the model check, shows the story step by step."""
+
+    sigRequestRun = Signal(object)  # Recording, to the worker
+    sigFinished = Signal(object)  # ModelCheckResult, after the views were filled
+    sigFailed = Signal(str)
+
+    def __init__(self, session=None, main_window=None):
+        super().__init__(main_window)
+        self.session = session
+        self.main_window = main_window
+        self.recording: Recording | None = None
+        self.result: ModelCheckResult | None = None
+        self._running = False
+        self._build()
+        self._thread = QThread(self)
+        self._thread.setObjectName("model check")
+        self._worker = _Worker()
+        self._worker.moveToThread(self._thread)
+        self.sigRequestRun.connect(self._worker.run)
+        self._worker.sigDone.connect(self._on_done)
+        self._worker.sigFailed.connect(self._on_failed)
+        self._thread.finished.connect(self._worker.deleteLater)
+        self._thread.start()
+        self._update_buttons()
+
+    # ---------------------------------------------------------------- layout
+    def _build(self) -> None:
+        self.open_button = QPushButton("Open recording…")
+        self.open_button.clicked.connect(self._open_clicked)
+        self.scope_button = QPushButton("Use the scope's capture")
+        self.scope_button.setToolTip("The trace, test or recording on show in the Scope page")
+        self.scope_button.clicked.connect(self._scope_clicked)
+        self.inertia_spin = QDoubleSpinBox()
+        self.inertia_spin.setDecimals(4)
+        self.inertia_spin.setRange(0.0, 10000.0)
+        self.inertia_spin.setSuffix(" kg m²")
+        self.inertia_spin.setToolTip("The load inertia declared for this recording (its metadata); "
+                                     "change it to check another declaration")
+        self.run_button = QPushButton("Run model check")
+        self.run_button.setDefault(True)
+        self.run_button.clicked.connect(self.run)
+        self.save_model_button = QPushButton("Save updated model…")
+        self.save_model_button.clicked.connect(self._save_model_clicked)
+        self.save_report_button = QPushButton("Save report (JSON)…")
+        self.save_report_button.clicked.connect(self._save_report_clicked)
+        bar = QHBoxLayout()
+        for w in (self.open_button, self.scope_button, QLabel("Declared load inertia:"), self.inertia_spin,
+                  self.run_button, self.save_model_button, self.save_report_button):
+            bar.addWidget(w)
+        bar.addStretch(1)
+        self.source_label = QLabel("No recording loaded. Open an fha-recording/1 file, or capture a move "
+                                   "in the Scope page and take it from there.")
+        self.source_label.setWordWrap(True)
+        self.summary = QPlainTextEdit()
+        self.summary.setReadOnly(True)
+        self.summary.setFont(QFont("monospace", 9))
+        self.summary.setPlaceholderText("The findings appear here: which effect is missing, its "
+                                        "parameters, and the gap before and after on held-out data.")
+
+        self.steps = QTabWidget()
+        self.steps.setDocumentMode(True)
+        self.steps.addTab(self._build_residual_tab(), "1 Residual")
+        self.steps.addTab(self._build_where_tab(), "2 Where")
+        self.steps.addTab(self._build_effects_tab(), "3-4 Effects && model")
+        self.steps.addTab(self._build_gap_tab(), "5 Gap (held-out)")
+        self.steps.addTab(self._build_resim_tab(), "5 Re-simulation")
+
+        split = QSplitter()
+        split.setOrientation(pg.QtCore.Qt.Orientation.Vertical)
+        split.addWidget(self.summary)
+        split.addWidget(self.steps)
+        split.setStretchFactor(0, 1)
+        split.setStretchFactor(1, 4)
+        split.setSizes([130, 520])  # the findings readable at once, the plots below
+        layout = QVBoxLayout(self)
+        layout.addLayout(bar)
+        layout.addWidget(self.source_label)
+        layout.addWidget(split, 1)
+
+    def _build_residual_tab(self) -> QWidget:
+        self.torque_plot = _plot("Motor torque (Kt x current) and what the nominal model needs", "N m")
+        self.residual_plot = _plot("Residual: measured - nominal", "")
+        self.residual_plot.setXLink(self.torque_plot)
+        return _stack(self.torque_plot, self.residual_plot)
+
+    def _build_where_tab(self) -> QWidget:
+        self.where_channel = QComboBox()
+        self.where_variable = QComboBox()
+        self.where_channel.currentIndexChanged.connect(self._fill_where_variables)
+        self.where_variable.currentIndexChanged.connect(self._draw_where)
+        self.where_plot = _plot("Residual against", "")
+        controls = QHBoxLayout()
+        controls.addWidget(QLabel("Channel:"))
+        controls.addWidget(self.where_channel)
+        controls.addWidget(QLabel("against:"))
+        controls.addWidget(self.where_variable)
+        controls.addWidget(QLabel("dots: residual of the nominal model; lines: mean per bin before "
+                                  "(red) and after (green) adding the effects"))
+        controls.addStretch(1)
+        box = QWidget()
+        layout = QVBoxLayout(box)
+        layout.addLayout(controls)
+        layout.addWidget(self.where_plot, 1)
+        return box
+
+    def _build_effects_tab(self) -> QWidget:
+        self.effects_table = QTableWidget(0, 4)
+        self.effects_table.setHorizontalHeaderLabels(["Effect", "Channel", "Parameters (± 1 sigma)",
+                                                      "Not separable from"])
+        self.effects_table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        self.effects_table.horizontalHeader().setStretchLastSection(True)
+        self.effects_table.verticalHeader().setVisible(False)
+        self.findings = QPlainTextEdit()
+        self.findings.setReadOnly(True)
+        self.findings.setPlaceholderText("Selection steps, ambiguities, unexplained structure, detection "
+                                         "limits and the updated model file appear here.")
+        return _stack(self.effects_table, self.findings)
+
+    def _build_gap_tab(self) -> QWidget:
+        self.gap_plots: dict[str, pg.PlotWidget] = {}
+        self.gap_box = QWidget()
+        QVBoxLayout(self.gap_box)
+        return self.gap_box
+
+    def _build_resim_tab(self) -> QWidget:
+        self.resim_torque_plot = _plot("Re-simulation of the recorded command: torque", "N m")
+        self.resim_pos_plot = _plot("Position: simulated - measured", "arcsec")
+        self.resim_pos_plot.setXLink(self.resim_torque_plot)
+        return _stack(self.resim_torque_plot, self.resim_pos_plot)
+
+    def _update_buttons(self) -> None:
+        self.run_button.setEnabled(self.recording is not None and not self._running)
+        self.inertia_spin.setEnabled(self.recording is not None and not self._running)
+        self.save_model_button.setEnabled(self.result is not None and not self._running)
+        self.save_report_button.setEnabled(self.result is not None and not self._running)
+        self.open_button.setEnabled(not self._running)
+        self.scope_button.setEnabled(not self._running and self._scope_view() is not None)
+
+    # ---------------------------------------------------------------- input
+    def load_recording(self, path: str | Path) -> Recording:
+        """Read a recording (RecordingError names line and field on bad input); nothing changes
+        on failure."""
+        recording = read_recording(path)
+        self._set_recording(recording, f"{Path(path).name}")
+        return recording
+
+    def _set_recording(self, recording: Recording, label: str) -> None:
+        self.recording = recording
+        self.result = None
+        m = recording.metadata
+        self.inertia_spin.setValue(m.load_inertia_kgm2)
+        columns = ", ".join(["t", "pos", "current"] + [c for c in ("cmd_pos", "load_pos", "vel")
+                                                        if getattr(recording, f"{c}_deg", None) is not None
+                                                        or (c == "vel" and recording.vel_rpm is not None)])
+        self.source_label.setText(
+            f"Recording: {label} — {m.actuator}, {len(recording)} samples over {recording.duration_s:.2f} s, "
+            f"columns {columns}. Declared load inertia {m.load_inertia_kgm2:g} kg m²."
+        )
+        self.summary.setPlainText("Not run yet: press Run model check.")
+        self._update_buttons()
+
+    def _open_clicked(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Open a recording", "",
+                                              "fha-recording/1 (*.csv);;All (*)")
+        if path:
+            try:
+                self.load_recording(path)
+            except (RecordingError, OSError) as exc:
+                self._show_error(str(exc))
+
+    def _scope_view(self):
+        window = self.main_window
+        lazy = getattr(window, "_lazy", {}).get("scope") if window is not None else None
+        if lazy is None or lazy.built is None:
+            return None
+        return lazy.built.view
+
+    def take_scope_capture(self) -> Path:
+        """Save the capture on show in the scope and load it here; returns the file written."""
+        view = self._scope_view()
+        if view is None:
+            raise ValueError("the Scope page has not been opened: capture a move there first")
+        folder = Path(QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation))
+        folder = folder / "captures"
+        folder.mkdir(parents=True, exist_ok=True)
+        path = view.save_capture(folder / f"capture-{time.strftime('%Y%m%d-%H%M%S')}.csv")
+        self._set_recording(read_recording(path), f"the scope's capture ({path})")
+        return path
+
+    def _scope_clicked(self) -> None:
+        try:
+            self.take_scope_capture()
+        except (ValueError, RecordingError, OSError) as exc:
+            self._show_error(str(exc))
+
+    # ---------------------------------------------------------------- run
+    def run(self) -> None:
+        """Start the workflow on the loaded recording (in the page's thread); sigFinished follows."""
+        if self.recording is None or self._running:
+            return
+        recording = self.recording
+        declared = self.inertia_spin.value()
+        if abs(declared - recording.metadata.load_inertia_kgm2) > 1e-12:
+            recording = dataclasses.replace(
+                recording, metadata=dataclasses.replace(recording.metadata, load_inertia_kgm2=declared)
+            )
+        self._running = True
+        self._update_buttons()
+        self.summary.setPlainText("Running the model check…")
+        self.sigRequestRun.emit(recording)
+
+    def _on_done(self, result: ModelCheckResult, seconds: float) -> None:
+        self._running = False
+        self.result = result
+        lines = result.summary_lines()
+        self.summary.setPlainText("\n".join(lines) + f"\n\n(analysis took {seconds:.1f} s)")
+        self._draw_residual(result)
+        self._fill_where(result)
+        self._fill_effects(result)
+        self._draw_gap(result)
+        self._draw_resimulation(result)
+        self._update_buttons()
+        self.sigFinished.emit(result)
+
+    def _on_failed(self, message: str) -> None:
+        self._running = False
+        self._update_buttons()
+        self._show_error(message)
+
+    def _show_error(self, message: str) -> None:
+        self.summary.setPlainText(f"Cannot run the model check:\n{message}")
+        self.sigFailed.emit(message)
+
+    # ---------------------------------------------------------------- drawing
+    def _draw_residual(self, r: ModelCheckResult) -> None:
+        res = r.residual
+        t = res["t_s"]
+        self.torque_plot.clear()
+        self.torque_plot.plot(t, res["torque_measured_nm"], pen=pg.mkPen(COLORS["measured"], width=1),
+                              name="measured (Kt x current)")
+        self.torque_plot.plot(t, res["torque_nominal_nm"], pen=pg.mkPen(COLORS["nominal"], width=1),
+                              name="nominal model (J x acceleration)")
+        self.residual_plot.clear()
+        self.residual_plot.plot(t, res["torque_residual_nm"], pen=pg.mkPen(COLORS["residual"], width=1),
+                                name="torque residual [N m]")
+        if "load_diff_arcsec" in res:
+            self.residual_plot.plot(t, res["load_diff_arcsec"], pen=pg.mkPen(COLORS["updated"], width=1),
+                                    name="load_pos - pos [arcsec]")
+
+    def _fill_where(self, r: ModelCheckResult) -> None:
+        self.where_channel.blockSignals(True)
+        self.where_channel.clear()
+        for name in r.where:
+            self.where_channel.addItem(name, name)
+        self.where_channel.blockSignals(False)
+        self._fill_where_variables()
+
+    def _fill_where_variables(self, *_args) -> None:
+        if self.result is None or self.where_channel.currentData() is None:
+            return
+        where = self.result.where[self.where_channel.currentData()]
+        self.where_variable.blockSignals(True)
+        self.where_variable.clear()
+        for var in where.before:
+            self.where_variable.addItem(VARIABLE_LABELS.get(var, var), var)
+        # speed first: friction and offsets show there at a glance
+        index = self.where_variable.findData("speed")
+        self.where_variable.setCurrentIndex(max(0, index))
+        self.where_variable.blockSignals(False)
+        self._draw_where()
+
+    def _draw_where(self, *_args) -> None:
+        if self.result is None:
+            return
+        channel, var = self.where_channel.currentData(), self.where_variable.currentData()
+        if channel is None or var is None:
+            return
+        where = self.result.where[channel]
+        plot = self.where_plot
+        plot.clear()
+        unit = where.variable_units.get(var, "")
+        plot.getPlotItem().setTitle(f"{channel} residual against {VARIABLE_LABELS.get(var, var)}",
+                                    color="#222", size="10pt")
+        plot.getPlotItem().setLabel("bottom", f"{VARIABLE_LABELS.get(var, var)} ({unit})")
+        plot.getPlotItem().setLabel("left", f"residual ({where.unit})")
+        x = where.variables[var]
+        plot.plot(x, where.residual_before, pen=None, symbol="o", symbolSize=3,
+                  symbolBrush=pg.mkBrush(120, 120, 120, 90), symbolPen=None, name="residual (nominal)")
+        for binned, color, label in ((where.before[var], COLORS["nominal"], "mean per bin, nominal"),
+                                     (where.after[var], COLORS["updated"], "mean per bin, updated")):
+            ok = binned.count > 0
+            plot.plot(binned.centers[ok], binned.mean[ok], pen=pg.mkPen(color, width=2), symbol="s",
+                      symbolSize=5, symbolBrush=color, name=label)
+            plot.addItem(pg.ErrorBarItem(x=binned.centers[ok], y=binned.mean[ok], height=2 * binned.sem[ok],
+                                         pen=pg.mkPen(color)))
+
+    def _fill_effects(self, r: ModelCheckResult) -> None:
+        table = self.effects_table
+        table.setRowCount(0)
+        for e in r.effects:
+            row = table.rowCount()
+            table.insertRow(row)
+            params = "; ".join(
+                f"{k} = {_num(v)} ± {_num(e.uncertainty.get(k, float('nan')))} {e.units.get(k, '')}".rstrip()
+                for k, v in e.params.items()
+            )
+            for col, text in enumerate((f"{e.label} ({e.id})", e.channel, params, ", ".join(e.alternatives))):
+                table.setItem(row, col, QTableWidgetItem(text))
+        text = []
+        for name, ch in r.channels.items():
+            text.append(f"{name} channel: {ch.n_samples} samples, AR({ch.ar_order}) whitening, "
+                        f"practical floor {_num(ch.floor)} {ch.unit}")
+            for step in ch.steps:
+                text.append(f"  {_describe_step(step)}")
+        for a in r.ambiguities:
+            text.append(f"{a.chosen} or {a.alternative}: not separable from this data "
+                        f"(ΔBIC {a.delta_bic:.1f}); to separate them: {a.separating_test}")
+        for s in r.structures:
+            text.append(f"Unexplained structure in {s.channel} by {s.variable}: {_num(s.rms)} {s.unit} rms "
+                        f"({100 * s.fraction:.0f} % of the residual)")
+        if r.detection_limits:
+            text.append("Detection limits of this recording:")
+            text.extend(f"  {d.id}: {d.param} {_num(d.value)} {d.param_unit}" for d in r.detection_limits)
+        text.append("")
+        text.append("Updated model (Save updated model… writes it for the simulated drive):")
+        text.append(r.updated_model.to_toml())
+        self.findings.setPlainText("\n".join(text))
+
+    def _draw_gap(self, r: ModelCheckResult) -> None:
+        layout = self.gap_box.layout()
+        for plot in self.gap_plots.values():
+            layout.removeWidget(plot)
+            plot.deleteLater()
+        self.gap_plots.clear()
+        for name, gap in r.gap.items():
+            plot = _plot(f"{name}: gap {_num(gap.rms_before)} -> {_num(gap.rms_after)} {gap.unit} rms "
+                         "on held-out blocks (shaded)", gap.unit)
+            for start, stop in gap.blocks:
+                region = pg.LinearRegionItem((start, stop), movable=False,
+                                             brush=pg.mkBrush(255, 200, 0, 40), pen=pg.mkPen(None))
+                plot.addItem(region)
+            plot.plot(gap.t_s, gap.measured, pen=pg.mkPen(COLORS["measured"], width=1),
+                      name="measured residual of the nominal model")
+            plot.plot(gap.t_s, gap.predicted_heldout, pen=pg.mkPen(COLORS["updated"], width=2),
+                      name="predicted by the added effects (not fitted on these blocks)")
+            self.gap_plots[name] = plot
+            layout.addWidget(plot, 1)
+
+    def _draw_resimulation(self, r: ModelCheckResult) -> None:
+        self.resim_torque_plot.clear()
+        self.resim_pos_plot.clear()
+        s = r.resimulation
+        if s is None:
+            self.resim_torque_plot.getPlotItem().setTitle("No re-simulation for this recording")
+            return
+        self.resim_torque_plot.getPlotItem().setTitle(
+            f"Re-simulation of the recorded {s.command}: torque {_num(s.rms_nominal_nm)} -> "
+            f"{_num(s.rms_updated_nm)} N m rms (nominal -> updated)", color="#222", size="10pt")
+        for y, color, label in ((s.torque_measured_nm, COLORS["measured"], "measured"),
+                                (s.torque_nominal_nm, COLORS["nominal"], "nominal model"),
+                                (s.torque_updated_nm, COLORS["updated"], "updated model")):
+            self.resim_torque_plot.plot(s.t_s, y, pen=pg.mkPen(color, width=1), name=label)
+        arcsec = 3600.0
+        for y, color, label in ((s.pos_nominal_deg, COLORS["nominal"], "nominal model"),
+                                (s.pos_updated_deg, COLORS["updated"], "updated model")):
+            self.resim_pos_plot.plot(s.t_s, (y - s.pos_measured_deg) * arcsec, pen=pg.mkPen(color, width=1),
+                                     name=label)
+
+    # ---------------------------------------------------------------- output
+    def save_model(self, path: str | Path) -> Path:
+        if self.result is None:
+            raise ValueError("run the model check first")
+        self.result.write_model(path)
+        return Path(path)
+
+    def save_report(self, path: str | Path) -> Path:
+        if self.result is None:
+            raise ValueError("run the model check first")
+        Path(path).write_text(json.dumps(self.result.to_json(), indent=2), encoding="utf-8")
+        return Path(path)
+
+    def _save_model_clicked(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Save the updated model", "axis-model.toml",
+                                              "TOML (*.toml)")
+        if path:
+            self.save_model(path)
+
+    def _save_report_clicked(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Save the report", "modelcheck.json", "JSON (*.json)")
+        if path:
+            self.save_report(path)
+
+    def showEvent(self, event) -> None:
+        self._update_buttons()  # the scope may have been opened since
+        super().showEvent(event)
+
+    def shutdown(self) -> None:
+        """End the analysis thread (waits for a running analysis to finish, at most 30 s)."""
+        if self._thread.isRunning():
+            self._thread.quit()
+            if not self._thread.wait(30000):
+                import logging
+
+                logging.getLogger(__name__).error("model check thread did not stop")
+
+
+def _stack(*widgets: QWidget) -> QWidget:
+    box = QWidget()
+    layout = QVBoxLayout(box)
+    layout.setContentsMargins(0, 0, 0, 0)
+    for w in widgets:
+        layout.addWidget(w, 1)
+    return box
+
+
+def _num(x: float) -> str:
+    if not np.isfinite(x):
+        return "?"
+    return f"{x:.3g}"
+
+
+def _describe_step(step) -> str:
+    """One selection step: which candidates were tried, how they scored, which was taken."""
+    chosen = step.chosen or "none"
+    tried = ", ".join(
+        f"{t.id} ΔBIC {t.delta_bic:.0f} cv {_num(t.cv_rms_before)}->{_num(t.cv_rms_after)}"
+        + ("" if t.accepted else f" ({t.reason})")
+        for t in sorted(step.trials, key=lambda t: -t.delta_bic)[:4]
+    )
+    return f"{step.kind} step (AR {step.ar_order}): chose {chosen}" + (f"; tried {tried}" if tried else "")
