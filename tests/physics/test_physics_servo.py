@@ -317,3 +317,41 @@ def test_quantised_feedback_holds_within_a_pulse_and_makes_current_noise(make_mo
         assert np.mean(tr["current"]) * 22 == pytest.approx(10 * RPM, rel=0.02)
     assert np.std(traces["ideal"]["current"]) < 1e-6
     assert 0.01 < np.std(traces["real"]["current"]) < 0.5
+
+
+def test_brake_holds_below_its_holding_torque_and_slips_above(make_model):
+    # servo off, an unbalanced load of 40 N m at 90 degrees: a 50 N m brake holds it, a 30 N m one
+    # lets it fall with (40 - 30) N m over the axis inertia
+    effects = Effects().with_effect("gravity_load", amplitude_nm=40.0, phase_deg=0.0)
+    model = make_model(CODE, 0.5, effects)
+    axis = ServoAxis(model, initial_pos_rad=math.pi / 2)
+    axis.set_brake(True, holding_torque_nm=50.0)
+    assert axis.brake_engaged
+    axis.advance(1.0)
+    assert axis.output_pos_rad == math.pi / 2
+    axis.set_brake(True, holding_torque_nm=30.0)
+    axis.advance(0.01)
+    assert axis.output_speed_rad_s == pytest.approx(-10.0 / 1.31 * 0.01, rel=0.02)
+    axis.set_brake(False)
+    assert not axis.brake_engaged
+
+
+def test_clear_error_and_direction_change_rebase_the_command(make_model):
+    model = make_model(CODE, 0.5)
+    axis = ServoAxis(model)
+    axis.servo_on()
+    axis.add_command_pulses(5000)
+    axis.step(10)
+    assert axis.error_pulses > 4000
+    axis.clear_error()
+    assert axis.error_pulses == 0
+    axis.advance(0.5)
+    assert axis.output_speed_rad_s == pytest.approx(0.0, abs=1e-3)
+    pos = axis.output_pos_rad
+    axis.set_settings(axis.settings.replace(rotary_direction=1))
+    axis.advance(0.2)
+    assert axis.output_pos_rad == pytest.approx(pos, abs=2 * model.output_pulse_rad)
+    assert axis.feedback_pulses < 0  # the drive now counts CW as negative
+    axis.jog(5 * RPM)
+    axis.advance(0.5)
+    assert axis.output_pos_rad < pos  # FWD turns CCW now
