@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from conftest import KGF_N, RAD_PER_ARCMIN, agree_within_rounding, half_unit
+from catalog_rounding import KGF_N, RAD_PER_ARCMIN, agree_within_rounding, half_unit
 
 from fha_studio.catalog import discrepancies, get_actuator
 from fha_studio.catalog import tables as t
