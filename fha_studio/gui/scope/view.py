@@ -74,6 +74,27 @@ _TRIGGERS = (
 _COLUMN_KEYS = {column: key for column, key in CONTRACT_SOURCES.items()}
 
 
+def peak_decimate(rows: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
+    """At most ``2 * bins`` rows keeping each bin's minimum and maximum per channel (peak
+    detection, as pyqtgraph's 'peak' mode, done once for all channels before ``setData``).
+
+    Returns (time of each output row, rows); short inputs come back unchanged.
+    """
+    n = len(rows)
+    if n <= 4 * bins:
+        return rows[:, 0], rows
+    k = n // bins
+    start = n - k * bins  # keep the newest samples whole; the few oldest go
+    blocks = rows[start:].reshape(bins, k, rows.shape[1])
+    out = np.empty((2 * bins, rows.shape[1]))
+    out[0::2] = blocks.min(axis=1)
+    out[1::2] = blocks.max(axis=1)
+    t = np.empty(2 * bins)
+    t[0::2] = blocks[:, 0, 0]
+    t[1::2] = blocks[:, -1, 0]
+    return t, out
+
+
 @dataclass(frozen=True)
 class ScopeContext:
     """What the scope must know of the axis: the actuator (resolution, ratio) and the load."""
@@ -128,6 +149,7 @@ class ScopeView(QWidget):
         self._indicator_text = ""
         self.frames = 0
         self._last_cursor_update = 0.0
+        self._last_draw = 0.0
         self.last_test: MoveTestResult | None = None
         self.last_trace: TraceResult | None = None
         self._build()
@@ -160,6 +182,10 @@ class ScopeView(QWidget):
         self.live_button.setCheckable(True)
         self.live_button.toggled.connect(self._live_toggled)
         bar.addWidget(self.live_button)
+        self.back_button = QPushButton("Back to live")
+        self.back_button.setToolTip("Leave the capture or file on show and return to the live view")
+        self.back_button.clicked.connect(self.back_to_live)
+        bar.addWidget(self.back_button)
         self.pause_button = QPushButton("Pause")
         self.pause_button.setCheckable(True)
         self.pause_button.toggled.connect(self.set_paused)
@@ -208,7 +234,7 @@ class ScopeView(QWidget):
         self.plot = pg.PlotWidget()
         self.plot.setObjectName("scopePlot")
         self.plot.setBackground("#111")
-        self.plot.showGrid(x=True, y=True, alpha=0.25)
+        self.plot.showGrid(x=False, y=True, alpha=0.25)  # x grid only when still: scrolling it is costly
         self.plot.setLabel("bottom", "time", units="s")
         self.plot.addLegend(offset=(8, 8))
         self.plot.setClipToView(True)
@@ -516,6 +542,7 @@ class ScopeView(QWidget):
         self._live = started
         self._static = None
         self._status = None
+        self.plot.showGrid(x=False, y=True, alpha=0.25)
         self._fill_channel_table()
         self._update_indicator()
 
@@ -576,16 +603,22 @@ class ScopeView(QWidget):
                 self.stop_recording()
         if self._paused:
             return
-        data = live.ring.window()
-        now = time.monotonic() - live.t0
         tb = float(self.time_base.currentData())
+        # redraw when the trace has moved by about a pixel (a 60 s time base needs ~16 frames/s)
+        interval_s = min(0.1, max(REFRESH_MS / 1000, tb / max(100, self.plot.width())))
+        clock = time.monotonic()
+        if clock - self._last_draw < interval_s * 0.9:
+            return
+        self._last_draw = clock
+        data = live.ring.window()
+        now = clock - live.t0
         if len(data):
-            t = data[:, 0]
-            i0 = int(np.searchsorted(t, now - tb))
+            i0 = int(np.searchsorted(data[:, 0], now - tb))
+            t, columns = peak_decimate(data[i0:], max(200, self.plot.width()))
             for j, c in enumerate(live.channels):
                 curve = self._curves.get(c.key)
                 if curve is not None:
-                    curve.setData(t[i0:], data[i0:, j + 1] * self._scale.get(c.key, 1.0))
+                    curve.setData(t, columns[:, j + 1] * self._scale.get(c.key, 1.0))
         self.plot.setXRange(now - tb, now, padding=0)
         self.frames += 1
         self.sigFrame.emit()
@@ -608,6 +641,7 @@ class ScopeView(QWidget):
                     uniform: bool = True) -> None:
         """Show data that is not live (a capture, a file); live acquisition goes on unseen."""
         self._static = _Static(tuple(channels), np.asarray(rows, dtype=float), label, sample_rate_hz, uniform)
+        self.plot.showGrid(x=True, y=True, alpha=0.25)
         for c in self._static.channels:
             self._visible.setdefault(c.key, True)
         self._fill_channel_table()
@@ -627,6 +661,7 @@ class ScopeView(QWidget):
 
     def back_to_live(self) -> None:
         self._static = None
+        self.plot.showGrid(x=False, y=True, alpha=0.25)
         self._fill_channel_table()
         self._update_indicator()
 
