@@ -56,6 +56,7 @@ class Cmd(enum.Enum):
     POWER_CYCLE = enum.auto()
     SET_INPUTS = enum.auto()  # args: bit mask (simulated drive only)
     CALL = enum.auto()  # args: a callable taking the client (for procedures of other pages)
+    SET_POLL_INTERVAL = enum.auto()  # args: ms between status polls (the scope slows them while live)
     SHUTDOWN = enum.auto()  # stop the axis, close the port, end the link thread
 
 
@@ -174,6 +175,7 @@ class LinkWorker(QObject):
     def __init__(self, abort: threading.Event, open_client: Callable[[str, int], Any] | None = None):
         super().__init__()
         self._abort = abort
+        self._poll_interval_ms = POLL_INTERVAL_MS
         self._open_client = open_client or _default_open
         self._client = None
         self._url = ""
@@ -453,6 +455,10 @@ class LinkWorker(QObject):
         state = self._client.set_inputs(**inputs)
         return int(getattr(state, "raw", state))
 
+    def _do_set_poll_interval(self, interval_ms: int) -> int:
+        self._poll_interval_ms = max(POLL_INTERVAL_MS, int(interval_ms))
+        return self._poll_interval_ms
+
     def _do_call(self, function: Callable[[Any], Any]) -> Any:
         return function(self._client)
 
@@ -485,7 +491,7 @@ class LinkWorker(QObject):
             self._timeouts = 0
         self.sigStatus.emit(DriveStatus(**status))
         if self._client is not None and self._poll_timer is not None:
-            self._poll_timer.start(POLL_INTERVAL_MS)
+            self._poll_timer.start(self._poll_interval_ms)
 
     def _poll_monitors(self, client, status: dict) -> None:
         """Output position (pulse), output speed (r/min) and motor current (A), scaled by the

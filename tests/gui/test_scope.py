@@ -114,7 +114,7 @@ def test_triggered_move_is_captured_saved_and_loads_everywhere(qtbot, scope, sim
     cmd = result.column("command_position")
     assert np.ptp(cmd[:100]) == 0  # still before the trigger
     assert cmd[-1] - cmd[0] == pytest.approx(20.0, abs=0.01)
-    assert view.indicator_text().startswith("NOT LIVE: showing the trace")
+    assert view.indicator_text().startswith("NOT LIVE: showing trace")
     path = view.save_capture(tmp_path / "move.csv")
     recording = read_recording(path)
     assert recording.metadata.sample_rate_hz == pytest.approx(1000)
@@ -127,7 +127,7 @@ def test_triggered_move_is_captured_saved_and_loads_everywhere(qtbot, scope, sim
     view.compute_spectrum()
     assert view.spectrum_label.text().startswith("Peaks:")
     view.open_recording(path)
-    assert view.indicator_text() == "NOT LIVE: showing the recording move.csv"
+    assert view.indicator_text() == "NOT LIVE: showing file move.csv"
     view.set_cursors(0.0, 0.5)
     readout = view.cursor_readout()
     assert readout["command_position"][0] == pytest.approx(0.5)
@@ -208,6 +208,8 @@ def test_the_main_window_scope_runs_in_the_link_thread(make_window, qtbot):
     qtbot.waitUntil(lambda: view.indicator_text() == "NOT LIVE: not started", timeout=5000)
     view.start_live()
     qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=10000)
+    # the line is the scope's: the worker's status poll slows down while live
+    qtbot.waitUntil(lambda: window.link._worker._poll_interval_ms == 500, timeout=3000)
     window.link.send(Cmd.SERVO, True)
     qtbot.waitUntil(lambda: window.link.servo_on, timeout=5000)
     window.link.jog_press(20.0)
@@ -215,6 +217,8 @@ def test_the_main_window_scope_runs_in_the_link_thread(make_window, qtbot):
         qtbot.waitUntil(lambda: abs(latest(view, "output_speed")[-1] - 20.0) < 0.5, timeout=10000)
     finally:
         window.link.jog_release()
+    view.stop_live()
+    qtbot.waitUntil(lambda: window.link._worker._poll_interval_ms == 100, timeout=3000)
     with qtbot.waitSignal(window.link.sigDisconnected, timeout=5000):
         window.link.close_link()
     qtbot.waitUntil(lambda: view.indicator_text().startswith("NOT LIVE"), timeout=3000)

@@ -72,3 +72,14 @@ def test_cursor_delta_interpolates_and_gives_slope():
     assert d.dt_s == pytest.approx(0.5)
     assert d.dvalue == pytest.approx(1.5)
     assert d.slope_per_s == pytest.approx(3)
+
+
+def test_prominent_peaks_find_a_line_on_a_drifting_spectrum():
+    t = np.arange(2048) / 1000.0
+    rng = np.random.default_rng(3)
+    drift = np.cumsum(rng.normal(0, 0.5, len(t)))  # a random walk: big at low frequencies
+    x = drift + 0.3 * np.sin(2 * np.pi * 166.7 * t) + rng.normal(0, 0.01, len(t))
+    spec = spectrum(t, x, detrend="constant")
+    assert spec.peaks(1)[0][0] < 5.0  # plain maxima: the drift
+    (f, amp), *_ = spec.prominent_peaks(1)
+    assert abs(f - 166.7) < 1.0 and abs(amp - 0.3) < 0.05

@@ -28,12 +28,14 @@ from fha_studio.logic.scope.acquisition import (
     TraceAcquisition,
     TraceSettings,
     load_scope_config,
+    readout_time_s,
 )
 
 log = logging.getLogger(__name__)
 
-#: Longest time one polling pass holds the link thread [s].
-PASS_BUDGET_S = 0.03
+#: Longest time one polling pass holds the link thread [s]: 0 = one sample per pass, so the
+#: worker's queued commands (a JOG keep-alive, a STOP) wait at most one exchange (~20 ms).
+PASS_BUDGET_S = 0.0
 #: How often the state goes out to the GUI [s].
 STATUS_INTERVAL_S = 0.2
 #: Period of the trace-status and move-test steps [ms].
@@ -76,6 +78,7 @@ class ScopeDriver(QObject):
     sigTraceState = Signal(str)  # a sentence: armed, capturing n, reading out ..., done
     sigTraceDone = Signal(object)  # TraceResult
     sigTestDone = Signal(object)  # MoveTestResult
+    sigTestState = Signal(str)  # what the running test is doing
     sigError = Signal(str)
     sigCallDone = Signal(object)  # the value of a CALL
 
@@ -203,8 +206,12 @@ class ScopeDriver(QObject):
     @Slot()
     def _step(self) -> None:
         try:
-            if self._test is not None and self._test.step():
-                self._test_finished()
+            if self._test is not None:
+                before = self._test.state_text
+                if self._test.step():
+                    self._test_finished()
+                elif self._test.state_text != before:
+                    self.sigTestState.emit(self._test.state_text)
             if self._trace is not None:
                 self._step_trace()
         except LinkError as exc:
@@ -217,10 +224,9 @@ class ScopeDriver(QObject):
         trace = self._trace
         status = trace.status()
         if status.state.name == "DONE":
-            settings = trace.settings
-            chars = status.count * (len(settings.items()) * 8) + status.count
-            self.sigTraceState.emit(f"reading out {status.count} samples (about "
-                                    f"{chars / 1920:.0f} s at 19200 bit/s)")
+            seconds = readout_time_s(status.count, len(trace.settings.items()))
+            self.sigTraceState.emit(f"reading out {status.count} samples (about {seconds:.0f} s at "
+                                    "19200 bit/s)")
             result = trace.read()
             self._trace = None
             self.sigTraceDone.emit(result)
@@ -252,6 +258,7 @@ class ScopeController(QObject):
     sigTraceState = Signal(str)
     sigTraceDone = Signal(object)
     sigTestDone = Signal(object)
+    sigTestState = Signal(str)
     sigError = Signal(str)
     sigCallDone = Signal(object)
 
@@ -268,7 +275,7 @@ class ScopeController(QObject):
         self.driver.moveToThread(thread)
         self.sigRequest.connect(self.driver.handle)
         for name in ("sigLiveStarted", "sigStatus", "sigTraceState", "sigTraceDone", "sigTestDone",
-                     "sigError", "sigCallDone"):
+                     "sigTestState", "sigError", "sigCallDone"):
             getattr(self.driver, name).connect(getattr(self, name))  # queued: into this thread
         self.connected = False
         self._shut = False

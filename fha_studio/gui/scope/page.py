@@ -12,12 +12,15 @@ from functools import partial
 from PySide6.QtWidgets import QVBoxLayout, QWidget
 
 from fha_studio.catalog import get_actuator
-from fha_studio.gui.link import Cmd, LinkInfo
+from fha_studio.gui.link import POLL_INTERVAL_MS, Cmd, LinkInfo
 
 from .driver import ScopeCmd, ScopeController, ScopeRequest
 from .view import ScopeContext, ScopeView
 
 DEFAULT_ACTUATOR = "FHA-25C-50-US250"
+#: The worker's status poll while the scope is live [ms]: the line is the scope's (its own
+#: channels carry position, speed, current and the I/O bits); the lamps update twice a second.
+STATUS_POLL_WHILE_LIVE_MS = 500
 
 
 def _attach_in_link_thread(controller: ScopeController, ratio: int | None, client) -> None:
@@ -40,6 +43,12 @@ class ScopePage(QWidget):
         link.sigConnected.connect(self._on_connected)
         link.sigDisconnected.connect(self._on_disconnected)
         session.sigActuatorChanged.connect(lambda _code: self.view.set_context(self._context()))
+        self.view.sigLiveChanged.connect(self._on_live_changed)
+
+    def _on_live_changed(self, live: bool) -> None:
+        if self.session.link.connected:
+            interval_ms = STATUS_POLL_WHILE_LIVE_MS if live else POLL_INTERVAL_MS
+            self.session.link.send(Cmd.SET_POLL_INTERVAL, interval_ms)
 
     def _context(self) -> ScopeContext:
         code = self.session.actuator_code

@@ -128,6 +128,7 @@ class ScopeView(QWidget):
     sigFrame = Signal()  # one live redraw done (benchmarks count these)
     sigTestDone = Signal(object)  # MoveTestResult
     sigTraceDone = Signal(object)  # TraceResult
+    sigLiveChanged = Signal(bool)  # live acquisition requested on / off
 
     def __init__(self, controller: ScopeController, context: ScopeContext | None = None,
                  parent: QWidget | None = None):
@@ -160,6 +161,7 @@ class ScopeView(QWidget):
         d.sigTraceDone.connect(self._on_trace_done)
         d.sigTestDone.connect(self._on_test_done)
         d.sigError.connect(self._on_error)
+        d.sigTestState.connect(lambda text: self.test_message.setText(f"Test: {text} …"))
         self._timer = QTimer(self)
         self._timer.setInterval(REFRESH_MS)
         self._timer.timeout.connect(self._refresh)
@@ -226,7 +228,12 @@ class ScopeView(QWidget):
         self.channel_table.setHorizontalHeaderLabels(["Channel", "Unit", "Scale ×"])
         self.channel_table.verticalHeader().setVisible(False)
         self.channel_table.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
-        self.channel_table.horizontalHeader().setStretchLastSection(True)
+        header = self.channel_table.horizontalHeader()
+        header.setSectionResizeMode(0, header.ResizeMode.Stretch)
+        header.setSectionResizeMode(1, header.ResizeMode.ResizeToContents)
+        header.setSectionResizeMode(2, header.ResizeMode.Fixed)
+        self.channel_table.setColumnWidth(2, 78)
+        self.channel_table.setMinimumWidth(300)
         self.channel_table.itemChanged.connect(self._channel_item_changed)
         split.addWidget(self.channel_table)
 
@@ -236,7 +243,7 @@ class ScopeView(QWidget):
         self.plot.setBackground("#111")
         self.plot.showGrid(x=False, y=True, alpha=0.25)  # x grid only when still: scrolling it is costly
         self.plot.setLabel("bottom", "time", units="s")
-        self.plot.addLegend(offset=(8, 8))
+        self.plot.addLegend(offset=(-8, 8), brush=pg.mkBrush(17, 17, 17, 200), labelTextColor="#ddd")
         self.plot.setClipToView(True)
         self.plot.setDownsampling(auto=True, mode="peak")
         self.plot.plotItem.vb.enableAutoRange(axis="y", enable=True)
@@ -261,7 +268,7 @@ class ScopeView(QWidget):
         side.addTab(self._build_trigger_panel(), "Trigger")
         side.addTab(self._build_test_panel(), "Tests")
         split.addWidget(side)
-        split.setSizes([230, 800, 290])
+        split.setSizes([300, 760, 300])
         split.setStretchFactor(1, 1)
         outer.addWidget(split, 1)
         self.info_label = QLabel("")
@@ -444,11 +451,11 @@ class ScopeView(QWidget):
             t.setItem(row, 1, unit)
             spin = QDoubleSpinBox()
             spin.setRange(1e-4, 1e4)
-            spin.setDecimals(4)
+            spin.setDecimals(3)
+            spin.setToolTip(f"Multiply {c.name} by this factor on the plot (cursors read {c.unit})")
             spin.setValue(self._scale.get(c.key, 1.0))
             spin.valueChanged.connect(lambda v, k=c.key: self.set_channel_scale(k, v))
             t.setCellWidget(row, 2, spin)
-        t.resizeColumnToContents(0)
         t.blockSignals(False)
         self._rebuild_curves()
         self.spectrum_channel.clear()
@@ -519,6 +526,7 @@ class ScopeView(QWidget):
             self.live_button.blockSignals(False)
         self.live_button.setText("Stop live")
         self.controller.send(ScopeCmd.START, tuple(wanted))
+        self.sigLiveChanged.emit(True)
 
     def stop_live(self) -> None:
         self.controller.send(ScopeCmd.STOP)
@@ -530,6 +538,7 @@ class ScopeView(QWidget):
         self.live_button.blockSignals(False)
         self.live_button.setText("Start live")
         self._update_indicator()
+        self.sigLiveChanged.emit(False)
 
     def set_paused(self, paused: bool) -> None:
         """Freeze the drawing; acquisition and recording go on."""
@@ -582,7 +591,7 @@ class ScopeView(QWidget):
             text = "NOT LIVE: no drive connected"
         if text != self._indicator_text:
             self._indicator_text = text
-            short = text if len(text) < 60 else text[:57] + "…"
+            short = text if len(text) < 48 else text[:46] + "…"
             self.indicator.setText(short)
             self.indicator.setToolTip(text)
             self.indicator.setStyleSheet(INDICATOR_STYLE[kind])
@@ -643,7 +652,7 @@ class ScopeView(QWidget):
         self._static = _Static(tuple(channels), np.asarray(rows, dtype=float), label, sample_rate_hz, uniform)
         self.plot.showGrid(x=True, y=True, alpha=0.25)
         for c in self._static.channels:
-            self._visible.setdefault(c.key, True)
+            self._visible[c.key] = True  # a capture shows all it has; hide by hand
         self._fill_channel_table()
         self._redraw_static()
         self.fit()
@@ -666,9 +675,21 @@ class ScopeView(QWidget):
         self._update_indicator()
 
     def fit(self) -> None:
-        self.plot.plotItem.vb.autoRange(padding=0.02)
+        """Show the whole capture (or the live time base) and scale Y to the visible channels."""
+        vb = self.plot.plotItem.vb
+        if self._static is not None and len(self._static.rows):
+            t = self._static.rows[:, 0]
+            vb.setXRange(float(t[0]), float(t[-1]), padding=0.02)  # from the data, not from clipped curves
+            shown = [j + 1 for j, c in enumerate(self._static.channels) if self._visible.get(c.key, True)]
+            if shown:
+                y = self._static.rows[:, shown] * [self._scale.get(self._static.channels[j - 1].key, 1.0)
+                                                   for j in shown]
+                lo, hi = float(np.nanmin(y)), float(np.nanmax(y))
+                vb.setYRange(lo, hi if hi > lo else lo + 1.0, padding=0.05)
+        else:
+            vb.autoRange(padding=0.02)
         if self.autoscale.isChecked():
-            self.plot.plotItem.vb.enableAutoRange(axis="y", enable=True)
+            vb.enableAutoRange(axis="y", enable=True)
 
     def _autoscale_toggled(self, on: bool) -> None:
         self.plot.plotItem.vb.enableAutoRange(axis="y", enable=bool(on))
@@ -854,7 +875,7 @@ class ScopeView(QWidget):
         rows = np.column_stack([recording.t_s, *columns])
         dt = np.diff(recording.t_s)
         uniform = len(dt) > 0 and float(np.ptp(dt)) <= 0.01 * float(np.median(dt))
-        self.show_static(channels, rows, f"the recording {Path(path).name}",
+        self.show_static(channels, rows, f"file {Path(path).name}",
                          recording.metadata.sample_rate_hz, uniform)
 
     # -------------------------------------------------------------------------------------- trace
@@ -898,7 +919,7 @@ class ScopeView(QWidget):
     def _on_trace_done(self, result: TraceResult) -> None:
         self.last_trace = result
         stamp = time.strftime("%H:%M:%S", time.localtime(result.captured_at))
-        self.show_static(result.channels, result.rows(), f"the trace of {stamp} ({result.trigger})",
+        self.show_static(result.channels, result.rows(), f"trace {stamp}, trigger: {result.trigger}",
                          result.sample_rate_hz, True)
         self.sigTraceDone.emit(result)
 
@@ -940,7 +961,7 @@ class ScopeView(QWidget):
             self.result_labels["method"].setText(
                 f"{'drive trace' if c.method == 'trace' else 'polling'}, {len(c.t_s)} samples"
                 + (f" at {c.sample_rate_hz:g} Hz" if c.method == "trace" else ""))
-            self.show_static(c.channels, c.rows(), f"the {result.kind} test capture", c.sample_rate_hz,
+            self.show_static(c.channels, c.rows(), f"{result.kind} test capture", c.sample_rate_hz,
                              c.method == "trace")
         self.sigTestDone.emit(result)
 
@@ -963,9 +984,9 @@ class ScopeView(QWidget):
         f, a = spec.frequency_hz[1:], np.maximum(spec.amplitude[1:], 1e-12)
         self.spectrum_curve.setData(f, a)
         unit = s.channels[j].unit
-        peaks = spec.peaks(4, min_hz=f[0] if len(f) else 0.0)
-        text = ", ".join(f"{hz:.2f} Hz ({amp:.3g} {unit})" for hz, amp in peaks)
-        self.spectrum_label.setText("Peaks: " + text)
+        peaks = spec.prominent_peaks(4, min_hz=f[0] if len(f) else 0.0)
+        text = ", ".join(f"{hz:.2f} Hz ({amp:.3g} {unit})" for hz, amp in peaks) or "none stand out"
+        self.spectrum_label.setText(f"Peaks: {text}. Resolution {f[0]:.3g} Hz." if len(f) else "Peaks: none")
         self.last_spectrum = spec
         self.plots.setCurrentIndex(1)
 

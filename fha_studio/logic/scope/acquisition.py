@@ -103,6 +103,14 @@ def estimated_rate_hz(item_count: int, digits_per_value: int = 6, baudrate: int 
     return theoretical_rate_hz([10 ** (digits_per_value - 1)] * item_count, baudrate)
 
 
+def readout_time_s(samples: int, items: int, digits_per_value: int = 7, baudrate: int = p.BAUDRATE) -> float:
+    """Line time to read a trace out with TRB (64 samples a block): ``digits_per_value``
+    characters per value (sign included) plus separators, CR per line, and the requests."""
+    blocks = math.ceil(samples / p.TRACE_BLOCK_SAMPLES)
+    chars = samples * (items * (digits_per_value + 1)) + blocks * (p.FRAME_LENGTH + 2)
+    return chars * p.character_time_s(baudrate)
+
+
 def dgr_line_time_s(value: int, baudrate: int = p.BAUDRATE) -> float:
     """Line time of one DGR exchange."""
     return (p.FRAME_LENGTH + len(str(int(value))) + 1 + 2) * p.character_time_s(baudrate)
@@ -488,6 +496,8 @@ class MoveTest:
     The servo must be on (the test does not switch it on).
     """
 
+    trace_samples = 1024
+
     def __init__(self, client, channels: Sequence[ScopeChannel], angle_deg: float, speed_rpm: float, *,
                  kind: str = "move", output_resolution_ppr: int | None = None, use_trace: bool | None = None,
                  settle_s: float = 0.3, config: ScopeConfig | None = None,
@@ -519,6 +529,7 @@ class MoveTest:
         self._settled_since: float | None = None
         self._restore_accel: int | None = None
         self._in_pos_deg: float | None = None
+        self.state_text = "starting"
 
     @property
     def done(self) -> bool:
@@ -586,31 +597,38 @@ class MoveTest:
         self.client.set_move_speed(self.speed_rpm)
         if self.use_trace:
             window = 0.1 * duration + duration + max(0.5, 3 * self.settle_s)
-            samples = p.TRACE_MAX_SAMPLES
+            samples = self.trace_samples  # enough for the metrics; every sample costs line time
             rate = min(self.config.servo_rate_hz, samples / window)
             moving = ScopeChannel("moving", "Moving", "bit", IO_STATE_ITEM, 1.0, int(p.IoBit.MOVING))
             self.trace.configure(TraceSettings(self.channels, rate, samples, samples // 10,
                                                Trigger(p.TriggerKind.IO_BIT_RISES, moving)))
             self.trace.arm()
             self._phase = "arming"
+            self.state_text = "trace armed, filling the pre-trigger"
         else:
             self._poller = PollingAcquisition(self.client, self.channels, config=self.config,
                                               clock=self.clock)
             self._poller.step(0.1)  # a few samples before the move
             self.client.move_by(self.angle_deg)
             self._phase = "polling"
+            self.state_text = f"moving {self.angle_deg:g} deg, polling"
         self._deadline = self.clock() + 3 * duration + 5.0
 
     def _phase_arming(self) -> None:
         if self.trace.ready_for_trigger(self.trace.status()):
             self.client.move_by(self.angle_deg)
             self._phase = "capturing"
+            self.state_text = f"moving {self.angle_deg:g} deg, capturing"
         elif self.clock() > self._deadline:
             raise ValueError("the trace did not get ready (pre-trigger never filled)")
 
     def _phase_capturing(self) -> None:
         status = self.trace.status()
-        if status.state is p.TraceState.DONE:
+        if status.state is p.TraceState.DONE and self.state_text.startswith("moving"):
+            self.state_text = (f"reading out {status.count} samples (about "
+                               f"{readout_time_s(status.count, len(self.trace.settings.items())):.0f} s "
+                               "at 19200 bit/s)")
+        elif status.state is p.TraceState.DONE:
             self._analyse(self.trace.read())
         elif self.clock() > self._deadline:
             raise ValueError(f"the move did not trigger or finish the trace in time (state "

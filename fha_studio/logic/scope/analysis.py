@@ -115,6 +115,33 @@ class Spectrum:
         idx = idx[np.argsort(a[idx])[::-1][:count]]
         return [(float(self.frequency_hz[i]), float(a[i])) for i in idx]
 
+    def prominent_peaks(self, count: int = 3, min_hz: float = 0.0, window_bins: int = 25,
+                        min_ratio: float = 4.0) -> list[tuple[float, float]]:
+        """Peaks that stand out of their surroundings (a resonance, a kinematic error's line),
+        not the slope of the low-frequency drift: local maxima ranked by amplitude over the
+        higher of the medians of the ``window_bins`` on the left and on the right (so a slope is
+        not a peak), kept when that ratio is >= ``min_ratio``. Peaks closer than 3 bins to
+        either end are not judged. Returns (frequency Hz, amplitude), strongest ratio first."""
+        a = self.amplitude
+        n = len(a)
+        if n < 3:
+            return []
+        is_peak = np.zeros(n, dtype=bool)
+        is_peak[1:-1] = (a[1:-1] > a[:-2]) & (a[1:-1] >= a[2:])
+        is_peak &= self.frequency_hz >= min_hz
+        ranked = []
+        for i in np.flatnonzero(is_peak):
+            left = a[max(0, i - window_bins):max(0, i - 2)]
+            right = a[i + 3:i + window_bins + 1]
+            if len(left) < 3 or len(right) < 3:
+                continue
+            floor = max(float(np.median(left)), float(np.median(right)))
+            ratio = a[i] / floor if floor > 0 else np.inf
+            if ratio >= min_ratio:
+                ranked.append((ratio, i))
+        ranked.sort(reverse=True)
+        return [(float(self.frequency_hz[i]), float(a[i])) for _, i in ranked[:count]]
+
 
 def spectrum(t_s, values, *, detrend: str = "linear") -> Spectrum:
     """Amplitude spectrum of a uniformly sampled channel (Hann window, amplitude-corrected).
