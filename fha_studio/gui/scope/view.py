@@ -915,11 +915,12 @@ class ScopeView(QWidget):
 
     def _on_trace_state(self, text: str) -> None:
         self.trace_state.setText(text)
+        self.trace_state.setToolTip(text)
 
     def _on_trace_done(self, result: TraceResult) -> None:
         self.last_trace = result
         stamp = time.strftime("%H:%M:%S", time.localtime(result.captured_at))
-        self.show_static(result.channels, result.rows(), f"trace {stamp}, trigger: {result.trigger}",
+        self.show_static(result.channels, result.rows(), f"trace {stamp}",
                          result.sample_rate_hz, True)
         self.sigTraceDone.emit(result)
 
@@ -960,7 +961,7 @@ class ScopeView(QWidget):
             c = result.capture
             self.result_labels["method"].setText(
                 f"{'drive trace' if c.method == 'trace' else 'polling'}, {len(c.t_s)} samples"
-                + (f" at {c.sample_rate_hz:g} Hz" if c.method == "trace" else ""))
+                + (f" at {c.sample_rate_hz:.0f} Hz" if c.method == "trace" else ""))
             self.show_static(c.channels, c.rows(), f"{result.kind} test capture", c.sample_rate_hz,
                              c.method == "trace")
         self.sigTestDone.emit(result)
