@@ -23,7 +23,8 @@ QT_OFFSCREEN_PACKAGES="libglib2.0-0 libegl1 libgl1 libdbus-1-3 libfontconfig1 li
 QT_XCB_PACKAGES="libxcb-cursor0 libxcb-icccm4 libxcb-keysyms1 libxcb-shape0 libxcb-xkb1 libxkbcommon-x11-0"
 
 missing_libraries() {
-    # Prints the Debian packages whose library is not known to the dynamic linker.
+    # Prints the Debian packages whose library is not known to the dynamic linker (or whose
+    # command is missing).
     local pkg lib
     for pkg in $1; do
         case "$pkg" in
@@ -39,6 +40,9 @@ missing_libraries() {
             libxcb-shape0) lib=libxcb-shape.so.0 ;;
             libxcb-xkb1) lib=libxcb-xkb.so.1 ;;
             libxkbcommon-x11-0) lib=libxkbcommon-x11.so.0 ;;
+            poppler-utils)  # a command, not a library: pdftotext checks the report PDFs' text
+                command -v pdftotext >/dev/null || echo -n "$pkg "
+                continue ;;
             *) lib="$pkg" ;;
         esac
         if ! /sbin/ldconfig -p 2>/dev/null | grep -q "$lib"; then echo -n "$pkg "; fi
@@ -49,7 +53,7 @@ ensure_system_packages() {
     local missing
     missing="$(missing_libraries "$1")"
     [ -z "$missing" ] && return 0
-    echo "Installing the Qt system libraries this machine lacks: $missing" >&2
+    echo "Installing the system packages this machine lacks: $missing" >&2
     if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
         (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $missing) >&2
     elif command -v sudo >/dev/null && sudo -n true 2>/dev/null && command -v apt-get >/dev/null; then
