@@ -8,6 +8,7 @@ simulated drive is ``fha_studio.hardware.sim``.
 
 from __future__ import annotations
 
+import logging
 import threading
 from collections.abc import Callable, Iterable
 from typing import Union
@@ -16,6 +17,8 @@ import serial
 
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.transport import PipeEnd
+
+log = logging.getLogger(__name__)
 
 Answer = Union[p.Reply, bytes, float, None, Iterable["Answer"]]  # noqa: UP007 - recursive alias
 Handler = Callable[[p.Request | p.UnknownRequest], Answer]
@@ -43,6 +46,7 @@ class ScriptedDrive:
         self.handler = handler
         self.requests: list[p.Request | p.UnknownRequest] = []
         self.garbage: list[p.Garbage] = []
+        self.errors: list[Exception] = []  # exceptions of the handler (answered with silence)
         self._stop = threading.Event()
         self._decoder = p.StreamDecoder(p.decode_request)
         self.end.timeout = 0.01
@@ -61,9 +65,13 @@ class ScriptedDrive:
                     continue
                 self.requests.append(message)
                 try:
-                    self._send(self.handler(message))
+                    answer = self.handler(message)
+                    self._send(answer)
                 except (serial.SerialException, OSError):
                     return
+                except Exception as exc:  # a broken script must not kill the drive silently
+                    log.exception("scripted drive: handler failed on %r", message)
+                    self.errors.append(exc)
 
     def _send(self, answer: Answer) -> None:
         if answer is None:
