@@ -14,6 +14,14 @@ The criterion (each gate must pass for an effect to be named):
 3. Practical significance: the effect's size (its typical magnitude in N m or arcsec) must exceed a
    floor, so that a statistically clear but practically irrelevant (or noise-level) term is not
    named. It must also have the physical sign (friction opposes motion, a spring winds up under load).
+4. Statistical significance of the size itself: it must stand MIN_SIGMAS (3) delete-one-block
+   jackknife sigmas above zero (an effect whose size the data does not pin down is not named).
+5. Look-elsewhere, for searched shapes (cycles per motor turn): the grid and the refinement pick
+   the largest of many noise peaks, which the BIC gate (one frequency) does not know about. The size
+   must be MIN_OFF_SHAPE_RATIO x the median size the same sinusoid reaches, next to the chosen one,
+   at quarter-cycle frequencies nobody claims. Found on a scope trace of the simulated drive: its
+   loops see whole encoder pulses, so the current carries coloured servo noise that a frequency
+   search over ~25 motor turns turned into a 0.8-0.9 N m "torque ripple".
 
 Parameters are estimated by ordinary least squares on the (unwhitened) residual: whitening
 emphasises the highest frequencies, where the rigid-body and timing approximations are weakest,
@@ -44,6 +52,12 @@ CV_MIN_GAIN = 0.005  # the held-out RMS must fall by at least 0.5 %
 MAX_AR_ORDER = 12
 MAX_EFFECTS = 4
 JACKKNIFE_BLOCKS = 10
+MIN_SIGMAS = 3.0  # a named effect's size must stand this many jackknife sigmas above zero
+# A searched shape (cycles per motor turn) picks the largest of many noise peaks (look-elsewhere): its
+# size must stand this many times above the median size the same fit finds at frequencies nobody
+# claims. Pure noise reaches ~3-4x (the largest of a few hundred peaks); real ripple 150x and more.
+MIN_OFF_SHAPE_RATIO = 6.0
+OFF_SHAPE_GAP = 0.45  # off-shape frequencies keep this far (cycles per turn) from the chosen one
 
 
 # ------------------------------------------------------------------------------- linear algebra
@@ -299,6 +313,16 @@ class ChannelSelector:
             reasons.append("held-out RMS does not fall")
         if size < self.floor:
             reasons.append(f"size {size:.3g} {self.unit} below the floor {self.floor:.3g}")
+        sigma = self.size_sigma(cand, x1, term.cols.shape[1])
+        if size < MIN_SIGMAS * sigma:
+            reasons.append(f"size {size:.3g} {self.unit} within {MIN_SIGMAS:g} sigma ({sigma:.3g}) of zero")
+        if cand.shape_refine and size >= self.floor:
+            off = self.off_shape_size(cand, x1, shape)
+            if size < MIN_OFF_SHAPE_RATIO * off:
+                reasons.append(
+                    f"size {size:.3g} {self.unit} not {MIN_OFF_SHAPE_RATIO:g}x above the median {off:.3g} "
+                    "found at other frequencies (a noise peak)"
+                )
         if not physical:
             reasons.append("unphysical sign")
         trial = Trial(
@@ -313,6 +337,35 @@ class ChannelSelector:
             "; ".join(reasons) or "named",
         )
         return trial, term
+
+    def size_sigma(self, cand: Candidate, x: np.ndarray, k: int) -> float:
+        """Delete-one-block jackknife sigma of cand's size (its last k columns of x, shape held)."""
+        sizes = []
+        for a, b in block_edges(self.n, JACKKNIFE_BLOCKS):
+            rows = np.ones(self.n, bool)
+            rows[a:b] = False
+            bj, _ = ols(self.y[rows], x[rows])
+            sizes.append(float(cand.size(bj[-k:], self.ctx)))
+        vals = np.array(sizes)
+        g = len(vals)
+        return math.sqrt((g - 1) / g * float(np.sum((vals - vals.mean()) ** 2)))
+
+    def off_shape_size(self, cand: Candidate, x1: np.ndarray, shape: tuple[float, ...]) -> float:
+        """Median size of a second cand fitted next to x1 (which holds cand at shape) at quarter-cycle
+        frequencies away from shape: the size noise alone reaches at a frequency nobody claims.
+
+        Fitted next to the chosen term, so a real effect's leakage (dwells at one motor angle) is
+        not counted as noise.
+        """
+        grid = [c for (c,) in cand.shape_grid]
+        offs = np.arange(0.25, max(grid) + 0.76, 0.25)
+        offs = offs[(np.abs(offs - shape[0]) >= OFF_SHAPE_GAP) & (np.abs(offs - np.round(offs)) > 0.1)]
+        sizes = []
+        for c in offs:
+            cols = self.cols(cand, (float(c),))
+            beta, _ = ols(self.y, np.column_stack([x1, cols]))
+            sizes.append(float(cand.size(beta[-cols.shape[1] :], self.ctx)))
+        return float(np.median(sizes)) if sizes else 0.0
 
     @staticmethod
     def _physical(cand: Candidate, beta: np.ndarray) -> bool:
@@ -499,7 +552,10 @@ class ChannelSelector:
         sigma = math.sqrt(float(np.mean(var)))
         unit_size = cand.size(np.full(k, 1.0 / math.sqrt(k)) if k > 1 else np.ones(1), self.ctx)
         z = math.sqrt(BIC_MIN + k * math.log(self.n))
-        return max(self.floor, z * sigma * unit_size), shape
+        limit = max(self.floor, z * sigma * unit_size, MIN_SIGMAS * sigma * unit_size)
+        if cand.shape_refine:  # the look-elsewhere gate of try_add
+            limit = max(limit, MIN_OFF_SHAPE_RATIO * self.off_shape_size(cand, x, shape))
+        return limit, shape
 
     def substitutes(self, terms: list[Term]) -> list[tuple[str, str, float]]:
         """(chosen, alternative, BIC difference) for alternatives that explain the data as well.
