@@ -63,7 +63,7 @@ def test_a_move_captured_in_the_scope_tells_the_missing_friction(make_window, qt
         qtbot.mouseClick(page.run_button, pg_left())
     result = done.args[0]
     ids = [e.id for e in result.effects]
-    assert "coulomb_friction" in ids, page.summary.toPlainText()
+    assert ids == ["coulomb_friction"], page.summary.toPlainText()  # and no noise named beside it
     friction = next(e for e in result.effects if e.id == "coulomb_friction")
     assert friction.params["torque_nm"] == pytest.approx(FRICTION_NM, rel=0.25)
     gap = result.gap["torque"]
