@@ -72,7 +72,7 @@ def main() -> int:
     QTimer.singleShot(1000, lambda: window.link.send(Cmd.CALL, back_and_forth))
     wait_for(scope.sigTraceDone, 30000)
     app.processEvents()
-    window.grab().save(str(OUT / "scope-trace.png"))
+    window.grab().save(str(OUT / "modelcheck-capture.png"))
     page = window.show_page("modelcheck")
     page.take_scope_capture()
     page.run()
