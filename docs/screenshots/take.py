@@ -74,13 +74,14 @@ def main() -> int:
 
     @step(600)
     def jog():
-        window.show_page("jog")
-        window.link.jog_press(8.0)
+        page = window.show_page("jog")
+        page.speed_spin.setValue(8.0)
+        page._jog(+1)  # as if FWD were held
 
     @step(700)
     def jog_shot():
         shot("jog")
-        window.link.jog_release()
+        window.jog_page.release_jog()
         window.link._worker._client._transport.inner.sim_drive.raise_alarm(20)
 
     @step(800)

@@ -3,7 +3,7 @@ written (verified), and checked live by jogging FWD and asking which way the fla
 
 from __future__ import annotations
 
-from PySide6.QtCore import QTimer, Slot
+from PySide6.QtCore import Qt, QTimer, Slot
 from PySide6.QtWidgets import (
     QButtonGroup,
     QGroupBox,
@@ -77,6 +77,9 @@ class DirectionPage(QWidget):
         b_layout.addWidget(self.ccw_radio)
         self.consequence = QLabel("")
         self.consequence.setWordWrap(True)
+        # word-wrapped labels in a group box get too little height: reserve five lines
+        self.consequence.setMinimumHeight(self.consequence.fontMetrics().lineSpacing() * 5)
+        self.consequence.setAlignment(Qt.AlignmentFlag.AlignTop | Qt.AlignmentFlag.AlignLeft)
         b_layout.addWidget(self.consequence)
         row = QHBoxLayout()
         self.write_button = QPushButton("&Write to the drive")
