@@ -25,6 +25,6 @@ echo "== starting it once: the CLI"
 echo "== starting it once: the GUI on the embedded simulated drive (closes after 4 s)"
 export QT_QPA_PLATFORM="${QT_QPA_PLATFORM:-offscreen}"
 start=$(date +%s.%N)
-"$APP/fha-studio" --quit-after-ms 4000
+"$APP/fha-studio" gui --quit-after-ms 4000
 echo "== the GUI started, connected and closed cleanly ($(echo "$(date +%s.%N) - $start" | bc) s including the 4 s)"
 echo "   install the desktop entry: cp $APP/fha-studio.desktop ~/.local/share/applications/ (Exec: put $APP on PATH)"

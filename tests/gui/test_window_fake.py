@@ -106,3 +106,32 @@ def test_lost_link_is_shown_within_a_second(window, fake, qtbot):
     assert lost.args[1] is True
     assert "LINK LOST" in window.caps_label.text()
     assert "LINK LOST" in window.connection_page.link_label.text()
+
+
+def test_closing_with_the_servo_on_asks_and_cancel_keeps_the_window(window, fake, qtbot, monkeypatch):
+    from PySide6.QtWidgets import QMessageBox
+
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO):
+        window.jog_page.servo_on_button.click()
+    qtbot.waitUntil(lambda: window.link.servo_on, timeout=3000)
+    asked = []
+
+    def answer(parent, title, text, *args):
+        asked.append(text)
+        return QMessageBox.StandardButton.Cancel
+
+    monkeypatch.setattr(QMessageBox, "warning", answer)
+    assert not window.close()
+    assert window.isVisible() and window.link.connected
+    assert "STOP" in asked[0] and "stays ON" in asked[0]
+    window.disconnect_drive()  # asks too; Cancel keeps the link
+    assert len(asked) == 2 and window.link.connected
+
+
+def test_drive_without_parameter_access_says_so(make_window, qtbot):
+    fake = FakeDriveClient()
+    fake.capabilities.parameters = False
+    window = make_window(open_client=lambda url, baud: fake, connect="fake://")
+    page = window.parameters_page
+    assert "front panel" in page.message.text()
+    assert not page.read_button.isEnabled()

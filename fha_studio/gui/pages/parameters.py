@@ -417,7 +417,8 @@ class ParametersPage(QWidget):
 
     # -- actions ------------------------------------------------------------------------------------
     def _update_buttons(self) -> None:
-        connected = self.link.connected
+        info = self.link.info
+        connected = self.link.connected and bool(info and info.can_parameters)
         for b in (self.read_button, self.write_all_button):
             b.setEnabled(connected)
         self.write_changed_button.setEnabled(connected and bool(self.model.edits))
@@ -534,8 +535,14 @@ class ParametersPage(QWidget):
         self.model.reload_items()  # a model reset: the selection model stays the same object
         self.model.restart_pending.clear()
         self.restart_banner.setVisible(False)
-        self.session.read_all()
         self._update_buttons()
+        if not info.can_parameters:
+            self.message.setText(
+                "This drive does not give parameter access over CN3 (it answers only the commands of "
+                "its manual): read and set the parameters on its front panel."
+            )
+            return
+        self.session.read_all()
 
     @Slot(QModelIndex, QModelIndex)
     def _show_details(self, current: QModelIndex, _previous: QModelIndex) -> None:
