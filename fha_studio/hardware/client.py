@@ -39,6 +39,7 @@ from fha_studio.hardware.errors import (
     LinkFailure,
     LinkLost,
     LinkTimeout,
+    ReadAborted,
     ServoOnRefused,
 )
 from fha_studio.hardware.parameters import (
@@ -66,6 +67,7 @@ __all__ = [
     "LinkLost",
     "LinkSettings",
     "LinkTimeout",
+    "ReadAborted",
     "ServoOnRefused",
     "TraceCapture",
     "TraceStatus",
@@ -867,8 +869,26 @@ class DriveClient:
         self._require(Command.TST)
         return self._transact(Command.TST, parse=_trace_status)
 
-    def read_trace(self) -> TraceCapture:
-        """Read out the finished capture, block by block (TRB)."""
+    def read_trace_block(self, block: int, count: int) -> list[tuple[int, ...]]:
+        """TRB: block ``block`` (64 samples) of a finished capture of ``count`` samples, one row of
+        wire values per sample in the order ``configure_trace`` returned. One exchange (~1 s for
+        4 channels at 19200 bit/s)."""
+        self._require(Command.TRB)
+        channels = self._trace_channels
+        if not channels:
+            raise ValueError("read_trace_block: configure_trace first (the channels are not known)")
+        expect = min(p.TRACE_BLOCK_SAMPLES, count - block * p.TRACE_BLOCK_SAMPLES)
+        if block < 0 or expect <= 0:
+            raise ValueError(f"read_trace_block: block {block} is outside a capture of {count} samples")
+        return self._transact(Command.TRB, block, parse=_trace_block(expect, len(channels)))
+
+    def read_trace(self, should_abort: Callable[[], bool] | None = None) -> TraceCapture:
+        """Read out the finished capture, block by block (TRB).
+
+        ``should_abort`` is asked before every block (e.g. a STOP's ``threading.Event.is_set``);
+        when it says True the read-out gives up there with ``ReadAborted`` (``done`` / ``total``
+        samples), so it keeps the link at most one block (~1 s) after being asked.
+        """
         self._require(Command.TST, Command.TRB)
         with self._lock:
             channels = self._trace_channels
@@ -879,8 +899,10 @@ class DriveClient:
                 raise CommandRejected(f"no finished capture (state {status.state.name.lower()})")
             rows: list[tuple[int, ...]] = []
             for block in range(math.ceil(status.count / p.TRACE_BLOCK_SAMPLES)):
-                expect = min(p.TRACE_BLOCK_SAMPLES, status.count - block * p.TRACE_BLOCK_SAMPLES)
-                rows += self._transact(Command.TRB, block, parse=_trace_block(expect, len(channels)))
+                if should_abort is not None and should_abort():
+                    raise ReadAborted(f"trace read-out stopped after {len(rows)} of {status.count} samples",
+                                      len(rows), status.count)
+                rows += self.read_trace_block(block, status.count)
         return TraceCapture(channels, tuple(rows))
 
 

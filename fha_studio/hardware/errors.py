@@ -5,6 +5,8 @@ Two families below it say very different things:
 
 - ``LinkFailure``: the link did not work: ``LinkTimeout`` (no usable reply after the retries),
   ``LinkLost`` (the port is gone, or too many failures in a row).
+- ``ReadAborted``: the caller asked a long read-out to give up (between exchanges); neither the
+  link nor the drive failed.
 - ``DriveRefused``: the link worked and the drive said no: ``ServoOnRefused`` (``s``: the servo
   is on, not now), ``CommandRejected`` (``x``), ``CommandNotSupported`` (the drive lacks the
   extension; nothing was sent). These are never retried and never count against the link.
@@ -34,6 +36,18 @@ class LinkLost(LinkFailure):
     def __init__(self, message: str, port: str = ""):
         super().__init__(message)
         self.port = port
+
+
+class ReadAborted(LinkError):
+    """A long read-out gave up between exchanges because the caller asked it to (``should_abort``).
+
+    ``done`` and ``total`` count what was read and what there was (samples for a trace).
+    """
+
+    def __init__(self, message: str, done: int = 0, total: int = 0):
+        super().__init__(message)
+        self.done = done
+        self.total = total
 
 
 class DriveRefused(LinkError):

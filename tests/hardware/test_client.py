@@ -18,6 +18,7 @@ from fha_studio.hardware.client import (
     LinkLost,
     LinkSettings,
     LinkTimeout,
+    ReadAborted,
     ServoOnRefused,
 )
 from fha_studio.hardware.parameters import ParameterValueError
@@ -188,6 +189,29 @@ def test_trace_capture_reads_all_blocks(client_for, mini):
     assert capture.column(103)[129] == 1291
     with pytest.raises(ValueError, match="channels"):
         client.configure_trace([100, 101, 102, 103, 104])
+
+
+def test_trace_read_out_block_by_block_gives_up_when_asked(client_for, mini):
+    client, drive = client_for(mini)
+    client.configure_trace([103, 100], divider=2)
+    client.arm_trace(130)  # 3 blocks: 64, 64, 2
+    assert client.read_trace_block(2, 130) == [(1280, 1281), (1290, 1291)]
+    with pytest.raises(ValueError, match="outside a capture of 130"):
+        client.read_trace_block(3, 130)
+    asked = []
+
+    def stop_after_two_blocks() -> bool:
+        asked.append(len(asked))
+        return len(asked) > 2
+
+    before = drive.commands().count("TRB")
+    with pytest.raises(ReadAborted, match="after 128 of 130 samples") as stopped:
+        client.read_trace(should_abort=stop_after_two_blocks)
+    assert (stopped.value.done, stopped.value.total) == (128, 130)
+    assert drive.commands().count("TRB") - before == 2  # the third block was never asked for
+    assert len(client.read_trace(should_abort=lambda: False).samples) == 130  # the link is fine
+    with pytest.raises(ReadAborted, match="after 0 of 130"):
+        client.read_trace(should_abort=lambda: True)  # a STOP before the read-out: nothing read
 
 
 def test_clear_multiturn_waits_for_the_late_acknowledgement(client_for, mini):
