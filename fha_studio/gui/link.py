@@ -607,6 +607,12 @@ class LinkController(QObject):
     def busy(self) -> bool:
         return bool(self._pending)
 
+    @property
+    def abort_event(self) -> threading.Event:
+        """Set by STOP (before the STOP is queued), cleared when the worker handles it: code
+        running in the link thread checks it between items of a long operation."""
+        return self._abort
+
     # -- commands ------------------------------------------------------------------------------
     def send(self, cmd: Cmd, *args) -> int:
         token = next(self._tokens)

@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import enum
 import logging
+import threading
 import time
 from dataclasses import dataclass
 from typing import Any
 
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
-from fha_studio.hardware.errors import LinkError
+from fha_studio.hardware.errors import LinkError, ReadAborted
 from fha_studio.logic.scope.acquisition import (
     LiveMode,
     LiveStatus,
@@ -82,9 +83,12 @@ class ScopeDriver(QObject):
     sigError = Signal(str)
     sigCallDone = Signal(object)  # the value of a CALL
 
-    def __init__(self, config: ScopeConfig | None = None):
+    def __init__(self, config: ScopeConfig | None = None, abort: threading.Event | None = None):
         super().__init__()
         self.config = config or load_scope_config()
+        # The link's STOP event (set in the GUI thread before the STOP is queued): a trace
+        # read-out gives up between blocks when it is set, so the STOP does not wait behind it.
+        self._should_abort = abort.is_set if abort is not None else None
         self._client = None
         self._ratio: int | None = None
         self._poller: PollingAcquisition | None = None
@@ -159,7 +163,7 @@ class ScopeDriver(QObject):
             raise ValueError("not connected to a drive")
         if self._test is not None:
             raise ValueError("a test is already running")
-        self._test = MoveTest(self._client, config=self.config, **kwargs)
+        self._test = MoveTest(self._client, config=self.config, should_abort=self._should_abort, **kwargs)
         if not self._test.use_trace and self._poller is not None:
             self._paused_for_test = True  # the test polls itself: give it the whole line
             self._poll_timer.stop()
@@ -227,8 +231,13 @@ class ScopeDriver(QObject):
             seconds = readout_time_s(status.count, len(trace.settings.items()))
             self.sigTraceState.emit(f"reading out {status.count} samples (about {seconds:.0f} s at "
                                     "19200 bit/s)")
-            result = trace.read()
             self._trace = None
+            try:
+                result = trace.read(self._should_abort)
+            except ReadAborted as exc:
+                self.sigTraceState.emit(f"abandoned by STOP during the read-out ({exc.done} of {exc.total} "
+                                        "samples read, none shown); arm again to capture")
+                return
             self.sigTraceDone.emit(result)
             self.sigTraceState.emit(f"done: {len(result.t_s)} samples at {result.sample_rate_hz:g} Hz")
         elif status.state.name == "ARMED" and trace.ready_for_trigger(status):
@@ -249,6 +258,8 @@ class ScopeController(QObject):
 
     ``thread``: the link worker's QThread (the driver is moved there). Without one, the
     controller starts its own (tests, or before the main window provides its link thread).
+    ``abort``: the link's STOP event (``LinkController.abort_event``); a trace read-out gives up
+    between blocks when it is set.
     """
 
     sigRequest = Signal(object)
@@ -263,7 +274,7 @@ class ScopeController(QObject):
     sigCallDone = Signal(object)
 
     def __init__(self, thread: QThread | None = None, parent: QObject | None = None,
-                 config: ScopeConfig | None = None):
+                 config: ScopeConfig | None = None, abort: threading.Event | None = None):
         super().__init__(parent)
         self._own_thread = thread is None
         if thread is None:
@@ -271,7 +282,7 @@ class ScopeController(QObject):
             thread.setObjectName("fha-scope")
             thread.start()
         self.thread = thread
-        self.driver = ScopeDriver(config)
+        self.driver = ScopeDriver(config, abort)
         self.driver.moveToThread(thread)
         self.sigRequest.connect(self.driver.handle)
         for name in ("sigLiveStarted", "sigStatus", "sigTraceState", "sigTraceDone", "sigTestDone",

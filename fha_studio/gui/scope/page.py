@@ -35,7 +35,7 @@ class ScopePage(QWidget):
         super().__init__(main_window)
         self.session = session
         link = session.link
-        self.controller = ScopeController(thread=link._thread, parent=self)
+        self.controller = ScopeController(thread=link._thread, parent=self, abort=link.abort_event)
         self.view = ScopeView(self.controller, self._context())
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)

@@ -41,6 +41,7 @@ from fha_studio.hardware.errors import (
     LinkError,
     LinkLost,
     LinkTimeout,
+    ReadAborted,
     ServoOnRefused,
 )
 from fha_studio.logic.scope.analysis import MoveMetrics, move_metrics
@@ -452,11 +453,14 @@ class TraceAcquisition:
             return status.count >= (self.settings.pre_trigger if self.settings else 0)
         return status.state in (p.TraceState.CAPTURING, p.TraceState.DONE)
 
-    def read(self) -> TraceResult:
+    def read(self, should_abort: Callable[[], bool] | None = None) -> TraceResult:
+        """Read the finished capture out (TRB blocks, ~1 s each for 4 channels). ``should_abort``
+        is asked between blocks; True gives up with ``ReadAborted`` (a STOP must not wait for the
+        whole read-out)."""
         settings = self.settings
         if settings is None:
             raise ValueError("no trace configured")
-        capture = self.client.read_trace()
+        capture = self.client.read_trace(should_abort=should_abort)
         values = convert_rows(settings.channels, capture.channels, capture.samples)
         rate = self.actual_rate_hz(settings)
         t = (np.arange(len(values)) - settings.pre_trigger) / rate
@@ -501,7 +505,8 @@ class MoveTest:
     def __init__(self, client, channels: Sequence[ScopeChannel], angle_deg: float, speed_rpm: float, *,
                  kind: str = "move", output_resolution_ppr: int | None = None, use_trace: bool | None = None,
                  settle_s: float = 0.3, config: ScopeConfig | None = None,
-                 clock: Callable[[], float] = time.monotonic):
+                 clock: Callable[[], float] = time.monotonic,
+                 should_abort: Callable[[], bool] | None = None):
         if kind not in ("move", "step"):
             raise ValueError(f"test kind {kind!r}: 'move' or 'step'")
         if angle_deg == 0 or speed_rpm <= 0:
@@ -517,6 +522,7 @@ class MoveTest:
         self.settle_s = settle_s
         self.config = config or load_scope_config()
         self.clock = clock
+        self.should_abort = should_abort  # asked between trace blocks (a STOP)
         self.trace = TraceAcquisition(client, self.config)
         self.use_trace = self.trace.available()[0] if use_trace is None else use_trace
         if self.use_trace:
@@ -562,6 +568,8 @@ class MoveTest:
 
     @staticmethod
     def _explain(exc: Exception) -> str:
+        if isinstance(exc, ReadAborted):
+            return f"abandoned by STOP: {exc}"
         if isinstance(exc, ServoOnRefused):
             return "the drive refuses commands while the servo is on (a drive of the manual's command set)"
         if isinstance(exc, CommandNotSupported):
@@ -629,7 +637,7 @@ class MoveTest:
                                f"{readout_time_s(status.count, len(self.trace.settings.items())):.0f} s "
                                "at 19200 bit/s)")
         elif status.state is p.TraceState.DONE:
-            self._analyse(self.trace.read())
+            self._analyse(self.trace.read(self.should_abort))
         elif self.clock() > self._deadline:
             raise ValueError(f"the move did not trigger or finish the trace in time (state "
                              f"{status.state.name.lower()}, {status.count} samples)")
