@@ -9,29 +9,20 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Callable, Sequence
-from enum import IntEnum
 
-MAX_CHANNELS = 4
-MAX_SAMPLES = 4096
-BLOCK_SAMPLES = 64
-MONITOR_FIRST = 100
-MONITOR_LAST = 115
+# The protocol's own definitions: the drive and the client must never disagree on them.
+from fha_studio.hardware.protocol import (
+    MONITOR_MASK_BASE,
+    MONITOR_MASK_ITEMS,
+    TraceState,
+    TriggerKind,
+)
+from fha_studio.hardware.protocol import TRACE_BLOCK_SAMPLES as BLOCK_SAMPLES
+from fha_studio.hardware.protocol import TRACE_MAX_CHANNELS as MAX_CHANNELS
+from fha_studio.hardware.protocol import TRACE_MAX_SAMPLES as MAX_SAMPLES
 
-
-class TraceState(IntEnum):
-    IDLE = 0
-    ARMED = 1
-    CAPTURING = 2
-    DONE = 3
-
-
-class TriggerKind(IntEnum):
-    IMMEDIATE = 0
-    RISING_LEVEL = 1
-    FALLING_LEVEL = 2
-    IO_BIT_RISES = 3
-    IO_BIT_FALLS = 4
-    ALARM = 5
+MONITOR_FIRST = MONITOR_MASK_BASE
+MONITOR_LAST = MONITOR_MASK_BASE + MONITOR_MASK_ITEMS - 1
 
 
 class TraceError(ValueError):
