@@ -21,7 +21,9 @@ cp "$HERE/fha-studio.desktop" "$APP/"
 cp "$ROOT/resources/icons/fha-studio.png" "$APP/"
 echo "== bundle: $APP ($(du -sh "$APP" | cut -f1))"
 echo "== starting it once: the CLI"
-"$APP/fha-studio" catalog FHA-25C-50-US250 | head -3
+# to a file, not a pipe into head: with pipefail, a closed pipe (exit 141) would end the script
+"$APP/fha-studio" catalog FHA-25C-50-US250 > "$HERE/build/catalog.txt"
+head -3 "$HERE/build/catalog.txt"
 echo "== starting it once: the GUI on the embedded simulated drive (closes after 4 s)"
 export QT_QPA_PLATFORM="${QT_QPA_PLATFORM:-offscreen}"
 start=$(date +%s.%N)
