@@ -37,6 +37,11 @@ log = logging.getLogger(__name__)
 #: Longest time one polling pass holds the link thread [s]: 0 = one sample per pass, so the
 #: worker's queued commands (a JOG keep-alive, a STOP) wait at most one exchange (~20 ms).
 PASS_BUDGET_S = 0.0
+#: Shortest polling pass [s]. A drive in this process (the unpaced simulated drive) answers in
+#: microseconds, and a link thread polling it back to back holds Python's GIL almost all the time:
+#: the GUI thread then waits ~5 ms for every call into Python and a frame takes seconds. A pass
+#: shorter than this waits out the rest; a real line (a few ms per exchange) never waits.
+MIN_PASS_S = 0.002
 #: How often the state goes out to the GUI [s].
 STATUS_INTERVAL_S = 0.2
 #: Period of the trace-status and move-test steps [ms].
@@ -195,6 +200,7 @@ class ScopeDriver(QObject):
         p = self._poller
         if p is None:
             return
+        started = time.monotonic()
         p.step(PASS_BUDGET_S)
         now = time.monotonic()
         status = p.status(now)
@@ -204,8 +210,13 @@ class ScopeDriver(QObject):
         if p.mode is LiveMode.NONE or p.lost:
             self.sigStatus.emit(status)
             return
-        # back to back while samples come; a slow retry while the drive refuses or is silent
-        self._poll_timer.start(0 if p.answering else int(p.retry_interval_s * 1000))
+        # back to back while samples come (a pass of at least MIN_PASS_S); a slow retry while the
+        # drive refuses or is silent
+        if not p.answering:
+            self._poll_timer.start(int(p.retry_interval_s * 1000))
+            return
+        rest_s = MIN_PASS_S - (now - started)
+        self._poll_timer.start(0 if rest_s <= 0 else max(1, round(rest_s * 1000)))
 
     @Slot()
     def _step(self) -> None:
