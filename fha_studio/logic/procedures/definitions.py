@@ -136,6 +136,8 @@ class Step:
             return "yes"
         if self.expect_any:
             return " or ".join(self.expect_any)
+        if isinstance(self.expect, bool):
+            return "yes" if self.expect else "no"
         if self.expect is not None:
             return str(self.expect)
         return ""

@@ -215,7 +215,8 @@ body { font-family: sans-serif; font-size: 10pt; }
 h1 { font-size: 16pt; } h2 { font-size: 13pt; margin-top: 14pt; } h3 { font-size: 11pt; }
 table { border-collapse: collapse; margin-bottom: 8pt; }
 th, td { border: 1px solid #888; padding: 2pt 4pt; vertical-align: top; }
-th { background: #e4e4e4; text-align: left; }
+th { background: #e4e4e4; text-align: left; white-space: nowrap; }
+.note { color: #444; font-size: 9pt; }
 .pass { color: #176b1d; font-weight: bold; } .fail { color: #b00000; font-weight: bold; }
 .warn { color: #b00000; }
 """
@@ -226,15 +227,25 @@ def _e(value: Any) -> str:
 
 
 def _value(record: CheckRecord) -> str:
-    if record.kind == "confirm":
+    if record.kind == "confirm" or isinstance(record.value, bool):
         return "yes" if record.value else "no"
     if isinstance(record.value, float):
         return f"{record.value:g} {record.unit}".strip()
     return f"{record.value} {record.unit}".strip() if record.value is not None else ""
 
 
-def _table(headers: list[str], rows: list[list[str]]) -> str:
-    head = "".join(f"<th>{h}</th>" for h in headers)
+def _when(at_utc: str) -> str:
+    """An ISO time as a person reads it on paper: '2026-11-30 03:56' (the column says UTC)."""
+    text = str(at_utc or "")
+    return text[:16].replace("T", " ") if len(text) >= 16 and text[10:11] == "T" else text
+
+
+def _table(headers: list[str], rows: list[list[str]], widths: list[int] | None = None) -> str:
+    """An HTML table; ``widths`` in per cent of the page, one per column."""
+    if widths is None:
+        head = "".join(f"<th>{h}</th>" for h in headers)
+    else:
+        head = "".join(f"<th width='{w}%'>{h}</th>" for h, w in zip(headers, widths, strict=True))
     body = "".join("<tr>" + "".join(f"<td>{c}</td>" for c in row) + "</tr>" for row in rows)
     return f'<table width="100%"><tr>{head}</tr>{body}</table>'
 
@@ -258,7 +269,7 @@ def render_html(report: CommissioningReport) -> str:
         ["Driver adjusted for", _e(d.get("adjusted_for", ""))],
         ["Driver version", _e(d.get("version", ""))],
         ["Commissioned by", _e(report.operator)],
-        ["Session started (UTC)", _e(report.created_utc)],
+        ["Session started (UTC)", _e(_when(report.created_utc))],
     ]
     out.append("<h2>Actuator and driver</h2>" + _table(["Item", "Value"], identity))
 
@@ -286,12 +297,18 @@ def render_html(report: CommissioningReport) -> str:
                 _e(r.expected),
                 "<span class='pass'>pass</span>" if r.passed else "<span class='fail'>FAIL</span>",
                 _e(r.who),
-                _e(r.at_utc),
+                _e(_when(r.at_utc)),
                 _e(r.detail),
             ]
             for r in result.records
         ]
-        out.append(_table(["§", "Check", "Value", "Expected", "Result", "Who", "When (UTC)", "Detail"], rows))
+        out.append(
+            _table(
+                ["§", "Check", "Value", "Expected", "Result", "Who", "When (UTC)", "Detail"],
+                rows,
+                [7, 37, 10, 10, 6, 10, 12, 8],
+            )
+        )
 
     out.append("<h2>Rotary position sensors (option L)</h2>")
     if report.sensor_angles_deg:
@@ -322,11 +339,18 @@ def render_html(report: CommissioningReport) -> str:
                 _e(p.name),
                 _e(p.value),
                 _e(p.default),
-                "" if p.certain else "assumed",
+                "" if p.certain else "assumed *",
             ]
             for p in report.parameters
         ]
         out.append("<h3>All values</h3>" + _table(["Item", "Name", "Value", "Default", "Note"], rows))
+        if any(not p.certain for p in report.parameters):
+            out.append(
+                "<p class='note'>* assumed: the public HA-655 manual does not state this item's range "
+                "or default; the default shown is FHA Studio's assumption. The value itself is what "
+                "the drive reported or the technician entered. Check assumed items against the "
+                "driver's own manual or front panel.</p>"
+            )
     else:
         out.append("<p>No parameters were read from the drive.</p>")
 
@@ -339,7 +363,10 @@ def render_html(report: CommissioningReport) -> str:
 
     if report.notes:
         out.append("<h2>Notes</h2>")
-        rows = [[_e(n.get("at_utc", "")), _e(n.get("who", "")), _e(n.get("text", ""))] for n in report.notes]
+        rows = [
+            [_e(_when(n.get("at_utc", ""))), _e(n.get("who", "")), _e(n.get("text", ""))]
+            for n in report.notes
+        ]
         out.append(_table(["When (UTC)", "Who", "Note"], rows))
 
     out.append("<h2>Signature</h2>")

@@ -50,3 +50,43 @@ def test_report_prints_to_pdf(qapp, tmp_path):
         "Not signed",
     ):
         assert wanted in text, wanted
+
+
+def test_page_breaks_never_cut_a_row_and_every_page_is_numbered(qapp, tmp_path):
+    """A long checklist spans pages: each break falls between table rows (Qt's own printing cuts
+    rows in half), and every page says 'page k of n'."""
+    from PySide6.QtGui import QTextDocument
+
+    from fha_studio.gui.procedures.report_pdf import _unbreakable_spans, page_breaks
+
+    context = build_context(CODE)
+    session = Session(actuator_code=CODE, operator="T. Trainee", site="Hall 2")
+    for procedure_id in ("receiving-inspection", "installation", "wiring"):
+        walk(ProcedureRun(session, load_procedure(procedure_id, context), autosave=False))
+    report = build_report(session, context)
+    from fha_studio.logic.procedures.report import render_html
+
+    document = QTextDocument()
+    document.setDocumentMargin(0)
+    document.setHtml(render_html(report))
+    document.setTextWidth(1062)  # A4 at 150 dpi less 15 mm margins
+    spans = _unbreakable_spans(document)
+    tops = page_breaks(spans, document.size().height(), 1500)
+    assert len(tops) >= 2
+    for top in tops[1:]:
+        cut = [s for s in spans if s.top < top < s.bottom]
+        assert not cut, f"a break at {top:.0f} px cuts {cut}"
+    assert page_breaks(spans, 100.0, 1500) == [0.0]
+
+    _, pdf_path = write_report(report, tmp_path / "r.html", tmp_path / "r.pdf")
+    assert not list(tmp_path.glob(".*partial"))
+    if shutil.which("pdftotext") is None:
+        pytest.skip("pdftotext is not installed: the page footers are not checked")
+    pages = subprocess.run(
+        ["pdftotext", "-layout", str(pdf_path), "-"], capture_output=True, text=True, check=True
+    ).stdout.split("\f")
+    pages = [p for p in pages if p.strip()]
+    assert len(pages) >= 2
+    for number, page in enumerate(pages, start=1):
+        assert f"page {number} of {len(pages)}" in page
+    assert "True" not in "".join(pages)  # yes/no, never a Python bool
