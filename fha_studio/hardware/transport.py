@@ -39,8 +39,10 @@ SIM_HANDLER_PACKAGE = "fha_studio.hardware.sim"
 class Transport(Protocol):
     """What the client needs of a port: the subset of pyserial's ``Serial`` it uses."""
 
-    port: str | None
     timeout: float | None
+
+    @property
+    def port(self) -> str | None: ...
 
     def write(self, data: bytes) -> int | None: ...
     def read(self, size: int = 1) -> bytes: ...

@@ -13,7 +13,7 @@ SIM_URL = "sim://FHA-25C-50-US250?paced=0"
 
 def sim_drive(window):
     """The SimDrive behind the link (for injecting what a technician would do at the machine)."""
-    return window.link._worker._client._transport.inner.sim_drive
+    return window.link._worker._client.transaction.transport.inner.sim_drive
 
 
 @pytest.fixture
@@ -169,7 +169,7 @@ def test_alarm_that_needs_a_power_cycle_says_so(window, qtbot):
 
 
 def test_lost_link_shown_within_a_second(window, qtbot):
-    window.link._worker._client._transport.inner.close()  # the cable is pulled
+    window.link._worker._client.transaction.transport.inner.close()  # the cable is pulled
     with qtbot.waitSignal(window.link.sigDisconnected, timeout=1000) as lost:
         pass
     assert lost.args[1] is True

@@ -435,3 +435,14 @@ def test_closed_client_refuses(client_for, mini):
 
 def test_fast_settings_are_what_the_tests_assume():
     assert FAST.response_timeout_s < 0.1 and S.status is p.Status.SERVO_ON and OK.status is p.Status.DONE
+
+
+def test_the_client_is_a_drive_api_and_its_transaction_layer_knows_no_command_meaning(client_for, mini):
+    from fha_studio.hardware.api import DriveApi
+    from fha_studio.hardware.transaction import one_int
+
+    client, _ = client_for(mini)
+    assert isinstance(client, DriveApi)
+    # the transaction layer alone: one exchange, its parser, its statistics
+    assert client.transaction.transact(Command.MON, 103, parse=one_int) == 1103
+    assert client.transaction.statistics["transactions"] >= 3  # CAP, DGR, MON

@@ -1,0 +1,313 @@
+"""The transaction layer of the CN3 link: one request, one reply, the one retry policy.
+
+As pymodbus separates its transaction manager from its client, this module knows frames, time and
+the line, and nothing of what a command means: ``DriveClient`` (``client.py``) builds the API on
+``Transaction.transact``. One ``Transaction`` owns its port; ``transact`` may be called from any
+thread (an RLock serialises it; ``lock`` lets the client hold it across a select-then-read).
+
+Retry policy (the only one): an attempt fails when no byte arrives for
+``settings.response_timeout_s`` (counted from the end of the request, restarted at every byte
+received), when the reply is marked corrupt by the codec, or when its lines do not have the form
+the command defines (the parser raises ``ValueError``). A failed attempt is retried
+``settings.retries`` times, after waiting until the line has been quiet for
+``settings.response_timeout_s`` (so a late reply is dropped, not taken for the next request's).
+Commands whose repetition could act twice (MOV, OWW, PWC) are never retried. ``s`` and ``x`` are
+answers, not failures: raised at once as ``ServoOnRefused`` / ``CommandRejected``, never retried.
+After ``settings.max_consecutive_failures`` failed transactions in a row the link is marked lost
+(``LinkLost``); one success resets the count.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TypeVar
+
+from fha_studio.hardware import protocol as p
+from fha_studio.hardware.errors import CommandRejected, LinkLost, LinkTimeout, ServoOnRefused
+from fha_studio.hardware.protocol import Command, Garbage, Reply, Request, Status
+from fha_studio.hardware.transport import GuardedTransport, Transport
+
+__all__ = [
+    "NOT_RETRIED",
+    "LinkSettings",
+    "PacketMonitor",
+    "ReplyShapeError",
+    "Transaction",
+    "no_data",
+    "one_int",
+]
+
+log = logging.getLogger(__name__)
+T = TypeVar("T")
+
+#: A bus monitor: called with every block written (True) and read (False).
+PacketMonitor = Callable[[bool, bytes], None]
+
+
+@dataclass(frozen=True)
+class LinkSettings:
+    """How the client uses the line. Times in seconds.
+
+    ``response_timeout_s`` is the longest silence the client accepts while it waits for (the
+    rest of) a reply; the time the request itself takes on the line (10 characters at
+    ``baudrate``) is added for the first byte.
+    """
+
+    baudrate: int = p.BAUDRATE
+    response_timeout_s: float = 0.3
+    retries: int = 2
+    max_consecutive_failures: int = 3
+    #: first-byte timeouts of the slow commands
+    oww_timeout_s: float = 6.5  # OWW: "q about 5 s later" (HA-655 manual p.21)
+    power_cycle_timeout_s: float = 5.0
+    eeprom_write_timeout_s: float = 0.5
+    #: cap on one attempt however long the drive keeps sending (a babbling line)
+    max_reply_s: float = 5.0
+    #: read timeout of the port: how often a waiting read wakes up to check its deadline
+    poll_s: float = 0.01
+
+    def __post_init__(self) -> None:
+        if self.baudrate <= 0 or self.response_timeout_s <= 0 or self.retries < 0:
+            raise ValueError("LinkSettings: baudrate and response_timeout_s must be > 0, retries >= 0")
+        if self.max_consecutive_failures < 1:
+            raise ValueError("LinkSettings: max_consecutive_failures must be >= 1")
+
+    @property
+    def character_time_s(self) -> float:
+        """Time of one character on the line (8N1: 10 bits)."""
+        return p.character_time_s(self.baudrate)
+
+    def transfer_time_s(self, characters: int) -> float:
+        """Time ``characters`` take on the line."""
+        return characters * self.character_time_s
+
+    def first_byte_timeout_s(self, command: Command) -> float:
+        """How long an attempt of ``command`` waits for the first byte of the reply."""
+        slow = {
+            Command.OWW: self.oww_timeout_s,
+            Command.PWC: self.power_cycle_timeout_s,
+            Command.PWR: self.eeprom_write_timeout_s,
+        }
+        wait = max(self.response_timeout_s, slow.get(command, 0.0))
+        return self.transfer_time_s(p.FRAME_LENGTH) + wait
+
+
+#: Commands whose repetition could act twice; sent once, never retried.
+NOT_RETRIED = frozenset({Command.MOV, Command.OWW, Command.PWC})
+
+
+class ReplyShapeError(ValueError):
+    """A reply with the wrong number or form of lines for its command (treated as corrupt)."""
+
+
+def one_int(reply: Reply) -> int:
+    """Parser of a reply with one integer line."""
+    if len(reply.lines) != 1:
+        raise ReplyShapeError(f"expected one value line, got {len(reply.lines)}")
+    return p.parse_int(reply.lines[0])
+
+
+def no_data(reply: Reply) -> None:
+    """Parser of a reply without data lines."""
+    if reply.lines:
+        raise ReplyShapeError(f"expected no data, got {len(reply.lines)} lines")
+
+
+@dataclass
+class _LinkHealth:
+    consecutive_failures: int = 0
+    lost: LinkLost | None = None
+    transactions: int = 0
+    failed_attempts: int = 0
+    garbage_bytes: int = 0
+
+
+class Transaction:
+    """Framing, timeouts, retries, resynchronisation and link health over one transport.
+
+    ``packet_monitor``: optional ``callable(sending: bool, data: bytes)`` called with every block
+    written (True) and read (False): a bus monitor. It runs in the caller's thread, under the
+    lock; it must be quick and must not call the link.
+    """
+
+    def __init__(self, transport: Transport, settings: LinkSettings | None = None):
+        self.settings = settings or LinkSettings()
+        self.transport = (
+            transport if isinstance(transport, GuardedTransport) else GuardedTransport(transport)
+        )
+        self.transport.timeout = self.settings.poll_s
+        self.lock = threading.RLock()
+        self._decoder: p.StreamDecoder[Reply | Garbage] = p.StreamDecoder(p.decode_reply)
+        self._health = _LinkHealth()
+        self._closed = False
+        self.packet_monitor: PacketMonitor | None = None
+
+    # --- state ----------------------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Close the port (idempotent)."""
+        with self.lock:
+            if not self._closed:
+                self._closed = True
+                self.transport.close()
+
+    @property
+    def port(self) -> str:
+        return self.transport.name
+
+    @property
+    def is_open(self) -> bool:
+        return not self._closed and self._health.lost is None
+
+    @property
+    def link_lost(self) -> bool:
+        return self._health.lost is not None
+
+    @property
+    def statistics(self) -> dict[str, int]:
+        """Transactions, failed attempts, garbage bytes seen, consecutive failures."""
+        h = self._health
+        return {
+            "transactions": h.transactions,
+            "failed_attempts": h.failed_attempts,
+            "garbage_bytes": h.garbage_bytes,
+            "consecutive_failures": h.consecutive_failures,
+        }
+
+    # --- one exchange ---------------------------------------------------------------------------
+
+    def transact(
+        self,
+        command: Command,
+        value: int = 0,
+        parse: Callable[[Reply], T] = no_data,  # type: ignore[assignment]  # T is None then
+        *,
+        retry: bool | None = None,
+    ) -> T:
+        """Send ``command`` and return ``parse(reply)``; the one place of the retry policy.
+
+        ``parse`` raises ``ValueError`` for a reply of the wrong form (the attempt is retried).
+        ``retry=False`` sends once whatever the command.
+        """
+        request = Request(command, value)
+        with self.lock:
+            if self._closed:
+                raise LinkLost(f"{self.port}: the client is closed", port=self.port)
+            if self._health.lost is not None:
+                raise LinkLost(str(self._health.lost), port=self.port)
+            attempts = 1 if (retry is False or command in NOT_RETRIED) else 1 + self.settings.retries
+            why = ""
+            try:
+                for attempt in range(attempts):
+                    if attempt:
+                        self._health.failed_attempts += 1
+                        log.info("%s: %s failed (%s), retry %d", self.port, command, why, attempt)
+                        self._drain_until_quiet()
+                    reply, why = self._attempt(request)
+                    if reply is None:
+                        continue
+                    if reply.status is Status.SERVO_ON:
+                        self._succeeded()
+                        raise ServoOnRefused(f"{command}: refused, the servo is on (not processed)")
+                    if reply.status is Status.REJECTED:
+                        self._succeeded()
+                        raise CommandRejected(f"{command}{value:+06d}: rejected by the drive (x)")
+                    try:
+                        result = parse(reply)
+                    except ValueError as exc:
+                        why = f"malformed reply {reply.lines!r}: {exc}"
+                        continue
+                    self._succeeded()
+                    return result
+            except LinkLost as exc:
+                self._health.lost = exc
+                raise
+            self._health.failed_attempts += 1
+            self._health.consecutive_failures += 1
+            self._drain_quietly()
+            unknown = " (not repeated: unknown whether the drive acted on it)" if attempts == 1 else ""
+            text = f"{command} on {self.port}: {why} after {attempts} attempt(s){unknown}"
+            if self._health.consecutive_failures >= self.settings.max_consecutive_failures:
+                lost = LinkLost(
+                    f"{text}; {self._health.consecutive_failures} failed transactions in a row: "
+                    "link marked lost (check the cable and the drive's power, then reconnect)",
+                    port=self.port,
+                )
+                self._health.lost = lost
+                raise lost
+            raise LinkTimeout(text)
+
+    # --- the line ---------------------------------------------------------------------------------
+
+    def _monitor(self, sending: bool, data: bytes) -> None:
+        if self.packet_monitor is not None and data:
+            try:
+                self.packet_monitor(sending, data)
+            except Exception:  # a monitor must never break the link
+                log.exception("packet monitor failed")
+
+    def _read_some(self) -> bytes:
+        waiting = self.transport.in_waiting
+        data = self.transport.read(max(1, waiting))
+        self._monitor(False, data)
+        return data
+
+    def _drain_until_quiet(self) -> None:
+        """Drop input until the line has been quiet for response_timeout_s: a reply that comes
+        late (after its attempt timed out) is dropped here, not taken for the next request's."""
+        quiet_until = time.monotonic() + self.settings.response_timeout_s
+        give_up = time.monotonic() + self.settings.max_reply_s
+        while time.monotonic() < min(quiet_until, give_up):
+            if self._read_some():
+                quiet_until = time.monotonic() + self.settings.response_timeout_s
+        self.transport.reset_input_buffer()
+        self._decoder.clear()
+
+    def _drain_quietly(self) -> None:
+        try:
+            self._drain_until_quiet()
+        except LinkLost as exc:
+            self._health.lost = exc
+            raise
+
+    def _attempt(self, request: Request) -> tuple[Reply | None, str]:
+        """Send once and wait for one reply: (reply, "") or (None, why it failed)."""
+        self.transport.reset_input_buffer()  # stale input from before this request
+        stale = self._decoder.clear()
+        if stale:
+            self._health.garbage_bytes += len(stale)
+        data = request.encode()
+        self.transport.write(data)
+        self._monitor(True, data)
+        start = time.monotonic()
+        deadline = start + self.settings.first_byte_timeout_s(request.command)
+        cap = deadline + self.settings.max_reply_s
+        tainted = False
+        while True:
+            now = time.monotonic()
+            if now >= min(deadline, cap):
+                pending = self._decoder.pending
+                return None, ("half a reply, then silence" if pending else "no reply") + (
+                    f" within {now - start:.2f} s"
+                )
+            chunk = self._read_some()
+            if not chunk:
+                continue
+            deadline = time.monotonic() + self.settings.response_timeout_s
+            for message in self._decoder.feed(chunk):
+                if isinstance(message, Garbage):
+                    self._health.garbage_bytes += len(message.data)
+                    log.debug("%s: skipped %r (%s)", self.port, message.data, message.reason)
+                    tainted = tainted or message.printable
+                    continue
+                if message.corrupt or tainted:
+                    return None, "corrupt reply (noise inside it)"
+                return message, ""
+
+    def _succeeded(self) -> None:
+        self._health.transactions += 1
+        self._health.consecutive_failures = 0
