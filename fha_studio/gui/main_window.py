@@ -18,6 +18,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo
+from fha_studio.gui.messages import Level, MessageArea
 from fha_studio.gui.session import DEFAULT_SIM_URL, Session
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton
 
@@ -25,6 +26,8 @@ log = logging.getLogger(__name__)
 
 #: The key bound to STOP, everywhere in the main window (documented in the README and tooltip).
 STOP_KEY = Qt.Key.Key_Escape
+#: Room for the link summary in the status bar [px]; the messages get the rest.
+CAPS_WIDTH_PX = 420
 
 
 class MainWindow(QMainWindow):
@@ -48,7 +51,7 @@ class MainWindow(QMainWindow):
         self.link.sigDisconnected.connect(self._on_disconnected)
         self.link.sigStatus.connect(self._on_status)
         self.link.sigResult.connect(self._on_result)
-        self.session.sigMessage.connect(lambda text: self.statusBar().showMessage(text, 8000))
+        self.session.sigMessage.connect(self._on_session_message)
         self.resize(1280, 720)
         self._restore_layout()
         self._on_disconnected("not connected", False)
@@ -149,9 +152,20 @@ class MainWindow(QMainWindow):
         self.alarm_lamp = Lamp("Alarm", RED)
         self.caps_label = QLabel("")
         self.caps_label.setObjectName("capabilities")
+        # the capabilities are a summary (full text in the tooltip): they never take the room of
+        # the messages, which a person must see
+        self.caps_label.setMaximumWidth(CAPS_WIDTH_PX)
+        self.message_area = MessageArea(self)
+        bar.addWidget(self.message_area, 1)
         for w in (self.link_lamp, self.servo_lamp, self.alarm_lamp):
             bar.addPermanentWidget(w)
-        bar.addPermanentWidget(self.caps_label, 1)
+        bar.addPermanentWidget(self.caps_label)
+
+    def _set_caps(self, text: str) -> None:
+        """The link summary at the right of the status bar, elided to its room; full in the tooltip."""
+        metrics = self.caps_label.fontMetrics()
+        self.caps_label.setText(metrics.elidedText(text, Qt.TextElideMode.ElideRight, CAPS_WIDTH_PX - 8))
+        self.caps_label.setToolTip(text)
 
     # -- settings -------------------------------------------------------------------------------
     def _restore_layout(self) -> None:
@@ -205,8 +219,20 @@ class MainWindow(QMainWindow):
     def stop_axis(self) -> None:
         """STOP: decelerate and hold. Sent even when the link looks idle."""
         self.jog_page.release_jog()
+        if not self.link.connected:
+            self.show_message("STOP: no drive is connected, nothing was sent.", Level.WARNING)
+            return
         self.link.stop_now()
-        self.statusBar().showMessage("STOP sent: the axis decelerates and holds (servo stays on).", 5000)
+        self.show_message("STOP sent: the axis decelerates and holds (servo stays on) …")
+
+    def show_message(self, text: str, level: Level = Level.INFO) -> None:
+        """Show an outcome the person caused in the message area (kept in its log with the time)."""
+        self.message_area.show_message(text, level)
+
+    @Slot(str)
+    def _on_session_message(self, text: str) -> None:
+        # the session says "Nothing written: ..." when a write it was asked for did not happen
+        self.show_message(text, Level.WARNING if text.startswith("Nothing written") else Level.INFO)
 
     def connect_to(self, url: str = DEFAULT_SIM_URL, baud_rate: int = 19200) -> bool:
         """Connects (after asking, when the axis is live); False when the user said no."""
@@ -214,7 +240,7 @@ class MainWindow(QMainWindow):
             return False
         self.link.open(url, baud_rate)
         self.link_lamp.set_state(None)
-        self.caps_label.setText(f"connecting to {url} …")
+        self._set_caps(f"connecting to {url} …")
         return True
 
     @Slot()
@@ -264,8 +290,8 @@ class MainWindow(QMainWindow):
         model = info.driver_model or "driver model unknown"
         self.link_lamp.setToolTip(f"Link: connected to {where} ({model})")
         first = (info.capabilities or "capabilities unknown").split(". ")[0].rstrip(".")
-        self.caps_label.setText(f"{model} · {where} · {first}.")
-        self.caps_label.setToolTip(info.capabilities)
+        self._set_caps(f"{model} · {where} · {first}.")
+        self.caps_label.setToolTip(f"{model} · {where}\n{info.capabilities}")
         self.disconnect_action.setEnabled(True)
         self.servo_action.setEnabled(info.can_move)
         self.setWindowTitle(f"FHA Studio — {model} — {where}")
@@ -282,10 +308,12 @@ class MainWindow(QMainWindow):
         if lost:
             self.link_lamp.set_state(True, RED)
             self.link_lamp.setToolTip(f"Link: LOST — {reason}")
-            self.caps_label.setText(f"LINK LOST: {reason}. Check the cable and power, then Connect… (Ctrl+K)")
+            self._set_caps(f"LINK LOST: {reason}. Check the cable and power, then Connect… (Ctrl+K)")
             self.caps_label.setStyleSheet("color: #b00020; font-weight: bold;")
+            self.show_message(f"Link lost: {reason}. Check the cable and power, then Connect… (Ctrl+K).",
+                              Level.ERROR)
         else:
-            self.caps_label.setText(f"Not connected ({reason}). Connect… (Ctrl+K)")
+            self._set_caps(f"Not connected ({reason}). Connect… (Ctrl+K)")
             self.caps_label.setStyleSheet("")
 
     @Slot(object)
@@ -301,14 +329,25 @@ class MainWindow(QMainWindow):
 
     @Slot(object)
     def _on_result(self, result: CommandResult) -> None:
+        if result.cmd is Cmd.STOP:
+            if result.ok:
+                self.show_message("STOP done: the drive decelerated the axis and holds it (servo stays on).")
+            else:
+                self.show_message(
+                    f"STOP could not be sent: {result.error}. Stop the axis with the emergency stop "
+                    "or the controller's servo-OFF.",
+                    Level.ERROR,
+                )
+            return
         if result.ok:
             return
         if result.cmd is Cmd.OPEN:
-            self.caps_label.setText(f"Could not connect: {result.error}")
+            self.show_message(f"Could not connect: {result.error}", Level.ERROR)
+            self._set_caps(f"Could not connect: {result.error}")
             self.caps_label.setStyleSheet("color: #b00020; font-weight: bold;")
             self.link_lamp.set_state(True, RED)
         elif result.cmd is not Cmd.JOG_LEASE:
-            self.statusBar().showMessage(f"{_command_words(result.cmd)} failed: {result.error}", 8000)
+            self.show_message(f"{_command_words(result.cmd)} failed: {result.error}", Level.ERROR)
 
     @Slot(int, bool)
     def _on_alarm_attention(self, code: int, attention: bool) -> None:

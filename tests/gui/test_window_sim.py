@@ -34,7 +34,7 @@ def test_connects_identifies_and_status_bar_says_what_the_drive_supports(window,
     assert info.driver_model == "HA-655-2-200"
     assert info.adjusted_for == "FHA-25C-50-US250"
     assert info.is_simulated
-    assert "HA-655-2-200" in window.caps_label.text() and "traces" in window.caps_label.text()
+    assert "HA-655-2-200" in window.caps_label.text() and "traces" in window.caps_label.toolTip()
     assert window.connection_page.adjusted_label.text() == "FHA-25C-50-US250"
     qtbot.waitUntil(lambda: window.alarm_lamp.state is False, timeout=3000)
     assert window.servo_lamp.state is False
@@ -176,3 +176,25 @@ def test_lost_link_shown_within_a_second(window, qtbot):
     assert "LINK LOST" in window.caps_label.text()
     assert window.link_lamp.state is True  # red lamp: lost, not merely disconnected
     assert not window.jog_page.fwd_button.isEnabled()
+
+
+def test_stop_and_failures_are_seen_in_the_message_area_and_kept_in_its_log(window, qtbot):
+    """A technician presses STOP and sees what happened; a refused command says so in red. The
+    message area is not covered by the status bar's other widgets, and every message is kept."""
+    window.resize(1366, 740)
+    area = window.message_area
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.STOP, timeout=10000):
+        qtbot.keyClick(window, Qt.Key.Key_Escape)
+    qtbot.waitUntil(lambda: "STOP done" in area.text_label.text(), timeout=10000)
+    assert area.isVisible() and not area.text_label.visibleRegion().isEmpty()
+    text_rect = area.text_label.geometry().translated(area.mapTo(window, area.rect().topLeft()))
+    caps_rect = window.caps_label.geometry().translated(
+        window.caps_label.parentWidget().mapTo(window, window.caps_label.parentWidget().rect().topLeft())
+    )
+    assert not text_rect.intersects(caps_rect)
+    window.link.send(Cmd.MOVE_BY, 10.0)  # servo off: the drive refuses to move
+    qtbot.waitUntil(lambda: "Move by failed" in area.text_label.text(), timeout=10000)
+    assert "#b00020" in area.text_label.styleSheet()
+    texts = [m.text for m in area.messages]
+    assert any(t.startswith("STOP sent") for t in texts) and any(t.startswith("STOP done") for t in texts)
+    assert area.log_button.text() == f"Messages ({len(texts)})"
