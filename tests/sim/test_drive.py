@@ -7,7 +7,7 @@ import math
 import pytest
 
 from fha_studio.hardware.parameters import Mode
-from fha_studio.hardware.sim.drive import (
+from fha_studio.hardware.sim.io import (
     BIT_ALARM,
     BIT_BRAKE_RELEASED,
     BIT_FWD_INHIBIT,

@@ -1,8 +1,11 @@
 """The simulated HA-655 / HA-675 drive with an FHA-C actuator.
 
-- :class:`SimDrive`: the drive (parameters in an EEPROM file, servo, jog with watchdog, moves,
-  alarms, I/O, brake, option-L sensors, absolute / incremental encoder, trace capture); stepped
-  (``advance(seconds)``) or real time (``start()`` ... ``close()``).
+- :class:`SimDrive` (:mod:`.drive`): the drive (servo, jog with watchdog, moves, positions,
+  monitors, absolute / incremental encoder); stepped (``advance(seconds)``) or real time
+  (``start()`` ... ``close()``). Its other jobs: items and EEPROM (:mod:`.memory`, :mod:`.eeprom`),
+  I/O, brake and option-L sensors (:mod:`.io`), alarms and supervision (:mod:`.supervision`),
+  the CN3 command table (:mod:`.commands`), trace capture (:mod:`.trace`), recording
+  (:mod:`.recorder`).
 - :class:`SimProtocolServer`: CN3 bytes in, bytes out, through the codec, paced like the line.
 - ``sim://ACTUATOR?options``: the pyserial URL handler (:mod:`.protocol_sim`), options in
   :mod:`.options`.
@@ -11,10 +14,12 @@
 
 from __future__ import annotations
 
-from fha_studio.hardware.sim.drive import AlarmRecord, Reply, SimDrive, SimRefused
+from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.eeprom import EepromError
 from fha_studio.hardware.sim.options import SimConfig, SimConfigError, config_from_url, parse_effects
+from fha_studio.hardware.sim.reply import SimRefused, SimReply
 from fha_studio.hardware.sim.server import SimProtocolServer
+from fha_studio.hardware.sim.supervision import SimAlarmRecord
 
 
 def register_url_handler() -> None:
@@ -26,14 +31,14 @@ def register_url_handler() -> None:
 
 
 __all__ = [
-    "AlarmRecord",
     "EepromError",
-    "Reply",
+    "SimAlarmRecord",
     "SimConfig",
     "SimConfigError",
     "SimDrive",
     "SimProtocolServer",
     "SimRefused",
+    "SimReply",
     "config_from_url",
     "parse_effects",
     "register_url_handler",

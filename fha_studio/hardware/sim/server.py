@@ -26,7 +26,8 @@ from fha_studio.hardware.protocol import (
     decode_request,
     encode_reply,
 )
-from fha_studio.hardware.sim.drive import Reply, SimDrive
+from fha_studio.hardware.sim.drive import SimDrive
+from fha_studio.hardware.sim.reply import SimReply
 
 _STATUS = {"q": Status.DONE, "s": Status.SERVO_ON, "x": Status.REJECTED}
 
@@ -44,7 +45,7 @@ class SimProtocolServer:
         paced: bool = True,
         baudrate: int = protocol.BAUDRATE,
         clock: Callable[[], float] = time.monotonic,
-        on_transaction: Callable[[str, Reply], None] | None = None,
+        on_transaction: Callable[[str, SimReply], None] | None = None,
     ):
         self.drive = drive
         self.paced = paced
@@ -144,9 +145,9 @@ class SimProtocolServer:
                 self._send(reply, at)
             if self._on_transaction is not None:
                 self._on_transaction(f"{name}{'-' if value < 0 else '+'}{abs(value):05d}",
-                                     reply or Reply("q", reason="deferred"))
+                                     reply or SimReply("q", reason="deferred"))
 
-    def _send(self, reply: Reply, at: float) -> None:
+    def _send(self, reply: SimReply, at: float) -> None:
         data = encode_reply(protocol.Reply(tuple(reply.lines), _STATUS[reply.terminal]))
         start = max(at, self._out_free_at)
         for i, byte in enumerate(data):

@@ -36,7 +36,7 @@ def channels_from_mask(mask: int) -> list[int]:
     return [MONITOR_FIRST + k for k in range(16) if mask >> k & 1]
 
 
-class TraceCapture:
+class SimTrace:
     """Settings and buffer of one trace. ``sample(read)`` is called every servo period by the
     drive; ``read(item)`` returns the wire value of a monitor item (I/O bits: item 106)."""
 
