@@ -26,8 +26,8 @@ import numpy as np
 from PySide6.QtCore import QEventLoop, QTimer
 from PySide6.QtWidgets import QApplication
 
-from fha_studio.gui.scope.driver import LiveStarted, ScopeCmd, ScopeController
-from fha_studio.gui.scope.view import ScopeContext, ScopeView
+from fha_studio.gui.pages.scope.driver import LiveStarted, ScopeCmd, ScopeController
+from fha_studio.gui.pages.scope.view import ScopeContext, ScopeView
 from fha_studio.hardware.client import DriveClient
 from fha_studio.logic.scope.acquisition import LiveMode, estimated_rate_hz
 from fha_studio.logic.scope.ring import RingBuffer

@@ -424,19 +424,19 @@ def _sizing_page(window: MainWindow) -> QWidget:
 
 
 def _scope_page(window: MainWindow) -> QWidget:
-    from fha_studio.gui.scope.page import ScopePage
+    from fha_studio.gui.pages.scope.page import ScopePage
 
     return ScopePage(window.session, window)
 
 
 def _modelcheck_page(window: MainWindow) -> QWidget:
-    from fha_studio.gui.modelcheck.page import ModelCheckPage
+    from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
 
     return ModelCheckPage(window.session, window)
 
 
 def _procedures_page(window: MainWindow) -> QWidget:
-    from fha_studio.gui.procedures.page import ProceduresPage
+    from fha_studio.gui.pages.procedures.page import ProceduresPage
 
     return ProceduresPage(window.session, window)
 

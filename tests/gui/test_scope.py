@@ -14,8 +14,8 @@ import pytest
 from PySide6.QtCore import Qt, QTimer
 
 from fha_studio.gui.link import Cmd
-from fha_studio.gui.scope.driver import ScopeCmd, ScopeController
-from fha_studio.gui.scope.view import ScopeContext, ScopeView
+from fha_studio.gui.pages.scope.driver import ScopeCmd, ScopeController
+from fha_studio.gui.pages.scope.view import ScopeContext, ScopeView
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.scripted import ScriptedDrive

@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 
-from fha_studio.gui.procedures.report_pdf import write_report
+from fha_studio.gui.pages.procedures.report_pdf import write_report
 from fha_studio.logic.procedures import ProcedureRun, Session, load_procedure
 from fha_studio.logic.procedures.context import build_context
 from fha_studio.logic.procedures.report import build_report
@@ -57,7 +57,7 @@ def test_page_breaks_never_cut_a_row_and_every_page_is_numbered(qapp, tmp_path):
     rows in half), and every page says 'page k of n'."""
     from PySide6.QtGui import QTextDocument
 
-    from fha_studio.gui.procedures.report_pdf import _unbreakable_spans, page_breaks
+    from fha_studio.gui.pages.procedures.report_pdf import _unbreakable_spans, page_breaks
 
     context = build_context(CODE)
     session = Session(actuator_code=CODE, operator="T. Trainee", site="Hall 2")

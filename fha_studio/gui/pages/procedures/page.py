@@ -36,7 +36,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.gui.link import IO_BRAKE_RELEASED, Cmd, CommandResult, DriveStatus
-from fha_studio.gui.procedures.dog_panel import SensorDogPanel
+from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
 from fha_studio.logic.procedures import (
     Observation,
     Procedure,
@@ -469,7 +469,7 @@ class ProceduresPage(QWidget):
 
     def write_report(self, html_path: str | Path, pdf_path: str | Path | None = None):
         """Write the commissioning report (HTML, and PDF when a path is given)."""
-        from fha_studio.gui.procedures.report_pdf import write_report
+        from fha_studio.gui.pages.procedures.report_pdf import write_report
 
         if self.session is None:
             raise SessionError("no session: nothing to report")
