@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
 
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo
 from fha_studio.gui.messages import Level, MessageArea
+from fha_studio.gui.mnemonics import mnemonic, resolve_mnemonics
 from fha_studio.gui.session import DEFAULT_SIM_URL, Session
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton
 
@@ -127,7 +128,19 @@ class MainWindow(QMainWindow):
         ):
             self.tabs.addTab(page, title)
         self.setCentralWidget(self.tabs)
+        for page in (self.connection_page, self.parameters_page, self.direction_page, self.alarms_page,
+                     self.jog_page):
+            resolve_mnemonics(page, self.window_mnemonics())
         self.alarms_page.sigAlarmAttention.connect(self._on_alarm_attention)
+
+    def window_mnemonics(self) -> set[str]:
+        """The Alt letters of the page tabs and the toolbar: no page may use them."""
+        letters = {mnemonic(self.tabs.tabText(i)) for i in range(self.tabs.count())}
+        actions = (self.connect_action, self.disconnect_action, self.servo_action)
+        letters |= {mnemonic(a.text()) for a in actions}
+        letters |= {"f"}  # the servo action reads "Servo O&FF" while the servo is on
+        letters.discard(None)
+        return letters  # type: ignore[return-value]
 
     @property
     def sizing_page(self):
@@ -402,6 +415,7 @@ class LazyPage(QWidget):
         if self.built is None:
             page = self._factory(self._window)
             self.built = page
+            resolve_mnemonics(page, self._window.window_mnemonics())
             self.layout().addWidget(page)
             restore = getattr(page, "restore_settings", None)
             if restore:

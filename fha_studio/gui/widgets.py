@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
-from PySide6.QtCore import QPointF, QRectF, QSize, Qt
+from PySide6.QtCore import QEvent, QObject, QPointF, QRectF, QSize, Qt
 from PySide6.QtGui import QBrush, QColor, QFont, QPainter, QPainterPath, QPen, QPolygonF
-from PySide6.QtWidgets import QLabel, QPushButton, QSizePolicy, QWidget
+from PySide6.QtWidgets import QAbstractButton, QLabel, QPushButton, QSizePolicy, QWidget
 
 GREEN = QColor("#2e9d3a")
 RED = QColor("#d12c2c")
@@ -176,3 +177,23 @@ class FlangeWidget(QWidget):
         p.setFont(font)
         label = "FWD = CW" if clockwise else "FWD = CCW"
         p.drawText(QRectF(-150, -150, 300, 30), Qt.AlignmentFlag.AlignCenter, label)
+
+
+class _SpaceSwallower(QObject):
+    """Eats the Space (and Select) key on the buttons it is installed on."""
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() not in (QEvent.Type.KeyPress, QEvent.Type.KeyRelease):
+            return False
+        return event.key() in (Qt.Key.Key_Space, Qt.Key.Key_Select)  # type: ignore[attr-defined]
+
+
+def space_jogs_only(root: QWidget, jog_buttons: Iterable[QAbstractButton]) -> None:
+    """Space holds a jog button; on every other button under ``root`` it does nothing. A
+    technician holding Space to jog must not start a move or switch the servo because the
+    keyboard focus happened to be on another button (those still take the mouse and Alt+letter)."""
+    keep = set(jog_buttons)
+    swallower = _SpaceSwallower(root)
+    for button in root.findChildren(QAbstractButton):
+        if button not in keep:
+            button.installEventFilter(swallower)

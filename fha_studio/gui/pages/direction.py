@@ -17,7 +17,7 @@ from PySide6.QtWidgets import (
 
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus
 from fha_studio.gui.session import Session
-from fha_studio.gui.widgets import FlangeWidget
+from fha_studio.gui.widgets import FlangeWidget, space_jogs_only
 
 KEY = "rotary_direction"
 #: How long the live check jogs FWD, in ms, and at what output speed, in r/min.
@@ -140,6 +140,7 @@ class DirectionPage(QWidget):
         self._stop_timer.timeout.connect(self._end_check_jog)
         self.cw_radio.setChecked(True)
         self._update()
+        space_jogs_only(self, ())  # "Jog FWD briefly" moves: only a deliberate click starts it
 
     # -- state --------------------------------------------------------------------------------------
     def _key(self) -> tuple[str, int]:

@@ -18,7 +18,7 @@ from PySide6.QtWidgets import (
 from fha_studio.gui import link as L
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
 from fha_studio.gui.session import Session
-from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp
+from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, space_jogs_only
 
 #: (I/O bit, caption, colour when on) of the inputs and outputs shown live.
 LIVE_SIGNALS = (
@@ -185,6 +185,7 @@ class JogPage(QWidget):
         self.link.sigConnected.connect(self._on_connected)
         self.link.sigDisconnected.connect(lambda *_: self._set_enabled(False, False))
         self._set_enabled(False, False)
+        space_jogs_only(self, (self.fwd_button, self.rev_button))
 
     # -- settings ---------------------------------------------------------------------------------
     def restore_settings(self, settings: QSettings) -> None:
