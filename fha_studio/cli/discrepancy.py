@@ -34,7 +34,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--window",
         type=int,
         metavar="SAMPLES",
-        help="Savitzky-Golay window in samples (default: chosen from the noise)",
+        help="Savitzky-Golay window in samples, which sets the analysis bandwidth (default: chosen from "
+        "the recording); refused outside what the recording supports",
     )
     p.add_argument("--no-resim", action="store_true", help="skip the closed-loop re-simulation")
     p.set_defaults(func=run)
@@ -44,8 +45,6 @@ def run(args: argparse.Namespace) -> int:
     from fha_studio.logic.modelcheck import ModelCheckError, run_modelcheck
     from fha_studio.recording import RecordingError, read_recording
 
-    if args.window is not None and args.window < 11:
-        raise CliError("--window must be at least 11 samples")
     try:
         rec = read_recording(args.recording)
     except RecordingError as exc:
@@ -56,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"{args.recording}: {exc}") from None
     print(
         f"{args.recording}: {result.actuator}, {len(rec)} samples over {rec.duration_s:.3g} s "
-        f"(Savitzky-Golay window {result.window_samples} samples = {1000 * result.window_s:.0f} ms)"
+        f"(analysis bandwidth {result.bandwidth_hz:.3g} Hz: Savitzky-Golay window "
+        f"{result.window_samples} samples = {1000 * result.window_s:.0f} ms, {result.window_reason})"
     )
     for line in result.summary_lines():
         print(line)

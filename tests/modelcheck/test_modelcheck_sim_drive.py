@@ -25,4 +25,8 @@ def test_the_simulated_drive_recording_reveals_its_hidden_effect(tmp_path):
     assert [e.id for e in result.effects] == ["coulomb_friction"], result.summary_lines()
     assert abs(result.effects[0].params["torque_nm"] - 5.0) < 0.5
     assert result.gap["torque"].rms_after < 0.5 * result.gap["torque"].rms_before
-    assert "position" in result.gap  # the simulated drive records load_pos
+    # the simulated drive records load_pos; its rigid gear shows nothing there beyond the encoders
+    position = result.channel_status["position"]
+    assert position.status == "too little signal", position
+    assert "position channel shows nothing above" in "\n".join(result.summary_lines())
+    assert result.to_json()["channels"]["position"]["status"] == "too little signal"

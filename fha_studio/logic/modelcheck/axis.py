@@ -10,6 +10,9 @@ import numpy as np
 from fha_studio.physics import AxisModel
 from fha_studio.recording import Recording
 
+# A current monitor's noise above this share of the actuator's maximum current is not a monitor.
+GARBAGE_CURRENT_NOISE_FRACTION = 0.05
+
 
 class ModelCheckError(ValueError):
     """The recording cannot be checked (wrong declared actuator, garbage columns, no motion)."""
@@ -115,17 +118,26 @@ def check_plausible(rec: Recording, axis: DeclaredAxis) -> list[str]:
             "wrong actuator declared, or 'current' is not the motor current in A"
         )
     _check_resolution(pos, q_deg, code, axis.model.output_resolution_ppr, rec.metadata.is_custom)
-    # garbage: a current that is all sample-to-sample scatter carries no torque information
+    # Garbage, not a weak signal: a current whose sample-to-sample scatter dominates its spread AND
+    # is large against the actuator's current range. A real monitor's noise is a few steps of a
+    # 10-bit converter (under 1 % of Imax); a weak but real current (a slow move, a heavy load on a
+    # 160:1 gear) is judged per channel later, at the analysis bandwidth, never refused here.
     from fha_studio.logic.modelcheck.signals import noise_sigma
 
     spread = float(np.std(cur))
-    if spread > 0 and noise_sigma(cur) > 0.5 * spread:
-        raise ModelCheckError(
-            f"column 'current' looks like noise (sample-to-sample scatter {noise_sigma(cur):.3g} A against a "
-            f"spread of {spread:.3g} A): is it the driver's current monitor?"
-        )
     if spread == 0:
         raise ModelCheckError("column 'current' is constant: no torque information")
+    scatter = noise_sigma(cur)
+    if (
+        not rec.metadata.is_custom
+        and scatter > 0.5 * spread
+        and scatter > GARBAGE_CURRENT_NOISE_FRACTION * model.max_current_a
+    ):
+        raise ModelCheckError(
+            f"column 'current' looks like noise (sample-to-sample scatter {scatter:.3g} A against a "
+            f"spread of {spread:.3g} A, {100 * scatter / model.max_current_a:.0f} % of {code}'s "
+            f"{model.max_current_a:g} A): is it the driver's current monitor?"
+        )
     load = rec.load_pos_deg
     if load is not None:
         diff = load - pos

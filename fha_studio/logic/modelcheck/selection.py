@@ -162,6 +162,7 @@ class Trial:
     physical: bool
     accepted: bool
     reason: str
+    noise_peak: bool = False  # a searched shape that does not stand above its neighbours (look-elsewhere)
 
 
 @dataclass
@@ -316,9 +317,11 @@ class ChannelSelector:
         sigma = self.size_sigma(cand, x1, term.cols.shape[1])
         if size < MIN_SIGMAS * sigma:
             reasons.append(f"size {size:.3g} {self.unit} within {MIN_SIGMAS:g} sigma ({sigma:.3g}) of zero")
+        noise_peak = False
         if cand.shape_refine and size >= self.floor:
             off = self.off_shape_size(cand, x1, shape)
-            if size < MIN_OFF_SHAPE_RATIO * off:
+            noise_peak = size < MIN_OFF_SHAPE_RATIO * off
+            if noise_peak:
                 reasons.append(
                     f"size {size:.3g} {self.unit} not {MIN_OFF_SHAPE_RATIO:g}x above the median {off:.3g} "
                     "found at other frequencies (a noise peak)"
@@ -335,6 +338,7 @@ class ChannelSelector:
             bool(physical),
             not reasons,
             "; ".join(reasons) or "named",
+            noise_peak,
         )
         return trial, term
 
@@ -530,6 +534,16 @@ class ChannelSelector:
             col += k
         return out
 
+    def _term_sizes(self, terms: list[Term], beta: np.ndarray) -> list[float]:
+        """Each term's size (channel unit) from the coefficients of the whole design (base first)."""
+        out = []
+        col = self.base.shape[1]
+        for t in terms:
+            k = t.cols.shape[1]
+            out.append(float(t.cand.size(beta[col : col + k], self.ctx)))
+            col += k
+        return out
+
     # --- after selection
     def detection_limit(self, terms: list[Term], cand: Candidate) -> tuple[float, tuple[float, ...]]:
         """Smallest size of cand this record would have revealed next to terms (channel unit).
@@ -560,7 +574,9 @@ class ChannelSelector:
     def substitutes(self, terms: list[Term]) -> list[tuple[str, str, float]]:
         """(chosen, alternative, BIC difference) for alternatives that explain the data as well.
 
-        An alternative (swapped in for one chosen term, passing every gate itself) is not separable
+        An alternative (swapped in for one chosen term, physical, above the floor and lowering the
+        held-out RMS; its own precision gates do not matter: a look-alike is as uncertain as the
+        term it could replace) is not separable
         when the whitened BIC does not prefer the chosen set by BIC_MIN, or when the two fits differ
         by less than the practical floor anywhere it matters (RMS of their difference): the data
         then cannot tell which is the cause, however precise it is.
@@ -574,18 +590,28 @@ class ChannelSelector:
         fit_full = x_full @ beta
         out = []
         chosen = {t.id for t in terms}
-        for term in terms:
+        sizes = self._term_sizes(terms, beta)
+        hidden = {c.id: self.detection_limit(terms, c)[0] for c in self.candidates if c.id not in chosen}
+        for term, size in zip(terms, sizes, strict=True):
             rest = [t for t in terms if t is not term]
             for cand in self.candidates:
                 if cand.id in chosen:
                     continue
                 trial, alt = self.try_add(cand, rest)
-                if not trial.accepted:
+                if not (
+                    trial.physical
+                    and not trial.noise_peak
+                    and trial.size >= self.floor
+                    and trial.cv_rms_after < trial.cv_rms_before
+                ):
                     continue
                 x_alt = self.design([*rest, alt])
                 alt_bic = self.score([*rest, alt], phi)
                 b_alt, _ = ols(self.y, x_alt)
                 differ = float(np.sqrt(np.mean((x_alt @ b_alt - fit_full) ** 2)))
-                if alt_bic - full < BIC_MIN or differ < 0.5 * self.floor:
+                # below what the record can show: next to the chosen terms, an effect of this kind as
+                # large as the chosen one would not have been seen, so the data cannot tell them apart
+                masked = hidden[cand.id] > size
+                if alt_bic - full < BIC_MIN or differ < 0.5 * self.floor or masked:
                     out.append((term.id, cand.id, alt_bic - full))
         return out

@@ -54,6 +54,11 @@ class AnalysisFilter:
         """Rough -3 dB frequency of the smoothing (informative)."""
         return 1.0 / (1.7 * (self.window - 2) * self.dt_s)
 
+    @property
+    def noise_gain(self) -> float:
+        """What the smoothing leaves of white noise: sqrt(sum g^2) (std after / std before)."""
+        return float(math.sqrt(np.sum(self.smooth**2)))
+
     def accel(self, x: np.ndarray) -> np.ndarray:
         """SG second derivative (x units per s^2) on the valid part (length len(x) - 2 half)."""
         return np.convolve(x, self.d2[::-1], "valid") / self.dt_s**2
@@ -80,6 +85,30 @@ def make_filter(window: int, dt_s: float) -> AnalysisFilter:
     return AnalysisFilter(window, dt_s, d2, d1, g)
 
 
+MIN_WINDOWS_PER_RECORD = 8  # the record must hold at least this many analysis windows
+
+
+def window_bounds(n_samples: int) -> tuple[int, int]:
+    """The odd window lengths (samples) a recording of n_samples supports: (shortest, longest).
+
+    The longest keeps MIN_WINDOWS_PER_RECORD windows within the record: a longer one leaves too few
+    independent stretches for the cross-validation blocks and smooths moves into each other.
+    """
+    longest = max(MIN_WINDOW, ((n_samples // MIN_WINDOWS_PER_RECORD) - 1) | 1)
+    return MIN_WINDOW, longest
+
+
+def check_window(window: int, n_samples: int) -> int:
+    """The window as used (odd), or ValueError naming the bounds this recording supports."""
+    lo, hi = window_bounds(n_samples)
+    if not lo <= window <= hi:
+        raise ValueError(
+            f"window {window} samples: this recording ({n_samples} samples) supports {lo} to {hi} "
+            f"(at least {MIN_WINDOWS_PER_RECORD} windows must fit in it)"
+        )
+    return int(window) | 1
+
+
 def noise_sigma(x: np.ndarray) -> float:
     """Standard deviation of the white-ish noise on x: robust, from the residual of a local cubic."""
     if len(x) < 16:
@@ -103,7 +132,7 @@ def choose_window(
 ) -> int:
     """The shortest odd window where inertia x acceleration noise <= Kt x smoothed current noise."""
     max_window = max(MIN_WINDOW, int(MAX_WINDOW_S / dt_s) | 1)
-    max_window = min(max_window, max(MIN_WINDOW, (n_samples // 8) | 1))
+    max_window = min(max_window, window_bounds(n_samples)[1])
     pos_noise = max(pos_noise_rad, 1e-12)
     for window in range(MIN_WINDOW, max_window + 1, 2):
         f = make_filter(window, dt_s)
@@ -139,6 +168,7 @@ class Signals:
     pos_noise_rad: float = 0.0
     current_noise_a: float = 0.0
     resampled: bool = False
+    window_reason: str = ""  # why this analysis window (bandwidth) was used
 
     @property
     def jerk_rad_s3(self) -> np.ndarray:
@@ -205,8 +235,12 @@ def build_signals(
     nonzero = steps[steps > 0]
     if nonzero.size:
         pos_noise = max(pos_noise, float(np.percentile(nonzero, 5)) / math.sqrt(12.0))
-    if window is None:
+    if window is not None:
+        window = check_window(window, len(t))
+        reason = "given by the user"
+    else:
         window = choose_window(dt, pos_noise, max(cur_noise, 1e-6), inertia_kgm2, kt_nm_per_a, len(t))
+        reason = "the shortest window where the acceleration noise falls to the current monitor's noise"
     f = make_filter(window, dt)
     h = f.half
     sig = Signals(
@@ -227,5 +261,6 @@ def build_signals(
         pos_noise_rad=pos_noise,
         current_noise_a=cur_noise,
         resampled=resampled,
+        window_reason=reason,
     )
     return sig

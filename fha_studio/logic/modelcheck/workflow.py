@@ -46,6 +46,8 @@ TORQUE_FLOOR_MIN_NM = 0.02
 POSITION_FLOOR_ARCSEC = 2.0
 STRUCTURE_MIN_FRACTION = 0.15  # a structured residual explains >= 15 % of the residual's variance
 RESIM_BANDWIDTH_HZ = 60.0  # speed-loop bandwidth of the stiff servo that follows the measured motion
+# A channel is checked when what it shows (smoothed) stands this many noise sigmas above its noise.
+SIGNAL_NOISE_FACTOR = 4.0
 TARGET_DECIMATED = 2500  # about this many samples for the selection (speed), see run_modelcheck
 
 
@@ -185,6 +187,29 @@ class ChannelReport:
     n_samples: int
 
 
+CHECKED = "checked"
+TOO_LITTLE_SIGNAL = "too little signal"
+ABSENT = "absent"
+
+
+@dataclass(frozen=True)
+class ChannelStatus:
+    """Whether a channel was checked, and why not: "checked" | "too little signal" | "absent"."""
+
+    channel: str
+    status: str
+    reason: str
+    level: float = 0.0  # channel unit: what the channel shows at most (too little signal)
+    unit: str = ""
+
+    @property
+    def checked(self) -> bool:
+        return self.status == CHECKED
+
+    def to_json(self) -> dict[str, Any]:
+        return {"status": self.status, "reason": self.reason, "level": self.level, "unit": self.unit}
+
+
 @dataclass
 class ModelCheckResult:
     """Everything the model check found, per step, as arrays a GUI can plot."""
@@ -207,6 +232,8 @@ class ModelCheckResult:
     resimulation: Resimulation | None
     notes: list[str]
     current_delay_ms: float = 0.0  # fitted time offset of the current against the position (recorder)
+    channel_status: dict[str, ChannelStatus] = field(default_factory=dict)
+    window_reason: str = ""  # why this analysis bandwidth
 
     @property
     def found(self) -> bool:
@@ -214,7 +241,7 @@ class ModelCheckResult:
 
     def summary_lines(self) -> list[str]:
         """The human summary (one finding per line)."""
-        lines = []
+        lines = self._status_lines()
         by_channel: dict[str, Effect] = {}
         for e in self.effects:
             by_channel.setdefault(e.channel, e)
@@ -246,7 +273,7 @@ class ModelCheckResult:
                 f"{_fmt(s.rms)} {s.unit} rms organised by {s.variable} ({100 * s.fraction:.0f} % of the "
                 "residual); not forced onto a named effect"
             )
-        if not self.effects:
+        if not self.effects and any(st.checked for st in self.channel_status.values()):
             lines.append("No missing effect found.")
             for ch, gap in self.gap.items():
                 lines.append(
@@ -267,12 +294,29 @@ class ModelCheckResult:
         lines.extend(self.notes)
         return lines
 
+    def _status_lines(self) -> list[str]:
+        """One line per channel that was not checked, and what was checked instead."""
+        skipped = [st for st in self.channel_status.values() if not st.checked]
+        if not skipped:
+            return []
+        checked = [ch for ch, st in self.channel_status.items() if st.checked]
+        if checked:
+            rest = f"only the {' and '.join(checked)} channel{'s are' if len(checked) > 1 else ' is'} checked"
+        else:
+            rest = "nothing is checked; record a move with more acceleration, speed or load"
+        return [
+            f"The {st.channel} channel {st.reason}: {rest}." for st in skipped if st.status != ABSENT
+        ] or ([f"Nothing is checked: {'; '.join(st.reason for st in skipped)}."] if not checked else [])
+
     def to_json(self) -> dict[str, Any]:
         """The JSON report (issue 4 contract: effects [{id, params, channel}], gap {channel: {...}})."""
         return {
             "format": "fha-modelcheck-report/1",
             "recording": self.source,
             "actuator": self.actuator,
+            "bandwidth_hz": self.bandwidth_hz,
+            "bandwidth_reason": self.window_reason,
+            "channels": {ch: st.to_json() for ch, st in self.channel_status.items()},
             "effects": [e.to_json() for e in self.effects],
             "gap": {
                 ch: {"rms_before": g.rms_before, "rms_after": g.rms_after, "unit": g.unit}
@@ -360,17 +404,7 @@ def run_modelcheck(
     axis = declared_axis(rec)
     notes = check_plausible(rec, axis)
     model = axis.model
-    sig = build_signals(
-        rec.t_s,
-        np.radians(rec.pos_deg),
-        rec.current_a,
-        kt_nm_per_a=axis.kt_nm_per_a,
-        inertia_kgm2=axis.nominal_inertia_kgm2,
-        ratio=axis.ratio,
-        load_pos_rad=None if rec.load_pos_deg is None else np.radians(rec.load_pos_deg),
-        cmd_pos_rad=None if rec.cmd_pos_deg is None else np.radians(rec.cmd_pos_deg),
-        window=window,
-    )
+    sig = _signals(rec, axis, window)
     if sig.resampled:
         notes.append("Note: the sampling was not uniform; the signals were resampled onto a uniform grid.")
     n = len(sig.t_s)
@@ -397,26 +431,38 @@ def run_modelcheck(
         TORQUE_FLOOR_MIN_NM,
         TORQUE_FLOOR_FRACTION_OF_MAX * (model.max_torque_nm or 3.0 * float(np.max(np.abs(sig.torque_f_nm)))),
     )
+    status: dict[str, ChannelStatus] = {TORQUE: _torque_status(sig, axis, torque_nominal, floor_t)}
+    channels: dict[str, ChannelReport] = {}
+    selectors: dict[str, tuple[ChannelSelector, list, list[FittedTerm], np.ndarray]] = {}
     ctx_t = ChannelContext(sig, TORQUE)
-    # Nuisance, always fitted: a time offset between the current monitor and the encoder (sampling
-    # instants, monitor delay) shows as -delay x J x jerk. It belongs to the recorder, not to the axis.
-    jerk_col = (axis.nominal_inertia_kgm2 * sig.jerk_rad_s3)[index][:, None]
-    sel_t = ChannelSelector(
-        ctx_t, y_torque[index], TORQUE_CANDIDATES, index, floor_t, CHANNEL_UNITS[TORQUE], base=jerk_col
-    )
-    terms_t, steps_t = sel_t.select(nominal_first=("inertia_error",))
-    fitted_t, fit_t, base_t, ar_t = sel_t.final_fit(terms_t)
-    delay_ms = -1000.0 * float(base_t[0])
-    if abs(delay_ms) > 0.05:
-        notes.append(
-            f"Note: the current is {'late' if delay_ms > 0 else 'early'} against the position by "
-            f"{abs(delay_ms):.2f} ms (fitted as a recorder property, not an effect of the axis)."
+    fitted_t: list[FittedTerm] = []
+    delay_ms = 0.0
+    if status[TORQUE].checked:
+        # Nuisance, always fitted: a time offset between the current monitor and the encoder (sampling
+        # instants, monitor delay) shows as -delay x J x jerk. It belongs to the recorder, not the axis.
+        jerk_col = (axis.nominal_inertia_kgm2 * sig.jerk_rad_s3)[index][:, None]
+        sel_t = ChannelSelector(
+            ctx_t, y_torque[index], TORQUE_CANDIDATES, index, floor_t, CHANNEL_UNITS[TORQUE], base=jerk_col
         )
-    channels = {TORQUE: ChannelReport(TORQUE, "N m", floor_t, steps_t, ar_t, len(index))}
-    selectors = {TORQUE: (sel_t, terms_t, fitted_t, fit_t)}
+        terms_t, steps_t = sel_t.select(nominal_first=("inertia_error",))
+        fitted_t, fit_t, base_t, ar_t = sel_t.final_fit(terms_t)
+        delay_ms = -1000.0 * float(base_t[0])
+        if abs(delay_ms) > 0.05:
+            notes.append(
+                f"Note: the current is {'late' if delay_ms > 0 else 'early'} against the position by "
+                f"{abs(delay_ms):.2f} ms (fitted as a recorder property, not an effect of the axis)."
+            )
+        channels[TORQUE] = ChannelReport(TORQUE, "N m", floor_t, steps_t, ar_t, len(index))
+        selectors[TORQUE] = (sel_t, terms_t, fitted_t, fit_t)
 
     # ---- position channel (needs load_pos)
-    if sig.load_diff_f_rad is not None:
+    if sig.load_diff_f_rad is None:
+        status[POSITION] = ChannelStatus(
+            POSITION,
+            ABSENT,
+            "is absent: the recording has no load_pos column (an external encoder on the load)",
+        )
+    else:
         motor_side = np.zeros(n)
         for ft in fitted_t:
             if ft.id in ("coulomb_friction", "viscous_friction", "torque_ripple"):
@@ -424,6 +470,10 @@ def run_modelcheck(
                 motor_side += cand.build(ctx_t, ft.shape) @ ft.beta
         gear_torque = sig.torque_f_nm - model.motor_side_inertia_kgm2 * sig.accel_rad_s2 - motor_side
         residual["gear_torque_nm"] = gear_torque
+        y_pos = sig.load_diff_f_rad * ARCSEC_PER_RAD
+        residual["load_diff_arcsec"] = y_pos
+        status[POSITION] = _position_status(sig, y_pos)
+    if status[POSITION].checked:
         breaks: list[float] = []
         if model.stiffness is not None:
             for t_break in (model.stiffness.t1_nm, model.stiffness.t2_nm):
@@ -431,8 +481,6 @@ def run_modelcheck(
                     break  # too little data beyond it to see another region
                 breaks.append(t_break)
         ctx_p = ChannelContext(sig, POSITION, gear_torque_nm=gear_torque, breakpoints_nm=tuple(breaks))
-        y_pos = sig.load_diff_f_rad * ARCSEC_PER_RAD
-        residual["load_diff_arcsec"] = y_pos
         base = np.ones((len(index), 1))  # the external encoder's zero is not an effect
         sel_p = ChannelSelector(
             ctx_p,
@@ -518,6 +566,72 @@ def run_modelcheck(
         resimulation=resim,
         notes=notes,
         current_delay_ms=delay_ms,
+        channel_status=status,
+        window_reason=sig.window_reason,
+    )
+
+
+def _signals(rec: Recording, axis: DeclaredAxis, window: int | None) -> Signals:
+    """Step 1's analysis signals; a window the recording cannot support is a ModelCheckError."""
+    try:
+        return build_signals(
+            rec.t_s,
+            np.radians(rec.pos_deg),
+            rec.current_a,
+            kt_nm_per_a=axis.kt_nm_per_a,
+            inertia_kgm2=axis.nominal_inertia_kgm2,
+            ratio=axis.ratio,
+            load_pos_rad=None if rec.load_pos_deg is None else np.radians(rec.load_pos_deg),
+            cmd_pos_rad=None if rec.cmd_pos_deg is None else np.radians(rec.cmd_pos_deg),
+            window=window,
+        )
+    except ValueError as exc:
+        raise ModelCheckError(str(exc)) from None
+
+
+def _shows(x: np.ndarray) -> float:
+    """What a smoothed channel shows at most: the 99.5th percentile of its distance from its median."""
+    return float(np.percentile(np.abs(x - np.median(x)), 99.5)) if len(x) else 0.0
+
+
+def _torque_status(
+    sig: Signals, axis: DeclaredAxis, nominal_nm: np.ndarray, floor_nm: float
+) -> ChannelStatus:
+    """The torque channel has too little signal when neither the measured torque (Kt x current) nor
+    the torque the nominal model needs rises above the practical floor and the smoothed monitor
+    noise: nothing an effect could add would then stand out."""
+    noise = axis.kt_nm_per_a * sig.current_noise_a * sig.filt.noise_gain
+    level = max(floor_nm, SIGNAL_NOISE_FACTOR * noise)
+    shown = max(_shows(sig.torque_f_nm), _shows(nominal_nm))
+    if shown >= level:
+        return ChannelStatus(TORQUE, CHECKED, "", shown, "N m")
+    return ChannelStatus(
+        TORQUE,
+        TOO_LITTLE_SIGNAL,
+        f"shows nothing above {_fmt(level)} N m (measured {_fmt(shown)} N m at most; the current "
+        f"monitor's noise is {_fmt(sig.current_noise_a)} A per sample)",
+        level,
+        "N m",
+    )
+
+
+def _position_status(sig: Signals, y_arcsec: np.ndarray) -> ChannelStatus:
+    """The position channel has too little signal when load_pos - pos stays within the practical
+    floor and the smoothed noise of the two encoders."""
+    raw = sig.raw_load_pos_rad - sig.raw_pos_rad if sig.raw_load_pos_rad is not None else np.zeros(1)
+    from fha_studio.logic.modelcheck.signals import noise_sigma
+
+    noise = noise_sigma(raw) * ARCSEC_PER_RAD * sig.filt.noise_gain
+    level = max(POSITION_FLOOR_ARCSEC, SIGNAL_NOISE_FACTOR * noise)
+    shown = _shows(y_arcsec)
+    if shown >= level:
+        return ChannelStatus(POSITION, CHECKED, "", shown, "arcsec")
+    return ChannelStatus(
+        POSITION,
+        TOO_LITTLE_SIGNAL,
+        f"shows nothing above {_fmt(level)} arcsec between load_pos and pos ({_fmt(shown)} arcsec at most)",
+        level,
+        "arcsec",
     )
 
 
