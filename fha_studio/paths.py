@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
 
 _PACKAGE_DIR = Path(__file__).resolve().parent
@@ -32,3 +34,22 @@ def resource(*parts: str) -> Path:
     if not path.exists():
         raise FileNotFoundError(f"resource not found: {path}")
     return path
+
+
+#: Names the GUI gives Qt (QCoreApplication organisation and application): its per-user data
+#: directory is built from them, and the Qt-free code finds the same directory here.
+ORGANISATION = "FHA Studio"
+APPLICATION = "fha-studio"
+
+
+def user_data_dir() -> Path:
+    """The per-user data directory, the same one the GUI gets from Qt's ``AppDataLocation``:
+    ``$XDG_DATA_HOME/FHA Studio/fha-studio`` (``~/.local/share/...``) on Linux,
+    ``~/Library/Application Support/...`` on macOS, ``%APPDATA%\\...`` on Windows. Not created here."""
+    if sys.platform == "win32":
+        base = Path(os.environ.get("APPDATA") or Path.home() / "AppData" / "Roaming")
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Application Support"
+    else:
+        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
+    return base / ORGANISATION / APPLICATION

@@ -13,6 +13,14 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 
 @pytest.fixture(autouse=True)
+def _user_data_elsewhere(tmp_path_factory, monkeypatch):
+    """No test reads or writes the user's data directory (the register, simulated EEPROMs): the
+    per-user data directory is a temporary one, and no site register is chosen."""
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path_factory.mktemp("user-data")))
+    monkeypatch.delenv("FHA_STUDIO_REGISTER", raising=False)
+
+
+@pytest.fixture(autouse=True)
 def _no_leaked_threads():
     """Fail a test that leaves a thread running (a link worker, a simulated drive, a reader)."""
     before = set(threading.enumerate())

@@ -1,0 +1,172 @@
+"""The register's schema and its migrations, versioned with SQLite's ``PRAGMA user_version``.
+
+A file's ``user_version`` is the number of migrations applied to it. Opening a file applies the
+missing ones in order, each in its own ``BEGIN IMMEDIATE`` transaction that also sets the
+version, so that a crash mid-migration leaves the file at the previous version, whole, and two
+processes opening one old file migrate it once. A file newer than this program is refused, never
+"downgraded".
+
+Times are UTC, ISO 8601 to the microsecond (``2026-11-30T04:05:06.000000+00:00``), so that text
+order is time order. Parameter values are the drive's wire integers (the parameter model's
+``scale`` converts), named by the manual's key (``rotary_direction``) beside mode and number.
+"""
+
+from __future__ import annotations
+
+# Each migration is a list of statements (run one by one: sqlite3's executescript would commit
+# the transaction the migration runs in).
+_V1 = [
+    """CREATE TABLE machine (
+        id INTEGER PRIMARY KEY,
+        name TEXT NOT NULL UNIQUE,
+        site TEXT NOT NULL DEFAULT '',
+        notes TEXT NOT NULL DEFAULT '',
+        created_utc TEXT NOT NULL
+    )""",
+    """CREATE TABLE axis (
+        id INTEGER PRIMARY KEY,
+        machine_id INTEGER NOT NULL REFERENCES machine(id),
+        name TEXT NOT NULL,
+        actuator_code TEXT NOT NULL DEFAULT '',
+        driver_model TEXT NOT NULL DEFAULT '',
+        port_url TEXT NOT NULL DEFAULT '',
+        load_inertia_kgm2 REAL,
+        notes TEXT NOT NULL DEFAULT '',
+        created_utc TEXT NOT NULL,
+        UNIQUE (machine_id, name)
+    )""",
+    # what happened to the axis itself: created, actuator or driver changed, a note
+    """CREATE TABLE axis_event (
+        id INTEGER PRIMARY KEY,
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        text TEXT NOT NULL
+    )""",
+    """CREATE TABLE snapshot (
+        id INTEGER PRIMARY KEY,
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        source TEXT NOT NULL CHECK (source IN ('link', 'front_panel', 'file')),
+        driver_model TEXT NOT NULL DEFAULT '',
+        file TEXT NOT NULL DEFAULT '',
+        note TEXT NOT NULL DEFAULT ''
+    )""",
+    """CREATE TABLE snapshot_value (
+        snapshot_id INTEGER NOT NULL REFERENCES snapshot(id) ON DELETE CASCADE,
+        mode TEXT NOT NULL,
+        number INTEGER NOT NULL,
+        key TEXT NOT NULL,
+        value INTEGER NOT NULL,
+        PRIMARY KEY (snapshot_id, mode, number)
+    )""",
+    """CREATE TABLE parameter_write (
+        id INTEGER PRIMARY KEY,
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        mode TEXT NOT NULL,
+        number INTEGER NOT NULL,
+        key TEXT NOT NULL,
+        old INTEGER,
+        new INTEGER NOT NULL,
+        read_back INTEGER,
+        verified INTEGER NOT NULL,
+        error TEXT NOT NULL DEFAULT ''
+    )""",
+    # where each procedure of an axis stands (one row per procedure, replaced as it moves on)
+    """CREATE TABLE procedure_run (
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        procedure_id TEXT NOT NULL,
+        title TEXT NOT NULL,
+        section TEXT NOT NULL DEFAULT '',
+        status TEXT NOT NULL,
+        updated_utc TEXT NOT NULL,
+        session_file TEXT NOT NULL DEFAULT '',
+        PRIMARY KEY (axis_id, procedure_id)
+    )""",
+    # every answer to every check; the same answer recorded twice (live, then from the session
+    # file) is one row
+    """CREATE TABLE check_result (
+        id INTEGER PRIMARY KEY,
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        procedure_id TEXT NOT NULL,
+        step_id TEXT NOT NULL,
+        kind TEXT NOT NULL,
+        section TEXT NOT NULL DEFAULT '',
+        text TEXT NOT NULL DEFAULT '',
+        value_json TEXT NOT NULL,
+        expected TEXT NOT NULL DEFAULT '',
+        unit TEXT NOT NULL DEFAULT '',
+        passed INTEGER NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        at_utc TEXT NOT NULL,
+        detail TEXT NOT NULL DEFAULT '',
+        session_file TEXT NOT NULL DEFAULT '',
+        UNIQUE (axis_id, procedure_id, step_id, at_utc)
+    )""",
+    """CREATE TABLE alarm (
+        id INTEGER PRIMARY KEY,
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        code INTEGER NOT NULL,
+        name TEXT NOT NULL DEFAULT '',
+        note TEXT NOT NULL DEFAULT ''
+    )""",
+    # a report of one axis (axis_id set) or of a whole machine (axis_id NULL)
+    """CREATE TABLE report (
+        id INTEGER PRIMARY KEY,
+        machine_id INTEGER NOT NULL REFERENCES machine(id),
+        axis_id INTEGER REFERENCES axis(id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        file TEXT NOT NULL,
+        sha256 TEXT NOT NULL,
+        signed_by TEXT NOT NULL DEFAULT '',
+        signed_utc TEXT NOT NULL DEFAULT '',
+        open_warnings INTEGER NOT NULL DEFAULT 0
+    )""",
+    """CREATE TABLE recording (
+        id INTEGER PRIMARY KEY,
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        file TEXT NOT NULL,
+        sha256 TEXT NOT NULL DEFAULT '',
+        summary TEXT NOT NULL DEFAULT ''
+    )""",
+    """CREATE TABLE model_check (
+        id INTEGER PRIMARY KEY,
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        file TEXT NOT NULL DEFAULT '',
+        recording_file TEXT NOT NULL DEFAULT '',
+        summary TEXT NOT NULL DEFAULT ''
+    )""",
+    "CREATE INDEX axis_event_by_axis ON axis_event (axis_id, at_utc)",
+    "CREATE INDEX snapshot_by_axis ON snapshot (axis_id, at_utc)",
+    "CREATE INDEX parameter_write_by_axis ON parameter_write (axis_id, at_utc)",
+    "CREATE INDEX check_result_by_axis ON check_result (axis_id, at_utc)",
+    "CREATE INDEX alarm_by_axis ON alarm (axis_id, at_utc)",
+    "CREATE INDEX report_by_machine ON report (machine_id, axis_id, at_utc)",
+    "CREATE INDEX recording_by_axis ON recording (axis_id, at_utc)",
+    "CREATE INDEX model_check_by_axis ON model_check (axis_id, at_utc)",
+]
+
+# v2: the serial number from the actuator's label (a replaced actuator on the same axis shows in
+# its history, the model code alone does not tell two FHA-25C-50 apart), and an index for "which
+# axes have this parameter value" that does not scan every snapshot.
+_V2 = [
+    "ALTER TABLE axis ADD COLUMN serial_number TEXT NOT NULL DEFAULT ''",
+    "CREATE INDEX snapshot_value_by_key ON snapshot_value (key, value)",
+    "CREATE INDEX parameter_write_by_key ON parameter_write (key, axis_id)",
+]
+
+#: MIGRATIONS[n] takes a file from user_version n to n + 1.
+MIGRATIONS: tuple[tuple[str, ...], ...] = (tuple(_V1), tuple(_V2))
+
+#: The version this program writes.
+SCHEMA_VERSION = len(MIGRATIONS)
