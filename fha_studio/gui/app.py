@@ -15,7 +15,7 @@ APPLICATION = "fha-studio"
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="fha-studio", description="FHA Studio, the commissioning GUI")
+    parser = argparse.ArgumentParser(prog="fha-studio [gui]", description="FHA Studio, the commissioning GUI")
     parser.add_argument(
         "--url",
         default=DEFAULT_SIM_URL,

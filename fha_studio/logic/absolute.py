@@ -1,0 +1,191 @@
+"""What a drive of the manual's command set gives: probe, absolute position (DGR), origin (OWW).
+
+A real HA-655 answers over CN3 only ``DGR`` (the absolute position, absolute encoders, servo off)
+and ``OWW`` (clear the multi-turn data): ``x`` to anything else, ``s`` to everything while the
+servo is on (HA-655 manual p.21; servo-ON comes from the controller through CN2). These functions
+work on any drive (the simulated drive's extensions only add to what they report) and run in the
+caller's thread: a GUI calls them in its link thread.
+
+Positions: DGR's value is multi-turn x 8192 + single-turn count of the motor encoder (FHA-C manual
+1-8: 8192 counts per motor turn); the output flange turns ``1 / ratio`` of a motor turn.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from fha_studio.catalog import ModelCodeError, parse_model_code
+from fha_studio.hardware import protocol as p
+from fha_studio.hardware.errors import CommandRejected, DriveRefused, ServoOnRefused
+
+#: What the technician is told when the drive answers ``s``.
+SERVO_ON_TEXT = "servo on (controller): the drive does not answer over CN3 until servo off"
+
+
+class _Client(Protocol):
+    capabilities: Any
+
+    def absolute_position(self) -> int: ...
+    def clear_multiturn(self) -> None: ...
+    def identify(self) -> Any: ...
+    def io_state(self) -> Any: ...
+
+
+def output_deg(counts: int, ratio: int) -> float:
+    """DGR counts -> output flange angle in degrees (CW positive seen from the flange)."""
+    return counts * 360.0 / (p.ABSOLUTE_COUNTS_PER_TURN * ratio)
+
+
+def counts_for_output_deg(angle_deg: float, ratio: int) -> float:
+    """How many DGR counts the output turning by ``angle_deg`` makes."""
+    return angle_deg * p.ABSOLUTE_COUNTS_PER_TURN * ratio / 360.0
+
+
+def ratio_of(code: str | None) -> int | None:
+    """The reduction ratio of an actuator model code, None when there is no code or it does not parse."""
+    if not code:
+        return None
+    try:
+        return parse_model_code(code).ratio
+    except ModelCodeError:
+        return None
+
+
+def documented_only(capabilities: Any) -> bool:
+    """True when the drive listed no extension command (it speaks only the manual's DGR and OWW)."""
+    return not (set(capabilities.commands) - p.DOCUMENTED_COMMANDS)
+
+
+def refusal_text(exc: DriveRefused, command: p.Command) -> str:
+    """One line for a person: why the drive said no to ``command`` (DGR or OWW)."""
+    if isinstance(exc, ServoOnRefused):
+        return SERVO_ON_TEXT + " (switch the servo off at the controller and try again)"
+    if isinstance(exc, CommandRejected) and command is p.Command.DGR:
+        return "the drive refuses DGR (x): it has no absolute position (an incremental encoder)"
+    if isinstance(exc, CommandRejected) and command is p.Command.OWW:
+        return ("the drive refused OWW (x): the manual allows it only with the servo off, on an absolute "
+                "encoder, and not again before the first acknowledgement")
+    return str(exc)
+
+
+@dataclass(frozen=True)
+class Probe:
+    """What a drive said when asked (``fha-studio drive probe``); see ``as_dict`` for the keys."""
+
+    driver: str | None
+    parameter_access: bool
+    documented_only: bool
+    servo: str  # "off" | "on" | "unknown"
+    encoder: str  # "absolute" | "incremental" | "unknown"
+    position_counts: int | None
+    position_deg: float | None
+    adjusted_for: str | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "link": "ok",
+            "driver": self.driver,
+            "parameter_access": self.parameter_access,
+            "documented_only": self.documented_only,
+            "servo": self.servo,
+            "encoder": self.encoder,
+            "position_counts": self.position_counts,
+            "position_deg": self.position_deg,
+        }
+
+    def lines(self) -> list[str]:
+        """The same for a person."""
+        servo = {"on": "on (controller): " + SERVO_ON_TEXT.split(": ", 1)[1], "off": "off",
+                 "unknown": "not known"}[self.servo]
+        out = [
+            "link: the drive answers",
+            f"driver: {self.driver or 'not reported (the drive has no identification command)'}",
+            "parameter access: " + ("yes" if self.parameter_access else "no: use the drive's front panel"),
+            "commands: " + ("only the manual's DGR and OWW" if self.documented_only
+                            else "the manual's DGR and OWW and FHA Studio's extensions"),
+            f"servo: {servo}",
+            f"encoder: {self.encoder if self.encoder != 'unknown' else 'not known'}",
+        ]
+        if self.position_counts is not None:
+            out.append("position: " + position_text(self.position_counts, self.position_deg))
+        return out
+
+
+def position_text(counts: int, angle_deg: float | None) -> str:
+    multi, single = p.split_absolute_position(counts)
+    text = f"{counts} counts (multi-turn {multi}, single-turn {single})"
+    if angle_deg is not None:
+        text += f" = {angle_deg:.4f} deg at the output flange"
+    return text
+
+
+def probe(client: _Client, ratio: int | None = None) -> Probe:
+    """Ask the drive what it is and where it stands. ``ratio`` scales the position; without it the
+    ratio of the actuator the drive says it is adjusted for (IDN) is used, if it says so."""
+    caps = client.capabilities
+    commands = set(caps.commands)
+    driver = adjusted = None
+    if p.Command.IDN in commands:
+        identity = client.identify()
+        if identity is not None:
+            driver, adjusted = identity.driver_model, identity.adjusted_for
+    ratio = ratio or ratio_of(adjusted)
+    servo = "unknown"
+    if p.Command.IOS in commands:
+        servo = "on" if client.io_state().servo_on else "off"
+    counts: int | None = None
+    encoder = "unknown"
+    try:
+        counts = client.absolute_position()
+        encoder, servo = "absolute", "off" if servo == "unknown" else servo
+    except ServoOnRefused:
+        servo = "on"
+    except CommandRejected:
+        # a drive answers s to everything while the servo is on, so x means: servo off, no DGR
+        encoder = "incremental"
+        servo = "off" if servo == "unknown" else servo
+    return Probe(
+        driver=driver,
+        parameter_access=bool(caps.parameters),
+        documented_only=documented_only(caps),
+        servo=servo,
+        encoder=encoder,
+        position_counts=counts,
+        position_deg=None if counts is None or not ratio else output_deg(counts, ratio),
+        adjusted_for=adjusted,
+    )
+
+
+@dataclass(frozen=True)
+class OriginResult:
+    """The OWW wizard's record: position before and after clearing the multi-turn data."""
+
+    before_counts: int
+    after_counts: int
+    after_deg: float | None
+    oww_s: float  # how long the drive took to acknowledge OWW
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "before_counts": self.before_counts,
+            "position_counts": self.after_counts,
+            "position_deg": self.after_deg,
+            "oww_s": round(self.oww_s, 2),
+        }
+
+
+def set_absolute_origin(client: _Client, ratio: int | None = None) -> OriginResult:
+    """The absolute-origin steps of the manual: DGR (proves servo off and an absolute encoder),
+    OWW (clears the multi-turn data, ``q`` about 5 s later), DGR again (the new position).
+
+    Raises ``ServoOnRefused`` / ``CommandRejected`` (use ``refusal_text``) when the drive says no;
+    nothing is cleared then.
+    """
+    before = client.absolute_position()
+    started = time.monotonic()
+    client.clear_multiturn()
+    took = time.monotonic() - started
+    after = client.absolute_position()
+    return OriginResult(before, after, None if not ratio else output_deg(after, ratio), took)
