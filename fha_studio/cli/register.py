@@ -1,0 +1,492 @@
+"""``fha-studio register [--db FILE] ACTION ...``: the questions a plant asks of the register.
+
+- ``machines``: the machines, their sites, how many axes and open items.
+- ``axes [MACHINE]``: every axis with actuator, driver, port, checks passed/failed, report.
+- ``history AXIS [--since TIME]``: everything recorded for an axis, oldest first.
+- ``diff A B``: the parameters that differ between two snapshots (by number) or two axes' latest
+  known values (``MACHINE/AXIS``: this axis against its twin).
+- ``find KEY[=VALUE] [--machine M]``: the axes whose latest known value of a parameter is VALUE.
+- ``open [MACHINE]``: open checks and unsigned reports.
+- ``export [--machine M] [-o FILE]``: everything as JSON.
+- ``add-machine NAME``, ``add-axis MACHINE/AXIS``, ``import FILE... --machine M``: fill it.
+
+Every action takes ``--json``. The register is ``--db FILE``, else ``$FHA_STUDIO_REGISTER``, else
+``register.sqlite`` in the user data directory.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from contextlib import contextmanager
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+from fha_studio.cli import CliError
+
+ORDER = 70
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "register",
+        help="the register of machines and axes: history, differences, find, open items",
+        description="The register keeps every commissioning fact of every axis (parameter snapshots, "
+        "verified writes, checks, alarms, reports, recordings, model checks) in one SQLite file.",
+    )
+    p.add_argument(
+        "--db",
+        type=Path,
+        metavar="FILE",
+        help="the register file (default: $FHA_STUDIO_REGISTER, "
+        "else register.sqlite in the user data directory)",
+    )
+    p.add_argument("--json", action="store_true", help="print JSON")
+    common = argparse.ArgumentParser(add_help=False)
+    # also accepted after the action; SUPPRESS keeps the action from resetting what came before it
+    common.add_argument("--db", type=Path, metavar="FILE", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    common.add_argument("--json", action="store_true", default=argparse.SUPPRESS, help="print JSON")
+    sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
+
+    s = sub.add_parser("machines", parents=[common], help="the machines in the register")
+    s.set_defaults(func=_machines)
+    s = sub.add_parser("axes", parents=[common], help="the axes (of one machine) and where they stand")
+    s.add_argument("machine", nargs="?", metavar="MACHINE")
+    s.set_defaults(func=_axes)
+    s = sub.add_parser("history", parents=[common], help="everything recorded for an axis")
+    s.add_argument("axis", metavar="AXIS", help="MACHINE/AXIS (or the axis name when it is unique)")
+    s.add_argument(
+        "--since", metavar="TIME", help="from this time on (ISO 8601, e.g. 2026-11-30 or 2026-11-30T08:00Z)"
+    )
+    s.set_defaults(func=_history)
+    s = sub.add_parser(
+        "diff",
+        parents=[common],
+        help="parameters that differ between two snapshots or two axes",
+        description="A and B are each a snapshot number (see history) or MACHINE/AXIS for that axis's "
+        'latest known values, e.g. \'diff "Line 3/table" "Line 3/table twin"\'.',
+    )
+    s.add_argument("a", metavar="A")
+    s.add_argument("b", metavar="B")
+    s.set_defaults(func=_diff)
+    s = sub.add_parser(
+        "find",
+        parents=[common],
+        help="the axes with a parameter value, e.g. rotary_direction=1",
+        description="KEY is the parameter's name in the manual's words (rotary_direction, or "
+        "'Rotary direction'); VALUE the drive's value (e.g. 1 = reversed). Without =VALUE every "
+        "axis's value is listed. Compared is each axis's latest known value.",
+    )
+    s.add_argument("query", metavar="KEY[=VALUE]")
+    s.add_argument("--machine", metavar="MACHINE")
+    s.set_defaults(func=_find)
+    s = sub.add_parser("open", parents=[common], help="open checks and unsigned reports")
+    s.add_argument("machine", nargs="?", metavar="MACHINE")
+    s.set_defaults(func=_open)
+    s = sub.add_parser("export", parents=[common], help="everything (of one machine) as JSON")
+    s.add_argument("--machine", metavar="MACHINE")
+    s.add_argument("-o", "--output", type=Path, metavar="FILE", help="write to FILE instead of printing")
+    s.set_defaults(func=_export)
+    s = sub.add_parser("add-machine", parents=[common], help="add a machine")
+    s.add_argument("name", metavar="NAME")
+    s.add_argument("--site", default="")
+    s.add_argument("--notes", default="")
+    s.set_defaults(func=_add_machine)
+    s = sub.add_parser("add-axis", parents=[common], help="add an axis to a machine")
+    s.add_argument("axis", metavar="MACHINE/AXIS")
+    s.add_argument("--actuator", default="", help="model code, e.g. FHA-25C-50-US250")
+    s.add_argument("--driver", default="", help="driver model, e.g. HA-655-2-200")
+    s.add_argument("--port", default="", help="the port: /dev/ttyUSB0, COM3, socket://host:port, sim://...")
+    s.add_argument(
+        "--load-inertia", type=float, default=None, metavar="KGM2", help="declared load inertia, kg m²"
+    )
+    s.add_argument("--serial-number", default="", help="from the actuator's label")
+    s.add_argument("--notes", default="")
+    s.add_argument("--operator", default="", help="who adds it")
+    s.set_defaults(func=_add_axis)
+    s = sub.add_parser(
+        "import",
+        parents=[common],
+        help="import session files and parameter files",
+        description="Session files (fha-session/1, JSON) and parameter files (fha-parameters/1, TOML) "
+        "into the register. The axis is the session's own (or --axis); importing a file again adds nothing.",
+    )
+    s.add_argument("files", nargs="+", type=Path, metavar="FILE")
+    s.add_argument("--machine", required=True, metavar="MACHINE", help="added when it is not there")
+    s.add_argument("--axis", metavar="AXIS", help="the axis (needed for a parameter file)")
+    s.add_argument("--operator", default="", help="who imports it (for parameter files)")
+    s.set_defaults(func=_import)
+
+
+# -- plumbing -------------------------------------------------------------------------------------------
+
+
+@contextmanager
+def _open_register(args):
+    from fha_studio.logic.register import Register, RegisterError
+
+    try:
+        reg = Register(args.db) if args.db else Register()
+    except RegisterError as exc:
+        raise CliError(str(exc)) from None
+    try:
+        yield reg
+    except RegisterError as exc:
+        raise CliError(str(exc)) from None
+    finally:
+        reg.close()
+
+
+def _print_json(data: Any) -> None:
+    print(json.dumps(data, indent=2, ensure_ascii=False))
+
+
+def _when(at_utc: str) -> str:
+    return at_utc[:19].replace("T", " ") if at_utc else ""
+
+
+def _table(rows: list[list[str]], headers: list[str]) -> None:
+    widths = [max(len(str(r[i])) for r in [headers, *rows]) for i in range(len(headers))]
+    for row in [headers, *rows]:
+        print("  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
+
+
+_PARAMETER_MODELS: dict[str, Any] = {}
+
+
+def _item(key: str, driver_model: str = ""):
+    """The parameter model's item for a key (None when the driver has no such item)."""
+    from fha_studio.hardware.parameters import load_parameter_model
+    from fha_studio.logic.register.importers import driver_family
+
+    family = driver_family(driver_model)
+    if family not in _PARAMETER_MODELS:
+        _PARAMETER_MODELS[family] = load_parameter_model(family)
+    try:
+        return _PARAMETER_MODELS[family].by_key(key)
+    except KeyError:
+        return None
+
+
+def _shown(key: str, value: int | None, driver_model: str = "") -> str:
+    if value is None:
+        return "(not in it)"
+    item = _item(key, driver_model)
+    return item.format(value) if item is not None else str(value)
+
+
+def _name(key: str, driver_model: str = "") -> str:
+    item = _item(key, driver_model)
+    return f"{item.mode.value} {item.number} {item.name}" if item is not None else key
+
+
+# -- actions --------------------------------------------------------------------------------------------
+
+
+def _machines(args) -> int:
+    with _open_register(args) as reg:
+        open_items = reg.open_items()
+        rows = []
+        for m in reg.machines():
+            axes = reg.axes(m.name)
+            n_open = sum(1 for i in open_items if i.axis.machine == m.name)
+            rows.append({**asdict(m), "axes": len(axes), "open_items": n_open})
+    if args.json:
+        _print_json(rows)
+    elif not rows:
+        print("No machines in the register yet (add one: fha-studio register add-machine NAME).")
+    else:
+        _table(
+            [[r["name"], r["site"], str(r["axes"]), str(r["open_items"])] for r in rows],
+            ["Machine", "Site", "Axes", "Open items"],
+        )
+    return 0
+
+
+def _axes(args) -> int:
+    with _open_register(args) as reg:
+        rows = []
+        for axis in reg.axes(args.machine):
+            passed, failed = reg.check_counts(axis)
+            report = reg.latest_report(axis)
+            direction = reg.current_values(axis).values.get("rotary_direction")
+            rows.append(
+                {
+                    **asdict(axis),
+                    "ref": axis.ref,
+                    "checks_passed": passed,
+                    "checks_failed": failed,
+                    "rotary_direction": direction.value if direction else None,
+                    "report": report["file"] if report else None,
+                    "report_signed_by": report["signed_by"] if report else None,
+                }
+            )
+    if args.json:
+        _print_json(rows)
+        return 0
+    if not rows:
+        print("No axes in the register yet (add one: fha-studio register add-axis MACHINE/AXIS).")
+        return 0
+    table = []
+    for r in rows:
+        report = (
+            "none"
+            if r["report"] is None
+            else (f"signed by {r['report_signed_by']}" if r["report_signed_by"] else "not signed")
+        )
+        direction = {None: "", 0: "FWD = CW", 1: "reversed"}.get(
+            r["rotary_direction"], str(r["rotary_direction"])
+        )
+        inertia = "" if r["load_inertia_kgm2"] is None else f"{r['load_inertia_kgm2']:g} kg m²"
+        table.append(
+            [
+                r["ref"],
+                r["actuator_code"],
+                r["driver_model"],
+                r["port_url"],
+                inertia,
+                direction,
+                f"{r['checks_passed']} / {r['checks_failed']}",
+                report,
+            ]
+        )
+    _table(
+        table,
+        ["Axis", "Actuator", "Driver", "Port", "Load inertia", "Direction", "Checks pass/fail", "Report"],
+    )
+    return 0
+
+
+def _history(args) -> int:
+    with _open_register(args) as reg:
+        axis = reg.axis(args.axis)
+        events = reg.history(axis, since=args.since)
+    if args.json:
+        _print_json({"axis": asdict(axis), "events": [e.as_dict() for e in events]})
+        return 0
+    entries = "entry" if len(events) == 1 else "entries"
+    driver = f" on {axis.driver_model}" if axis.driver_model else ""
+    print(
+        f"{axis.ref}: {axis.actuator_code or 'actuator not given'}{driver}"
+        f" — {len(events)} {entries} (times UTC)"
+    )
+    kinds = {
+        "axis": "axis",
+        "snapshot": "parameters",
+        "write": "write",
+        "check": "check",
+        "alarm": "alarm",
+        "report": "report",
+        "recording": "recording",
+        "model_check": "model check",
+    }
+    for e in events:
+        who = f" [{e.who}]" if e.who else ""
+        print(f"{_when(e.at_utc)}  {kinds[e.kind]:<11} {e.text}{who}")
+    return 0
+
+
+def _diff(args) -> int:
+    with _open_register(args) as reg:
+        a, b = reg.parameter_set(args.a), reg.parameter_set(args.b)
+        differences = reg.diff(a, b)
+    driver = a.axis.driver_model or b.axis.driver_model
+    if args.json:
+        _print_json({"a": a.label, "b": b.label, "differences": [asdict(d) for d in differences]})
+        return 0
+    print(f"A: {a.label}\nB: {b.label}")
+    if not differences:
+        print(f"No difference in the {len(set(a.values) | set(b.values))} parameters they hold.")
+        return 0
+    _table(
+        [[_name(d.key, driver), _shown(d.key, d.a, driver), _shown(d.key, d.b, driver)] for d in differences],
+        ["Parameter", "A", "B"],
+    )
+    return 0
+
+
+def _parse_query(reg, query: str) -> tuple[str, int | None, Any]:
+    key_text, _, value_text = query.partition("=")
+    wanted = key_text.strip().lower().replace(" ", "_").replace("-", "_")
+    if not wanted:
+        raise CliError("find: give a parameter, e.g. rotary_direction=1")
+    item = _item(wanted)
+    if item is None:
+        from fha_studio.hardware.parameters import load_parameter_model
+
+        by_name = {i.name.lower().replace(" ", "_"): i for i in load_parameter_model("HA-655")}
+        item = by_name.get(wanted)
+    key = item.key if item is not None else wanted
+    if item is None and key not in reg.known_keys():
+        raise CliError(
+            f"find: no parameter called '{key_text.strip()}' (e.g. rotary_direction, in_position_range)"
+        )
+    if not value_text.strip():
+        return key, None, item
+    try:
+        value = int(value_text.strip())
+    except ValueError:
+        allowed = (
+            ", ".join(f"{k} = {v}" for k, v in item.choices.items())
+            if item is not None and item.choices
+            else ""
+        )
+        raise CliError(
+            f"find: '{value_text.strip()}' for {item.name if item else key} is not the drive's"
+            " whole-number value" + (f" ({allowed})" if allowed else "")
+        ) from None
+    if item is not None:
+        try:
+            item.check(value)
+        except ValueError as exc:
+            raise CliError(f"find: {exc}") from None
+    return key, value, item
+
+
+def _find(args) -> int:
+    with _open_register(args) as reg:
+        key, value, item = _parse_query(reg, args.query)
+        found = reg.find(key, value, machine=args.machine)
+    if args.json:
+        _print_json(
+            {"key": key, "value": value, "axes": [{"axis": f.axis.ref, **asdict(f.value)} for f in found]}
+        )
+        return 0
+    what = item.name if item is not None else key
+    if not found:
+        wanted = f" = {_shown(key, value)}" if value is not None else ""
+        print(f"No axis has {what}{wanted}.")
+        return 0
+    sources = {
+        "link": "read over the link",
+        "front_panel": "front panel",
+        "file": "from a file",
+        "write": "verified write",
+    }
+    _table(
+        [
+            [
+                f.axis.ref,
+                _shown(key, f.value.value, f.axis.driver_model),
+                sources[f.value.source],
+                _when(f.value.at_utc),
+            ]
+            for f in found
+        ],
+        ["Axis", what, "Known from", "When (UTC)"],
+    )
+    return 0
+
+
+def _open(args) -> int:
+    with _open_register(args) as reg:
+        items = reg.open_items(args.machine)
+    if args.json:
+        _print_json([{"axis": i.axis.ref, "kind": i.kind, "text": i.text} for i in items])
+        return 0
+    if not items:
+        print("Nothing open: every check passed and every report is signed.")
+        return 0
+    for i in items:
+        print(f"{i.axis.ref}: {'report' if i.kind == 'report' else 'check'}: {i.text}")
+    return 0
+
+
+def _export(args) -> int:
+    with _open_register(args) as reg:
+        data = reg.export(args.machine)
+    text = json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    if args.output:
+        args.output.parent.mkdir(parents=True, exist_ok=True)
+        tmp = args.output.with_name(args.output.name + ".tmp")
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(args.output)  # a reader never sees half an export
+        print(f"{args.output}: {len(data['machines'])} machine(s)", file=sys.stderr)
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
+def _add_machine(args) -> int:
+    with _open_register(args) as reg:
+        machine = reg.add_machine(args.name, site=args.site, notes=args.notes)
+    if args.json:
+        _print_json(asdict(machine))
+    else:
+        print(f"Machine '{machine.name}' added.")
+    return 0
+
+
+def _add_axis(args) -> int:
+    machine, sep, name = args.axis.partition("/")
+    if not sep or not machine.strip() or not name.strip():
+        raise CliError(f"add-axis: '{args.axis}': name the axis as MACHINE/AXIS")
+    if args.actuator:
+        from fha_studio.catalog import ModelCodeError, parse_model_code
+
+        try:
+            parse_model_code(args.actuator)
+        except ModelCodeError as exc:
+            raise CliError(f"add-axis: --actuator: {exc}") from None
+    with _open_register(args) as reg:
+        axis = reg.add_axis(
+            machine,
+            name,
+            actuator_code=args.actuator,
+            driver_model=args.driver,
+            port_url=args.port,
+            load_inertia_kgm2=args.load_inertia,
+            notes=args.notes,
+            serial_number=args.serial_number,
+            who=args.operator,
+        )
+    if args.json:
+        _print_json(asdict(axis))
+    else:
+        print(f"Axis '{axis.ref}' added.")
+    return 0
+
+
+def _import(args) -> int:
+    from fha_studio.logic.register import import_parameter_file, import_session_file
+
+    results = []
+    with _open_register(args) as reg:
+        for path in args.files:
+            if not path.is_file():
+                raise CliError(f"import: {path}: no such file")
+            if _is_session(path):
+                result = import_session_file(reg, path, args.machine, args.axis)
+                what = f"{result.checks_added} new check(s), {result.procedures} procedure(s)"
+            else:
+                if not args.axis:
+                    raise CliError(f"import: {path} is a parameter file: say which axis with --axis")
+                result = import_parameter_file(reg, path, args.machine, args.axis, who=args.operator)
+                what = "already there" if result.snapshot is None else f"snapshot {result.snapshot}"
+            if result.snapshot is not None and _is_session(path):
+                what += f", snapshot {result.snapshot}"
+            results.append(
+                {
+                    "file": str(path),
+                    "axis": result.axis.ref,
+                    "checks_added": result.checks_added,
+                    "snapshot": result.snapshot,
+                    "not_taken": list(result.not_taken),
+                }
+            )
+            if not args.json:
+                print(f"{path} -> {result.axis.ref}: {what}")
+                for line in result.not_taken:
+                    print(f"  not taken: {line}")
+    if args.json:
+        _print_json(results)
+    return 0
+
+
+def _is_session(path: Path) -> bool:
+    """A session file is JSON (starts with '{'); a parameter file is TOML."""
+    with path.open("rb") as fh:
+        head = fh.read(256).lstrip()
+    return head.startswith(b"{")
