@@ -1,4 +1,4 @@
-"""The drive link off the GUI thread: a worker QObject in its own QThread owns the DriveClient.
+"""The drive link off the GUI thread: a worker QObject in its own QThread owns the drive (a DriveApi).
 
 PyMoDAQ's pattern: commands go in through one queued signal carrying a small `LinkCommand`
 (an Enum name and its arguments); results and status come out through signals. Qudi's polling
@@ -18,9 +18,23 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypedDict
 
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
+
+from fha_studio.hardware.api import (
+    AlarmRecord,
+    CommandNotSupported,
+    CommandRejected,
+    DriveApi,
+    DriveRefused,
+    LinkError,
+    LinkLost,
+    LinkTimeout,
+    ServoOnRefused,
+)
+from fha_studio.hardware.parameters import Mode, MonitorItem
+from fha_studio.hardware.protocol import IoBit
 
 log = logging.getLogger(__name__)
 
@@ -35,6 +49,8 @@ JOG_LEASE_RENEW_MS = 150
 JOG_LEASE_S = 0.5
 #: Consecutive timeouts after which the link is declared lost (the client has retried already).
 TIMEOUTS_TO_LOST = 1
+#: The monitor items of the status poll: output position, output speed, motor current.
+STATUS_MONITORS = (MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.MOTOR_CURRENT)
 
 
 class Cmd(enum.Enum):
@@ -54,10 +70,18 @@ class Cmd(enum.Enum):
     CLEAR_ALARM = enum.auto()
     ALARM_HISTORY = enum.auto()
     POWER_CYCLE = enum.auto()
-    SET_INPUTS = enum.auto()  # args: bit mask (simulated drive only)
-    CALL = enum.auto()  # args: a callable taking the client (for procedures of other pages)
+    SET_INPUTS = enum.auto()  # args: {input name: on} (simulated drive only)
+    CALL = enum.auto()  # args: a callable taking the DriveApi (for procedures of other pages)
     SET_POLL_INTERVAL = enum.auto()  # args: ms between status polls (the scope slows them while live)
     SHUTDOWN = enum.auto()  # stop the axis, close the port, end the link thread
+
+
+#: Commands that need no open link (the rest answer "not connected" without one).
+_WITHOUT_LINK = frozenset({Cmd.OPEN, Cmd.CLOSE, Cmd.STOP, Cmd.JOG, Cmd.JOG_LEASE, Cmd.SET_POLL_INTERVAL})
+
+
+class NotConnected(LinkError):
+    """A command that needs a drive came while no link was open."""
 
 
 @dataclass(frozen=True)
@@ -65,23 +89,28 @@ class LinkCommand:
     """One command for the worker. `token` ties the result to the request."""
 
     cmd: Cmd
-    args: tuple = ()
+    args: tuple[Any, ...] = ()
     token: int = 0
 
 
 @dataclass(frozen=True)
 class CommandResult:
-    """What came of one command: `value` on success, else `error` (one line for the user)."""
+    """What came of one command: `value` on success, else `error` (one line for the user) and
+    `error_type`, the class of the exception (``ServoOnRefused``, ``LinkLost``, ``NotConnected``...)."""
 
     token: int
     cmd: Cmd
     value: Any = None
     error: str | None = None
-    error_kind: str | None = None  # the exception's class name, e.g. "ServoOnRefused"
+    error_type: type[Exception] | None = None
 
     @property
     def ok(self) -> bool:
         return self.error is None
+
+    def failed_with(self, kind: type[Exception]) -> bool:
+        """True when the command failed with ``kind`` (or a subclass): ``failed_with(DriveRefused)``."""
+        return self.error_type is not None and issubclass(self.error_type, kind)
 
 
 @dataclass(frozen=True)
@@ -99,19 +128,26 @@ class LinkInfo:
     is_simulated: bool = False
 
 
-# I/O bits (docs/protocol.md, IOS)
-IO_SERVO_ON = 0
-IO_READY = 1
-IO_ALARM = 2
-IO_IN_POSITION = 3
-IO_FWD_INHIBIT = 4
-IO_REV_INHIBIT = 5
-IO_ORIGIN = 6
-IO_LIMIT_CCW = 7
-IO_LIMIT_CW = 8
-IO_BRAKE_RELEASED = 9
-IO_CLEAR = 10
-IO_MOVING = 15
+class ReadParametersResult(TypedDict):
+    """The value of READ_PARAMETERS: wire values, and a sentence per item that could not be read."""
+
+    values: dict[tuple[str, int], int]
+    errors: dict[tuple[str, int], str]
+
+
+class WriteEntry(TypedDict, total=False):
+    """One write of WRITE_PARAMETERS (and of ``sigWrite``), for the session log."""
+
+    time: float
+    mode: str
+    number: int
+    new: int
+    old: int | None
+    read_back: int | None
+    verified: bool
+    error: str | None
+    restart_required: bool
+    message: str
 
 
 @dataclass(frozen=True)
@@ -129,15 +165,19 @@ class DriveStatus:
     jogging: bool = False
     refused: bool = False  # the drive answered "servo on: not now"
 
-    def bit(self, number: int) -> bool | None:
-        return None if self.io_bits is None else bool(self.io_bits >> number & 1)
+    def bit(self, bit: IoBit) -> bool | None:
+        return None if self.io_bits is None else bool(self.io_bits >> bit & 1)
 
     @property
     def moving(self) -> bool:
-        return bool(self.jogging or self.bit(IO_MOVING))
+        return bool(self.jogging or self.bit(IoBit.MOVING))
 
 
-def _default_open(url: str, baud_rate: int):
+#: Opens a drive: (url, baud rate) -> an open DriveApi. Raises LinkError when it cannot.
+OpenClient = Callable[[str, int], DriveApi]
+
+
+def _default_open(url: str, baud_rate: int) -> DriveApi:
     from fha_studio.hardware.client import DriveClient, LinkSettings
 
     # short timeouts: a dead link must show within a second (one retry of 0.25 s each)
@@ -145,39 +185,43 @@ def _default_open(url: str, baud_rate: int):
     return DriveClient.open(url, settings)
 
 
-def _error_kind(exc: BaseException) -> str:
-    return type(exc).__name__
+_PLAIN_FAILURES: tuple[tuple[type[Exception], str], ...] = (
+    (NotConnected, "not connected"),
+    (LinkLost, "the link is lost"),
+    (LinkTimeout, "the drive did not answer"),
+    (ServoOnRefused, "refused: the servo is on"),
+    (DriveRefused, "refused by the drive"),
+)
 
 
-def _is_lost(exc: BaseException) -> bool:
-    return _error_kind(exc) in {"LinkLost", "SerialException", "OSError", "BrokenPipeError"} or isinstance(
-        exc, OSError
-    )
+def _message(exc: Exception) -> str:
+    """One line for the user: the exception's text, or what its kind means when it has none."""
+    text = str(exc)
+    if text:
+        return text
+    return next((plain for kind, plain in _PLAIN_FAILURES if isinstance(exc, kind)), "failed")
 
 
-def _is_timeout(exc: BaseException) -> bool:
-    return _error_kind(exc) == "LinkTimeout" or isinstance(exc, TimeoutError)
-
-
-def _is_refusal(exc: BaseException) -> bool:
-    return _error_kind(exc) == "ServoOnRefused"
+def _is_link_failure(exc: Exception) -> bool:
+    """True for what ends a link: lost, or a timeout (the client has retried already)."""
+    return isinstance(exc, LinkLost | LinkTimeout)
 
 
 class LinkWorker(QObject):
-    """Owns the DriveClient; lives in the link thread. Talk to it only through signals."""
+    """Owns the DriveApi; lives in the link thread. Talk to it only through signals."""
 
     sigConnected = Signal(object)  # LinkInfo
     sigDisconnected = Signal(str, bool)  # reason, lost (True: the link died, not closed by us)
     sigStatus = Signal(object)  # DriveStatus
     sigResult = Signal(object)  # CommandResult
-    sigWrite = Signal(object)  # one write, as a dict for the session log
+    sigWrite = Signal(object)  # WriteEntry: one write, for the session log
 
-    def __init__(self, abort: threading.Event, open_client: Callable[[str, int], Any] | None = None):
+    def __init__(self, abort: threading.Event, open_client: OpenClient | None = None):
         super().__init__()
         self._abort = abort
         self._poll_interval_ms = POLL_INTERVAL_MS
-        self._open_client = open_client or _default_open
-        self._client = None
+        self._open_client: OpenClient = open_client or _default_open
+        self._client: DriveApi | None = None
         self._url = ""
         self._poll_timer: QTimer | None = None
         self._jog_timer: QTimer | None = None
@@ -185,7 +229,27 @@ class LinkWorker(QObject):
         self._jog_lease_s = 0.0
         self._timeouts = 0
         self._monitor_ok = True
-        self._last_servo_on: bool | None = None
+        #: What each command runs (every Cmd has one; a test checks it).
+        self.handlers: dict[Cmd, Callable[..., Any]] = {
+            Cmd.OPEN: self._do_open,
+            Cmd.CLOSE: self._do_close,
+            Cmd.IDENTIFY: self._do_identify,
+            Cmd.READ_PARAMETERS: self._do_read_parameters,
+            Cmd.WRITE_PARAMETERS: self._do_write_parameters,
+            Cmd.SERVO: self._do_servo,
+            Cmd.JOG: self._do_jog,
+            Cmd.JOG_LEASE: self._do_jog_lease,
+            Cmd.SET_MOVE_SPEED: self._do_set_move_speed,
+            Cmd.MOVE_BY: self._do_move_by,
+            Cmd.STOP: self._do_stop,
+            Cmd.CLEAR_ALARM: self._do_clear_alarm,
+            Cmd.ALARM_HISTORY: self._do_alarm_history,
+            Cmd.POWER_CYCLE: self._do_power_cycle,
+            Cmd.SET_INPUTS: self._do_set_inputs,
+            Cmd.CALL: self._do_call,
+            Cmd.SET_POLL_INTERVAL: self._do_set_poll_interval,
+            Cmd.SHUTDOWN: self._shutdown,
+        }
 
     # -- life ---------------------------------------------------------------------------------
     @Slot()
@@ -198,41 +262,48 @@ class LinkWorker(QObject):
         self._jog_timer.setInterval(JOG_KEEPALIVE_MS)
         self._jog_timer.timeout.connect(self._jog_keepalive)
 
+    @property
+    def client(self) -> DriveApi:
+        """The open drive; ``NotConnected`` without one."""
+        if self._client is None:
+            raise NotConnected("not connected")
+        return self._client
+
     @Slot(object)
     def handle(self, command: LinkCommand) -> None:
+        handler = self.handlers[command.cmd]
         if command.cmd is Cmd.SHUTDOWN:
-            self._shutdown()
+            handler()
             return
-        handler = getattr(self, f"_do_{command.cmd.name.lower()}")
         if command.cmd is Cmd.STOP:
             self._abort.clear()
-        if command.cmd is not Cmd.OPEN and self._client is None:
-            if command.cmd not in (Cmd.CLOSE, Cmd.STOP, Cmd.JOG, Cmd.JOG_LEASE):
-                self._emit(command, error="not connected", kind="NotConnected")
+        if self._client is None and command.cmd not in _WITHOUT_LINK:
+            self._emit(command, error=NotConnected("not connected"))
             return
         try:
             value = handler(*command.args)
         except Exception as exc:
-            if self._client is not None and (_is_lost(exc) or (_is_timeout(exc) and self._count_timeout())):
-                self._emit(command, error=str(exc) or _error_kind(exc), kind=_error_kind(exc))
+            self._emit(command, error=exc)
+            if self._client is not None and (
+                isinstance(exc, LinkLost) or (isinstance(exc, LinkTimeout) and self._count_timeout())
+            ):
                 self._lose(exc)
-                return
-            self._emit(command, error=str(exc) or _error_kind(exc), kind=_error_kind(exc))
             return
         self._timeouts = 0
         self._emit(command, value=value)
 
-    def _emit(
-        self, command: LinkCommand, value: Any = None, error: str | None = None, kind: str | None = None
-    ):
-        self.sigResult.emit(CommandResult(command.token, command.cmd, value, error, kind))
+    def _emit(self, command: LinkCommand, value: Any = None, error: Exception | None = None) -> None:
+        if error is None:
+            self.sigResult.emit(CommandResult(command.token, command.cmd, value))
+        else:
+            self.sigResult.emit(CommandResult(command.token, command.cmd, None, _message(error), type(error)))
 
     def _count_timeout(self) -> bool:
         self._timeouts += 1
         return self._timeouts >= TIMEOUTS_TO_LOST
 
-    def _lose(self, exc: BaseException) -> None:
-        reason = f"link lost: {exc or _error_kind(exc)}"
+    def _lose(self, exc: Exception) -> None:
+        reason = f"link lost: {_message(exc)}"
         self._shut(stop_axis=False)
         self.sigDisconnected.emit(reason, True)
 
@@ -248,11 +319,11 @@ class LinkWorker(QObject):
         if stop_axis:
             try:
                 client.stop()
-            except Exception as exc:  # the port may already be gone; closing goes on
+            except (LinkError, OSError) as exc:  # the port may already be gone; closing goes on
                 log.info("stop on close failed: %s", exc)
         try:
             client.close()
-        except Exception as exc:
+        except (LinkError, OSError) as exc:
             log.info("close failed: %s", exc)
 
     def _shutdown(self) -> None:
@@ -275,7 +346,6 @@ class LinkWorker(QObject):
         self._url = url
         self._timeouts = 0
         self._monitor_ok = True
-        self._last_servo_on = None
         info = self._describe(url)
         self.sigConnected.emit(info)
         assert self._poll_timer is not None
@@ -283,32 +353,25 @@ class LinkWorker(QObject):
         return info
 
     def _describe(self, url: str) -> LinkInfo:
-        client = self._client
-        driver_model = adjusted_for = firmware = ""
+        client = self.client
+        ident = None
         try:
             ident = client.identify()  # None on a drive without IDN
-            driver_model = getattr(ident, "driver_model", "") or ""
-            adjusted_for = getattr(ident, "adjusted_for", "") or ""
-            firmware = getattr(ident, "firmware", "") or ""
-        except Exception as exc:
-            if _is_lost(exc):
-                raise
+        except LinkLost:
+            raise
+        except LinkError as exc:
             log.info("identify failed: %s", exc)
-        caps = getattr(client, "capabilities", None)
-        if callable(caps):
-            caps = caps()
-        describe = getattr(caps, "describe", None)
-        text = describe() if callable(describe) else (str(caps) if caps is not None else "")
+        caps = client.capabilities
         return LinkInfo(
             url=url,
-            driver_model=driver_model,
-            adjusted_for=adjusted_for,
-            firmware=firmware,
-            capabilities=text,
-            can_move=_capability(caps, ("JOG", "SVO"), "can_jog", True),
-            can_monitor=_capability(caps, ("MON",), "can_monitor", True),
-            can_parameters=bool(getattr(caps, "parameters", True)),
-            is_simulated=bool(getattr(caps, "simulated", url.startswith("sim://"))),
+            driver_model=ident.driver_model if ident else "",
+            adjusted_for=ident.adjusted_for if ident else "",
+            firmware=ident.firmware if ident else "",
+            capabilities=caps.describe(),
+            can_move=caps.can_move,
+            can_monitor=caps.can_monitor,
+            can_parameters=caps.parameters,
+            is_simulated=caps.simulated,
         )
 
     def _do_close(self) -> None:
@@ -320,7 +383,7 @@ class LinkWorker(QObject):
     def _do_identify(self) -> LinkInfo:
         return self._describe(self._url)
 
-    def _do_read_parameters(self, items) -> dict:
+    def _do_read_parameters(self, items: list[tuple[str, int]]) -> ReadParametersResult:
         values: dict[tuple[str, int], int] = {}
         errors: dict[tuple[str, int], str] = {}
         for mode, number in items:
@@ -328,18 +391,16 @@ class LinkWorker(QObject):
                 errors[(mode, number)] = "stopped"
                 continue
             try:
-                values[(mode, number)] = self._client.read_parameter(mode, number)
-            except Exception as exc:
-                if _is_lost(exc) or _is_timeout(exc):
-                    raise
-                errors[(mode, number)] = str(exc) or _error_kind(exc)
+                values[(mode, number)] = self.client.read_parameter(mode, number)
+            except (DriveRefused, ValueError) as exc:  # this item; the link failures end the read
+                errors[(mode, number)] = _message(exc)
         return {"values": values, "errors": errors}
 
-    def _do_write_parameters(self, writes) -> list[dict]:
+    def _do_write_parameters(self, writes: list[tuple[str, int, int]]) -> list[WriteEntry]:
         """Writes one by one; each entry says old, new, verified (by read-back) or the error."""
-        done: list[dict] = []
+        done: list[WriteEntry] = []
         for mode, number, value in writes:
-            entry = {
+            entry: WriteEntry = {
                 "time": time.time(),
                 "mode": mode,
                 "number": number,
@@ -355,26 +416,27 @@ class LinkWorker(QObject):
                 self.sigWrite.emit(entry)
                 continue
             try:
-                result = self._client.write_parameter(mode, number, value)
-                entry["old"] = _field(result, ("old", "old_value", "previous"))
-                entry["read_back"] = _field(result, ("read_back", "value"))
-                entry["verified"] = bool(_field(result, ("verified",)))
-                entry["restart_required"] = bool(_field(result, ("needs_restart", "restart_required")))
-                entry["message"] = _field(result, ("message",)) or ""
-                if not entry["verified"]:
-                    entry["error"] = _field(result, ("message", "error")) or "read-back differs"
-            except Exception as exc:
-                if _is_lost(exc) or _is_timeout(exc):
-                    entry["error"] = str(exc) or _error_kind(exc)
-                    self.sigWrite.emit(entry)
-                    raise
-                entry["error"] = str(exc) or _error_kind(exc)
+                result = self.client.write_parameter(mode, number, value)
+            except (DriveRefused, ValueError) as exc:
+                entry["error"] = _message(exc)
+            except LinkError as exc:
+                entry["error"] = _message(exc)
+                self.sigWrite.emit(entry)
+                raise
+            else:
+                entry["old"] = result.previous
+                entry["read_back"] = result.value
+                entry["verified"] = result.verified
+                entry["restart_required"] = result.needs_restart
+                entry["message"] = result.message
+                if not result.verified:
+                    entry["error"] = result.message or "read-back differs"
             done.append(entry)
             self.sigWrite.emit(entry)
         return done
 
     def _do_servo(self, on: bool) -> bool:
-        self._client.servo(bool(on))
+        self.client.servo(bool(on))
         return bool(on)
 
     def _do_jog(self, speed_rpm: float) -> float:
@@ -416,21 +478,19 @@ class LinkWorker(QObject):
             return
         try:
             self._client.jog(self._jog_speed_rpm)
-        except Exception as exc:
+        except (LinkError, ValueError) as exc:
             self._jog_speed_rpm = 0.0
             self._jog_timer.stop()
-            self.sigResult.emit(
-                CommandResult(0, Cmd.JOG, None, str(exc) or _error_kind(exc), _error_kind(exc))
-            )
-            if _is_lost(exc) or (_is_timeout(exc) and self._count_timeout()):
+            self._emit(LinkCommand(Cmd.JOG), error=exc)
+            if isinstance(exc, LinkLost) or (isinstance(exc, LinkTimeout) and self._count_timeout()):
                 self._lose(exc)
 
     def _do_set_move_speed(self, speed_rpm: float) -> float:
-        self._client.set_move_speed(float(speed_rpm))
+        self.client.set_move_speed(float(speed_rpm))
         return float(speed_rpm)
 
     def _do_move_by(self, angle_deg: float) -> float:
-        self._client.move_by(float(angle_deg))
+        self.client.move_by(float(angle_deg))
         return float(angle_deg)
 
     def _do_stop(self) -> None:
@@ -441,26 +501,25 @@ class LinkWorker(QObject):
             self._client.stop()
 
     def _do_clear_alarm(self) -> int:
-        self._client.clear_alarm()
-        return int(self._client.alarm())
+        self.client.clear_alarm()
+        return self.client.alarm()
 
-    def _do_alarm_history(self) -> list:
-        return list(self._client.alarm_history())
+    def _do_alarm_history(self) -> list[AlarmRecord]:
+        return self.client.alarm_history()
 
     def _do_power_cycle(self) -> None:
-        self._client.power_cycle()
+        self.client.power_cycle()
 
-    def _do_set_inputs(self, inputs: dict) -> int:
+    def _do_set_inputs(self, inputs: dict[str, bool]) -> int:
         """Simulated CN2 inputs by name (fwd_inhibit=True, ...); the simulated drive only."""
-        state = self._client.set_inputs(**inputs)
-        return int(getattr(state, "raw", state))
+        return self.client.set_inputs(**inputs).raw
 
     def _do_set_poll_interval(self, interval_ms: int) -> int:
         self._poll_interval_ms = max(POLL_INTERVAL_MS, int(interval_ms))
         return self._poll_interval_ms
 
-    def _do_call(self, function: Callable[[Any], Any]) -> Any:
-        return function(self._client)
+    def _do_call(self, function: Callable[[DriveApi], Any]) -> Any:
+        return function(self.client)
 
     # -- polling ------------------------------------------------------------------------------
     @Slot()
@@ -468,24 +527,24 @@ class LinkWorker(QObject):
         client = self._client
         if client is None:
             return
-        status = {"time_s": time.monotonic(), "jogging": bool(self._jog_speed_rpm)}
+        status: dict[str, Any] = {"time_s": time.monotonic(), "jogging": bool(self._jog_speed_rpm)}
         try:
             try:
-                status["alarm_code"] = int(client.alarm())
-                bits = client.io_state()
-                status["io_bits"] = int(getattr(bits, "raw", bits))
-                status["servo_on"] = bool(status["io_bits"] & 1)
+                status["alarm_code"] = client.alarm()
+                io = client.io_state()
+                status["io_bits"] = io.raw
+                status["servo_on"] = io.servo_on
                 if self._monitor_ok:
                     self._poll_monitors(client, status)
-            except Exception as exc:
-                if not _is_refusal(exc):
-                    raise
+            except ServoOnRefused:
                 status["refused"] = True
                 status["servo_on"] = True  # a real drive refuses CN3 commands while the servo is on
-        except Exception as exc:
-            if _is_lost(exc) or (_is_timeout(exc) and self._count_timeout()):
+        except (LinkLost, LinkTimeout) as exc:
+            if isinstance(exc, LinkLost) or self._count_timeout():
                 self._lose(exc)
                 return
+            log.info("poll failed: %s", exc)
+        except LinkError as exc:
             log.info("poll failed: %s", exc)
         else:
             self._timeouts = 0
@@ -493,34 +552,24 @@ class LinkWorker(QObject):
         if self._client is not None and self._poll_timer is not None:
             self._poll_timer.start(self._poll_interval_ms)
 
-    def _poll_monitors(self, client, status: dict) -> None:
+    def _poll_monitors(self, client: DriveApi, status: dict[str, Any]) -> None:
         """Output position (pulse), output speed (r/min) and motor current (A), scaled by the
-        parameter model's monitor items (100, 103, 104)."""
-        items = (100, 103, 104)
+        parameter model's monitor items."""
         try:
-            reader = getattr(client, "read_monitors", None)
-            values = reader(items) if reader else {i: client.read_monitor(i) for i in items}
-        except Exception as exc:
-            if _is_lost(exc) or _is_timeout(exc) or _is_refusal(exc):
-                raise
+            values = client.read_monitors(STATUS_MONITORS)
+        except (CommandNotSupported, CommandRejected) as exc:
             self._monitor_ok = False  # a drive without the monitor extension: stop asking
             log.info("monitors not available: %s", exc)
             return
-        model = getattr(client, "model", None)
 
-        def scaled(number: int) -> float | None:
-            wire = values.get(number)
-            if wire is None:
-                return None
-            try:
-                return model.item("monitor", number).to_unit(wire) if model is not None else float(wire)
-            except (KeyError, ValueError):
-                return float(wire)
+        def scaled(item: MonitorItem) -> float | None:
+            wire = values.get(item)
+            return None if wire is None else client.model.item(Mode.MONITOR, item).to_unit(wire)
 
-        position = values.get(100)
-        status["position_pulse"] = None if position is None else int(position)
-        status["speed_rpm"] = scaled(103)
-        status["current_a"] = scaled(104)
+        position = values.get(MonitorItem.FEEDBACK_POSITION)
+        status["position_pulse"] = position
+        status["speed_rpm"] = scaled(MonitorItem.OUTPUT_SPEED)
+        status["current_a"] = scaled(MonitorItem.MOTOR_CURRENT)
 
 
 def _forget_dummy_thread() -> None:
@@ -529,29 +578,8 @@ def _forget_dummy_thread() -> None:
     entries, so the ended link thread would look alive forever. Called in the thread, at its end."""
     current = threading.current_thread()
     if isinstance(current, threading._DummyThread):
-        with threading._active_limbo_lock:
-            threading._active.pop(threading.get_ident(), None)
-
-
-def _field(obj: Any, names: tuple[str, ...]) -> Any:
-    for name in names:
-        if isinstance(obj, dict) and name in obj:
-            return obj[name]
-        if hasattr(obj, name):
-            return getattr(obj, name)
-    return None
-
-
-def _capability(caps: Any, commands: tuple[str, ...], attribute: str, default: bool) -> bool:
-    if caps is None:
-        return default
-    if hasattr(caps, attribute):
-        return bool(getattr(caps, attribute))
-    supported = getattr(caps, "commands", None) or getattr(caps, "supported", None)
-    if supported is not None:
-        names = {getattr(c, "value", c) for c in supported}
-        return all(c in names for c in commands)
-    return default
+        with threading._active_limbo_lock:  # type: ignore[attr-defined]
+            threading._active.pop(threading.get_ident(), None)  # type: ignore[attr-defined]
 
 
 class LinkController(QObject):
@@ -566,7 +594,7 @@ class LinkController(QObject):
     sigWrite = Signal(object)
     sigBusyChanged = Signal(bool)
 
-    def __init__(self, parent: QObject | None = None, open_client=None):
+    def __init__(self, parent: QObject | None = None, open_client: OpenClient | None = None):
         super().__init__(parent)
         self._tokens = itertools.count(1)
         self._abort = threading.Event()
@@ -690,6 +718,7 @@ class LinkController(QObject):
 
 
 __all__ = [
+    "STATUS_MONITORS",
     "Cmd",
     "CommandResult",
     "DriveStatus",
@@ -697,4 +726,8 @@ __all__ = [
     "LinkController",
     "LinkInfo",
     "LinkWorker",
+    "NotConnected",
+    "OpenClient",
+    "ReadParametersResult",
+    "WriteEntry",
 ]

@@ -13,7 +13,7 @@ from __future__ import annotations
 import tomllib
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from enum import StrEnum
+from enum import IntEnum, StrEnum
 from types import MappingProxyType
 from typing import Any
 
@@ -118,6 +118,22 @@ class ParameterItem:
     def label(self) -> str:
         """``"system 8 (rotary_direction)"``: how messages name the item."""
         return f"{self.mode.value} {self.number} ({self.key})"
+
+
+class MonitorItem(IntEnum):
+    """The extension monitor items by name (numbers and keys as in the parameter model's
+    ``monitor`` items, resources/drive/ha655-parameters.toml; a test keeps the two equal).
+    Scale a wire value with ``model.item(Mode.MONITOR, item).to_unit``."""
+
+    FEEDBACK_POSITION = 100  # output pulses
+    COMMAND_POSITION = 101  # output pulses
+    ERROR_PULSES = 102
+    OUTPUT_SPEED = 103  # 0.01 r/min
+    MOTOR_CURRENT = 104  # 0.001 A
+    OVERLOAD_RATE = 105  # 0.1 %
+    IO_STATE = 106  # the I/O bits (protocol.IoBit)
+    LOAD_POSITION = 107  # external encoder pulses
+    OUTPUT_TORQUE = 108  # 0.01 N m
 
 
 class ParameterModel:

@@ -1,161 +1,315 @@
-"""A stand-in DriveClient in memory, for GUI tests that must not depend on the simulated drive's
-timing. It follows the DriveClient API (fha_studio.hardware.client) and the protocol's rules."""
+"""A stand-in drive in memory, for GUI tests that must not depend on the simulated drive's timing.
+
+It implements ``fha_studio.hardware.api.DriveApi`` with the real result types and the real errors
+(mypy checks that it does: tests/typecheck_drive_api.py), and follows the protocol's rules:
+servo-on refusals, alarms that need a power cycle, a jog that stops 100 ms after the last JOG.
+Commands it does not model raise ``CommandNotSupported``, as the client does for a drive without
+the extension.
+"""
 
 from __future__ import annotations
 
-import threading
 import time
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable
 
+from fha_studio.hardware import protocol as p
+from fha_studio.hardware.api import (
+    INPUT_NAMES,
+    AlarmRecord,
+    Capabilities,
+    CommandNotSupported,
+    CommandRejected,
+    Held,
+    Identity,
+    IoState,
+    LinkLost,
+    ServoOnRefused,
+    TraceCapture,
+    TraceStatus,
+    WriteResult,
+)
+from fha_studio.hardware.parameters import Mode, ParameterModel, ParameterValueError, load_parameter_model
+from fha_studio.hardware.protocol import Command, IoBit
 
-class LinkLost(Exception):
-    pass
+#: What the fake answers: the manual's commands, parameters, monitors, motion, alarms, I/O and the
+#: simulated power cycle; no trace capture and no simulated inputs or sensors.
+FAKE_COMMANDS = frozenset(
+    {
+        Command.DGR, Command.OWW, Command.IDN, Command.CAP, Command.PSL, Command.TSL, Command.JSL,
+        Command.PRD, Command.PWR, Command.MON, Command.MMR, Command.SVO, Command.JOG, Command.SPD,
+        Command.MOV, Command.STP, Command.ALM, Command.AHS, Command.ACL, Command.IOS, Command.PWC,
+    }
+)
 
-
-class ServoOnRefused(Exception):
-    pass
-
-
-class CommandRejected(Exception):
-    pass
-
-
-@dataclass
-class Identity:
-    driver_model: str = "HA-655-2-200"
-    adjusted_for: str = "FHA-25C-50-US250"
-    firmware: str = "fake 1.0"
-
-
-class Capabilities:
-    can_jog = True
-    can_monitor = True
-
-    def describe(self) -> str:
-        return "fake drive: parameters, monitors, jog, alarms"
+#: Monitor items the fake has: output position, output speed, motor current, I/O state.
+_FEEDBACK_POSITION, _OUTPUT_SPEED, _MOTOR_CURRENT, _IO_STATE = 100, 103, 104, 106
 
 
 class FakeDriveClient:
-    def __init__(self, url="fake://", model=None):
-        from fha_studio.hardware.parameters import load_parameter_model
+    """An HA-655-2-200 adjusted for an FHA-25C-50-US250, in memory (a ``DriveApi``).
 
+    ``values`` maps ``(mode name, number)`` to the wire value; ``calls`` records jog and stop;
+    ``raise_alarm(code)`` plays the drive's supervision. ``commands`` narrows what it supports.
+    """
+
+    def __init__(self, model: ParameterModel | None = None, commands: Iterable[Command] = FAKE_COMMANDS):
         self.model = model or load_parameter_model()
-        self.values = {(i.mode.value, i.number): i.default for i in self.model if i.default is not None}
+        self.values: dict[tuple[str, int], int] = {
+            (i.mode.value, i.number): i.default for i in self.model if i.default is not None
+        }
         self.effective = dict(self.values)
-        self.capabilities = Capabilities()
+        self._capabilities = Capabilities(frozenset(commands), True, True)
         self.closed = False
         self.servo_on = False
         self.alarm_code = 0
-        self.history = []
+        self.history: list[AlarmRecord] = []
         self.inputs = 0
-        self.position = 0.0
-        self.jog_speed = 0.0
+        self.position_pulse = 0.0
+        self.jog_speed_rpm = 0.0
         self.jog_until = 0.0
+        self.move_speed_rpm = 10.0
         self.t = time.monotonic()
-        self.lock = threading.Lock()
-        self.calls = []
+        self.calls: list[tuple[object, ...]] = []
 
-    def _check(self):
-        if self.closed:
-            raise LinkLost("port closed")
-        now = time.monotonic()
-        if self.jog_speed and now < self.jog_until:
-            self.position += self.jog_speed * (now - self.t) * 1000
-        elif now >= self.jog_until:
-            self.jog_speed = 0.0
-        self.t = now
+    # --- the link ----------------------------------------------------------------------------
+    @property
+    def port(self) -> str:
+        return "fake://"
 
-    def close(self):
+    @property
+    def is_open(self) -> bool:
+        return not self.closed
+
+    @property
+    def link_lost(self) -> bool:
+        return self.closed
+
+    def close(self) -> None:
         self.closed = True
 
-    def identify(self):
-        self._check()
-        return Identity()
+    def _check(self, *commands: Command) -> None:
+        if self.closed:
+            raise LinkLost("fake:// is closed", port=self.port)
+        missing = [c.value for c in commands if c not in self._capabilities.commands]
+        if missing:
+            raise CommandNotSupported(f"this drive does not have {', '.join(missing)}")
+        now = time.monotonic()
+        if self.jog_speed_rpm and now < self.jog_until:
+            self.position_pulse += self.jog_speed_rpm * (now - self.t) * 1000
+        elif now >= self.jog_until:
+            self.jog_speed_rpm = 0.0
+        self.t = now
 
-    def read_parameter(self, mode, number):
-        self._check()
-        return self.values[(str(mode), number)]
+    # --- what the drive is -------------------------------------------------------------------
+    @property
+    def capabilities(self) -> Capabilities:
+        return self._capabilities
 
-    def write_parameter(self, mode, number, value):
+    @capabilities.setter
+    def capabilities(self, capabilities: Capabilities) -> None:
+        self._capabilities = capabilities
+
+    def without(self, *commands: Command) -> FakeDriveClient:
+        """The same fake lacking ``commands`` (e.g. the parameter commands); returns self."""
+        self._capabilities = Capabilities(self._capabilities.commands - set(commands), True, True)
+        return self
+
+    def detect_capabilities(self) -> Capabilities:
         self._check()
-        key = (str(mode), number)
+        return self._capabilities
+
+    def identify(self) -> Identity | None:
+        self._check()
+        return Identity("HA-655-2-200", "FHA-25C-50-US250", "fake 1.0")
+
+    # --- parameters ----------------------------------------------------------------------------
+    def read_parameter(self, mode: Mode | str, number: int) -> int:
+        mode = Mode(mode)
+        if mode is Mode.MONITOR:
+            return self.read_monitor(number)
+        self._check(Command.PRD)
+        try:
+            return self.values[(mode.value, number)]
+        except KeyError:
+            raise CommandRejected(f"{mode.value} {number}: no such item (x)") from None
+
+    def read_all_parameters(self, mode: Mode | str) -> dict[int, int | None]:
+        values: dict[int, int | None] = {}
+        for item in self.model.in_mode(mode):
+            try:
+                values[item.number] = self.read_parameter(item.mode, item.number)
+            except CommandRejected:
+                values[item.number] = None
+        return values
+
+    def write_parameter(self, mode: Mode | str, number: int, value: int) -> WriteResult:
+        mode = Mode(mode)
+        self._check(Command.PRD, Command.PWR)
         item = self.model.item(mode, number)
-        if str(mode) == "system" and self.servo_on:
-            raise ServoOnRefused("servo on")
+        if not item.writable:
+            raise ParameterValueError(f"{item.label} is read-only")
         item.check(value)
-        old = self.values[key]
+        if mode is Mode.SYSTEM and self.servo_on:
+            raise ServoOnRefused("PWR: refused, the servo is on (not processed)")
+        key = (mode.value, number)
+        previous = self.values[key]
         self.values[key] = value
         if not item.restart_required:
             self.effective[key] = value
-        return {
-            "old": old,
-            "read_back": self.values[key],
-            "verified": True,
-            "restart_required": item.restart_required,
-        }
+        message = f"{item.label} = {item.format(value)}"
+        if item.restart_required and previous != value:
+            message += " (takes effect after a power cycle)"
+        return WriteResult(item, value, previous, value, Held.NEW, message)
 
-    def alarm(self):
-        self._check()
-        return self.alarm_code
+    # --- monitors ------------------------------------------------------------------------------
+    def _monitor_wire(self, item: int) -> int:
+        if item == _FEEDBACK_POSITION:
+            return int(self.position_pulse)
+        if item == _OUTPUT_SPEED:
+            return round(self.jog_speed_rpm / self.model.item(Mode.MONITOR, item).scale)
+        if item == _MOTOR_CURRENT:
+            return round((0.5 if self.jog_speed_rpm else 0.0) / self.model.item(Mode.MONITOR, item).scale)
+        if item == _IO_STATE:
+            return self._io_bits()
+        raise CommandRejected(f"MON{item:+06d}: rejected by the drive (x)")
 
-    def alarm_history(self):
-        self._check()
-        return list(self.history)
+    def read_monitor(self, item: int) -> int:
+        self._check(Command.MON)
+        return self._monitor_wire(item)
 
-    def raise_alarm(self, code):
-        self.alarm_code = code
-        self.servo_on = False
-        self.history.insert(0, (code, 123.0))
+    def read_monitors(self, items: Iterable[int]) -> dict[int, int]:
+        self._check(Command.MON)
+        return {i: self._monitor_wire(i) for i in sorted(set(items))}
 
-    def clear_alarm(self):
-        self._check()
-        if self.alarm_code not in (0, 20, 60):
-            raise CommandRejected("needs a power cycle")
-        self.alarm_code = 0
-
-    def io_state(self):
-        self._check()
-        bits = int(self.servo_on) | (1 << 1) | (bool(self.alarm_code) << 2) | self.inputs
-        if self.jog_speed:
-            bits |= 1 << 15
-        return bits
-
-    def read_monitors(self, items):
-        self._check()
-        return {100: int(self.position), 103: self.jog_speed, 104: 0.5 if self.jog_speed else 0.0}
-
-    def servo(self, on):
-        self._check()
+    # --- motion --------------------------------------------------------------------------------
+    def servo(self, on: bool) -> None:
+        self._check(Command.SVO)
         if on and self.alarm_code:
-            raise CommandRejected("alarm active")
+            raise CommandRejected("SVO+00001: rejected by the drive (x)")
         self.servo_on = bool(on)
 
-    def jog(self, speed_rpm):
-        self._check()
+    def jog(self, speed_rpm: float) -> None:
+        self._check(Command.JOG)
         if not self.servo_on:
-            raise CommandRejected("servo off")
+            raise CommandRejected("JOG: rejected by the drive (x)")
         self.calls.append(("jog", speed_rpm))
-        self.jog_speed = speed_rpm
-        self.jog_until = time.monotonic() + 0.1
+        self.jog_speed_rpm = speed_rpm
+        self.jog_until = time.monotonic() + p.JOG_HOLD_S
 
-    def stop(self):
-        self._check()
-        self.calls.append(("stop",))
-        self.jog_speed = 0.0
+    def set_move_speed(self, speed_rpm: float) -> None:
+        if speed_rpm <= 0:
+            raise ValueError(f"move speed must be positive, got {speed_rpm} r/min")
+        self._check(Command.SPD)
+        self.move_speed_rpm = speed_rpm
 
-    def set_move_speed(self, speed_rpm):
-        self._check()
-
-    def move_by(self, angle_deg):
-        self._check()
+    def move_by(self, angle_deg: float) -> None:
+        self._check(Command.MOV)
         if not self.servo_on:
-            raise CommandRejected("servo off")
-        self.position += angle_deg / 360 * 1_000_000
+            raise CommandRejected("MOV: rejected by the drive (x)")
+        self.position_pulse += angle_deg / 360 * 1_000_000
 
-    def power_cycle(self):
-        self._check()
+    def stop(self) -> None:
+        self._check(Command.STP)
+        self.calls.append(("stop",))
+        self.jog_speed_rpm = 0.0
+
+    # --- alarms and I/O ------------------------------------------------------------------------
+    def alarm(self) -> int:
+        self._check(Command.ALM)
+        return self.alarm_code
+
+    def alarm_history(self) -> list[AlarmRecord]:
+        self._check(Command.AHS)
+        return list(self.history)
+
+    def raise_alarm(self, code: int) -> None:
+        """The drive's supervision raises alarm ``code`` (servo off, history entry)."""
+        self.alarm_code = code
+        self.servo_on = False
+        self.history.insert(0, AlarmRecord(code, 123))
+
+    def clear_alarm(self) -> None:
+        self._check(Command.ACL)
+        if self.alarm_code not in (0, 20, 60):
+            raise CommandRejected("ACL: rejected by the drive (x): needs a power cycle")
+        self.alarm_code = 0
+
+    def _io_bits(self) -> int:
+        bits = self.inputs | 1 << IoBit.READY
+        bits |= int(self.servo_on) << IoBit.SERVO_ON | int(bool(self.alarm_code)) << IoBit.ALARM
+        if self.jog_speed_rpm:
+            bits |= 1 << IoBit.MOVING
+        return bits
+
+    def io_state(self) -> IoState:
+        self._check(Command.IOS)
+        return IoState(self._io_bits())
+
+    def set_inputs(self, **inputs: bool) -> IoState:
+        unknown = sorted(set(inputs) - set(INPUT_NAMES))
+        if unknown:
+            raise ValueError(f"unknown inputs {unknown}")
+        self._check(Command.INP, Command.IOS)
+        for name, on in inputs.items():
+            bit = 1 << INPUT_NAMES[name]
+            self.inputs = (self.inputs | bit) if on else (self.inputs & ~bit)
+        return IoState(self._io_bits())
+
+    def power_cycle(self) -> None:
+        self._check(Command.PWC)
         if self.servo_on:
-            raise ServoOnRefused("servo on")
+            raise ServoOnRefused("PWC: refused, the servo is on (not processed)")
         self.effective = dict(self.values)
-        if self.alarm_code:
-            self.alarm_code = 0
+        self.alarm_code = 0
+
+    def inject_alarm(self, code: int) -> None:
+        self._check(Command.FLT)
+        self.raise_alarm(code)
+
+    def set_sensor_angle(self, which: str, angle_deg: float) -> None:
+        self._check(Command.SNO, Command.SNA, Command.SNB)
+
+    def sensor_angles(self) -> dict[str, float]:
+        self._check(Command.SNQ)
+        return {}
+
+    # --- the documented commands ------------------------------------------------------------
+    def absolute_position(self) -> int:
+        self._check(Command.DGR)
+        if self.servo_on:
+            raise ServoOnRefused("DGR: refused, the servo is on (not processed)")
+        return int(self.position_pulse)
+
+    def clear_multiturn(self) -> None:
+        self._check(Command.OWW)
+        if self.servo_on:
+            raise CommandRejected("OWW: rejected by the drive (x)")
+
+    # --- trace capture (not modelled: a drive without the extension) --------------------------
+    def configure_trace(
+        self,
+        channels: Iterable[int],
+        *,
+        divider: int = 1,
+        trigger: p.TriggerKind = p.TriggerKind.IMMEDIATE,
+        trigger_channel: int = 0,
+        trigger_level: int = 0,
+        pre_trigger: int = 0,
+    ) -> tuple[int, ...]:
+        self._check(Command.TCH)
+        return ()
+
+    def arm_trace(self, samples: int) -> None:
+        self._check(Command.TAR)
+
+    def trace_status(self) -> TraceStatus:
+        self._check(Command.TST)
+        return TraceStatus(p.TraceState.IDLE, 0)
+
+    def read_trace_block(self, block: int, count: int) -> list[tuple[int, ...]]:
+        self._check(Command.TRB)
+        return []
+
+    def read_trace(self, should_abort: Callable[[], bool] | None = None) -> TraceCapture:
+        self._check(Command.TRB)
+        return TraceCapture((), ())

@@ -10,6 +10,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from fha_studio.gui.link import Cmd
+from fha_studio.hardware.protocol import Command
 from tests.gui.fake_drive import FakeDriveClient
 
 
@@ -129,8 +130,7 @@ def test_closing_with_the_servo_on_asks_and_cancel_keeps_the_window(window, fake
 
 
 def test_drive_without_parameter_access_says_so(make_window, qtbot):
-    fake = FakeDriveClient()
-    fake.capabilities.parameters = False
+    fake = FakeDriveClient().without(Command.PRD, Command.PWR)
     window = make_window(open_client=lambda url, baud: fake, connect="fake://")
     page = window.parameters_page
     assert "front panel" in page.message.text()

@@ -136,9 +136,9 @@ def test_inputs_shown_live(window, qtbot):
     page = window.show_page("jog")
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SET_INPUTS):
         window.link.send(Cmd.SET_INPUTS, {"fwd_inhibit": True})
-    from fha_studio.gui.link import IO_FWD_INHIBIT
+    from fha_studio.hardware.protocol import IoBit
 
-    qtbot.waitUntil(lambda: page.signal_lamps[IO_FWD_INHIBIT].state is True, timeout=3000)
+    qtbot.waitUntil(lambda: page.signal_lamps[IoBit.FWD_INHIBIT].state is True, timeout=3000)
 
 
 def test_alarm_raised_highlighted_acknowledged_cleared(window, qtbot):

@@ -121,3 +121,13 @@ def test_malformed_item_is_reported_with_file_and_item(tmp_path, monkeypatch):
     monkeypatch.setattr(P, "resource", lambda *parts: tmp_path.joinpath(*parts))
     with pytest.raises(P.ParameterFileError, match=r"ha655-parameters.toml: item #1 \(tune 0 k\).*minimum"):
         P.load_parameter_model()
+
+
+def test_named_monitor_items_are_the_parameter_models():
+    from fha_studio.hardware.parameters import MonitorItem
+
+    model = P.load_parameter_model()
+    for item in MonitorItem:
+        assert model.item("monitor", item).key == item.name.lower()
+    extension = {i.number for i in model.in_mode("monitor") if i.number >= 100}
+    assert extension == {int(i) for i in MonitorItem}

@@ -20,6 +20,7 @@ from PySide6.QtWidgets import (
 
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
 from fha_studio.gui.session import Session
+from fha_studio.hardware.api import AlarmRecord
 
 _TABLES: dict[str, object] = {}
 
@@ -62,7 +63,7 @@ class AlarmsPage(QWidget):
         self.current_code: int | None = None
         self.unacknowledged: int | None = None
         self._appeared_at: dict[int, float] = {}
-        self._seen_at: dict[tuple[int, int | None], float | None] = {}
+        self._seen_at: dict[tuple[int, int], float | None] = {}
         layout = QVBoxLayout(self)
 
         current_box = QGroupBox("Current alarm")
@@ -227,15 +228,11 @@ class AlarmsPage(QWidget):
         self.sigAlarmAttention.emit(code or 0, False)
         self._show(self.current_code)
 
-    def _fill_history(self, history) -> None:
-        entries = list(history)
-        self.history_table.setRowCount(len(entries))
-        for row, entry in enumerate(entries):
-            code = int(getattr(entry, "code", entry[0] if isinstance(entry, (tuple, list)) else entry))
-            seconds = getattr(entry, "seconds_since_power_on", None)
-            if seconds is None and isinstance(entry, (tuple, list)) and len(entry) > 1:
-                seconds = entry[1]
-            key = (code, None if seconds is None else round(float(seconds)))
+    def _fill_history(self, history: list[AlarmRecord]) -> None:
+        self.history_table.setRowCount(len(history))
+        for row, entry in enumerate(history):
+            code, seconds = entry.code, entry.seconds_since_power_on
+            key = (code, seconds)
             if key not in self._seen_at:
                 # the drive keeps time since its power-on only; the PC's clock is known for alarms
                 # FHA Studio saw appear, and only for the newest entry of that code
@@ -254,10 +251,7 @@ class AlarmsPage(QWidget):
         self.history_table.resizeColumnToContents(3)
 
 
-def _duration(seconds: float | None) -> str:
-    if seconds is None:
-        return "—"
-    seconds = int(seconds)
+def _duration(seconds: int) -> str:
     h, rest = divmod(seconds, 3600)
     m, s = divmod(rest, 60)
     return f"{h} h {m:02d} min {s:02d} s" if h else f"{m} min {s:02d} s"

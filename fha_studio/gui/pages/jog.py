@@ -15,23 +15,23 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui import link as L
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
 from fha_studio.gui.session import Session
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, space_jogs_only
+from fha_studio.hardware.protocol import IoBit
 
 #: (I/O bit, caption, colour when on) of the inputs and outputs shown live.
 LIVE_SIGNALS = (
-    (L.IO_READY, "Ready", GREEN),
-    (L.IO_IN_POSITION, "In position", GREEN),
-    (L.IO_MOVING, "Moving", AMBER),
-    (L.IO_BRAKE_RELEASED, "Brake released", AMBER),
-    (L.IO_FWD_INHIBIT, "FWD inhibit", RED),
-    (L.IO_REV_INHIBIT, "REV inhibit", RED),
-    (L.IO_LIMIT_CW, "Limit switch 2 (CW end)", RED),
-    (L.IO_LIMIT_CCW, "Limit switch 1 (CCW end)", RED),
-    (L.IO_ORIGIN, "Origin sensor", AMBER),
-    (L.IO_ALARM, "Alarm output", RED),
+    (IoBit.READY, "Ready", GREEN),
+    (IoBit.IN_POSITION, "In position", GREEN),
+    (IoBit.MOVING, "Moving", AMBER),
+    (IoBit.BRAKE_RELEASED, "Brake released", AMBER),
+    (IoBit.FWD_INHIBIT, "FWD inhibit", RED),
+    (IoBit.REV_INHIBIT, "REV inhibit", RED),
+    (IoBit.LIMIT_SWITCH_2, "Limit switch 2 (CW end)", RED),
+    (IoBit.LIMIT_SWITCH_1, "Limit switch 1 (CCW end)", RED),
+    (IoBit.ORIGIN_SENSOR, "Origin sensor", AMBER),
+    (IoBit.ALARM, "Alarm output", RED),
 )
 
 
@@ -160,7 +160,7 @@ class JogPage(QWidget):
         l_layout.addRow("Output position:", self.position_label)
         l_layout.addRow("Output speed:", self.speed_label)
         l_layout.addRow("Motor current:", self.current_label)
-        self.signal_lamps: dict[int, Lamp] = {}
+        self.signal_lamps: dict[IoBit, Lamp] = {}
         for bit, caption, colour in LIVE_SIGNALS:
             lamp = Lamp(caption, colour)
             self.signal_lamps[bit] = lamp

@@ -8,7 +8,8 @@ import subprocess
 
 import pytest
 
-from fha_studio.gui.link import IO_BRAKE_RELEASED, Cmd
+from fha_studio.gui.link import Cmd
+from fha_studio.hardware.protocol import IoBit
 from fha_studio.logic.procedures import Session
 from tests.procedures.walk import good_answer
 
@@ -95,7 +96,7 @@ def test_trainee_walks_inspection_and_wiring_with_a_failed_check_and_a_resume(wi
         if step.id in ("brake-releases", "brake-holds"):
             want = step.id == "brake-releases"
             window.link.send(Cmd.SET_INPUTS, {"brake_released": want})
-            qtbot.waitUntil(lambda: window.link.status.bit(IO_BRAKE_RELEASED) is want, timeout=15000)
+            qtbot.waitUntil(lambda: window.link.status.bit(IoBit.BRAKE_RELEASED) is want, timeout=15000)
 
     _walk(page, qtbot, "wiring", before=trainee)
     wiring = Session.load(path).runs["wiring"]
@@ -168,7 +169,7 @@ def test_from_boxed_actuator_to_signed_report(make_window, qtbot, tmp_path):
             assert page.sim_brake_check.isVisibleTo(page)
             want = step.id == "brake-releases"
             page.sim_brake_check.setChecked(want)
-            qtbot.waitUntil(lambda: window.link.status.bit(IO_BRAKE_RELEASED) is want, timeout=15000)
+            qtbot.waitUntil(lambda: window.link.status.bit(IoBit.BRAKE_RELEASED) is want, timeout=15000)
 
     for procedure_id in ("receiving-inspection", "installation", "wiring", "rotary-direction"):
         _walk(page, qtbot, procedure_id, before=trainee)

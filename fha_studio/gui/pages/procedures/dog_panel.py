@@ -20,8 +20,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui.link import IO_BRAKE_RELEASED, IO_LIMIT_CCW, IO_LIMIT_CW, IO_ORIGIN, Cmd, DriveStatus
+from fha_studio.gui.link import Cmd, DriveStatus
 from fha_studio.gui.widgets import AMBER, Lamp
+from fha_studio.hardware.api import IoState
 from fha_studio.logic.procedures.sensor_dogs import SENSOR_NAMES, MoveRefused, SensorDogWizard
 
 #: Output speed of the jog buttons (r/min): low, as 4-7-2 (4) asks for finding the origin.
@@ -149,10 +150,11 @@ class SensorDogPanel(QWidget):
         self.observe(angle, status.io_bits)
 
     def observe(self, angle_deg: float, io_bits: int) -> None:
+        io = IoState(io_bits)
         states = {
-            "limit_switch_1": bool(io_bits >> IO_LIMIT_CCW & 1),
-            "limit_switch_2": bool(io_bits >> IO_LIMIT_CW & 1),
-            "origin_sensor": bool(io_bits >> IO_ORIGIN & 1),
+            "limit_switch_1": io.limit_switch_1,
+            "limit_switch_2": io.limit_switch_2,
+            "origin_sensor": io.origin_sensor,
         }
         switched = self.wizard.observe(angle_deg, states)
         self.angle_label.setText(f"Output angle: {angle_deg:+.2f}°")
@@ -160,7 +162,7 @@ class SensorDogPanel(QWidget):
             lamp.set_state(states[name])
         if self.brake_check.isVisible():
             self.brake_check.blockSignals(True)
-            self.brake_check.setChecked(bool(io_bits >> IO_BRAKE_RELEASED & 1))
+            self.brake_check.setChecked(io.brake_released)
             self.brake_check.blockSignals(False)
         if self.sensor in switched:
             self.found_label.setText(f"{SENSOR_NAMES[self.sensor]} switched on at {angle_deg:+.2f}°")

@@ -35,8 +35,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui.link import IO_BRAKE_RELEASED, Cmd, CommandResult, DriveStatus
+from fha_studio.gui.link import Cmd, CommandResult, DriveStatus
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
+from fha_studio.hardware.protocol import IoBit
 from fha_studio.logic.procedures import (
     Observation,
     Procedure,
@@ -403,7 +404,7 @@ class ProceduresPage(QWidget):
 
     @Slot(object)
     def _on_status(self, status: DriveStatus) -> None:
-        released = status.bit(IO_BRAKE_RELEASED)
+        released = status.bit(IoBit.BRAKE_RELEASED)
         if released is not None and self.sim_brake_check.isVisible():
             self.sim_brake_check.blockSignals(True)
             self.sim_brake_check.setChecked(released)

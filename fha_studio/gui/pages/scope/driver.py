@@ -14,12 +14,15 @@ import enum
 import logging
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
+from fha_studio.hardware.api import DriveApi
 from fha_studio.hardware.errors import LinkError, ReadAborted
+from fha_studio.hardware.protocol import TraceState
 from fha_studio.logic.scope.acquisition import (
     LiveMode,
     LiveStatus,
@@ -94,7 +97,7 @@ class ScopeDriver(QObject):
         # The link's STOP event (set in the GUI thread before the STOP is queued): a trace
         # read-out gives up between blocks when it is set, so the STOP does not wait behind it.
         self._should_abort = abort.is_set if abort is not None else None
-        self._client = None
+        self._client: DriveApi | None = None
         self._ratio: int | None = None
         self._poller: PollingAcquisition | None = None
         self._trace: TraceAcquisition | None = None
@@ -103,6 +106,18 @@ class ScopeDriver(QObject):
         self._step_timer: QTimer | None = None
         self._last_status = 0.0
         self._paused_for_test = False
+        #: What each request runs (every ScopeCmd has one; a test checks it).
+        self.handlers: dict[ScopeCmd, Callable[..., None]] = {
+            ScopeCmd.SET_CLIENT: self._do_set_client,
+            ScopeCmd.START: self._do_start,
+            ScopeCmd.STOP: self._do_stop,
+            ScopeCmd.ARM_TRACE: self._do_arm_trace,
+            ScopeCmd.CANCEL_TRACE: self._do_cancel_trace,
+            ScopeCmd.RUN_TEST: self._do_run_test,
+            ScopeCmd.ABORT_TEST: self._do_abort_test,
+            ScopeCmd.CALL: self._do_call,
+            ScopeCmd.SHUTDOWN: self._do_shutdown,
+        }
 
     def _timers(self) -> None:
         # Timers are made on first use, so they belong to the thread the driver lives in.
@@ -118,12 +133,12 @@ class ScopeDriver(QObject):
     def handle(self, request: ScopeRequest) -> None:
         self._timers()
         try:
-            getattr(self, f"_do_{request.cmd.name.lower()}")(*request.args)
+            self.handlers[request.cmd](*request.args)
         except (LinkError, ValueError) as exc:
             self.sigError.emit(str(exc))
 
     # -- commands -------------------------------------------------------------------------------
-    def _do_set_client(self, client, ratio: int | None = None) -> None:
+    def _do_set_client(self, client: DriveApi | None, ratio: int | None = None) -> None:
         self._do_stop()
         self._abort_test("the drive was disconnected")
         self._trace = None
@@ -185,7 +200,7 @@ class ScopeDriver(QObject):
         if quit_thread:
             self.thread().quit()
 
-    def _do_call(self, function) -> None:
+    def _do_call(self, function: Callable[[DriveApi | None], Any]) -> None:
         self.sigCallDone.emit(function(self._client))
 
     def _abort_test(self, why: str) -> None:
@@ -238,7 +253,7 @@ class ScopeDriver(QObject):
     def _step_trace(self) -> None:
         trace = self._trace
         status = trace.status()
-        if status.state.name == "DONE":
+        if status.state is TraceState.DONE:
             seconds = readout_time_s(status.count, len(trace.settings.items()))
             self.sigTraceState.emit(f"reading out {status.count} samples (about {seconds:.0f} s at "
                                     "19200 bit/s)")
@@ -251,7 +266,7 @@ class ScopeDriver(QObject):
                 return
             self.sigTraceDone.emit(result)
             self.sigTraceState.emit(f"done: {len(result.t_s)} samples at {result.sample_rate_hz:g} Hz")
-        elif status.state.name == "ARMED" and trace.ready_for_trigger(status):
+        elif status.state is TraceState.ARMED and trace.ready_for_trigger(status):
             self.sigTraceState.emit(f"armed, waiting for the trigger ({status.count} pre-trigger samples)")
         else:
             self.sigTraceState.emit(f"{status.state.name.lower()}: {status.count} samples")
@@ -305,7 +320,7 @@ class ScopeController(QObject):
     def send(self, cmd: ScopeCmd, *args) -> None:
         self.sigRequest.emit(ScopeRequest(cmd, tuple(args)))
 
-    def attach(self, client, ratio: int | None = None) -> None:
+    def attach(self, client: DriveApi | None, ratio: int | None = None) -> None:
         """Hand the driver a client (it uses it only in its thread); None detaches."""
         self.connected = client is not None
         self.send(ScopeCmd.SET_CLIENT, client, ratio)

@@ -1,0 +1,90 @@
+"""The link worker against the in-memory DriveApi fake: typed results, typed failures, dispatch."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from fha_studio.gui.link import Cmd, CommandResult, LinkController, LinkWorker, NotConnected
+from fha_studio.gui.scope.driver import ScopeCmd, ScopeDriver
+from fha_studio.hardware.api import CommandRejected, DriveRefused, ServoOnRefused
+from tests.gui.fake_drive import FakeDriveClient
+
+
+def test_every_link_command_has_a_handler(qtbot):
+    worker = LinkWorker(threading.Event())
+    assert set(worker.handlers) == set(Cmd)
+
+
+def test_every_scope_command_has_a_handler(qtbot):
+    driver = ScopeDriver()
+    assert set(driver.handlers) == set(ScopeCmd)
+
+
+@pytest.fixture
+def fake():
+    return FakeDriveClient()
+
+
+@pytest.fixture
+def link(qtbot):
+    controllers = []
+
+    def make(open_client=None) -> LinkController:
+        controller = LinkController(open_client=open_client)
+        controllers.append(controller)
+        return controller
+
+    yield make
+    for controller in controllers:
+        assert controller.shutdown(10000)
+
+
+def _result_of(qtbot, link: LinkController, cmd: Cmd, *args) -> CommandResult:
+    token = None
+    with qtbot.waitSignal(link.sigResult, timeout=10000, check_params_cb=lambda r: r.token == token) as got:
+        token = link.send(cmd, *args)
+    return got.args[0]
+
+
+def test_a_command_without_a_link_fails_as_not_connected(qtbot, link):
+    controller = link()
+    result = _result_of(qtbot, controller, Cmd.SERVO, True)
+    assert not result.ok and result.error_type is NotConnected and result.error == "not connected"
+    assert not controller.busy  # STOP without a link answers too: nothing stays pending
+    assert _result_of(qtbot, controller, Cmd.STOP).ok
+    assert not controller.busy
+
+
+def test_failures_carry_the_exception_class(qtbot, link, fake):
+    controller = link(lambda url, baud: fake)
+    with qtbot.waitSignal(controller.sigConnected, timeout=10000):
+        controller.open("fake://")
+    assert _result_of(qtbot, controller, Cmd.SERVO, True).ok
+    refused = _result_of(qtbot, controller, Cmd.POWER_CYCLE)
+    assert refused.error_type is ServoOnRefused and refused.failed_with(DriveRefused)
+    assert "servo is on" in refused.error
+    fake.raise_alarm(71)  # needs a power cycle
+    rejected = _result_of(qtbot, controller, Cmd.CLEAR_ALARM)
+    assert rejected.failed_with(CommandRejected) and not rejected.failed_with(ServoOnRefused)
+
+
+def test_writes_are_reported_from_the_typed_write_result(qtbot, link, fake):
+    controller = link(lambda url, baud: fake)
+    with qtbot.waitSignal(controller.sigConnected, timeout=10000):
+        controller.open("fake://")
+    direction = fake.model.by_key("rotary_direction")
+    result = _result_of(qtbot, controller, Cmd.WRITE_PARAMETERS, [(direction.mode.value, direction.number, 1)])
+    [entry] = result.value
+    assert entry["old"] == 0 and entry["read_back"] == 1 and entry["verified"]
+    assert entry["restart_required"] and "power cycle" in entry["message"]
+
+
+def test_alarm_history_is_alarm_records(qtbot, link, fake):
+    controller = link(lambda url, baud: fake)
+    with qtbot.waitSignal(controller.sigConnected, timeout=10000):
+        controller.open("fake://")
+    fake.raise_alarm(20)
+    result = _result_of(qtbot, controller, Cmd.ALARM_HISTORY)
+    assert [(r.code, r.seconds_since_power_on) for r in result.value] == [(20, 123)]
