@@ -7,7 +7,7 @@ import threading
 import pytest
 
 from fha_studio.gui.link import Cmd, CommandResult, LinkController, LinkWorker, NotConnected
-from fha_studio.gui.scope.driver import ScopeCmd, ScopeDriver
+from fha_studio.gui.pages.scope.driver import ScopeCmd, ScopeDriver
 from fha_studio.hardware.api import CommandRejected, DriveRefused, ServoOnRefused
 from tests.gui.fake_drive import FakeDriveClient
 
@@ -75,7 +75,8 @@ def test_writes_are_reported_from_the_typed_write_result(qtbot, link, fake):
     with qtbot.waitSignal(controller.sigConnected, timeout=10000):
         controller.open("fake://")
     direction = fake.model.by_key("rotary_direction")
-    result = _result_of(qtbot, controller, Cmd.WRITE_PARAMETERS, [(direction.mode.value, direction.number, 1)])
+    writes = [(direction.mode.value, direction.number, 1)]
+    result = _result_of(qtbot, controller, Cmd.WRITE_PARAMETERS, writes)
     [entry] = result.value
     assert entry["old"] == 0 and entry["read_back"] == 1 and entry["verified"]
     assert entry["restart_required"] and "power cycle" in entry["message"]
