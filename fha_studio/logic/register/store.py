@@ -40,6 +40,7 @@ _SOURCE_WORDS = {
     "file": "from a file",
 }
 _COMPLETED = "completed"
+_ORIGIN_PREFIX = "origin: "
 _NOT_APPLICABLE = "not applicable"
 
 
@@ -431,6 +432,30 @@ class Register:
                 "INSERT INTO axis_event (axis_id, at_utc, who, text) VALUES (?, ?, ?, ?)",
                 (current.id, utc_stamp(at_utc), who, f"note: {text}"),
             )
+
+    def record_origin(
+        self, axis: Axis | str | int, text: str, who: str = "", at_utc: str | None = None
+    ) -> None:
+        """Where the axis's origin was set and how, e.g. "multi-turn data cleared (OWW) at
+        +0.00°" or "origin sensor at +1.25°" (goes into its history as "origin: ...")."""
+        current = self.axis(axis)
+        with self._transaction() as db:
+            db.execute(
+                "INSERT INTO axis_event (axis_id, at_utc, who, text) VALUES (?, ?, ?, ?)",
+                (current.id, utc_stamp(at_utc), who, f"{_ORIGIN_PREFIX}{text}"),
+            )
+
+    def latest_origin(self, axis: Axis | str | int) -> dict[str, str] | None:
+        """The latest origin recorded for the axis: {"text", "at_utc", "who"}; None when none was."""
+        current = self.axis(axis)
+        row = self._db.execute(
+            "SELECT * FROM axis_event WHERE axis_id = ? AND text LIKE ?"
+            " ORDER BY at_utc DESC, id DESC LIMIT 1",
+            (current.id, f"{_ORIGIN_PREFIX}%"),
+        ).fetchone()
+        if row is None:
+            return None
+        return {"text": row["text"][len(_ORIGIN_PREFIX) :], "at_utc": row["at_utc"], "who": row["who"]}
 
     def axis(self, ref: Axis | str | int) -> Axis:
         """An axis by id, by ``MACHINE/AXIS``, or by its name alone when only one axis has it."""

@@ -1,0 +1,233 @@
+"""The machine report: a summary table of every axis, then each axis's commissioning report.
+
+The summary says per axis: actuator, driver, rotary direction, origin, checks passed and failed
+(the latest answer to each check), and whether its report is signed. Each axis's report is the
+one :mod:`fha_studio.logic.procedures.report` renders from its session file, so the machine report
+says nothing an axis report does not. Plain HTML (QTextDocument prints it to PDF).
+"""
+
+from __future__ import annotations
+
+import html
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from fha_studio.logic.machine import MachineAxis, MachineProject
+from fha_studio.logic.procedures.report import CommissioningReport, build_report, render_html
+from fha_studio.logic.procedures.session import Session, SessionError, utc_now
+
+#: (mode, number) of the rotary direction item (HA-655 manual, parameter mode 8; FHA-C manual 1-10).
+ROTARY_DIRECTION = ("system", 8)
+
+
+@dataclass(frozen=True)
+class AxisSummary:
+    """One row of the summary table."""
+
+    axis: str
+    actuator: str
+    driver: str
+    direction: str
+    origin: str
+    checks_passed: int
+    checks_failed: int
+    signed: str  # "signed by NAME (time UTC)" or "not signed"
+    is_signed: bool
+    open_warnings: int
+
+
+@dataclass(frozen=True)
+class MachineReport:
+    title: str
+    machine: str
+    site: str
+    created_utc: str
+    summaries: tuple[AxisSummary, ...]
+    axis_reports: tuple[CommissioningReport | None, ...]  # None: the axis has no session yet
+    problems: tuple[str, ...] = ()  # session files that could not be read, one line each
+
+
+def direction_text(value: int | None) -> str:
+    """The rotary direction in the manual's words (1-10 table): "0: FWD command -> FWD rotation
+    (default)"; "not known" when nobody read or entered it."""
+    if value is None:
+        return "not known"
+    from fha_studio.catalog.tables import rotary_direction
+
+    for setting in rotary_direction():
+        if setting.value == value:
+            default = " (default)" if setting.default else ""
+            return f"{value}: FWD command → {setting.fwd_command}{default}"
+    return f"{value}: not a value of the 1-10 table"
+
+
+def _checks(session: Session | None) -> tuple[int, int]:
+    if session is None:
+        return 0, 0
+    latest: dict[tuple[str, str], bool] = {}
+    for state in session.runs.values():
+        for record in state.records:
+            latest[(record.procedure_id, record.step_id)] = bool(record.passed)
+    passed = sum(1 for ok in latest.values() if ok)
+    return passed, len(latest) - passed
+
+
+def _origin(axis: MachineAxis, session: Session | None, register: Any, axis_ref: str) -> str:
+    angles = session.sensor_angles_deg if session is not None else {}
+    if "origin_sensor" in angles:
+        return f"origin sensor at {float(angles['origin_sensor']):+.2f}° (4-7-2)"
+    if register is not None:
+        try:
+            origin = register.latest_origin(axis_ref)
+        except ValueError:
+            origin = None
+        if origin is not None:
+            return f"{origin['text']} ({origin['at_utc'][:16].replace('T', ' ')} UTC)"
+    return "not recorded"
+
+
+def _direction_value(axis: MachineAxis, session: Session | None, register: Any, axis_ref: str) -> int | None:
+    value = axis.state.value_of(*ROTARY_DIRECTION)
+    if value is not None:
+        return value
+    if register is not None:
+        try:
+            known = register.current_values(axis_ref).values.get("rotary_direction")
+        except ValueError:
+            known = None
+        if known is not None:
+            return int(known.value)
+    if session is not None:
+        stored = (session.parameters or {}).get("values", {}).get("rotary_direction")
+        if stored is not None:
+            return int(stored)
+    return None
+
+
+def build_machine_report(
+    project: MachineProject,
+    sessions: Mapping[str, Session | None] | None = None,
+    register: Any = None,
+) -> MachineReport:
+    """The report of ``project``. ``sessions`` maps axis names to their procedure sessions (an
+    axis not in it: its ``session_file`` is read, when it has one); ``register`` (optional) gives
+    values and origins recorded there."""
+    sessions = dict(sessions or {})
+    summaries, reports, problems = [], [], []
+    for axis in project:
+        session = sessions.get(axis.name)
+        if axis.name not in sessions and axis.session_file is not None:
+            try:
+                session = Session.load(axis.session_file)
+            except SessionError as exc:
+                problems.append(f"axis {axis.name}: {exc}")
+        ref = f"{project.name}/{axis.name}"
+        report = build_report(session) if session is not None else None
+        passed, failed = _checks(session)
+        signature = session.signature if session is not None else {}
+        if signature:
+            signed = f"signed by {signature['who']} ({signature['at_utc'][:16].replace('T', ' ')} UTC)"
+        else:
+            signed = "not signed"
+        driver = axis.driver_model or (session.driver.get("model", "") if session is not None else "")
+        summaries.append(
+            AxisSummary(
+                axis=axis.name,
+                actuator=axis.actuator_code or (session.actuator_code if session is not None else ""),
+                driver=driver,
+                direction=direction_text(_direction_value(axis, session, register, ref)),
+                origin=_origin(axis, session, register, ref),
+                checks_passed=passed,
+                checks_failed=failed,
+                signed=signed,
+                is_signed=bool(signature),
+                open_warnings=len(report.warnings) if report is not None else 0,
+            )
+        )
+        reports.append(report)
+    return MachineReport(
+        title=f"Machine report — {project.name}",
+        machine=project.name,
+        site=project.site,
+        created_utc=utc_now(),
+        summaries=tuple(summaries),
+        axis_reports=tuple(reports),
+        problems=tuple(problems),
+    )
+
+
+_STYLE = re.compile(r"<style>(.*?)</style>", re.S)
+_BODY = re.compile(r"<body>(.*)</body>", re.S)
+
+
+def _e(value: Any) -> str:
+    return html.escape("" if value is None else str(value))
+
+
+def render_machine_html(report: MachineReport) -> str:
+    """The machine report as one HTML document: summary table, then every axis's report."""
+    axis_html = [render_html(r) if r is not None else "" for r in report.axis_reports]
+    style = next((m.group(1) for h in axis_html if (m := _STYLE.search(h))), "")
+    if not style:
+        style = _fallback_style()
+    out = [
+        f"<html><head><meta charset='utf-8'><title>{_e(report.title)}</title>",
+        f"<style>{style}</style></head><body>",
+        f"<h1>{_e(report.title)}</h1>",
+        f"<p>Site: {_e(report.site) or 'not given'} — {len(report.summaries)} axes — "
+        f"written {_e(report.created_utc[:16].replace('T', ' '))} UTC</p>",
+        "<h2>Axes</h2>",
+    ]
+    head = [
+        "Axis",
+        "Actuator",
+        "Driver",
+        "Rotary direction",
+        "Origin",
+        "Checks passed",
+        "Checks failed",
+        "Report",
+    ]
+    rows = []
+    for s in report.summaries:
+        failed = f"<span class='fail'>{s.checks_failed}</span>" if s.checks_failed else "0"
+        signed = (
+            f"<span class='pass'>{_e(s.signed)}</span>"
+            if s.is_signed
+            else f"<span class='warn'>{_e(s.signed)}</span>"
+        )
+        rows.append(
+            [
+                _e(s.axis),
+                _e(s.actuator),
+                _e(s.driver),
+                _e(s.direction),
+                _e(s.origin),
+                str(s.checks_passed),
+                failed,
+                signed,
+            ]
+        )
+    header = "".join(f"<th>{h}</th>" for h in head)
+    body = "".join("<tr>" + "".join(f"<td>{c}</td>" for c in row) + "</tr>" for row in rows)
+    out.append(f"<table width='100%'><tr>{header}</tr>{body}</table>")
+    if report.problems:
+        out.append("<ul>" + "".join(f"<li class='warn'>{_e(p)}</li>" for p in report.problems) + "</ul>")
+    for summary, axis_report, text in zip(report.summaries, report.axis_reports, axis_html, strict=True):
+        out.append(f"<h1 style='page-break-before: always'>Axis {_e(summary.axis)}</h1>")
+        if axis_report is None:
+            out.append("<p class='warn'>No procedure session for this axis yet: nothing was checked.</p>")
+            continue
+        match = _BODY.search(text)
+        out.append(match.group(1) if match else text)
+    out.append("</body></html>")
+    return "\n".join(out)
+
+
+def _fallback_style() -> str:
+    # no axis has a report: the axis report's style, taken from an empty session's report
+    sample = render_html(build_report(Session(actuator_code="FHA-25C-50-US250")))
+    match = _STYLE.search(sample)
+    return match.group(1) if match else ""
