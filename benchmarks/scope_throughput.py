@@ -10,6 +10,11 @@ Run: QT_QPA_PLATFORM=offscreen python benchmarks/scope_throughput.py [--seconds 
    compared with the bound for the replies actually seen (``PollingAcquisition.limit_hz``).
 2. View: a producer thread writes 4 channels at 1 kHz into the ring (as a fast acquisition
    would); the view shows a 60 s time base (240 000 points), peak downsampling, clip to view.
+3. GUI: the main window on the paced simulated drive, the Scope page showing and plotting its
+   default channels; samples/s against the line's limit, as a user sees it.
+
+"% of the limit" counts every character on the line (a bus monitor on the client): the samples'
+share of the line time the other exchanges (the held JOG, the window's status poll) leave free.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ from PySide6.QtWidgets import QApplication
 
 from fha_studio.gui.pages.scope.driver import LiveStarted, ScopeCmd, ScopeController
 from fha_studio.gui.pages.scope.view import ScopeContext, ScopeView
+from fha_studio.hardware import protocol as p
 from fha_studio.hardware.client import DriveClient
 from fha_studio.logic.scope.acquisition import LiveMode, estimated_rate_hz
 from fha_studio.logic.scope.ring import RingBuffer
@@ -46,6 +52,25 @@ def cpu_s() -> float:
     return t.user + t.system
 
 
+class LineCounter:
+    """Counts the characters on the line (both ways) through the client's bus-monitor hook."""
+
+    def __init__(self) -> None:
+        self.chars = 0
+
+    def __call__(self, sending: bool, data: bytes) -> None:
+        self.chars += len(data)
+
+
+def pct_of_limit(samples: int, seconds: float, limit_hz: float, line_chars: int) -> float:
+    """Samples per second as a percentage of what the line could carry in the time the other
+    exchanges left free: ``samples * sample_line_time / (seconds - other_line_time)``."""
+    char_s = p.character_time_s()
+    sample_line_s = samples / limit_hz
+    other_line_s = max(0.0, line_chars * char_s - sample_line_s)
+    return 100.0 * sample_line_s / max(1e-9, seconds - other_line_s)
+
+
 def polling(keys: tuple[str, ...], seconds: float, jog_rpm: float) -> dict:
     client = DriveClient.open(f"sim://{ACTUATOR}")  # paced like the real line
     controller = ScopeController()
@@ -53,6 +78,8 @@ def polling(keys: tuple[str, ...], seconds: float, jog_rpm: float) -> dict:
     view.resize(1200, 700)
     view.show()
     jog = QTimer()
+    counter = LineCounter()
+    client.trace_packet = counter
     try:
         controller.attach(client, 50)
         for c in view.all_channels:
@@ -63,14 +90,15 @@ def polling(keys: tuple[str, ...], seconds: float, jog_rpm: float) -> dict:
             jog.start(40)  # the held jog button: JOG every 40 ms (it shares the line)
         view.start_live()
         run_for(1.0)  # settle: first replies, speed reached
-        status0 = view._status
+        status0, chars0, t0 = view._status, counter.chars, time.monotonic()
         run_for(seconds)
-        status = view._status
+        status, chars, elapsed = view._status, counter.chars - chars0, time.monotonic() - t0
         jog.stop()
-        rate = (status.samples - status0.samples) / seconds
+        samples = status.samples - status0.samples
         items = len(controller.driver._poller.items)
-        return {"items": items, "rate": rate, "limit": status.limit_hz, "dropped": status.dropped,
-                "estimate": estimated_rate_hz(items)}
+        return {"items": items, "rate": samples / elapsed, "limit": status.limit_hz,
+                "dropped": status.dropped, "estimate": estimated_rate_hz(items),
+                "pct": pct_of_limit(samples, elapsed, status.limit_hz, chars)}
     finally:
         jog.stop()
         view.shutdown()
@@ -126,6 +154,58 @@ def view_load(seconds: float, rate_hz: float = 1000.0, channels: int = 4, span_s
             "dropped": ring.dropped}
 
 
+def gui_polling(seconds: float) -> dict:
+    """The main window on the paced simulated drive, Scope page showing, live with its default
+    channels: samples/s where the view gets them, against the line's limit."""
+    from fha_studio.gui.link import Cmd
+    from fha_studio.gui.main_window import MainWindow
+
+    window = MainWindow()
+    window.resize(1366, 768)
+    window.show()
+    counter = LineCounter()
+    connected = []
+    window.link.sigConnected.connect(connected.append)
+    window.connect_to(f"sim://{ACTUATOR}")
+    deadline = time.monotonic() + 30
+    while not connected and time.monotonic() < deadline:
+        run_for(0.05)
+    if not connected:
+        raise SystemExit("the GUI did not connect to the simulated drive within 30 s")
+    window.link.send(Cmd.CALL, lambda client: setattr(client, "trace_packet", counter))
+    try:
+        window.show_page("scope")
+        view = window.scope_page.view
+        view.start_live()
+        run_for(1.5)  # settle: first replies, the window's own status poll slowed down
+        status0, chars0, frames0, t0 = view._status, counter.chars, view.frames, time.monotonic()
+        run_for(seconds)
+        status, chars, elapsed = view._status, counter.chars - chars0, time.monotonic() - t0
+        samples = status.samples - status0.samples
+        return {"items": len(view._live.channels), "rate": samples / elapsed, "limit": status.limit_hz,
+                "dropped": status.dropped, "fps": (view.frames - frames0) / elapsed,
+                "pct": pct_of_limit(samples, elapsed, status.limit_hz, chars)}
+    finally:
+        window._closing_confirmed = True
+        window.close()
+        window.shutdown()
+
+
+def isolate_settings() -> None:
+    """Keep the user's settings and data out of a benchmark (QSettings and XDG paths in a temp dir)."""
+    import tempfile
+
+    from PySide6.QtCore import QCoreApplication, QSettings
+
+    tmp = tempfile.mkdtemp(prefix="fha-bench-")
+    for fmt in (QSettings.Format.NativeFormat, QSettings.Format.IniFormat):
+        QSettings.setPath(fmt, QSettings.Scope.UserScope, f"{tmp}/settings")
+    QCoreApplication.setOrganizationName("FHA Studio Benchmark")
+    QCoreApplication.setApplicationName("fha-studio-benchmark")
+    os.environ["XDG_CONFIG_HOME"] = f"{tmp}/config"
+    os.environ["XDG_DATA_HOME"] = f"{tmp}/data"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="measuring time per case [s]")
@@ -149,8 +229,12 @@ def main() -> None:
     for name, keys, jog in cases:
         r = polling(keys, args.seconds, jog)
         print(f"  {name}: {r['items']} items, {r['rate']:.1f} samples/s delivered, line limit "
-              f"{r['limit']:.1f}/s for the replies seen ({100 * r['rate'] / r['limit']:.0f} %), "
-              f"dropped {r['dropped']}")
+              f"{r['limit']:.1f}/s for the replies seen ({r['pct']:.0f} % of the line time left by the "
+              f"other exchanges), dropped {r['dropped']}")
+    isolate_settings()
+    g = gui_polling(args.seconds)
+    print(f"  GUI, Scope page showing and plotting: {g['items']} channels, {g['rate']:.1f} samples/s, line "
+          f"limit {g['limit']:.1f}/s ({g['pct']:.0f} %), {g['fps']:.1f} frames/s, dropped {g['dropped']}")
     print("Live view, 4 channels x 60 s at 1 kHz (offscreen, peak downsampling, clip to view)")
     v = view_load(args.seconds)
     print(f"  {v['points']} points on show: {v['fps']:.1f} frames/s (wanted: ~16/s, a pixel per frame), "

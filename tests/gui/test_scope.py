@@ -231,7 +231,7 @@ PACED_URL = f"sim://{ACTUATOR}?paced=1"
 @pytest.mark.slow
 def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_window, qtbot):
     """The read-out of a trace holds the link thread for seconds on a real line; a STOP pressed
-    then must reach the drive at the next TRB block, and the capture is abandoned, not shown."""
+    then must reach the drive at the next block (TRP), and the capture is abandoned, not shown."""
     window = make_window(connect=PACED_URL)
     link = window.link
     page = window.show_page("scope")
@@ -243,11 +243,11 @@ def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_w
     link.send(Cmd.MOVE_BY, 360.0)  # 12 s at 5 r/min: the axis moves through the whole read-out
     qtbot.waitUntil(lambda: link.status is not None and abs(link.status.speed_rpm or 0.0) > 4.0,
                     timeout=5000)
-    # two channels, 1024 samples at the servo rate: 16 blocks, each ~0.5 s of line time
+    # two channels, 2048 samples at the servo rate: 32 packed blocks, each ~0.15 s of line time
     for box in view.trace_channels[2:]:
         box.setCurrentIndex(box.findData(None))
     view.trigger_kind.setCurrentIndex(view.trigger_kind.findData(p.TriggerKind.IMMEDIATE))
-    view.trace_samples.setValue(1024)
+    view.trace_samples.setValue(2048)
     view.trace_rate.setValue(5000)
     view.trace_pre.setValue(0)
     assert len(view.trace_settings().items()) == 2
@@ -256,8 +256,8 @@ def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_w
     sent = []  # requests on the line, seen in the link thread (the client's bus monitor)
     link.send(Cmd.CALL, lambda c: setattr(c, "trace_packet", lambda out, data: out and sent.append(data)))
     view.arm_trace()
-    qtbot.waitUntil(lambda: view.trace_state.text().startswith("reading out 1024 samples"), timeout=10000)
-    qtbot.waitUntil(lambda: sum(b"TRB" in d for d in sent) >= 2, timeout=5000)  # block 0 is in
+    qtbot.waitUntil(lambda: view.trace_state.text().startswith("reading out 2048 samples"), timeout=10000)
+    qtbot.waitUntil(lambda: sum(b"TRP" in d for d in sent) >= 2, timeout=5000)  # block 0 is in
     stops = []
     link.sigResult.connect(lambda r: stops.append((time.monotonic(), r)) if r.cmd is Cmd.STOP else None)
     pressed = time.monotonic()
@@ -265,11 +265,11 @@ def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_w
     qtbot.waitUntil(lambda: bool(stops), timeout=5000)
     arrived, result = stops[0]
     assert result.ok, result.error
-    # one block (~0.5 s) at most, not the ~8 s of the rest of the read-out (generous for a loaded host)
+    # one block (~0.15 s) at most, not the ~5 s of the rest of the read-out (generous for a loaded host)
     assert arrived - pressed < 2.0
     qtbot.waitUntil(lambda: view.trace_state.text().startswith("abandoned by STOP"), timeout=3000)
     read = int(view.trace_state.text().split("(")[1].split(" of ")[0])
-    assert 64 <= read < 1024 and "of 1024 samples read" in view.trace_state.text() and not done
+    assert 64 <= read < 2048 and "of 2048 samples read" in view.trace_state.text() and not done
     qtbot.waitUntil(lambda: link.status is not None and abs(link.status.speed_rpm or 0.0) < 0.1
                     and not link.status.moving, timeout=3000)  # the axis stopped and holds
     assert link.servo_on

@@ -111,9 +111,12 @@ class MiniDrive:
             return OK
         if c is Command.TST:
             return Reply((p.format_values([3 if self.trace_count else 0, self.trace_count]),))
-        if c is Command.TRB:
+        if c in (Command.TRB, Command.TRP):
             first = v * p.TRACE_BLOCK_SAMPLES
-            rows = range(first, min(first + p.TRACE_BLOCK_SAMPLES, self.trace_count))
             width = len(self.trace_channels)
-            return Reply(tuple(p.format_values([i * 10 + k for k in range(width)]) for i in rows))
+            rows = [[i * 10 + k for k in range(width)]
+                    for i in range(first, min(first + p.TRACE_BLOCK_SAMPLES, self.trace_count))]
+            if c is Command.TRP:
+                return Reply(tuple(p.encode_packed_block(rows)))
+            return Reply(tuple(p.format_values(row) for row in rows))
         return X

@@ -178,8 +178,16 @@ def test_sim_only_training_commands(client_for, mini):
     assert mini.moves == [("FLT", 50), ("SNA", -9550)]
 
 
-def test_trace_capture_reads_all_blocks(client_for, mini):
-    client, _ = client_for(mini)
+WITHOUT_PACKED = sorted(c.value for c in p.EXTENSION_COMMANDS if c is not Command.TRP)
+
+
+@pytest.mark.parametrize(("caps", "encoding", "command"), [
+    (None, "packed", "TRP"),  # a drive that lists TRP in CAP
+    (WITHOUT_PACKED, "text", "TRB"),  # an older drive: text blocks only
+])
+def test_trace_capture_reads_all_blocks(client_for, caps, encoding, command):
+    client, drive = client_for(MiniDrive(caps))
+    assert client.trace_encoding == encoding
     assert client.configure_trace([103, 100], divider=2) == (100, 103)
     client.arm_trace(130)
     status = client.trace_status()
@@ -187,6 +195,9 @@ def test_trace_capture_reads_all_blocks(client_for, mini):
     capture = client.read_trace()
     assert len(capture.samples) == 130
     assert capture.column(103)[129] == 1291
+    assert list(capture.column(100)[:3]) == [0, 10, 20]
+    other = "TRB" if command == "TRP" else "TRP"
+    assert drive.commands().count(command) == 3 and drive.commands().count(other) == 0
     with pytest.raises(ValueError, match="channels"):
         client.configure_trace([100, 101, 102, 103, 104])
 
@@ -204,11 +215,11 @@ def test_trace_read_out_block_by_block_gives_up_when_asked(client_for, mini):
         asked.append(len(asked))
         return len(asked) > 2
 
-    before = drive.commands().count("TRB")
+    before = drive.commands().count("TRP")
     with pytest.raises(ReadAborted, match="after 128 of 130 samples") as stopped:
         client.read_trace(should_abort=stop_after_two_blocks)
     assert (stopped.value.done, stopped.value.total) == (128, 130)
-    assert drive.commands().count("TRB") - before == 2  # the third block was never asked for
+    assert drive.commands().count("TRP") - before == 2  # the third block was never asked for
     assert len(client.read_trace(should_abort=lambda: False).samples) == 130  # the link is fine
     with pytest.raises(ReadAborted, match="after 0 of 130"):
         client.read_trace(should_abort=lambda: True)  # a STOP before the read-out: nothing read

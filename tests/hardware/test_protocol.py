@@ -254,5 +254,68 @@ def test_protocol_doc_examples_are_what_the_codec_says():
                 assert messages[-1].corrupt
 
 
+def test_protocol_doc_packed_block_example_is_what_the_codec_says():
+    """The TRP example of docs/protocol.md: its bytes decode to the values the text states, and
+    encoding those values gives exactly its bytes."""
+    doc = (paths.resources_dir().parent / "docs" / "protocol.md").read_text()
+    examples = doc[doc.index("## Examples, byte by byte") : doc.index("## Transports")]
+    start = examples.index("A packed trace block")
+    block = examples[start : examples.index("```", examples.index("```", start) + 3)]
+    text_rows = re.search(r"a capture of 3 samples\s+\(([-0-9, ()]+)\)\.", block).group(1)
+    pairs = re.findall(r"\(?([-0-9]+, [-0-9]+)\)?", text_rows)
+    rows = [tuple(int(v) for v in pair.split(",")) for pair in pairs]
+    assert rows == [(1000, 0), (1010, -150), (1025, -300)]
+    (request_hex,) = re.findall(r"^> ((?:[0-9A-F]{2} )+)", block, flags=re.M)
+    (reply_hex,) = re.findall(r"^< ((?:[0-9A-F]{2} )+)", block, flags=re.M)
+    used, request = decode_request(bytes.fromhex(request_hex))
+    assert used == p.FRAME_LENGTH and request == Request(Command.TRP, 0)
+    messages, pending = feed_all(decode_reply, [bytes.fromhex(reply_hex)])
+    reply = messages[-1]
+    assert pending == b"" and isinstance(reply, Reply) and not reply.corrupt
+    assert p.decode_packed_block(reply.lines, 3, 2) == rows
+    assert Reply(tuple(p.encode_packed_block(rows))).encode() == bytes.fromhex(reply_hex)
+    check = int(re.search(r"Check (\d+) = ", block).group(1))
+    assert p.packed_check(reply.lines[0][:-2]) == check
+
+
 def encode_or_none(request):
     return request.encode() if isinstance(request, Request) else None
+
+
+# --- the packed trace block (TRP) ------------------------------------------------------------
+
+_blocks = st.integers(1, p.TRACE_MAX_CHANNELS).flatmap(
+    lambda c: st.lists(st.tuples(*[st.integers(-(2**31), 2**31 - 1)] * c), min_size=1,
+                       max_size=p.TRACE_BLOCK_SAMPLES))
+
+
+@given(_blocks)
+@settings(max_examples=200, suppress_health_check=[HealthCheck.too_slow])
+def test_packed_block_round_trips_in_printable_lines_that_are_never_a_terminal(rows):
+    lines = p.encode_packed_block(rows)
+    assert p.decode_packed_block(lines, len(rows), len(rows[0])) == rows
+    for line in lines:
+        assert 2 <= len(line) <= p.PACKED_LINE_CHARS and set(line) <= set(p.PACKED_ALPHABET)
+    # through the reply codec: the lines come back as one reply, not cut short by a terminal
+    messages, pending = feed_all(decode_reply, [Reply(tuple(lines)).encode()])
+    assert pending == b"" and messages == [Reply(tuple(lines))]
+
+
+def test_packed_block_refuses_a_changed_character_a_short_block_and_a_foreign_character():
+    rows = [(100 * i, -7 * i, 3, 12345678) for i in range(64)]
+    (line, *rest) = p.encode_packed_block(rows)
+    for k in range(len(line) - 2):  # every single substitution in the first line is seen
+        v = p.PACKED_ALPHABET.index(line[k])
+        changed = line[:k] + p.PACKED_ALPHABET[(v + 1) % 64] + line[k + 1:]
+        with pytest.raises(ValueError, match="check"):
+            p.decode_packed_block([changed, *rest], 64, 4)
+    with pytest.raises(ValueError, match="expected 63 samples x 4 channels"):
+        p.decode_packed_block([line, *rest], 63, 4)
+    with pytest.raises(ValueError, match="alphabet"):
+        p.decode_packed_block(["A,B" + line[3:], *rest], 64, 4)
+
+
+def test_packed_block_of_slow_signals_is_about_one_character_per_value():
+    rows = [(1000 + 2 * i, 5000, i % 3, 0) for i in range(64)]
+    chars = sum(len(line) for line in p.encode_packed_block(rows))
+    assert chars <= 64 * 4 + 8

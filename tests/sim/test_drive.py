@@ -306,6 +306,35 @@ def test_trace_capture_in_blocks(make_drive):
     assert drive.execute("TCH", 0b11111).terminal == "x"  # more than 4 channels
 
 
+def test_packed_trace_blocks_carry_the_text_blocks_values_in_fewer_characters(make_drive):
+    from fha_studio.hardware import protocol as p
+
+    drive = make_drive()
+    assert "TRP" in drive.execute("CAP", 0).lines[0].split()
+    drive.set_servo(True)
+    for cmd, value in (("TCH", 0b11011), ("TDV", 5), ("TTG", 0), ("TPR", 0), ("TAR", 100)):
+        assert drive.execute(cmd, value).terminal == "q", cmd
+    jog_for(drive, 20.0, 0.15)
+    for block, samples in ((0, 64), (1, 36)):
+        text = drive.execute("TRB", block).lines
+        packed = drive.execute("TRP", block).lines
+        assert p.decode_packed_block(packed, samples, 4) == [tuple(p.parse_values(line)) for line in text]
+        assert all(2 <= len(line) <= p.PACKED_LINE_CHARS for line in packed)
+        assert sum(len(line) + 1 for line in packed) * 2 < sum(len(line) + 1 for line in text)
+    assert drive.execute("TRP", 2).terminal == "x"
+
+
+def test_a_drive_from_before_the_packed_encoding_has_no_trp(make_drive):
+    drive = make_drive(packed_trace=False)
+    assert "TRP" not in drive.execute("CAP", 0).lines[0].split()
+    assert "TRB" in drive.execute("CAP", 0).lines[0].split()
+    for cmd, value in (("TCH", 0b1), ("TTG", 0), ("TAR", 10)):
+        drive.execute(cmd, value)
+    drive.advance(0.01)
+    assert drive.execute("TRP", 0).terminal == "x"
+    assert len(drive.execute("TRB", 0).lines) == 10
+
+
 def test_trace_level_trigger_keeps_pretrigger_samples(make_drive):
     drive = make_drive()
     drive.set_servo(True)

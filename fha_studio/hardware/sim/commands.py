@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Final
 
 from fha_studio import __version__ as _version
 from fha_studio.hardware.parameters import Mode
-from fha_studio.hardware.protocol import Command
+from fha_studio.hardware.protocol import Command, encode_packed_block
 from fha_studio.hardware.sim.reply import SimRefused, rejected
 
 if TYPE_CHECKING:
@@ -169,6 +169,10 @@ def _trb(d: SimDrive, value: int) -> list[str]:
     return [",".join(str(v) for v in row) for row in d.trace.block(value)]
 
 
+def _trp(d: SimDrive, value: int) -> list[str]:
+    return encode_packed_block(d.trace.block(value))
+
+
 def _flt(d: SimDrive, value: int) -> None:
     d.raise_alarm(value)
 
@@ -217,6 +221,7 @@ COMMANDS: Mapping[Command, Handler] = {
     Command.TAR: _tar,
     Command.TST: _tst,
     Command.TRB: _trb,
+    Command.TRP: _trp,
     Command.FLT: _flt,
     Command.SNO: _sensor("origin"),
     Command.SNA: _sensor("ls1"),

@@ -84,6 +84,8 @@ class SimDrive:
         elif actuator is not None or options:
             config = config.replace(**({"actuator": actuator} if actuator else {}), **options)
         self.config = config
+        if not config.packed_trace:  # a drive from before the packed encoding: no TRP
+            self.command_table = {c: h for c, h in self.command_table.items() if c is not Command.TRP}
         self.constants = constants or load_sim_constants()
         self.servo_rate_hz = float(servo_rate_hz)
         self._lock = threading.RLock()

@@ -23,6 +23,8 @@ Options (all optional):
 ``quantised``      1 (default): the servo loops see whole encoder pulses (a real drive's current
                    noise); 0: ideal feedback
 ``oww_clear_s``    how long OWW takes to clear the multi-turn data [s] (default 5)
+``packed_trace``   1 (default): trace blocks also in the packed encoding (TRP, listed in CAP);
+                   0: text blocks (TRB) only, as a drive from before the packed encoding
 =================  ==========================================================================
 """
 
@@ -55,6 +57,7 @@ class SimConfig:
     paced: bool = True
     quantised: bool = True
     oww_clear_s: float | None = None
+    packed_trace: bool = True
 
     def __post_init__(self) -> None:
         if not isinstance(self.actuator, str) or not self.actuator.strip():
@@ -121,6 +124,7 @@ def parse_effects(specs: list[str]) -> dict[str, dict[str, float]]:
 _URL_KEYS = {
     "driver", "load_inertia", "load_inertia_kgm2", "brake", "sensors", "origin_deg", "ls1_deg",
     "ls2_deg", "effects", "effect", "eeprom", "paced", "quantised", "oww_clear_s",
+    "packed_trace",
 }
 
 
@@ -148,7 +152,7 @@ def config_from_url(url: str) -> SimConfig:
     inertia = last("load_inertia_kgm2") if last("load_inertia_kgm2") is not None else last("load_inertia")
     if inertia is not None:
         values["load_inertia_kgm2"] = _finite("load_inertia", inertia, minimum=0.0)
-    for key in ("brake", "sensors", "paced", "quantised"):
+    for key in ("brake", "sensors", "paced", "quantised", "packed_trace"):
         if last(key) is not None:
             values[key] = _flag(key, last(key))
     for key in ("origin_deg", "ls1_deg", "ls2_deg", "oww_clear_s"):
