@@ -11,6 +11,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QMainWindow,
     QMessageBox,
+    QPushButton,
     QTabWidget,
     QToolBar,
     QVBoxLayout,
@@ -83,8 +84,12 @@ class MainWindow(QMainWindow):
             spacer.sizePolicy().horizontalPolicy().Expanding, spacer.sizePolicy().verticalPolicy().Preferred
         )
         bar.addWidget(spacer)
-        self.alarm_banner = QLabel("")
+        self.alarm_banner = QPushButton("")
         self.alarm_banner.setObjectName("alarmBanner")
+        self.alarm_banner.setToolTip("Show the alarm, its cause and remedy on the Alarms page")
+        self.alarm_banner.setCursor(Qt.CursorShape.PointingHandCursor)
+        self.alarm_banner.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+        self.alarm_banner.clicked.connect(lambda: self.show_page("alarms"))
         self.alarm_banner_action = bar.addWidget(
             self.alarm_banner
         )  # a toolbar widget shows through its action
@@ -366,7 +371,7 @@ class MainWindow(QMainWindow):
     def _on_alarm_attention(self, code: int, attention: bool) -> None:
         self.alarm_banner_action.setVisible(attention)
         if attention:
-            self.alarm_banner.setText(f"  NEW ALARM {code} — see the Alarms page  ")
+            self.alarm_banner.setText(f"NEW ALARM {code} — show it")
             self.alarm_banner.setStyleSheet(
                 "background: #b00020; color: white; font-weight: bold; border-radius: 4px; padding: 4px;"
             )

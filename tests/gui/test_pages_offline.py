@@ -63,6 +63,8 @@ def test_pairing_warning_must_be_acknowledged(make_window, qtbot):
     window = make_window(open_client=lambda url, baud: fake, connect="fake://")
     page = window.connection_page
     assert not page.warning_pending  # the label's actuator was taken over: no warning
+    assert page.warning_label.isVisible()  # but a positive result, saying what was checked
+    assert page.warning_label.text().startswith("✓ The pair is right: HA-655-2-200 is adjusted for")
     page.actuator_combo.setCurrentText("FHA-32C-50-US250")
     page.check_pairing()
     assert page.warning_pending

@@ -150,6 +150,9 @@ def test_alarm_raised_highlighted_acknowledged_cleared(window, qtbot):
     assert "Remedy" in page.cause_label.text()
     qtbot.waitUntil(lambda: page.history_table.rowCount() >= 1, timeout=3000)
     assert page.history_table.item(0, 0).text() == "20"
+    window.show_page("jog")
+    window.alarm_banner.click()  # the red banner takes the technician to the alarm
+    assert window.tabs.currentWidget() is page
     page.ack_button.click()
     qtbot.waitUntil(lambda: not window.alarm_banner.isVisible(), timeout=1000)
     assert window.alarm_lamp.state is True  # acknowledged is not cleared

@@ -172,7 +172,7 @@ class ConnectionPage(QWidget):
         self.actuator_summary.setText(self._summary(code, result))
         self.session.set_actuator(code, acknowledged=result.ok)
         if result.ok:
-            self._show_warning("")
+            self._show_pairing_ok(code, info)
         else:
             self._show_warning("<br>".join(f"⚠ {w}" for w in result.warnings))
 
@@ -190,6 +190,33 @@ class ConnectionPage(QWidget):
         if result.compatible_drivers:
             text += f" Drivers for it (manual 1-3): {', '.join(result.compatible_drivers)}."
         return text
+
+    def _show_pairing_ok(self, code: str, info: LinkInfo | None) -> None:
+        """A pair that passes says so (green); without the driver's label lines it says what was
+        checked and what is still to check by eye."""
+        if info is not None and info.driver_model and info.adjusted_for:
+            text = (
+                f"✓ The pair is right: {info.driver_model} is adjusted for {info.adjusted_for} and is a "
+                f"driver for {code} in the manual's combination table (1-3)."
+            )
+        elif info is not None and (info.driver_model or info.adjusted_for):
+            told = info.driver_model or f"adjusted for {info.adjusted_for}"
+            text = (
+                f"✓ Nothing wrong found: the drive reports {told}. Compare the other line of the "
+                "driver's label (TYPE and ADJUSTED FOR USE WITH) with the actuator by eye (manual 3-1)."
+            )
+        else:
+            text = (
+                f"✓ {code} is a valid model code. This drive does not report its label: compare the "
+                "driver's TYPE and ADJUSTED FOR USE WITH lines with the actuator by eye (manual 3-1)."
+            )
+        self.warning_label.setText(text)
+        self.warning_label.setVisible(True)
+        self.warning_label.setStyleSheet(
+            "background: #e6f4e7; color: #176b1d; border: 1px solid #5aa65f; padding: 6px; "
+            "border-radius: 4px;"
+        )
+        self.ack_button.setVisible(False)
 
     def _show_warning(self, html: str, can_ack: bool = True) -> None:
         self.warning_label.setText(html)
