@@ -201,3 +201,40 @@ def test_stop_and_failures_are_seen_in_the_message_area_and_kept_in_its_log(wind
     texts = [m.text for m in area.messages]
     assert any(t.startswith("STOP sent") for t in texts) and any(t.startswith("STOP done") for t in texts)
     assert area.log_button.text() == f"Messages ({len(texts)})"
+
+
+def test_parameter_mode_writes_are_prevented_up_front_while_the_servo_is_on(window, qtbot):
+    page = window.show_page("parameters")
+    model = page.model
+    servo_on(window, qtbot)
+    assert model.setData(model.index(model.row_of("position_error_allowance"), 3), "200")
+    qtbot.waitUntil(lambda: page.servo_note.isVisible(), timeout=10000)
+    assert not page.write_changed_button.isEnabled() and not page.write_all_button.isEnabled()
+    assert "servo off" in page.servo_note.text()
+    sent = []
+    window.link.sigCommand.connect(lambda command: sent.append(command.cmd))
+    page.write_changed()  # e.g. a keyboard shortcut: still refused, nothing sent
+    assert Cmd.WRITE_PARAMETERS not in sent and "Nothing written" in page.message.text()
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO, timeout=10000):
+        window.jog_page.servo_off_button.click()
+    qtbot.waitUntil(page.write_changed_button.isEnabled, timeout=10000)
+    assert not page.servo_note.isVisible()
+
+
+def test_after_the_power_cycle_nothing_is_pending(window, qtbot):
+    page = window.show_page("parameters")
+    model = page.model
+    row = model.row_of("rotary_direction")
+    assert model.setData(model.index(row, 3), "1")
+    with qtbot.waitSignal(window.session.sigWritesDone, timeout=10000):
+        page.write_changed()
+    from fha_studio.gui.pages.parameters import COLUMNS
+
+    def state() -> str:
+        return model.data(model.index(row, COLUMNS.index("State")))
+
+    assert "power cycle needed" in state()
+    cycled = lambda r: r.cmd is Cmd.POWER_CYCLE  # noqa: E731
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=cycled, timeout=10000):
+        page.power_cycle_button.click()
+    qtbot.waitUntil(lambda: "power cycle" not in state() and "restart" not in state(), timeout=10000)

@@ -33,6 +33,11 @@ COL_VALUE = 3
 EDITED_BRUSH = QBrush(QColor("#fff1b8"))
 DIFFERS_COLOUR = QColor("#0d47a1")
 MODE_WORDS = {"tune": "tune", "system": "parameter"}
+#: Why the write buttons are off while the servo is on (the driver's rule for parameter mode).
+SERVO_ON_WRITE_REASON = (
+    "The servo is on: parameter-mode items can be written only with the servo off. "
+    "Switch the servo off (toolbar or controller) to write them."
+)
 _ROOT = QModelIndex()
 
 
@@ -144,9 +149,9 @@ class ParameterTableModel(QAbstractTableModel):
         if shown is not None and item.default is not None and shown != item.default:
             words.append("≠ default")
         if key in self.restart_pending:
+            # the item's nature (takes effect at power-on) is in its help, not in its state: after
+            # the power cycle nothing is pending, and the State column must say so
             words.append("power cycle needed")
-        elif item.restart_required:
-            words.append("needs restart")
         return ", ".join(words)
 
     def data(self, index, role=Qt.ItemDataRole.DisplayRole):
@@ -314,6 +319,15 @@ class ParametersPage(QWidget):
         )
         for b in (self.read_button, self.write_changed_button, self.write_all_button, self.revert_button):
             buttons.addWidget(b)
+        for b in (self.write_changed_button, self.write_all_button):
+            b.setProperty("plainToolTip", b.toolTip())
+        self.servo_note = QLabel("")
+        self.servo_note.setObjectName("servoOnWriteNote")
+        self.servo_note.setWordWrap(True)
+        self.servo_note.setStyleSheet("color: #8a5a00; font-weight: bold;")
+        self.servo_note.setVisible(False)
+        self._servo_was_on = False
+        buttons.addWidget(self.servo_note, 1)
         buttons.addStretch(1)
         buttons.addWidget(self.save_button)
         buttons.addWidget(self.load_button)
@@ -403,6 +417,7 @@ class ParametersPage(QWidget):
         self.link.sigConnected.connect(self._on_connected)
         self.link.sigDisconnected.connect(lambda *_: self._update_buttons())
         self.link.sigResult.connect(self._on_result)
+        self.link.sigStatus.connect(self._on_status_for_buttons)
         self.link.sigBusyChanged.connect(lambda _b: self._update_buttons())
         self._update_buttons()
 
@@ -416,12 +431,25 @@ class ParametersPage(QWidget):
         settings.setValue("parameters/splitter", self.splitter.saveState())
 
     # -- actions ------------------------------------------------------------------------------------
+    def _servo_blocks(self, modes) -> bool:
+        """Parameter-mode (system) items are written with the servo off only (the driver refuses
+        them while it is on): say so before anything is sent, not after the drive refused."""
+        return self.link.servo_on and any(str(m) == "system" for m in modes)
+
     def _update_buttons(self) -> None:
         info = self.link.info
         connected = self.link.connected and bool(info and info.can_parameters)
-        for b in (self.read_button, self.write_all_button):
-            b.setEnabled(connected)
-        self.write_changed_button.setEnabled(connected and bool(self.model.edits))
+        self.read_button.setEnabled(connected)
+        all_blocked = self._servo_blocks(["system"])
+        changed_blocked = self._servo_blocks(m for m, _ in self.model.edits)
+        self.write_all_button.setEnabled(connected and not all_blocked)
+        self.write_changed_button.setEnabled(connected and bool(self.model.edits) and not changed_blocked)
+        reason = SERVO_ON_WRITE_REASON if (all_blocked and connected) else ""
+        for b in (self.write_all_button, self.write_changed_button):
+            b.setToolTip(reason or b.property("plainToolTip") or "")
+        self.servo_note.setText(reason if (changed_blocked and connected) else "")
+        self.servo_note.setVisible(bool(changed_blocked and connected))
+        self._servo_was_on = self.link.servo_on
         self.revert_button.setEnabled(bool(self.model.edits))
         self.save_button.setEnabled(bool(self.session.drive_values))
 
@@ -450,14 +478,16 @@ class ParametersPage(QWidget):
     def _write(self, writes) -> None:
         if not writes:
             return
-        if self.link.servo_on and any(m == "system" for m, _, _ in writes):
-            self.message.setText(
-                "Note: parameter (system) items cannot be written while the servo is on; "
-                "the drive will refuse them."
-            )
-        else:
-            self.message.setText(f"Writing {len(writes)} item(s) …")
+        if self._servo_blocks(m for m, _, _ in writes):
+            self.message.setText(f"Nothing written. {SERVO_ON_WRITE_REASON}")
+            return
+        self.message.setText(f"Writing {len(writes)} item(s) …")
         self.session.write(writes)
+
+    @Slot(object)
+    def _on_status_for_buttons(self, status) -> None:
+        if status.servo_on is not None and status.servo_on != self._servo_was_on:
+            self._update_buttons()
 
     @Slot(object)
     def _writes_done(self, entries: list) -> None:
@@ -523,6 +553,7 @@ class ParametersPage(QWidget):
             if result.ok:
                 self.model.restart_pending.clear()
                 self.restart_banner.setVisible(False)
+                self.model._all_changed()  # the State column: nothing pending any more
                 self.message.setText(
                     "Power cycled: the restart-required items are now in effect. Reading back …"
                 )
