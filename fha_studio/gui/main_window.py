@@ -4,6 +4,7 @@ status bar with link, servo, alarm and what the drive supports."""
 from __future__ import annotations
 
 import logging
+from typing import cast
 
 from PySide6.QtCore import QSettings, Qt, Slot
 from PySide6.QtGui import QAction, QKeySequence, QShortcut
@@ -21,6 +22,13 @@ from PySide6.QtWidgets import (
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo
 from fha_studio.gui.messages import Level, MessageArea
 from fha_studio.gui.mnemonics import mnemonic, resolve_mnemonics
+from fha_studio.gui.pages.alarms import AlarmsPage
+from fha_studio.gui.pages.base import Page, PageId
+from fha_studio.gui.pages.connection import ConnectionPage
+from fha_studio.gui.pages.direction import DirectionPage
+from fha_studio.gui.pages.jog import JogPage
+from fha_studio.gui.pages.parameters import ParametersPage
+from fha_studio.gui.pages.registry import PAGES, PageEntry
 from fha_studio.gui.session import DEFAULT_SIM_URL, Session
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton
 
@@ -50,7 +58,7 @@ class MainWindow(QMainWindow):
         self.stop_shortcut.setContext(Qt.ShortcutContext.WindowShortcut)
         self.stop_shortcut.activated.connect(self.stop_axis)
         self.link.sigConnected.connect(self._on_connected)
-        self.link.sigDisconnected.connect(self._on_disconnected)
+        self.link.sigDisconnected.connect(self._on_link_disconnected)
         self.link.sigStatus.connect(self._on_status)
         self.link.sigResult.connect(self._on_result)
         self.session.sigMessage.connect(self._on_session_message)
@@ -99,42 +107,17 @@ class MainWindow(QMainWindow):
         bar.addWidget(self.stop_button)
 
     def _build_pages(self) -> None:
-        from fha_studio.gui.pages.alarms import AlarmsPage
-        from fha_studio.gui.pages.connection import ConnectionPage
-        from fha_studio.gui.pages.direction import DirectionPage
-        from fha_studio.gui.pages.jog import JogPage
-        from fha_studio.gui.pages.parameters import ParametersPage
-
         self.tabs = QTabWidget(self)
         self.tabs.setObjectName("pages")
         self.tabs.setDocumentMode(True)
-        self.connection_page = ConnectionPage(self.session, self)
-        self.parameters_page = ParametersPage(self.session, self)
-        self.direction_page = DirectionPage(self.session, self)
-        self.alarms_page = AlarmsPage(self.session, self)
-        self.jog_page = JogPage(self.session, self)
-        # pages with plots (pyqtgraph, numpy) are built when first shown: start-up stays short
-        self._lazy: dict[str, LazyPage] = {
-            "sizing": LazyPage(self, _sizing_page),
-            "scope": LazyPage(self, _scope_page),
-            "procedures": LazyPage(self, _procedures_page),
-            "modelcheck": LazyPage(self, _modelcheck_page),
-        }
-        for page, title in (
-            (self.connection_page, "C&onnection"),
-            (self.parameters_page, "&Parameters"),
-            (self.direction_page, "&Rotary direction"),
-            (self.alarms_page, "&Alarms"),
-            (self.jog_page, "&Jog && test run"),
-            (self._lazy["sizing"], "Si&zing"),
-            (self._lazy["scope"], "&Scope"),
-            (self._lazy["procedures"], "Proced&ures"),
-            (self._lazy["modelcheck"], "Model chec&k"),
-        ):
-            self.tabs.addTab(page, title)
+        self._tabs: dict[PageId, QWidget] = {}
+        for entry in PAGES:
+            tab = LazyPage(self, entry) if entry.lazy else entry.build(self.session, self)
+            assert isinstance(tab, QWidget)
+            self._tabs[entry.id] = tab
+            self.tabs.addTab(tab, entry.tab_text)
         self.setCentralWidget(self.tabs)
-        for page in (self.connection_page, self.parameters_page, self.direction_page, self.alarms_page,
-                     self.jog_page):
+        for page in self._pages():  # the eager ones; a lazy page does it when it is built
             resolve_mnemonics(page, self.window_mnemonics())
         self.alarms_page.sigAlarmAttention.connect(self._on_alarm_attention)
 
@@ -147,21 +130,55 @@ class MainWindow(QMainWindow):
         letters.discard(None)
         return letters  # type: ignore[return-value]
 
-    @property
-    def sizing_page(self):
-        return self._lazy["sizing"].page
+    def page(self, name: PageId | str) -> Page:
+        """The page ``name`` (a :class:`PageId` or its value), built now if it is a lazy page not
+        yet shown; ValueError naming the pages otherwise."""
+        try:
+            tab = self._tabs[PageId(name)]
+        except ValueError:
+            raise ValueError(f"no page {name!r}; pages: {', '.join(PageId)}") from None
+        return tab.page if isinstance(tab, LazyPage) else cast(Page, tab)
+
+    def built_page(self, name: PageId) -> Page | None:
+        """The page ``name`` if it has been built (a lazy page is built when first shown), else None."""
+        tab = self._tabs[name]
+        return tab.built if isinstance(tab, LazyPage) else cast(Page, tab)
 
     @property
-    def modelcheck_page(self):
-        return self._lazy["modelcheck"].page
+    def connection_page(self) -> ConnectionPage:
+        return cast(ConnectionPage, self.page(PageId.CONNECTION))
 
     @property
-    def scope_page(self):
-        return self._lazy["scope"].page
+    def parameters_page(self) -> ParametersPage:
+        return cast(ParametersPage, self.page(PageId.PARAMETERS))
 
     @property
-    def procedures_page(self):
-        return self._lazy["procedures"].page
+    def direction_page(self) -> DirectionPage:
+        return cast(DirectionPage, self.page(PageId.DIRECTION))
+
+    @property
+    def alarms_page(self) -> AlarmsPage:
+        return cast(AlarmsPage, self.page(PageId.ALARMS))
+
+    @property
+    def jog_page(self) -> JogPage:
+        return cast(JogPage, self.page(PageId.JOG))
+
+    @property
+    def sizing_page(self) -> Page:
+        return self.page(PageId.SIZING)
+
+    @property
+    def scope_page(self) -> Page:
+        return self.page(PageId.SCOPE)
+
+    @property
+    def procedures_page(self) -> Page:
+        return self.page(PageId.PROCEDURES)
+
+    @property
+    def modelcheck_page(self) -> Page:
+        return self.page(PageId.MODELCHECK)
 
     def _build_status_bar(self) -> None:
         bar = self.statusBar()
@@ -194,43 +211,32 @@ class MainWindow(QMainWindow):
         state = settings.value("window/state")
         if state is not None:
             self.restoreState(state)
-        self.tabs.setCurrentIndex(int(settings.value("window/page", 0)))
+        remembered = str(settings.value("window/page", ""))
+        if remembered in set(PageId):  # else none (or one of an older version): the first page
+            self.tabs.setCurrentWidget(self._tabs[PageId(remembered)])
         for page in self._pages():
-            restore = getattr(page, "restore_settings", None)
-            if restore:
-                restore(settings)
+            page.restore_settings(settings)
 
     def save_layout(self) -> None:
         settings = QSettings()
         settings.setValue("window/geometry", self.saveGeometry())
         settings.setValue("window/state", self.saveState())
-        settings.setValue("window/page", self.tabs.currentIndex())
+        current = self.tabs.currentWidget()
+        settings.setValue("window/page", next(str(i) for i, tab in self._tabs.items() if tab is current))
         for page in self._pages():
-            save = getattr(page, "save_settings", None)
-            if save:
-                save(settings)
+            page.save_settings(settings)
 
-    def _pages(self) -> list[QWidget]:
-        """The pages built so far (a lazy page not yet shown has nothing to save or stop)."""
-        pages = []
-        for i in range(self.tabs.count()):
-            widget = self.tabs.widget(i)
-            if isinstance(widget, LazyPage):
-                widget = widget.built
-            if widget is not None:
-                pages.append(widget)
-        return pages
+    def _pages(self) -> list[Page]:
+        """The pages built so far, in tab order (a lazy page not yet shown has nothing to save,
+        stop or tell)."""
+        return [page for entry in PAGES if (page := self.built_page(entry.id)) is not None]
 
-    PAGE_NAMES = ("connection", "parameters", "direction", "alarms", "jog", "sizing", "scope", "procedures",
-                  "modelcheck")
-
-    def show_page(self, name: str) -> QWidget:
-        """Shows the page called `name` (one of PAGE_NAMES); ValueError naming them otherwise."""
-        if name not in self.PAGE_NAMES:
-            raise ValueError(f"no page {name!r}; pages: {', '.join(self.PAGE_NAMES)}")
-        self.tabs.setCurrentIndex(self.PAGE_NAMES.index(name))
-        widget = self.tabs.currentWidget()
-        return widget.page if isinstance(widget, LazyPage) else widget
+    def show_page(self, name: PageId | str) -> Page:
+        """Shows the page ``name`` (a :class:`PageId` or its value) and returns it; ValueError
+        naming the pages otherwise."""
+        page = self.page(name)
+        self.tabs.setCurrentWidget(self._tabs[PageId(name)])
+        return page
 
     # -- actions --------------------------------------------------------------------------------
     @Slot()
@@ -313,6 +319,14 @@ class MainWindow(QMainWindow):
         self.disconnect_action.setEnabled(True)
         self.servo_action.setEnabled(info.can_move)
         self.setWindowTitle(f"FHA Studio — {model} — {where}")
+        for page in self._pages():
+            page.link_connected(info)
+
+    @Slot(str, bool)
+    def _on_link_disconnected(self, reason: str, lost: bool) -> None:
+        self._on_disconnected(reason, lost)
+        for page in self._pages():
+            page.link_disconnected(reason, lost)
 
     @Slot(str, bool)
     def _on_disconnected(self, reason: str, lost: bool) -> None:
@@ -395,69 +409,39 @@ class MainWindow(QMainWindow):
             return
         self._shut_down = True
         for page in self._pages():
-            stop = getattr(page, "shutdown", None)
-            if stop:
-                stop()
+            page.shutdown()
         self.link.shutdown()
 
 
 class LazyPage(QWidget):
-    """A tab whose page is built the first time it is shown (or asked for through `page`).
+    """A tab whose page is built the first time it is shown (or asked for through `page`); the
+    page then gets its saved settings and, if a drive is connected, the connection hook."""
 
-    A page built after the link came up learns of it through its `_on_connected(info)` (the
-    slot it connects to the link's sigConnected), and gets its saved settings restored."""
-
-    def __init__(self, window: MainWindow, factory):
+    def __init__(self, window: MainWindow, entry: PageEntry):
         super().__init__()
         self._window = window
-        self._factory = factory
-        self.built: QWidget | None = None
+        self._entry = entry
+        self.built: Page | None = None
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
 
     @property
-    def page(self) -> QWidget:
+    def page(self) -> Page:
         if self.built is None:
-            page = self._factory(self._window)
+            window = self._window
+            page = self._entry.build(window.session, window)
+            assert isinstance(page, QWidget)
             self.built = page
             resolve_mnemonics(page, self._window.window_mnemonics())
             self.layout().addWidget(page)
-            restore = getattr(page, "restore_settings", None)
-            if restore:
-                restore(QSettings())
-            link = self._window.link
-            on_connected = getattr(page, "_on_connected", None)
-            if link.connected and on_connected is not None:
-                on_connected(link.info)
+            page.restore_settings(QSettings())
+            if window.link.connected and window.link.info is not None:
+                page.link_connected(window.link.info)
         return self.built
 
     def showEvent(self, event) -> None:
         _ = self.page
         super().showEvent(event)
-
-
-def _sizing_page(window: MainWindow) -> QWidget:
-    from fha_studio.gui.pages.sizing import SizingPage
-
-    return SizingPage(window.session, window)
-
-
-def _scope_page(window: MainWindow) -> QWidget:
-    from fha_studio.gui.pages.scope.page import ScopePage
-
-    return ScopePage(window.session, window)
-
-
-def _modelcheck_page(window: MainWindow) -> QWidget:
-    from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
-
-    return ModelCheckPage(window.session, window)
-
-
-def _procedures_page(window: MainWindow) -> QWidget:
-    from fha_studio.gui.pages.procedures.page import ProceduresPage
-
-    return ProceduresPage(window.session, window)
 
 
 def _command_words(cmd: Cmd) -> str:

@@ -15,10 +15,10 @@ from PySide6.QtWidgets import (
     QTableWidget,
     QTableWidgetItem,
     QVBoxLayout,
-    QWidget,
 )
 
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
+from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
 from fha_studio.hardware.api import AlarmRecord
 
@@ -51,7 +51,7 @@ def alarm_text(code: int, driver: str = "HA-655") -> dict:
     }
 
 
-class AlarmsPage(QWidget):
+class AlarmsPage(BasePage):
     """Alarm state, always current while connected."""
 
     sigAlarmAttention = Signal(int, bool)  # code, True while a new alarm waits for acknowledgement
@@ -126,19 +126,15 @@ class AlarmsPage(QWidget):
         self.refresh_button.clicked.connect(lambda: self.link.send(Cmd.ALARM_HISTORY))
         self.link.sigStatus.connect(self._on_status)
         self.link.sigResult.connect(self._on_result)
-        self.link.sigConnected.connect(self._on_connected)
-        self.link.sigDisconnected.connect(self._on_disconnected)
         self._show(None)
 
     # -- from the link ----------------------------------------------------------------------------
-    @Slot(object)
-    def _on_connected(self, info: LinkInfo) -> None:
+    def link_connected(self, info: LinkInfo) -> None:
         self._seen_at.clear()
         self.power_cycle_button.setVisible(info.is_simulated)
         self.link.send(Cmd.ALARM_HISTORY)
 
-    @Slot(str, bool)
-    def _on_disconnected(self, reason: str, lost: bool) -> None:
+    def link_disconnected(self, reason: str, lost: bool) -> None:
         self.current_code = None
         self._show(None)
 

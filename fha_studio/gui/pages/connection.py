@@ -11,11 +11,11 @@ from PySide6.QtWidgets import (
     QLabel,
     QPushButton,
     QVBoxLayout,
-    QWidget,
 )
 
 from fha_studio.gui.connect_dialog import catalogue_codes
 from fha_studio.gui.link import LinkInfo
+from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
 
 
@@ -26,7 +26,7 @@ def _value_label() -> QLabel:
     return label
 
 
-class ConnectionPage(QWidget):
+class ConnectionPage(BasePage):
     """Drive identity, the actuator code and the pairing check."""
 
     def __init__(self, session: Session, main_window=None):
@@ -113,10 +113,8 @@ class ConnectionPage(QWidget):
         self.actuator_combo.lineEdit().returnPressed.connect(self.check_pairing)
         self.actuator_combo.activated.connect(lambda _i: self.check_pairing())
         self.ack_button.clicked.connect(self.acknowledge)
-        session.link.sigConnected.connect(self._on_connected)
-        session.link.sigDisconnected.connect(self._on_disconnected)
         session.sigActuatorChanged.connect(self._on_actuator_changed)
-        self._on_disconnected("not connected", False)
+        self.link_disconnected("not connected", False)
 
     # -- settings ---------------------------------------------------------------------------------
     def restore_settings(self, settings: QSettings) -> None:
@@ -129,8 +127,7 @@ class ConnectionPage(QWidget):
             settings.setValue("session/actuator", self.session.actuator_code)
 
     # -- behaviour --------------------------------------------------------------------------------
-    @Slot(object)
-    def _on_connected(self, info: LinkInfo) -> None:
+    def link_connected(self, info: LinkInfo) -> None:
         self.link_label.setText(("embedded simulated drive — " if info.is_simulated else "") + info.url)
         self.driver_label.setText(info.driver_model or "not reported by this drive")
         self.adjusted_label.setText(info.adjusted_for or "not reported: read it from the driver's label")
@@ -142,8 +139,7 @@ class ConnectionPage(QWidget):
         if self.actuator_combo.currentText().strip():
             self.check_pairing()
 
-    @Slot(str, bool)
-    def _on_disconnected(self, reason: str, lost: bool) -> None:
+    def link_disconnected(self, reason: str, lost: bool) -> None:
         self.link_label.setText(("LINK LOST: " if lost else "not connected: ") + reason)
         self.link_label.setStyleSheet("color: #b00020; font-weight: bold;" if lost else "")
         self.disconnect_button.setEnabled(False)

@@ -12,10 +12,10 @@ from PySide6.QtWidgets import (
     QPushButton,
     QRadioButton,
     QVBoxLayout,
-    QWidget,
 )
 
-from fha_studio.gui.link import Cmd, CommandResult, DriveStatus
+from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
+from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
 from fha_studio.gui.widgets import FlangeWidget, space_jogs_only
 
@@ -38,7 +38,7 @@ CONSEQUENCE = {
 }
 
 
-class DirectionPage(QWidget):
+class DirectionPage(BasePage):
     """Set and check the rotary direction."""
 
     def __init__(self, session: Session, main_window=None):
@@ -133,8 +133,6 @@ class DirectionPage(QWidget):
         session.sigWritesDone.connect(self._writes_done)
         self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status)
-        self.link.sigConnected.connect(lambda _i: self._update())
-        self.link.sigDisconnected.connect(lambda *_: self._update())
         self._stop_timer = QTimer(self)
         self._stop_timer.setSingleShot(True)
         self._stop_timer.timeout.connect(self._end_check_jog)
@@ -305,6 +303,12 @@ class DirectionPage(QWidget):
             return int(get_actuator(self.session.actuator_code).output_resolution_ppr)
         except Exception:
             return None
+
+    def link_connected(self, info: LinkInfo) -> None:
+        self._update()
+
+    def link_disconnected(self, reason: str, lost: bool) -> None:
+        self._update()
 
     def shutdown(self) -> None:
         if self._check_running:

@@ -16,6 +16,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
+from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, space_jogs_only
 from fha_studio.hardware.protocol import IoBit
@@ -79,7 +80,7 @@ class HoldButton(QPushButton):
         return super().event(event)
 
 
-class JogPage(QWidget):
+class JogPage(BasePage):
     """Servo, jog, move-by and the live I/O of the drive."""
 
     def __init__(self, session: Session, main_window=None):
@@ -182,8 +183,6 @@ class JogPage(QWidget):
         self.move_button.clicked.connect(self.move_by)
         self.link.sigStatus.connect(self._on_status)
         self.link.sigResult.connect(self._on_result)
-        self.link.sigConnected.connect(self._on_connected)
-        self.link.sigDisconnected.connect(lambda *_: self._set_enabled(False, False))
         self._set_enabled(False, False)
         space_jogs_only(self, (self.fwd_button, self.rev_button))
 
@@ -240,8 +239,10 @@ class JogPage(QWidget):
                 lamp.set_state(None)
             self.servo_lamp.set_state(None)
 
-    @Slot(object)
-    def _on_connected(self, info: LinkInfo) -> None:
+    def link_disconnected(self, reason: str, lost: bool) -> None:
+        self._set_enabled(False, False)
+
+    def link_connected(self, info: LinkInfo) -> None:
         self._output_ppr = None
         try:
             from fha_studio.catalog import get_actuator

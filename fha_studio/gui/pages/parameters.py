@@ -26,6 +26,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.gui.link import Cmd, CommandResult, LinkInfo
+from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
 
 COLUMNS = ("Mode", "No.", "Name", "Value", "Unit", "Range", "Default", "State")
@@ -290,7 +291,7 @@ class ValueDelegate(QStyledItemDelegate):
             model.setData(index, editor.text())
 
 
-class ParametersPage(QWidget):
+class ParametersPage(BasePage):
     """Read, edit, write (verified), save and load the driver's parameters."""
 
     def __init__(self, session: Session, main_window=None):
@@ -414,8 +415,6 @@ class ParametersPage(QWidget):
         self.model.sigEditsChanged.connect(self._edits_changed)
         session.sigLogChanged.connect(self._log_changed)
         session.sigWritesDone.connect(self._writes_done)
-        self.link.sigConnected.connect(self._on_connected)
-        self.link.sigDisconnected.connect(lambda *_: self._update_buttons())
         self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status_for_buttons)
         self.link.sigBusyChanged.connect(lambda _b: self._update_buttons())
@@ -561,8 +560,10 @@ class ParametersPage(QWidget):
             else:
                 self.message.setText(f"Power cycle failed: {result.error}")
 
-    @Slot(object)
-    def _on_connected(self, info: LinkInfo) -> None:
+    def link_disconnected(self, reason: str, lost: bool) -> None:
+        self._update_buttons()
+
+    def link_connected(self, info: LinkInfo) -> None:
         self.model.reload_items()  # a model reset: the selection model stays the same object
         self.model.restart_pending.clear()
         self.restart_banner.setVisible(False)

@@ -32,6 +32,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.gui.connect_dialog import catalogue_codes
+from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import DEFAULT_ACTUATOR, Session
 
 PASS_COLOUR = QColor("#2e7d32")
@@ -52,7 +53,7 @@ def _words(name: str) -> str:
     return name.replace("_", " ").capitalize()
 
 
-class SizingPage(QWidget):
+class SizingPage(BasePage):
     """Load inertia, duty cycle, checks, torque-speed picture, suggestion."""
 
     def __init__(self, session: Session, main_window=None):

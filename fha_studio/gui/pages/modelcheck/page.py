@@ -31,6 +31,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.logic.modelcheck import ModelCheckError, ModelCheckResult, run_modelcheck
 from fha_studio.recording import Recording, RecordingError, read_recording
 
@@ -78,7 +79,7 @@ def _plot(title: str, left: str, bottom: str = "time (s)") -> pg.PlotWidget:
     return widget
 
 
-class ModelCheckPage(QWidget):
+class ModelCheckPage(BasePage):
     """Loads a recording, runs the model check, shows the story step by step."""
 
     sigRequestRun = Signal(object)  # Recording, to the worker
@@ -250,11 +251,11 @@ class ModelCheckPage(QWidget):
                 self._show_error(str(exc))
 
     def _scope_view(self):
-        window = self.main_window
-        lazy = getattr(window, "_lazy", {}).get("scope") if window is not None else None
-        if lazy is None or lazy.built is None:
+        """The Scope page's view if that page has been opened, else None."""
+        if self.main_window is None:
             return None
-        return lazy.built.view
+        scope = self.main_window.built_page(PageId.SCOPE)
+        return None if scope is None else scope.view
 
     def take_scope_capture(self) -> Path:
         """Save the capture on show in the scope and load it here; returns the file written."""

@@ -35,7 +35,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui.link import Cmd, CommandResult, DriveStatus
+from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
+from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
 from fha_studio.hardware.protocol import IoBit
 from fha_studio.logic.procedures import (
@@ -76,7 +77,7 @@ def _live_check_in_link_thread(step: Step, context, angles: dict, relay: _Sample
     return run_live_check(client, step, env)
 
 
-class ProceduresPage(QWidget):
+class ProceduresPage(BasePage):
     """Receiving inspection, installation, wiring, sensor set, rotary direction; the report."""
 
     sigStepChanged = Signal()  # the current step or the run's state changed
@@ -95,7 +96,6 @@ class ProceduresPage(QWidget):
         self._relay = _SampleRelay(self)
         self._build()
         self.link.sigResult.connect(self._on_result)
-        self.link.sigConnected.connect(lambda _info: self._refresh())
         self.link.sigStatus.connect(self._on_status)
         self._relay.sigSample.connect(
             lambda angle, bits: self.dog_panel.observe(angle, bits) if self.dog_panel.wizard else None
@@ -458,8 +458,10 @@ class ProceduresPage(QWidget):
 
     def capture_scope_plot(self, title: str = "") -> Path | None:
         """Save the Scope page's plot as a PNG beside the session and add it to the report."""
-        scope = getattr(self.main_window, "scope_page", None)
-        if self.session is None or self.session.path is None or scope is None:
+        if self.session is None or self.session.path is None or self.main_window is None:
+            return None
+        scope = self.main_window.scope_page
+        if scope is None:
             return None
         number = len(self.session.plots) + 1
         path = self.session.path.with_name(f"{self.session.path.stem}-plot{number}.png")
@@ -631,6 +633,9 @@ class ProceduresPage(QWidget):
                 self.open_session(str(path))
             except (ValueError, OSError) as exc:
                 self._message(f"The last session could not be reopened: {exc}")
+
+    def link_connected(self, info: LinkInfo) -> None:
+        self._refresh()
 
     def shutdown(self) -> None:
         self.dog_panel.shutdown()

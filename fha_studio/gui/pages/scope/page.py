@@ -9,10 +9,11 @@ from __future__ import annotations
 
 from functools import partial
 
-from PySide6.QtWidgets import QVBoxLayout, QWidget
+from PySide6.QtWidgets import QVBoxLayout
 
 from fha_studio.catalog import get_actuator
 from fha_studio.gui.link import POLL_INTERVAL_MS, Cmd, LinkInfo
+from fha_studio.gui.pages.base import BasePage
 
 from .driver import ScopeCmd, ScopeController, ScopeRequest
 from .view import ScopeContext, ScopeView
@@ -28,7 +29,7 @@ def _attach_in_link_thread(controller: ScopeController, ratio: int | None, clien
     controller.driver.handle(ScopeRequest(ScopeCmd.SET_CLIENT, (client, ratio)))
 
 
-class ScopePage(QWidget):
+class ScopePage(BasePage):
     """Page "Scope": live view, trace, built-in tests, recording."""
 
     def __init__(self, session, main_window=None):
@@ -40,8 +41,6 @@ class ScopePage(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.view)
-        link.sigConnected.connect(self._on_connected)
-        link.sigDisconnected.connect(self._on_disconnected)
         session.sigActuatorChanged.connect(lambda _code: self.view.set_context(self._context()))
         self.view.sigLiveChanged.connect(self._on_live_changed)
 
@@ -58,12 +57,12 @@ class ScopePage(QWidget):
             code = DEFAULT_ACTUATOR
         return ScopeContext(code, load_inertia_kgm2=0.0, driver=self.session.driver)
 
-    def _on_connected(self, info: LinkInfo) -> None:
+    def link_connected(self, info: LinkInfo) -> None:
         self.view.set_context(self._context())
         self.controller.connected = True
         self.session.link.send(Cmd.CALL, partial(_attach_in_link_thread, self.controller, self.view.ratio))
 
-    def _on_disconnected(self, reason: str, lost: bool) -> None:
+    def link_disconnected(self, reason: str, lost: bool) -> None:
         self.view.stop_live()
         self.controller.attach(None)
 

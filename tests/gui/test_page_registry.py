@@ -1,0 +1,63 @@
+"""The page registry: tabs in its order, every page keeps the page protocol, and the main window
+gives each page its settings and the link's connect / disconnect, also to a page built late."""
+
+from __future__ import annotations
+
+import pytest
+from PySide6.QtCore import QSettings
+from PySide6.QtWidgets import QWidget
+
+from fha_studio.gui.main_window import MainWindow
+from fha_studio.gui.pages.base import BasePage, Page, PageId
+from fha_studio.gui.pages.registry import PAGES, PageEntry
+from tests.gui.fake_drive import FakeDriveClient
+
+
+def test_every_page_has_one_entry_and_its_own_alt_letter():
+    assert [e.id for e in PAGES] == list(PageId)
+    letters = [e.mnemonic.lower() for e in PAGES]
+    assert len(set(letters)) == len(letters), letters
+    assert PAGES[4].tab_text == "&Jog && test run"  # a literal & is doubled, the mnemonic marked
+    with pytest.raises(ValueError, match="mnemonic 'q'"):
+        PageEntry(PageId.JOG, "Jog", "q", BasePage)
+
+
+def test_tabs_follow_the_registry_and_every_page_keeps_the_protocol(make_window):
+    window = make_window(show=False)
+    assert [window.tabs.tabText(i) for i in range(window.tabs.count())] == [e.tab_text for e in PAGES]
+    for entry in PAGES:
+        page = window.page(entry.id)
+        assert isinstance(page, Page) and isinstance(page, QWidget), entry.id
+    with pytest.raises(ValueError, match="no page 'plots'; pages: connection, parameters"):
+        window.show_page("plots")
+
+
+class _Spy(BasePage):
+    def __init__(self, session, main_window=None):
+        super().__init__()
+        self.calls: list[tuple] = []
+
+    def restore_settings(self, settings: QSettings) -> None:
+        self.calls.append(("restore",))
+
+    def link_connected(self, info) -> None:
+        self.calls.append(("connected", info.url))
+
+    def link_disconnected(self, reason: str, lost: bool) -> None:
+        self.calls.append(("disconnected", lost))
+
+
+def test_pages_hear_of_the_link_also_when_built_after_it_came_up(make_window, qtbot, monkeypatch):
+    spy_for = {PageId.DIRECTION: PageEntry(PageId.DIRECTION, "Eager", "e", _Spy),
+               PageId.SCOPE: PageEntry(PageId.SCOPE, "Lazy", "l", _Spy, lazy=True)}
+    spies = tuple(spy_for.get(e.id, e) for e in PAGES)
+    monkeypatch.setattr("fha_studio.gui.main_window.PAGES", spies)
+    window: MainWindow = make_window(open_client=lambda url, baud: FakeDriveClient(), connect="fake://")
+    eager = window.built_page(PageId.DIRECTION)
+    assert window.built_page(PageId.SCOPE) is None  # not shown yet: not built
+    assert eager.calls == [("restore",), ("connected", "fake://")]
+    lazy = window.show_page(PageId.SCOPE)
+    assert lazy.calls == [("restore",), ("connected", "fake://")]
+    with qtbot.waitSignal(window.link.sigDisconnected, timeout=10000):
+        window.link.close_link()
+    assert eager.calls[-1] == lazy.calls[-1] == ("disconnected", False)
