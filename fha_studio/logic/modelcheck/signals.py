@@ -15,9 +15,10 @@ ripple) are attenuated equally on both sides so their amplitudes stay unbiased.
 Window: the acceleration noise falls as ``N^-2.5`` while the smoothed current noise falls only as
 ``N^-0.5``. We take the shortest window at which the acceleration noise (estimated from the
 position's own high-frequency noise, i.e. its quantisation, times the declared inertia) has
-fallen to the current monitor's smoothed noise (times Kt): a longer window would mostly blur the
-signal for little gain; a shorter one lets quantisation dominate the residual. The window is
-clamped to 11 samples .. 0.12 s.
+fallen to the current monitor's smoothed noise (times Kt): a shorter one lets quantisation
+dominate the residual. That window (clamped to 11 samples .. 0.12 s) is the shortest one tried;
+bandwidth.py then lengthens it where the data say the rigid model stops explaining the torque
+(drive-train dynamics). A window given by the user must lie within `window_bounds()`.
 """
 
 from __future__ import annotations

@@ -17,6 +17,7 @@ from fha_studio.logic.modelcheck.axis import (
     declared_axis,
     rms,
 )
+from fha_studio.logic.modelcheck.bandwidth import BandwidthPoint, choose_bandwidth
 from fha_studio.logic.modelcheck.candidates import (
     CHANNEL_UNITS,
     LABELS,
@@ -36,7 +37,13 @@ from fha_studio.logic.modelcheck.selection import (
     block_cv,
     block_edges,
 )
-from fha_studio.logic.modelcheck.signals import ARCSEC_PER_RAD, POLYORDER, Signals, build_signals
+from fha_studio.logic.modelcheck.signals import (
+    ARCSEC_PER_RAD,
+    POLYORDER,
+    Signals,
+    build_signals,
+    window_bounds,
+)
 from fha_studio.physics import AxisModel, Effects, ServoSettings, simulate
 from fha_studio.recording import Recording
 
@@ -234,6 +241,7 @@ class ModelCheckResult:
     current_delay_ms: float = 0.0  # fitted time offset of the current against the position (recorder)
     channel_status: dict[str, ChannelStatus] = field(default_factory=dict)
     window_reason: str = ""  # why this analysis bandwidth
+    bandwidth_profile: tuple[BandwidthPoint, ...] = ()  # the bandwidths tried and what each left unexplained
 
     @property
     def found(self) -> bool:
@@ -355,6 +363,14 @@ class ModelCheckResult:
                 "floors": {ch: {"value": c.floor, "unit": c.unit} for ch, c in self.channels.items()},
                 "criterion": f"AR-whitened BIC gain >= {BIC_MIN:g}, contiguous-block CV, floor",
                 "current_delay_ms": self.current_delay_ms,
+                "bandwidths_tried": [
+                    {
+                        "bandwidth_hz": b.bandwidth_hz,
+                        "window_samples": b.window,
+                        "unexplained_nm": b.unexplained_nm,
+                    }
+                    for b in self.bandwidth_profile
+                ],
             },
             "resimulation": None
             if self.resimulation is None
@@ -405,6 +421,32 @@ def run_modelcheck(
     notes = check_plausible(rec, axis)
     model = axis.model
     sig = _signals(rec, axis, window)
+    floor_t = max(
+        TORQUE_FLOOR_MIN_NM,
+        TORQUE_FLOOR_FRACTION_OF_MAX * (model.max_torque_nm or 3.0 * float(np.max(np.abs(sig.torque_f_nm)))),
+    )
+    bandwidth = None
+    if (
+        window is None
+        and _torque_status(sig, axis, axis.nominal_inertia_kgm2 * sig.accel_rad_s2, floor_t).checked
+    ):
+        # the analysis bandwidth from the data: where the rigid model still explains the torque
+        bandwidth = choose_bandwidth(
+            pos_rad=sig.raw_pos_rad,
+            current_a=sig.raw_current_a,
+            dt_s=sig.filt.dt_s,
+            kt_nm_per_a=axis.kt_nm_per_a,
+            inertia_kgm2=axis.nominal_inertia_kgm2,
+            ratio=axis.ratio,
+            pos_noise_rad=sig.pos_noise_rad,
+            current_noise_a=sig.current_noise_a,
+            shortest=sig.filt.window,
+            longest=window_bounds(len(sig.raw_t_s))[1],
+            floor_nm=floor_t,
+        )
+        if bandwidth.window != sig.filt.window:
+            sig = _signals(rec, axis, bandwidth.window)
+        sig.window_reason = bandwidth.reason
     if sig.resampled:
         notes.append("Note: the sampling was not uniform; the signals were resampled onto a uniform grid.")
     n = len(sig.t_s)
@@ -427,10 +469,6 @@ def run_modelcheck(
     }
 
     # ---- step 3 on the torque channel
-    floor_t = max(
-        TORQUE_FLOOR_MIN_NM,
-        TORQUE_FLOOR_FRACTION_OF_MAX * (model.max_torque_nm or 3.0 * float(np.max(np.abs(sig.torque_f_nm)))),
-    )
     status: dict[str, ChannelStatus] = {TORQUE: _torque_status(sig, axis, torque_nominal, floor_t)}
     channels: dict[str, ChannelReport] = {}
     selectors: dict[str, tuple[ChannelSelector, list, list[FittedTerm], np.ndarray]] = {}
@@ -568,6 +606,7 @@ def run_modelcheck(
         current_delay_ms=delay_ms,
         channel_status=status,
         window_reason=sig.window_reason,
+        bandwidth_profile=() if bandwidth is None else bandwidth.profile,
     )
 
 
