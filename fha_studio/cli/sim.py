@@ -48,6 +48,13 @@ def register(subparsers: Any) -> None:
                    help="EEPROM file (default: the user data directory, one file per driver and actuator)")
     p.add_argument("--unpaced", action="store_true", help="reply at memory speed instead of 19200 baud")
     p.add_argument("--oww-seconds", type=float, metavar="S", help="how long OWW takes (default 5 s)")
+    p.add_argument("--profile", choices=("full", "documented"), default="full",
+                   help="full: every command of docs/protocol.md (default); documented: only what the "
+                   "HA-655 manual documents (DGR, OWW; s to everything while the servo is on)")
+    p.add_argument("--panel", action="store_true",
+                   help="read the controller's side from stdin, one per line: 'servo on', 'servo off' "
+                   "(the CN2 servo-ON input), 'fwd DEG' (a command pulse train, servo on), 'turn DEG' "
+                   "(turn the output by hand, servo off), 'brake release', 'brake hold'")
     p.add_argument("--record", metavar="FILE.csv", help="write what the axis does as an fha-recording/1 CSV")
     p.add_argument("--record-rate", type=float, default=1000.0, metavar="HZ",
                    help="recording sample rate (default %(default)s Hz)")
@@ -74,6 +81,7 @@ def run(args: Any) -> int:
             eeprom=args.eeprom or "user",
             paced=not args.unpaced,
             oww_clear_s=args.oww_seconds,
+            profile=args.profile,
         )
         drive = SimDrive(config=config)
     except (SimConfigError, EepromError) as exc:
@@ -101,6 +109,9 @@ def run(args: Any) -> int:
             except (OSError, ValueError) as exc:
                 raise CliError(f"--record {args.record}: {exc}") from None
         drive.start()
+        if args.panel:
+            threading.Thread(target=_panel, args=(drive, sys.stdin, stop), name="sim-panel",
+                             daemon=True).start()
         if args.pty:
             serve_pty(server, stop, announce)
         else:
@@ -113,3 +124,44 @@ def run(args: Any) -> int:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     return 0
+
+
+def panel_line(drive: Any, line: str) -> str:
+    """Do one line of ``--panel`` input on ``drive``; returns what happened (one line)."""
+    from fha_studio.hardware import protocol
+    from fha_studio.hardware.sim import SimRefused
+
+    words = line.strip().lower().split()
+    try:
+        match words:
+            case ["servo", ("on" | "off") as state]:
+                drive.set_servo(state == "on")
+                return f"servo {state} (CN2)"
+            case ["fwd" | "rev" as sense, angle]:
+                sign = 1.0 if sense == "fwd" else -1.0
+                drive.controller_command(sign * float(angle))
+                return f"controller: {sense.upper()} {float(angle):g} deg"
+            case ["turn", angle]:
+                drive.turn_by_hand(float(angle))
+                return f"turned by hand by {float(angle):g} deg"
+            case ["brake", ("release" | "hold") as state]:
+                bit = 1 << protocol.IoBit.BRAKE_RELEASED
+                mask = drive.io_bits() & protocol.INPUT_MASK & ~bit
+                drive.set_inputs(mask | (bit if state == "release" else 0))
+                return f"brake {'released' if state == 'release' else 'holds'}"
+            case []:
+                return ""
+    except SimRefused as exc:
+        return f"refused: {exc.reason}"
+    except ValueError:
+        pass
+    return f"not understood: {line.strip()!r} (servo on|off, fwd DEG, rev DEG, turn DEG, brake release|hold)"
+
+
+def _panel(drive: Any, stream: Any, stop: threading.Event) -> None:
+    for line in stream:
+        if stop.is_set():
+            return
+        answer = panel_line(drive, line)
+        if answer:
+            print(f"# {answer}", file=sys.stderr, flush=True)

@@ -282,6 +282,18 @@ class ServoAxis:
         self._servo_on = False
         self._state.current = 0.0
 
+    def turn_by_hand(self, angle_rad: float) -> None:
+        """Someone turns the de-energised axis by ``angle_rad`` (physical frame, CW +) and lets go:
+        motor and load side move together and come to rest there. Refused with the servo on."""
+        if self._servo_on:
+            raise RuntimeError("cannot turn the axis by hand: the servo is on")
+        s = self._state
+        s.xm += float(angle_rad)
+        s.xl = self._load_rest_position(s.xm)
+        s.vm = s.vl = 0.0
+        s.fb_prev = None
+        self._rebase_command()
+
     def set_brake(self, engaged: bool, holding_torque_nm: float = 0.0) -> None:
         """Motor brake (non-excitation type: the sim engages it when the coil is unpowered).
 

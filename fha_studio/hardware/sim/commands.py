@@ -229,4 +229,7 @@ COMMANDS: Mapping[Command, Handler] = {
     Command.SNQ: _snq,
 }
 
-__all__ = ["COMMANDS", "DEFERRED", "IDENTIFICATION", "Handler", "HandlerResult"]
+#: What a drive of the public HA-655 manual speaks (the ``documented`` profile): DGR and OWW.
+DOCUMENTED_ONLY: Mapping[Command, Handler] = {c: COMMANDS[c] for c in (Command.DGR, Command.OWW)}
+
+__all__ = ["COMMANDS", "DEFERRED", "DOCUMENTED_ONLY", "IDENTIFICATION", "Handler", "HandlerResult"]

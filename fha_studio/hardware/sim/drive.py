@@ -42,7 +42,7 @@ from fha_studio.hardware.sim.axis import (
     resolve_actuator,
     servo_settings,
 )
-from fha_studio.hardware.sim.commands import COMMANDS, DEFERRED, Handler
+from fha_studio.hardware.sim.commands import COMMANDS, DEFERRED, DOCUMENTED_ONLY, Handler
 from fha_studio.hardware.sim.constants import SimConstants, load_sim_constants
 from fha_studio.hardware.sim.eeprom import EepromFile, default_eeprom_dir
 from fha_studio.hardware.sim.io import IoState
@@ -86,6 +86,8 @@ class SimDrive:
         self.config = config
         if not config.packed_trace:  # a drive from before the packed encoding: no TRP
             self.command_table = {c: h for c, h in self.command_table.items() if c is not Command.TRP}
+        if config.profile == "documented":
+            self.command_table = DOCUMENTED_ONLY
         self.constants = constants or load_sim_constants()
         self.servo_rate_hz = float(servo_rate_hz)
         self._lock = threading.RLock()
@@ -374,8 +376,9 @@ class SimDrive:
 
     # ------------------------------------------------------------------ servo and motion
     def set_servo(self, on: bool) -> None:
-        """Servo on / off. On is refused (``x``) while an alarm is active; a holding brake is not
-        an error (the motor then works against it)."""
+        """Servo on / off: SVO over CN3 (full profile), or the controller's servo-ON input on CN2
+        (any profile; the only way with the ``documented`` one). On is refused (``x``) while an
+        alarm is active; a holding brake is not an error (the motor then works against it)."""
         with self._lock:
             if on:
                 if self.alarm:
@@ -386,6 +389,23 @@ class SimDrive:
                 self.servo_on = True
             else:
                 self._servo_off()
+
+    def turn_by_hand(self, angle_deg: float) -> None:
+        """Someone turns the output flange by ``angle_deg`` (CW positive seen from the flange)
+        with the servo off, as in the encoder check or the sensor-dog adjustment (FHA-C manual
+        4-7-2). Refused (``x``) with the servo on or while the brake holds."""
+        with self._lock:
+            if self.servo_on:
+                raise rejected("the servo is on: the axis cannot be turned by hand")
+            if self.brake_holding:
+                raise rejected("the brake holds: release it (24 V on the brake) to turn the axis by hand")
+            self.axis.turn_by_hand(math.radians(angle_deg))
+
+    def controller_command(self, angle_deg: float) -> None:
+        """The controller's pulse train on CN2: turn the output by ``angle_deg`` in the command
+        sense (FWD positive; the rotary direction, system 8, decides CW or CCW). Needs the servo
+        on (``x`` otherwise), as on a real drive."""
+        self.move_by(angle_deg)
 
     def _servo_off(self) -> None:
         self.servo_on = False
@@ -700,10 +720,18 @@ class SimDrive:
         raise rejected(f"no monitor item {item}")
 
     # ------------------------------------------------------------------ the protocol
+    @property
+    def documented_only(self) -> bool:
+        """True for the ``documented`` profile: DGR and OWW only, ``s`` to all while the servo is on."""
+        return self.command_table is DOCUMENTED_ONLY
+
     def execute(self, command: Command | str, value: int) -> SimReply | None:
         """Do one CN3 command (a :class:`Command` or its name). Returns its reply, or None when
         the reply comes later (OWW: see :meth:`take_deferred_replies`)."""
         with self._lock:
+            if self.documented_only and self.servo_on:
+                # HA-655 manual p.21: with the servo on the drive processes nothing over CN3
+                return SimReply("s", reason=f"{command}: the servo is on (CN2)")
             try:
                 handler = self.command_table[Command(command)]
             except (ValueError, KeyError):

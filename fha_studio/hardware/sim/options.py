@@ -25,6 +25,10 @@ Options (all optional):
 ``oww_clear_s``    how long OWW takes to clear the multi-turn data [s] (default 5)
 ``packed_trace``   1 (default): trace blocks also in the packed encoding (TRP, listed in CAP);
                    0: text blocks (TRB) only, as a drive from before the packed encoding
+``profile``        ``full`` (default): every command of docs/protocol.md; ``documented``: only
+                   what the public HA-655 manual documents (DGR, OWW; ``x`` to the rest, ``s`` to
+                   everything while the servo is on). Servo-ON then comes from the simulated CN2
+                   input (``SimDrive.set_servo``), as on a real drive from the controller
 =================  ==========================================================================
 """
 
@@ -34,6 +38,9 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 from urllib.parse import parse_qs, unquote, urlsplit
+
+#: The command sets a simulated drive can speak (see ``profile`` above).
+PROFILES = ("full", "documented")
 
 
 class SimConfigError(ValueError):
@@ -58,8 +65,13 @@ class SimConfig:
     quantised: bool = True
     oww_clear_s: float | None = None
     packed_trace: bool = True
+    profile: str = "full"
 
     def __post_init__(self) -> None:
+        if self.profile not in PROFILES:
+            raise SimConfigError(
+                f"simulated drive option profile: {self.profile!r} is not one of {', '.join(PROFILES)}"
+            )
         if not isinstance(self.actuator, str) or not self.actuator.strip():
             raise SimConfigError("simulated drive: an actuator model code is needed, e.g. FHA-25C-50-US250")
         _finite("load_inertia_kgm2", self.load_inertia_kgm2, minimum=0.0)
@@ -124,7 +136,7 @@ def parse_effects(specs: list[str]) -> dict[str, dict[str, float]]:
 _URL_KEYS = {
     "driver", "load_inertia", "load_inertia_kgm2", "brake", "sensors", "origin_deg", "ls1_deg",
     "ls2_deg", "effects", "effect", "eeprom", "paced", "quantised", "oww_clear_s",
-    "packed_trace",
+    "packed_trace", "profile",
 }
 
 
@@ -163,4 +175,6 @@ def config_from_url(url: str) -> SimConfig:
         values["effects"] = parse_effects(specs)
     if last("eeprom") is not None:
         values["eeprom"] = last("eeprom")
+    if last("profile") is not None:
+        values["profile"] = last("profile").strip().lower()
     return SimConfig(**values)

@@ -1,0 +1,150 @@
+"""The simulated drive's ``documented`` profile: only what the public HA-655 manual documents.
+
+DGR and OWW over CN3, ``x`` to everything else, ``s`` to everything while the servo is on; the
+servo is switched by the controller's CN2 input; the output can be turned by hand with the servo off.
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from fha_studio.cli.sim import panel_line
+from fha_studio.hardware.client import CapabilityLevel, DriveClient
+from fha_studio.hardware.errors import ServoOnRefused
+from fha_studio.hardware.protocol import EXTENSION_COMMANDS
+from fha_studio.hardware.sim import SimConfigError, SimDrive, config_from_url
+
+ROOT = Path(__file__).resolve().parents[2]
+COUNTS_PER_DEG_50 = 8192 * 50 / 360  # DGR counts per output degree at ratio 50
+
+
+def dgr(drive: SimDrive) -> int:
+    reply = drive.execute("DGR", 0)
+    assert reply is not None and reply.terminal == "q", reply
+    return int(reply.lines[0])
+
+
+def test_answers_only_dgr_and_oww(make_drive):
+    drive = make_drive("FHA-25C-50-S248", profile="documented")
+    assert drive.documented_only and drive.capabilities() == []
+    for command in EXTENSION_COMMANDS:
+        assert drive.execute(command, 0).terminal == "x", command
+    assert drive.execute("DGR", 0).terminal == "q"
+
+
+def test_servo_on_from_cn2_answers_s_to_everything(make_drive):
+    drive = make_drive("FHA-25C-50-S248", profile="documented")
+    drive.set_servo(True)
+    for command in ("DGR", "OWW", "CAP", "SVO", "MON"):
+        assert drive.execute(command, 0).terminal == "s", command
+    drive.set_servo(False)
+    assert drive.execute("DGR", 0).terminal == "q"
+
+
+def test_turning_by_hand_changes_dgr_by_ratio_x_8192_per_motor_turn(make_drive):
+    drive = make_drive("FHA-25C-50-S248", profile="documented")
+    start = dgr(drive)
+    drive.turn_by_hand(10.0)  # CW seen from the flange
+    assert dgr(drive) - start == pytest.approx(10 * COUNTS_PER_DEG_50, abs=1)
+    drive.turn_by_hand(-25.0)
+    assert dgr(drive) - start == pytest.approx(-15 * COUNTS_PER_DEG_50, abs=1)
+    drive.set_servo(True)
+    with pytest.raises(Exception, match="servo is on"):
+        drive.turn_by_hand(1.0)
+
+
+def test_a_held_brake_cannot_be_turned_by_hand(make_drive):
+    drive = make_drive("FHA-25C-50-S248-B", profile="documented")
+    assert "refused: the brake holds" in panel_line(drive, "turn 5")
+    assert panel_line(drive, "brake release") == "brake released"
+    assert panel_line(drive, "turn 5") == "turned by hand by 5 deg"
+
+
+@pytest.mark.parametrize("rotary_direction, sign", [(0, 1), (1, -1)])
+def test_a_fwd_command_turns_cw_unless_parameter_8_reverses_it(make_drive, rotary_direction, sign):
+    drive = make_drive("FHA-25C-50-S248", profile="documented")
+    drive.write_parameter("system", 8, rotary_direction)  # on the front panel
+    drive.power_cycle()
+    before = dgr(drive)
+    assert panel_line(drive, "servo on") == "servo on (CN2)"
+    assert panel_line(drive, "fwd 5") == "controller: FWD 5 deg"
+    drive.advance(2.0)
+    assert panel_line(drive, "servo off") == "servo off (CN2)"
+    assert (dgr(drive) - before) * sign == pytest.approx(5 * COUNTS_PER_DEG_50, rel=0.02)
+
+
+def test_oww_clears_the_multi_turn_data_about_5_s_later(make_drive):
+    drive = make_drive("FHA-25C-50-S248", profile="documented")
+    drive.turn_by_hand(3 * 360 / 50 + 1.0)  # three motor turns and a bit
+    assert dgr(drive) // 8192 == 3
+    single = dgr(drive) % 8192
+    assert drive.execute("OWW", 0) is None  # the q comes later
+    assert drive.execute("OWW", 0).terminal == "x"  # repeated before the first acknowledgement
+    drive.advance(4.9)
+    assert drive.take_deferred_replies() == []
+    drive.advance(0.2)
+    assert [r.terminal for r in drive.take_deferred_replies()] == ["q"]
+    assert dgr(drive) == single
+
+
+def test_an_incremental_encoder_answers_x_to_dgr_and_oww(make_drive):
+    drive = make_drive("FHA-25C-50-US250", profile="documented")
+    assert drive.execute("DGR", 0).terminal == "x"
+    assert drive.execute("OWW", 0).terminal == "x"
+
+
+def test_url_option_and_its_check():
+    assert config_from_url("sim://FHA-25C-50-S248?profile=documented").profile == "documented"
+    assert config_from_url("sim://FHA-25C-50-S248").profile == "full"
+    with pytest.raises(SimConfigError, match="profile"):
+        config_from_url("sim://FHA-25C-50-S248?profile=everything")
+
+
+def test_the_client_sees_a_drive_of_the_manual(tmp_path):
+    url = f"sim://FHA-25C-50-S248?profile=documented&paced=0&eeprom={tmp_path / 'e.json'}"
+    with DriveClient.open(url) as client:
+        caps = client.capabilities
+        assert caps.level is CapabilityLevel.ABSOLUTE_POSITION and not caps.parameters
+        assert isinstance(client.absolute_position(), int)
+
+
+@pytest.mark.e2e
+def test_probe_a_documented_sim_in_another_process_and_switch_its_servo(tmp_path):
+    """``fha-studio sim --profile documented --panel`` over a pty; servo-ON typed on its stdin."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    sim = subprocess.Popen(
+        [sys.executable, "-m", "fha_studio", "sim", "--pty", "--unpaced", "--profile", "documented",
+         "--panel", "--actuator", "FHA-25C-50-S248", "--eeprom", str(tmp_path / "e.json")],
+        cwd=ROOT, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        ready, _, _ = select.select([sim.stdout], [], [], 30.0)
+        assert ready, "the sim printed no pty path"
+        path = sim.stdout.readline().decode().strip()
+
+        def fha(*args: str) -> subprocess.CompletedProcess:
+            return subprocess.run([sys.executable, "-m", "fha_studio", "drive", *args, "--url", path],
+                                  cwd=ROOT, env=env, capture_output=True, text=True, timeout=60)
+
+        done = fha("probe", "--json")
+        assert done.returncode == 0, done.stderr
+        assert '"documented_only": true' in done.stdout and '"servo": "off"' in done.stdout
+        sim.stdin.write(b"servo on\n")
+        sim.stdin.flush()
+        ready, _, _ = select.select([sim.stderr], [], [], 30.0)
+        assert ready
+        while b"servo on (CN2)" not in sim.stderr.readline():
+            pass
+        done = fha("position", "--actuator", "FHA-25C-50-S248")
+        assert done.returncode == 4 and "servo on (controller)" in done.stderr
+        with pytest.raises(ServoOnRefused), DriveClient.open(path) as client:
+            client.absolute_position()
+    finally:
+        sim.terminate()
+        sim.communicate(timeout=10)
+    assert sim.returncode == 0
