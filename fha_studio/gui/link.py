@@ -34,7 +34,7 @@ from fha_studio.hardware.api import (
     ServoOnRefused,
 )
 from fha_studio.hardware.parameters import Mode, MonitorItem
-from fha_studio.hardware.protocol import IoBit
+from fha_studio.hardware.protocol import INPUT_MASK, Command, IoBit
 
 log = logging.getLogger(__name__)
 
@@ -47,6 +47,14 @@ JOG_LEASE_RENEW_MS = 150
 #: ... and the worker stops jogging if the lease is older than this (a frozen GUI must not
 #: leave the axis running), in s.
 JOG_LEASE_S = 0.5
+#: Idle probe period of a drive without status commands (a drive of the manual's DGR and OWW),
+#: in ms: one DGR about once a second, so a drive switched off or unplugged shows within 2 s
+#: (this period plus one failed exchange with its retry, about 1 s).
+PROBE_INTERVAL_MS = 700
+#: While the drive answers "servo on" (s), it is asked at most once a second.
+SERVO_ON_PROBE_MS = 1000
+#: What the technician is told while a drive answers s.
+SERVO_ON_NOTE = "servo on (controller): the drive does not answer over CN3 until servo off"
 #: Consecutive timeouts after which the link is declared lost (the client has retried already).
 TIMEOUTS_TO_LOST = 1
 #: The monitor items of the status poll: output position, output speed, motor current.
@@ -72,6 +80,7 @@ class Cmd(enum.Enum):
     POWER_CYCLE = enum.auto()
     SET_INPUTS = enum.auto()  # args: {input name: on} (simulated drive only)
     CALL = enum.auto()  # args: a callable taking the DriveApi (for procedures of other pages)
+    SIM_PANEL = enum.auto()  # args: SimPanelAction, value (the embedded simulated drive's CN2 and hands)
     SET_POLL_INTERVAL = enum.auto()  # args: ms between status polls (the scope slows them while live)
     SHUTDOWN = enum.auto()  # stop the axis, close the port, end the link thread
 
@@ -82,6 +91,20 @@ _WITHOUT_LINK = frozenset({Cmd.OPEN, Cmd.CLOSE, Cmd.STOP, Cmd.JOG, Cmd.JOG_LEASE
 
 class NotConnected(LinkError):
     """A command that needs a drive came while no link was open."""
+
+
+class SimPanelAction(enum.Enum):
+    """What the embedded simulated drive's panel does: the controller's side (CN2) and the
+    technician's hands, which a real drive gets from outside CN3."""
+
+    SERVO = "servo"  # value: on (the controller's servo-ON input, CN2)
+    COMMAND = "command"  # value: output degrees, FWD positive (a command pulse train, servo on)
+    TURN_BY_HAND = "turn"  # value: output degrees, CW positive (servo off, brake released)
+    BRAKE_RELEASED = "brake"  # value: True = 24 V on the brake coil
+
+
+class PanelRefused(DriveRefused):
+    """The simulated drive's panel could not do it (servo on for turning by hand, ...)."""
 
 
 @dataclass(frozen=True)
@@ -126,6 +149,9 @@ class LinkInfo:
     can_monitor: bool = True
     can_parameters: bool = True
     is_simulated: bool = False
+    documented_only: bool = False  # the drive answers only the manual's DGR and OWW
+    absolute_position: bool | None = None  # DGR answered (True), x (False), unknown (None: s)
+    embedded_sim: bool = False  # an embedded simulated drive: its panel (SIM_PANEL) can be used
 
 
 class ReadParametersResult(TypedDict):
@@ -164,6 +190,8 @@ class DriveStatus:
     current_a: float | None = None
     jogging: bool = False
     refused: bool = False  # the drive answered "servo on: not now"
+    absolute_counts: int | None = None  # DGR's position (servo off, absolute encoder)
+    note: str = ""  # one line for the technician about this poll (servo on, DGR refused)
 
     def bit(self, bit: IoBit) -> bool | None:
         return None if self.io_bits is None else bool(self.io_bits >> bit & 1)
@@ -247,6 +275,7 @@ class LinkWorker(QObject):
             Cmd.POWER_CYCLE: self._do_power_cycle,
             Cmd.SET_INPUTS: self._do_set_inputs,
             Cmd.CALL: self._do_call,
+            Cmd.SIM_PANEL: self._do_sim_panel,
             Cmd.SET_POLL_INTERVAL: self._do_set_poll_interval,
             Cmd.SHUTDOWN: self._shutdown,
         }
@@ -362,6 +391,7 @@ class LinkWorker(QObject):
         except LinkError as exc:
             log.info("identify failed: %s", exc)
         caps = client.capabilities
+        extensions = set(caps.commands) - {Command.DGR, Command.OWW}
         return LinkInfo(
             url=url,
             driver_model=ident.driver_model if ident else "",
@@ -372,6 +402,9 @@ class LinkWorker(QObject):
             can_monitor=caps.can_monitor,
             can_parameters=caps.parameters,
             is_simulated=caps.simulated,
+            documented_only=not extensions,
+            absolute_position=caps.absolute_position,
+            embedded_sim=_embedded_sim(client) is not None,
         )
 
     def _do_close(self) -> None:
@@ -521,6 +554,29 @@ class LinkWorker(QObject):
     def _do_call(self, function: Callable[[DriveApi], Any]) -> Any:
         return function(self.client)
 
+    def _do_sim_panel(self, action: SimPanelAction, value: Any) -> str:
+        """Do what the embedded simulated drive's panel asks; one line saying what happened."""
+        drive = _embedded_sim(self.client)
+        if drive is None:
+            raise NotConnected("this is not an embedded simulated drive: it has no panel")
+        from fha_studio.hardware.sim import SimRefused
+
+        try:
+            if action is SimPanelAction.SERVO:
+                drive.set_servo(bool(value))
+                return f"servo-ON input (CN2) {'on' if value else 'off'}"
+            if action is SimPanelAction.COMMAND:
+                drive.controller_command(float(value))
+                return f"controller: {'FWD' if value > 0 else 'REV'} command of {abs(float(value)):g} deg"
+            if action is SimPanelAction.TURN_BY_HAND:
+                drive.turn_by_hand(float(value))
+                return f"output turned by hand by {float(value):+g} deg"
+            bit = 1 << IoBit.BRAKE_RELEASED
+            drive.set_inputs(drive.io_bits() & INPUT_MASK & ~bit | (bit if value else 0))
+            return "brake released (24 V on the brake)" if value else "brake holds (no 24 V)"
+        except SimRefused as exc:
+            raise PanelRefused(exc.reason) from None
+
     # -- polling ------------------------------------------------------------------------------
     @Slot()
     def _poll(self) -> None:
@@ -528,17 +584,23 @@ class LinkWorker(QObject):
         if client is None:
             return
         status: dict[str, Any] = {"time_s": time.monotonic(), "jogging": bool(self._jog_speed_rpm)}
+        interval_ms = self._poll_interval_ms
         try:
-            try:
-                status["alarm_code"] = client.alarm()
-                io = client.io_state()
-                status["io_bits"] = io.raw
-                status["servo_on"] = io.servo_on
-                if self._monitor_ok:
-                    self._poll_monitors(client, status)
-            except ServoOnRefused:
-                status["refused"] = True
-                status["servo_on"] = True  # a real drive refuses CN3 commands while the servo is on
+            if not client.capabilities.supports(Command.IOS):
+                interval_ms = self._probe(client, status)
+            else:
+                try:
+                    status["alarm_code"] = client.alarm()
+                    io = client.io_state()
+                    status["io_bits"] = io.raw
+                    status["servo_on"] = io.servo_on
+                    if self._monitor_ok:
+                        self._poll_monitors(client, status)
+                except ServoOnRefused:
+                    status["refused"] = True
+                    status["servo_on"] = True  # a drive refuses CN3 commands while the servo is on
+                    status["note"] = SERVO_ON_NOTE
+                    interval_ms = max(interval_ms, SERVO_ON_PROBE_MS)
         except (LinkLost, LinkTimeout) as exc:
             if isinstance(exc, LinkLost) or self._count_timeout():
                 self._lose(exc)
@@ -550,7 +612,24 @@ class LinkWorker(QObject):
             self._timeouts = 0
         self.sigStatus.emit(DriveStatus(**status))
         if self._client is not None and self._poll_timer is not None:
-            self._poll_timer.start(self._poll_interval_ms)
+            self._poll_timer.start(interval_ms)
+
+    def _probe(self, client: DriveApi, status: dict[str, Any]) -> int:
+        """The idle probe of a drive without status commands: one DGR. Data, s and x all prove
+        the drive is there; silence ends the link (the caller). Returns the next poll's delay."""
+        try:
+            status["absolute_counts"] = client.absolute_position()
+            status["servo_on"] = False
+        except ServoOnRefused:
+            status["servo_on"] = True
+            status["refused"] = True
+            status["note"] = SERVO_ON_NOTE
+            return max(self._poll_interval_ms, SERVO_ON_PROBE_MS)
+        except CommandRejected:
+            # s comes to everything while the servo is on, so x means: servo off, no DGR
+            status["servo_on"] = False
+            status["note"] = "the drive refuses DGR (x): no absolute position (an incremental encoder)"
+        return max(self._poll_interval_ms, PROBE_INTERVAL_MS)
 
     def _poll_monitors(self, client: DriveApi, status: dict[str, Any]) -> None:
         """Output position (pulse), output speed (r/min) and motor current (A), scaled by the
@@ -570,6 +649,14 @@ class LinkWorker(QObject):
         status["position_pulse"] = position
         status["speed_rpm"] = scaled(MonitorItem.OUTPUT_SPEED)
         status["current_a"] = scaled(MonitorItem.MOTOR_CURRENT)
+
+
+def _embedded_sim(client: DriveApi) -> Any | None:
+    """The SimDrive behind an embedded ``sim://`` port, None for any other drive. Only the link
+    thread uses it (its panel), like the port itself."""
+    transport = getattr(getattr(client, "transaction", None), "transport", None)
+    port = getattr(transport, "inner", transport)
+    return getattr(port, "sim_drive", None)
 
 
 def _forget_dummy_thread() -> None:
@@ -728,6 +815,8 @@ __all__ = [
     "LinkWorker",
     "NotConnected",
     "OpenClient",
+    "PanelRefused",
     "ReadParametersResult",
+    "SimPanelAction",
     "WriteEntry",
 ]

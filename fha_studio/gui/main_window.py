@@ -51,6 +51,7 @@ class MainWindow(QMainWindow):
         self.session = Session(self.link, self)
         self._closing_confirmed = False
         self._shut_down = False
+        self._status_note = ""
         self._build_toolbar()
         self._build_pages()
         self._build_status_bar()
@@ -105,6 +106,12 @@ class MainWindow(QMainWindow):
         self.stop_button = StopButton()
         self.stop_button.clicked.connect(self.stop_axis)
         bar.addWidget(self.stop_button)
+        from fha_studio.gui.sim_panel import SimPanelBar
+
+        self.sim_panel = SimPanelBar(self.link, self)
+        self.sim_panel.sigMessage.connect(self.show_message)
+        self.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
+        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.sim_panel)
 
     def _build_pages(self) -> None:
         self.tabs = QTabWidget(self)
@@ -246,6 +253,9 @@ class MainWindow(QMainWindow):
         if not self.link.connected:
             self.show_message("STOP: no drive is connected, nothing was sent.", Level.WARNING)
             return
+        if not self.stop_button.can_send:
+            self.show_message(f"STOP: nothing was sent. {StopButton.NO_STOP_TEXT}", Level.WARNING)
+            return
         self.link.stop_now()
         self.show_message("STOP sent: the axis decelerates and holds (servo stays on) …")
 
@@ -318,6 +328,12 @@ class MainWindow(QMainWindow):
         self.caps_label.setToolTip(f"{model} · {where}\n{info.capabilities}")
         self.disconnect_action.setEnabled(True)
         self.servo_action.setEnabled(info.can_move)
+        self.servo_action.setToolTip(
+            "Switch the servo on or off (nothing moves without servo on)" if info.can_move else
+            "This drive takes servo-ON only from the controller through CN2: switch it there"
+        )
+        self.stop_button.set_can_send(info.can_move)
+        self.sim_panel.set_available(info.embedded_sim)
         self.setWindowTitle(f"FHA Studio — {model} — {where}")
         for page in self._pages():
             page.link_connected(info)
@@ -330,11 +346,14 @@ class MainWindow(QMainWindow):
 
     @Slot(str, bool)
     def _on_disconnected(self, reason: str, lost: bool) -> None:
+        self._status_note = ""
         self.link_lamp.set_state(False, GREEN)
         self.servo_lamp.set_state(None)
         self.alarm_lamp.set_state(None)
         self.disconnect_action.setEnabled(False)
         self.servo_action.setEnabled(False)
+        self.stop_button.set_can_send(True)
+        self.sim_panel.set_available(False)
         self.servo_action.setChecked(False)
         self.setWindowTitle("FHA Studio — not connected")
         if lost:
@@ -351,8 +370,17 @@ class MainWindow(QMainWindow):
     @Slot(object)
     def _on_status(self, status: DriveStatus) -> None:
         self.caps_label.setStyleSheet("")
+        if status.note != self._status_note:
+            self._status_note = status.note
+            info = self.link.info
+            if status.note:
+                self._set_caps(f"Link OK · {status.note}")
+            elif info is not None:
+                self._on_connected(info)
         if status.servo_on is not None:
             self.servo_lamp.set_state(status.servo_on)
+            if status.refused:
+                self.servo_lamp.setToolTip(f"Servo: {status.note}")
             self.servo_action.setChecked(status.servo_on)
             self.servo_action.setText("Servo O&N" if not status.servo_on else "Servo O&FF")
         if status.alarm_code is not None:
@@ -378,7 +406,7 @@ class MainWindow(QMainWindow):
             self._set_caps(f"Could not connect: {result.error}")
             self.caps_label.setStyleSheet("color: #b00020; font-weight: bold;")
             self.link_lamp.set_state(True, RED)
-        elif result.cmd is not Cmd.JOG_LEASE:
+        elif result.cmd not in (Cmd.JOG_LEASE, Cmd.SIM_PANEL):
             self.show_message(f"{_command_words(result.cmd)} failed: {result.error}", Level.ERROR)
 
     @Slot(int, bool)

@@ -78,12 +78,42 @@ class StopButton(QPushButton):
         font.setBold(True)
         font.setPointSizeF(font.pointSizeF() * 1.3)
         self.setFont(font)
-        self.setStyleSheet(
-            "QPushButton#stopButton { background: #c62828; color: white; border: 2px solid #7f0000;"
-            " border-radius: 6px; padding: 4px 14px; }"
-            "QPushButton#stopButton:pressed { background: #8e0000; }"
-            "QPushButton#stopButton:focus { border: 3px solid #ffd54f; }"
-        )
+        self.can_send = True
+        self._apply_style()
+
+    #: What stops an axis whose drive has no stop command over CN3 (a real HA-655).
+    NO_STOP_TEXT = (
+        "This drive has no stop command over CN3: FHA Studio cannot stop this axis. Stop it with the "
+        "emergency stop or the controller's servo-OFF (CN2)."
+    )
+
+    def set_can_send(self, can_send: bool) -> None:
+        """True: STOP goes to the drive. False: the drive has no stop command, so the button says
+        what stops the axis instead and looks like advice, not like a live control."""
+        self.can_send = can_send
+        if can_send:
+            self.setText("STOP  (Esc)")
+            self.setToolTip("Stop the axis now: decelerate and hold (the servo stays on). Key: Esc")
+        else:
+            self.setText("E-STOP / servo-OFF")
+            self.setToolTip(self.NO_STOP_TEXT)
+        self.setAccessibleDescription(self.toolTip())
+        self._apply_style()
+
+    def _apply_style(self) -> None:
+        if self.can_send:
+            self.setStyleSheet(
+                "QPushButton#stopButton { background: #c62828; color: white; border: 2px solid #7f0000;"
+                " border-radius: 6px; padding: 4px 14px; }"
+                "QPushButton#stopButton:pressed { background: #8e0000; }"
+                "QPushButton#stopButton:focus { border: 3px solid #ffd54f; }"
+            )
+        else:
+            self.setStyleSheet(
+                "QPushButton#stopButton { background: #fff3e0; color: #7f0000; border: 2px dashed #c62828;"
+                " border-radius: 6px; padding: 4px 10px; }"
+                "QPushButton#stopButton:focus { border: 3px dashed #ffd54f; }"
+            )
 
 
 class FlangeWidget(QWidget):

@@ -1,0 +1,115 @@
+"""The main window on a drive that answers only its manual's commands (DGR, OWW): the simulated
+drive's documented profile, embedded, through the real client and codec, with the servo switched
+by the simulated CN2 input as a trainee does in the panel."""
+
+from __future__ import annotations
+
+import itertools
+import time
+
+import pytest
+
+from fha_studio.gui.link import PROBE_INTERVAL_MS, SERVO_ON_NOTE, SERVO_ON_PROBE_MS, Cmd
+from fha_studio.hardware import protocol as p
+from fha_studio.hardware.scripted import ScriptedDrive, documented_only
+from fha_studio.hardware.transport import pipe_pair
+
+URL = "sim://FHA-25C-50-S248?paced=0&profile=documented&oww_clear_s=1"
+
+
+def sim_drive(window):
+    return window.link._worker._client.transaction.transport.inner.sim_drive
+
+
+@pytest.fixture
+def window(make_window, qtbot):
+    w = make_window(connect=URL)
+    qtbot.waitUntil(lambda: w.link.status is not None and w.link.status.absolute_counts is not None,
+                    timeout=10000)
+    return w
+
+
+def switch_servo(window, qtbot, on: bool) -> None:
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SIM_PANEL,
+                          timeout=10000) as done:
+        window.sim_panel.servo_check.setChecked(on)
+    assert done.args[0].ok, done.args[0].error
+    qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on is on,
+                    timeout=10000)
+
+
+def test_panel_is_shown_and_servo_on_comes_from_cn2_only(window, qtbot):
+    info = window.link.info
+    assert info.documented_only and info.embedded_sim and not info.can_move
+    assert window.sim_panel.isVisible()
+    assert not window.servo_action.isEnabled()
+    assert "CN2" in window.servo_action.toolTip()
+    switch_servo(window, qtbot, True)
+    assert window.servo_lamp.state is True
+    qtbot.waitUntil(lambda: SERVO_ON_NOTE in window.caps_label.toolTip(), timeout=10000)
+    assert window.link_lamp.state is True  # s proves the drive is there
+    switch_servo(window, qtbot, False)
+    qtbot.waitUntil(lambda: SERVO_ON_NOTE not in window.caps_label.toolTip(), timeout=10000)
+
+
+def test_idle_probe_is_dgr_about_once_a_second_and_at_most_once_a_second_with_servo_on(window, qtbot):
+    sent: list[tuple[float, bytes]] = []
+    client = window.link._worker._client
+    client.trace_packet = lambda sending, data: sending and sent.append((time.monotonic(), data))
+    qtbot.waitUntil(lambda: len(sent) >= 4, timeout=10000)
+    assert {data for _, data in sent} == {b"DGR+00000\r"}
+    switch_servo(window, qtbot, True)
+    sent.clear()
+    qtbot.waitUntil(lambda: len(sent) >= 4, timeout=15000)
+    gaps = [b[0] - a[0] for a, b in itertools.pairwise(sent)]
+    assert min(gaps) >= SERVO_ON_PROBE_MS / 1000 * 0.9, gaps
+    assert PROBE_INTERVAL_MS <= SERVO_ON_PROBE_MS
+    client.trace_packet = None
+
+
+def test_stop_says_what_stops_this_axis_and_sends_nothing(window, qtbot):
+    button = window.stop_button
+    assert not button.can_send and "emergency stop" in button.toolTip()
+    assert "servo-OFF" in button.text()
+    sent: list[bytes] = []
+    window.link._worker._client.trace_packet = lambda sending, data: sending and sent.append(data)
+    for page in window.PAGE_NAMES:
+        window.show_page(page)
+        button.click()
+        assert "nothing was sent" in window.message_area.latest().text
+        assert "emergency stop" in window.message_area.latest().text
+    assert all(data == b"DGR+00000\r" for data in sent)  # only the idle probe went out
+    window.link._worker._client.trace_packet = None
+
+
+def test_a_silent_drive_turns_the_link_lamp_red_within_2_s(make_window, qtbot):
+    host, drive_end = pipe_pair("documented")
+    alive = {"on": True}
+    handler = documented_only()
+
+    def answer(request):
+        return handler(request) if alive["on"] else None
+
+    scripted = ScriptedDrive(drive_end, answer)
+
+    def open_client(url, baud):
+        from fha_studio.hardware.client import DriveClient, LinkSettings
+
+        return DriveClient.attach(host, LinkSettings(response_timeout_s=0.25, retries=1))
+
+    try:
+        window = make_window(open_client=open_client, connect="documented")
+        qtbot.waitUntil(lambda: window.link.status is not None, timeout=10000)
+        assert window.link_lamp.state is True
+        with qtbot.waitSignal(window.link.sigDisconnected, timeout=10000) as lost:
+            alive["on"] = False
+            switched_off = time.monotonic()
+        took = time.monotonic() - switched_off
+        assert lost.args[1] is True
+        assert window.link_lamp.state is True and window.link_lamp.toolTip().startswith("Link: LOST")
+        assert "Link lost" in window.message_area.latest().text
+        print(f"link lost shown {took:.2f} s after the drive fell silent")
+        assert took < 2.0 + 1.0  # 2 s by design; the extra second is for a loaded test machine
+        assert p.Command.DGR.value in scripted.commands()
+    finally:
+        scripted.close()
