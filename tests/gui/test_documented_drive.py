@@ -73,7 +73,9 @@ def test_stop_says_what_stops_this_axis_and_sends_nothing(window, qtbot):
     assert "servo-OFF" in button.text()
     sent: list[bytes] = []
     window.link._worker._client.trace_packet = lambda sending, data: sending and sent.append(data)
-    for page in window.PAGE_NAMES:
+    from fha_studio.gui.pages.registry import PAGES
+
+    for page in (entry.id for entry in PAGES):
         window.show_page(page)
         button.click()
         assert "nothing was sent" in window.message_area.latest().text
