@@ -52,6 +52,8 @@ TORQUE_FLOOR_FRACTION_OF_MAX = 0.005  # 0.5 % of the actuator's maximum torque
 TORQUE_FLOOR_MIN_NM = 0.02
 POSITION_FLOOR_ARCSEC = 2.0
 STRUCTURE_MIN_FRACTION = 0.15  # a structured residual explains >= 15 % of the residual's variance
+BURST_FACTOR = 6.0  # a burst in time: local RMS this many times the residual's median local RMS
+BURST_EDGE_FACTOR = 3.0  # ... and it lasts while the local RMS stays above this many times the median
 RESIM_BANDWIDTH_HZ = 60.0  # speed-loop bandwidth of the stiff servo that follows the measured motion
 # A channel is checked when what it shows (smoothed) stands this many noise sigmas above its noise.
 SIGNAL_NOISE_FACTOR = 4.0
@@ -131,9 +133,10 @@ class Structure:
 
     channel: str
     variable: str
-    rms: float  # of the part explained by the variable, held-out
+    rms: float  # of the part explained by the variable, held-out (variable "time": within the bursts)
     fraction: float  # of the residual variance
     unit: str
+    spans: list[tuple[float, float, float]] = field(default_factory=list)  # "time": (start s, end s, peak)
 
 
 @dataclass
@@ -276,6 +279,17 @@ class ModelCheckResult:
                 f"to separate them: {a.separating_test}"
             )
         for s in self.structures:
+            if s.variable == "time":
+                where = ", ".join(f"{a:.2f}-{b:.2f} s" for a, b, _ in s.spans[:6])
+                more = f" and {len(s.spans) - 6} more" if len(s.spans) > 6 else ""
+                peak = max(p for _, _, p in s.spans)
+                lines.append(
+                    f"Structured residual in the {s.channel} channel that no candidate explains: "
+                    f"{len(s.spans)} burst{'s' if len(s.spans) > 1 else ''} up to {_fmt(peak)} {s.unit} at "
+                    f"t = {where}{more} ({100 * s.fraction:.0f} % of the residual): a disturbance the "
+                    "recording does not measure; not forced onto a named effect"
+                )
+                continue
             lines.append(
                 f"Structured residual in the {s.channel} channel that no candidate explains: "
                 f"{_fmt(s.rms)} {s.unit} rms organised by {s.variable} ({100 * s.fraction:.0f} % of the "
@@ -341,6 +355,8 @@ class ModelCheckResult:
                     "rms": s.rms,
                     "fraction": s.fraction,
                     "unit": s.unit,
+                    "spans_s": [[a, b] for a, b, _ in s.spans],
+                    "peaks": [peak for _, _, peak in s.spans],
                 }
                 for s in self.structures
             ],
@@ -563,6 +579,15 @@ def run_modelcheck(
         s = _structure(after, candidates_vars, sel.floor, block_len)
         if s is not None:
             structures.append(Structure(ch, s[0], s[1], s[2], unit))
+        # an unmeasured load acts on the torque; the position channel's model errors (a dead band's
+        # transitions) sit at reversals and would read as bursts there
+        bursts = (
+            _bursts_in_time(after, sig.t_s[index], sel.floor, max(5, 4 * sig.filt.window // step))
+            if ch == TORQUE
+            else None
+        )
+        if bursts is not None:
+            structures.append(Structure(ch, "time", bursts[0], bursts[1], unit, bursts[2]))
         where[ch] = ChannelWhere(
             ch,
             unit,
@@ -777,6 +802,41 @@ def _structure(
         if frac >= STRUCTURE_MIN_FRACTION and peak >= floor and (best is None or frac > best[2]):
             best = (name, explained, frac)
     return best
+
+
+def _bursts_in_time(
+    e: np.ndarray, t: np.ndarray, floor: float, length: int
+) -> tuple[float, float, list[tuple[float, float, float]]] | None:
+    """Bursts of residual at times no state variable explains (an unmeasured disturbance).
+
+    The residual's local RMS over `length` samples (a few analysis windows) is compared with its
+    median: a burst peaks above BURST_FACTOR x the median and above twice the practical floor; it
+    extends while the local RMS stays above BURST_EDGE_FACTOR x the median. A model's own errors sit
+    at every acceleration change and stay within a few times the median; a disturbance at
+    irregular times stands out by an order of magnitude. Returns (rms within the bursts, their share
+    of the residual variance, [(start s, end s, peak local RMS)]) or None.
+    """
+    total = float(np.sum(e**2))
+    if total <= 0 or len(e) < 4 * length:
+        return None
+    local = np.sqrt(np.convolve(e**2, np.ones(length) / length, mode="same"))
+    median = float(np.median(local))
+    threshold = max(BURST_FACTOR * median, 2.0 * floor)
+    if not np.any(local > threshold):
+        return None
+    inside = local > BURST_EDGE_FACTOR * median
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], inside.astype(np.int8), [0]])))
+    spans = []
+    mask = np.zeros(len(e), bool)
+    for a, b in zip(edges[::2], edges[1::2], strict=True):
+        peak = float(local[a:b].max())
+        if peak > threshold:
+            spans.append((float(t[a]), float(t[b - 1]), peak))
+            mask[a:b] = True
+    fraction = float(np.sum(e[mask] ** 2)) / total
+    if fraction < STRUCTURE_MIN_FRACTION:
+        return None
+    return float(np.sqrt(np.mean(e[mask] ** 2))), fraction, spans
 
 
 def _gap(sel: ChannelSelector, terms, ch: str, unit: str, t: np.ndarray) -> Gap:
