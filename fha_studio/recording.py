@@ -32,8 +32,9 @@ The file loads in plain numpy, e.g. ``np.genfromtxt(path, delimiter=",", comment
 (the header row reads as NaN and is dropped) or ``np.loadtxt(path, delimiter=",", comments="#",
 skiprows=...)``.
 
-This module sits outside the layer list (like :mod:`fha_studio.paths`): the simulated drive in
-the hardware layer, the GUI recorder and the model check all use it. It imports no Qt.
+In the layers it sits beside :mod:`fha_studio.physics`, below the hardware layer (the simulated
+drive records with it) and above the catalogue (which says whether an actuator exists). It
+imports no Qt.
 """
 
 from __future__ import annotations
@@ -48,6 +49,8 @@ from pathlib import Path
 from typing import TextIO
 
 import numpy as np
+
+from fha_studio.catalog import get_actuator
 
 FORMAT_ID = "fha-recording/1"
 
@@ -314,11 +317,7 @@ def _check_model_code(code: str, line: int, source: str, check_actuator: bool) -
     if not check_actuator:
         return
     try:
-        from fha_studio.catalog import get_actuator  # the catalogue decides whether it exists
-    except ImportError:  # pragma: no cover - only before the catalogue exists
-        return
-    try:
-        get_actuator(code)
+        get_actuator(code)  # the catalogue decides whether it exists
     except (ValueError, KeyError, LookupError) as exc:
         raise RecordingError(f"unknown actuator '{code}': {exc}", source=source, line=line,
                              field="actuator") from None

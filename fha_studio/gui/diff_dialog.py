@@ -17,6 +17,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio.gui.parameter_text import MODE_WORDS, value_text
 from fha_studio.gui.session import Session
 
 CHOICES = ("drive", "file", "default")
@@ -28,8 +29,6 @@ class ParameterDiffDialog(QDialog):
 
     def __init__(self, session: Session, loaded, file_name: str, parent: QWidget | None = None):
         super().__init__(parent)
-        from fha_studio.gui.pages.parameters import MODE_WORDS, value_text
-
         self.setWindowTitle(f"Compare {file_name} with the drive")
         self.session = session
         self.loaded = loaded

@@ -25,66 +25,22 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio.gui.diff_dialog import ParameterDiffDialog
 from fha_studio.gui.link import Cmd, CommandResult, LinkInfo
 from fha_studio.gui.pages.base import BasePage
+from fha_studio.gui.parameter_text import MODE_WORDS, parse_value, range_text, value_text
 from fha_studio.gui.session import Session
 
 COLUMNS = ("Mode", "No.", "Name", "Value", "Unit", "Range", "Default", "State")
 COL_VALUE = 3
 EDITED_BRUSH = QBrush(QColor("#fff1b8"))
 DIFFERS_COLOUR = QColor("#0d47a1")
-MODE_WORDS = {"tune": "tune", "system": "parameter"}
 #: Why the write buttons are off while the servo is on (the driver's rule for parameter mode).
 SERVO_ON_WRITE_REASON = (
     "The servo is on: parameter-mode items can be written only with the servo off. "
     "Switch the servo off (toolbar or controller) to write them."
 )
 _ROOT = QModelIndex()
-
-
-def parse_value(item, text: str) -> int:
-    """The wire integer for what was typed: a choice number, or a value in the item's unit.
-    Raises ValueError saying the allowed range."""
-    text = text.strip()
-    if item.choices:
-        head = text.split(":", 1)[0].strip()
-        try:
-            wire = int(head)
-        except ValueError:
-            raise ValueError(f"{item.name}: choose one of {_choices(item)}") from None
-        if wire not in item.choices:
-            raise ValueError(f"{item.name}: {wire} is not allowed; choose one of {_choices(item)}")
-        return wire
-    try:
-        value = float(text.replace(",", "."))
-    except ValueError:
-        raise ValueError(f"{item.name}: '{text}' is not a number; allowed {range_text(item)}") from None
-    wire = round(value / item.scale)
-    if not item.minimum <= wire <= item.maximum or abs(wire * item.scale - value) > item.scale * 0.5 + 1e-9:
-        raise ValueError(f"{item.name}: {text} is outside the allowed range {range_text(item)}")
-    return wire
-
-
-def _choices(item) -> str:
-    return ", ".join(f"{k} ({v})" for k, v in item.choices.items())
-
-
-def _num(value: float) -> str:
-    return f"{value:g}"
-
-
-def range_text(item) -> str:
-    if item.choices:
-        return " / ".join(str(k) for k in item.choices)
-    return f"{_num(item.to_unit(item.minimum))} … {_num(item.to_unit(item.maximum))}"
-
-
-def value_text(item, wire: int | None) -> str:
-    if wire is None:
-        return ""
-    if item.choices:
-        return f"{wire}: {item.choices.get(wire, '?')}"
-    return _num(item.to_unit(wire))
 
 
 class ParameterTableModel(QAbstractTableModel):
@@ -627,7 +583,6 @@ class ParametersPage(BasePage):
     def load_file(self, path: str | None = None, exec_dialog: bool = True):
         """Reads a parameter file and shows the three-way comparison; nothing is applied until the
         user confirms. Returns the dialog (tests drive it) or None when the file was refused."""
-        from fha_studio.gui.diff_dialog import ParameterDiffDialog
         from fha_studio.logic.paramfile import ParameterFileError, read_parameter_file
 
         if path is None:
