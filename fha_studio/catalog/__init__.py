@@ -23,10 +23,17 @@ from fha_studio.catalog.actuator import (
     options_allowed,
     ratios,
 )
-from fha_studio.catalog.model_code import OPTION_ORDER, ModelCode, ModelCodeError, parse_model_code
+from fha_studio.catalog.model_code import (
+    DEFAULT_ACTUATOR,
+    OPTION_ORDER,
+    ModelCode,
+    ModelCodeError,
+    parse_model_code,
+)
 from fha_studio.catalog.tables import Discrepancy, Environment, Lead, discrepancies, environment
 
 __all__ = [
+    "DEFAULT_ACTUATOR",
     "OPTION_ORDER",
     "Actuator",
     "Bearing",

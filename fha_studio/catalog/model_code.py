@@ -92,6 +92,11 @@ def _split_options(text: object, groups: list[str]) -> list[str]:
     return options
 
 
+#: The actuator FHA Studio starts with until the user names one: the embedded simulated drive's
+#: actuator, the sizing page's first choice, the scope's scaling before a model code is known.
+DEFAULT_ACTUATOR = "FHA-25C-50-US250"
+
+
 def parse_model_code(text: str) -> ModelCode:
     """Parse a model code such as ``FHA-32C-100-S248-B``; raises :class:`ModelCodeError`."""
     if not isinstance(text, str):

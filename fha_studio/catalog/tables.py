@@ -627,12 +627,26 @@ def position_sensors() -> PositionSensors:
 
 @dataclass(frozen=True)
 class RotaryDirectionSetting:
-    """1-10: one value of [parameter mode] -> [8: rotary direction] and what FWD/REV commands do."""
+    """1-10: one value of [parameter mode] -> [8: rotary direction] and what FWD/REV commands do.
+
+    ``fwd_command`` is the rotation a FWD command gives: "FWD rotation" is the manual's forward
+    direction (CW seen from the output flange), "REV rotation" the other one.
+    """
 
     value: int
     fwd_command: str
     rev_command: str
     default: bool
+
+    @property
+    def fwd_turns_cw(self) -> bool:
+        """True when a FWD command turns the output flange clockwise, seen from the flange."""
+        return self.fwd_command == "FWD rotation"
+
+    @property
+    def fwd_direction(self) -> str:
+        """ "CW" or "CCW": where a FWD command turns the output flange, seen from the flange."""
+        return "CW" if self.fwd_turns_cw else "CCW"
 
 
 @cache
@@ -643,3 +657,17 @@ def rotary_direction() -> tuple[RotaryDirectionSetting, ...]:
         RotaryDirectionSetting(v["value"], v["fwd_command"], v["rev_command"], v["setting"] == "Default")
         for v in r["values"]
     )
+
+
+def rotary_direction_setting(value: int) -> RotaryDirectionSetting:
+    """The row of the 1-10 table for ``value``; ValueError naming the allowed values otherwise."""
+    for setting in rotary_direction():
+        if setting.value == value:
+            return setting
+    allowed = " or ".join(str(s.value) for s in rotary_direction())
+    raise ValueError(f"rotary direction {value!r}: the manual (1-10) allows {allowed}")
+
+
+def default_rotary_direction() -> RotaryDirectionSetting:
+    """The row of the 1-10 table marked Default."""
+    return next(s for s in rotary_direction() if s.default)

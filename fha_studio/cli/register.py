@@ -185,6 +185,21 @@ def _name(key: str, driver_model: str = "") -> str:
 # -- actions --------------------------------------------------------------------------------------------
 
 
+def _direction_text(value: int | None) -> str:
+    """ "FWD = CW", or "reversed (FWD = CCW)" for a rotary direction value (the 1-10 table); ""
+    when unknown."""
+    if value is None:
+        return ""
+    from fha_studio.catalog.tables import rotary_direction_setting
+
+    try:
+        setting = rotary_direction_setting(value)
+    except ValueError:
+        return str(value)
+    fwd = f"FWD = {setting.fwd_direction}"
+    return fwd if setting.default else f"reversed ({fwd})"
+
+
 def _machines(args) -> int:
     with _open_register(args) as reg:
         open_items = reg.open_items()
@@ -236,9 +251,7 @@ def _axes(args) -> int:
             if r["report"] is None
             else (f"signed by {r['report_signed_by']}" if r["report_signed_by"] else "not signed")
         )
-        direction = {None: "", 0: "FWD = CW", 1: "reversed"}.get(
-            r["rotary_direction"], str(r["rotary_direction"])
-        )
+        direction = _direction_text(r["rotary_direction"])
         inertia = "" if r["load_inertia_kgm2"] is None else f"{r['load_inertia_kgm2']:g} kg m²"
         table.append(
             [

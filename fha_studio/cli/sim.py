@@ -16,6 +16,7 @@ import sys
 import threading
 from typing import Any
 
+from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.cli import CliError
 
 ORDER = 30
@@ -33,7 +34,7 @@ def register(subparsers: Any) -> None:
                        help="serve on a new pseudo-terminal; prints its path")
     where.add_argument("--tcp", type=int, metavar="PORT",
                        help="serve socket://127.0.0.1:PORT (0: any free port)")
-    p.add_argument("--actuator", default="FHA-25C-50-US250", metavar="CODE",
+    p.add_argument("--actuator", default=DEFAULT_ACTUATOR, metavar="CODE",
                    help="actuator model code, options included (e.g. FHA-25C-50-S248-B-L); "
                    "default %(default)s")
     p.add_argument("--driver", metavar="MODEL", help="driver model (default: the HA-655 of FHA-C manual 1-3)")

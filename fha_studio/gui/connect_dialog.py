@@ -16,8 +16,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.forms import child, load_form
-from fha_studio.gui.session import DEFAULT_ACTUATOR
 
 BAUD_RATES = (9600, 19200, 38400, 57600, 115200)
 DEFAULT_BAUD = 19200

@@ -9,13 +9,13 @@ from pathlib import Path
 
 from PySide6.QtCore import QObject, QStandardPaths, Signal, Slot
 
+from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.link import Cmd, CommandResult, LinkController, LinkInfo
 from fha_studio.logic.paramfile import dump_parameter_file
 from fha_studio.logic.session_log import SessionLog, WriteRecord
 
 log = logging.getLogger(__name__)
 
-DEFAULT_ACTUATOR = "FHA-25C-50-US250"
 DEFAULT_SIM_URL = f"sim://{DEFAULT_ACTUATOR}"
 
 

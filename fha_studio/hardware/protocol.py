@@ -349,7 +349,9 @@ def parse_int(line: str) -> int:
     return int(line)
 
 
-#: Single-turn counts per motor turn of the absolute encoder (DGR = multi-turn x 8192 + single-turn).
+#: Single-turn counts per motor turn of the absolute encoder: DGR = multi-turn x 8192 + single-turn
+#: (HA-655 manual p.21). The one constant of the wire format; the catalogue's absolute encoder
+#: (resources/catalog/specs.toml, FHA-C manual 1-8: 13 bit) says the same, a test keeps them equal.
 ABSOLUTE_COUNTS_PER_TURN = 8192
 
 

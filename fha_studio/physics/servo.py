@@ -26,6 +26,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from fha_studio.catalog.tables import rotary_direction, rotary_direction_setting
 from fha_studio.physics import _kernel
 from fha_studio.physics.model import AxisModel
 from fha_studio.physics.motion import MotionGenerator
@@ -84,7 +85,9 @@ class ServoSettings:
               and self.electronic_gear_numerator > 0, "a positive integer")
         check("electronic_gear_denominator", isinstance(self.electronic_gear_denominator, int)
               and self.electronic_gear_denominator > 0, "a positive integer")
-        check("rotary_direction", self.rotary_direction in (0, 1), "0 (FWD = CW) or 1 (reversed)")
+        directions = rotary_direction()
+        check("rotary_direction", self.rotary_direction in {s.value for s in directions},
+              " or ".join(f"{s.value} (FWD = {s.fwd_direction})" for s in directions))
         check("in_position_range_pulses", self.in_position_range_pulses >= 0, "non-negative")
         check("servo_rate_hz", self.servo_rate_hz >= MIN_SERVO_RATE_HZ, f"at least {MIN_SERVO_RATE_HZ:g}")
         check("control_mode", self.control_mode in ("position", "speed"), '"position" or "speed"')
@@ -120,8 +123,9 @@ class ServoSettings:
 
     @property
     def direction_sign(self) -> float:
-        """+1 when FWD = CW (rotary direction 0), -1 when reversed."""
-        return -1.0 if self.rotary_direction else 1.0
+        """+1 when a FWD command turns the flange CW (the 1-10 table's row for
+        ``rotary_direction``), -1 when it turns it CCW."""
+        return 1.0 if rotary_direction_setting(self.rotary_direction).fwd_turns_cw else -1.0
 
 
 def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelParams:

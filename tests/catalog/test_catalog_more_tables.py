@@ -168,3 +168,11 @@ def test_position_sensor_set_and_rotary_direction():
     rd = t.rotary_direction()
     assert [(r.value, r.default) for r in rd] == [(0, True), (1, False)]
     assert rd[0].fwd_command == "FWD rotation" and rd[1].fwd_command == "REV rotation"
+
+
+def test_1_10_rotary_direction_says_where_a_fwd_command_turns():
+    default = t.default_rotary_direction()
+    assert default.value == 0 and default.fwd_turns_cw and default.fwd_direction == "CW"
+    assert t.rotary_direction_setting(1).fwd_direction == "CCW"
+    with pytest.raises(ValueError, match="0 or 1"):
+        t.rotary_direction_setting(2)

@@ -28,7 +28,13 @@ from fha_studio.hardware.api import (
     TraceStatus,
     WriteResult,
 )
-from fha_studio.hardware.parameters import Mode, ParameterModel, ParameterValueError, load_parameter_model
+from fha_studio.hardware.parameters import (
+    Mode,
+    MonitorItem,
+    ParameterModel,
+    ParameterValueError,
+    load_parameter_model,
+)
 from fha_studio.hardware.protocol import Command, IoBit
 
 #: What the fake answers: the manual's commands, parameters, monitors, motion, alarms, I/O and the
@@ -40,9 +46,6 @@ FAKE_COMMANDS = frozenset(
         Command.MOV, Command.STP, Command.ALM, Command.AHS, Command.ACL, Command.IOS, Command.PWC,
     }
 )
-
-#: Monitor items the fake has: output position, output speed, motor current, I/O state.
-_FEEDBACK_POSITION, _OUTPUT_SPEED, _MOTOR_CURRENT, _IO_STATE = 100, 103, 104, 106
 
 
 class FakeDriveClient:
@@ -163,13 +166,13 @@ class FakeDriveClient:
 
     # --- monitors ------------------------------------------------------------------------------
     def _monitor_wire(self, item: int) -> int:
-        if item == _FEEDBACK_POSITION:
+        if item == MonitorItem.FEEDBACK_POSITION:
             return int(self.position_pulse)
-        if item == _OUTPUT_SPEED:
+        if item == MonitorItem.OUTPUT_SPEED:
             return round(self.jog_speed_rpm / self.model.item(Mode.MONITOR, item).scale)
-        if item == _MOTOR_CURRENT:
+        if item == MonitorItem.MOTOR_CURRENT:
             return round((0.5 if self.jog_speed_rpm else 0.0) / self.model.item(Mode.MONITOR, item).scale)
-        if item == _IO_STATE:
+        if item == MonitorItem.IO_STATE:
             return self._io_bits()
         raise CommandRejected(f"MON{item:+06d}: rejected by the drive (x)")
 

@@ -319,3 +319,9 @@ def test_packed_block_of_slow_signals_is_about_one_character_per_value():
     rows = [(1000 + 2 * i, 5000, i % 3, 0) for i in range(64)]
     chars = sum(len(line) for line in p.encode_packed_block(rows))
     assert chars <= 64 * 4 + 8
+
+
+def test_the_dgr_count_per_motor_turn_is_the_catalogues_absolute_encoder():
+    from fha_studio.catalog import tables
+
+    assert tables.encoder_resolution_table("absolute").counts_per_motor_rev == p.ABSOLUTE_COUNTS_PER_TURN

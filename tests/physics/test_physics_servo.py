@@ -355,3 +355,14 @@ def test_clear_error_and_direction_change_rebase_the_command(make_model):
     axis.jog(5 * RPM)
     axis.advance(0.5)
     assert axis.output_pos_rad < pos  # FWD turns CCW now
+
+
+def test_the_direction_sign_follows_the_manuals_rotary_direction_table():
+    from fha_studio.catalog.tables import rotary_direction
+    from fha_studio.physics import ServoSettings
+
+    for setting in rotary_direction():
+        sign = ServoSettings(rotary_direction=setting.value).direction_sign
+        assert sign == (1.0 if setting.fwd_turns_cw else -1.0)
+    with pytest.raises(ValueError, match="rotary_direction"):
+        ServoSettings(rotary_direction=2)

@@ -14,6 +14,7 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
 )
 
+from fha_studio.catalog.tables import default_rotary_direction, rotary_direction_setting
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
@@ -36,6 +37,14 @@ CONSEQUENCE = {
         "search direction of the machine afterwards."
     ),
 }
+
+
+def _fwd_words(value: int) -> str:
+    """Where a FWD command turns the flange with rotary direction ``value`` (the 1-10 table)."""
+    try:
+        return "clockwise" if rotary_direction_setting(value).fwd_turns_cw else "counter-clockwise"
+    except ValueError:
+        return "(a value the manual does not list)"
 
 
 class DirectionPage(BasePage):
@@ -136,7 +145,7 @@ class DirectionPage(BasePage):
         self._stop_timer = QTimer(self)
         self._stop_timer.setSingleShot(True)
         self._stop_timer.timeout.connect(self._end_check_jog)
-        self.cw_radio.setChecked(True)
+        self.group.button(default_rotary_direction().value).setChecked(True)
         self._update()
         space_jogs_only(self, ())  # "Jog FWD briefly" moves: only a deliberate click starts it
 
@@ -163,8 +172,7 @@ class DirectionPage(BasePage):
             )
         else:
             self.drive_label.setText(
-                f"On the drive: <b>{value}</b> — FWD turns the flange "
-                f"{'clockwise' if value == 0 else 'counter-clockwise'}"
+                f"On the drive: <b>{value}</b> — FWD turns the flange {_fwd_words(value)}"
             )
         self.write_button.setEnabled(connected and value is not None and self.chosen() != value)
         self.check_button.setEnabled(connected and self.link.servo_on and not self._check_running)
@@ -173,7 +181,7 @@ class DirectionPage(BasePage):
     def _choice_changed(self, button_id: int, checked: bool) -> None:
         if not checked:
             return
-        self.flange.set_clockwise(button_id == 0)
+        self.flange.set_clockwise(rotary_direction_setting(button_id).fwd_turns_cw)
         self.consequence.setText(
             CONSEQUENCE[button_id] + " Takes effect after the driver's control power is cycled."
         )
@@ -263,7 +271,8 @@ class DirectionPage(BasePage):
         for b in (self.seen_cw, self.seen_ccw, self.seen_none):
             b.setEnabled(False)
         value = self.drive_value()
-        expected = "cw" if value in (0, None) else "ccw"
+        setting = default_rotary_direction() if value is None else rotary_direction_setting(value)
+        expected = setting.fwd_direction.lower()
         if seen == "none":
             self.check_result.setText(
                 "No motion seen: check that the servo is on, no inhibit or limit switch is active, "
@@ -274,7 +283,7 @@ class DirectionPage(BasePage):
         if ok:
             self.check_result.setText(
                 f"<span style='color:#2e7d32'><b>Confirmed</b>: FWD turns the flange {seen.upper()}, "
-                f"as rotary direction = {value if value is not None else 0} says.</span>"
+                f"as rotary direction = {setting.value} says.</span>"
             )
         else:
             self.check_result.setText(

@@ -31,9 +31,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.connect_dialog import catalogue_codes
 from fha_studio.gui.pages.base import BasePage
-from fha_studio.gui.session import DEFAULT_ACTUATOR, Session
+from fha_studio.gui.session import Session
 
 PASS_COLOUR = QColor("#2e7d32")
 FAIL_COLOUR = QColor("#b00020")

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Final
 
 from fha_studio import __version__ as _version
 from fha_studio.hardware.parameters import Mode
-from fha_studio.hardware.protocol import Command, encode_packed_block
+from fha_studio.hardware.protocol import Command, encode_packed_block, mask_items
 from fha_studio.hardware.sim.reply import SimRefused, rejected
 
 if TYPE_CHECKING:
@@ -82,7 +82,7 @@ def _mon(d: SimDrive, value: int) -> str:
 def _mmr(d: SimDrive, value: int) -> str:
     if value <= 0 or value >= 1 << 16:
         raise rejected(f"MMR: mask {value} selects no monitor item 100-115")
-    items = [100 + k for k in range(16) if value >> k & 1]
+    items = mask_items(value)
     return ",".join(str(d.monitor(i)) for i in items)
 
 

@@ -33,8 +33,14 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import __version__ as _version
-from fha_studio.hardware.parameters import Mode, load_alarm_table, load_parameter_model, split_low_high
-from fha_studio.hardware.protocol import EXTENSION_COMMANDS, Command
+from fha_studio.hardware.parameters import (
+    Mode,
+    MonitorItem,
+    load_alarm_table,
+    load_parameter_model,
+    split_low_high,
+)
+from fha_studio.hardware.protocol import ABSOLUTE_COUNTS_PER_TURN, EXTENSION_COMMANDS, Command
 from fha_studio.hardware.sim.axis import (
     DEFAULT_SERVO_RATE_HZ,
     build_axis,
@@ -56,7 +62,6 @@ from fha_studio.physics import ServoAxis, ServoSettings
 
 TWO_PI = 2.0 * math.pi
 RPM = TWO_PI / 60.0  # rad/s per r/min
-ABS_COUNTS_PER_MOTOR_REV = 8192  # 13-bit single-turn (FHA-C manual 1-8, HA-655 p.20)
 
 
 class SimDrive:
@@ -304,7 +309,7 @@ class SimDrive:
     def absolute_counts(self) -> int:
         """Multi-turn x 8192 + single-turn of the absolute motor encoder (DGR), physical sense."""
         turns = (self.axis.output_pos_rad - self._absolute_zero_rad) / TWO_PI * self.model.ratio
-        return math.floor(turns * ABS_COUNTS_PER_MOTOR_REV + 0.5)
+        return math.floor(turns * ABSOLUTE_COUNTS_PER_TURN + 0.5)
 
     @property
     def _angle_deg(self) -> float:
@@ -517,7 +522,7 @@ class SimDrive:
             self._oww_done_at = self.time_s + self.oww_clear_s
 
     def _finish_oww(self) -> None:
-        multi = math.floor(self.absolute_counts / ABS_COUNTS_PER_MOTOR_REV)
+        multi = math.floor(self.absolute_counts / ABSOLUTE_COUNTS_PER_TURN)
         delta = multi * TWO_PI / self.model.ratio  # output angle of the cleared motor turns
         self._absolute_zero_rad += delta
         self._feedback_zero_rad = self._absolute_zero_rad
@@ -600,7 +605,7 @@ class SimDrive:
             allowance = self._param("position_error_allowance") * item.scale
         multi_turn = None
         if self.absolute_encoder:
-            multi_turn = math.floor(self.absolute_counts / ABS_COUNTS_PER_MOTOR_REV)
+            multi_turn = math.floor(self.absolute_counts / ABSOLUTE_COUNTS_PER_TURN)
         tripped = self.supervisor.check(self.axis, error_allowance_pulses=allowance, multi_turn=multi_turn)
         if tripped:
             self.raise_alarm(tripped[0])
@@ -684,23 +689,23 @@ class SimDrive:
     def _monitor(self, item: int) -> int:
         axis = self.axis
         d = self._direction
-        if item == 100:
+        if item == MonitorItem.FEEDBACK_POSITION:
             return self.feedback_pulses
-        if item == 101:
+        if item == MonitorItem.COMMAND_POSITION:
             return self.command_pulses
-        if item == 102:
+        if item == MonitorItem.ERROR_PULSES:
             return self.error_pulses
-        if item == 103:
+        if item == MonitorItem.OUTPUT_SPEED:
             return round(d * axis.output_speed_rad_s / RPM * 100)
-        if item == 104:
+        if item == MonitorItem.MOTOR_CURRENT:
             return round(d * axis.current_a * 1000)
-        if item == 105:
+        if item == MonitorItem.OVERLOAD_RATE:
             return round(self.overload_rate * 1000)
-        if item == 106:
+        if item == MonitorItem.IO_STATE:
             return self.io_bits()
-        if item == 107:
+        if item == MonitorItem.LOAD_POSITION:
             return self._pulses(self.load_angle_rad)
-        if item == 108:
+        if item == MonitorItem.OUTPUT_TORQUE:
             return round(d * axis.torque_nm * 100)
         if item == 0:
             return round(d * axis.output_speed_rad_s / RPM * self.model.ratio)
@@ -755,4 +760,4 @@ class SimDrive:
         return [c.value for c in Command if c in EXTENSION_COMMANDS and c in self.command_table]
 
 
-__all__ = ["ABS_COUNTS_PER_MOTOR_REV", "SimAlarmRecord", "SimDrive", "SimRefused", "SimReply"]
+__all__ = ["SimAlarmRecord", "SimDrive", "SimRefused", "SimReply"]

@@ -39,6 +39,8 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
+from fha_studio.catalog import DEFAULT_ACTUATOR
+
 #: The command sets a simulated drive can speak (see ``profile`` above).
 PROFILES = ("full", "documented")
 
@@ -51,7 +53,7 @@ class SimConfigError(ValueError):
 class SimConfig:
     """Everything that chooses one simulated drive. Units in the names."""
 
-    actuator: str = "FHA-25C-50-US250"
+    actuator: str = DEFAULT_ACTUATOR
     driver: str | None = None
     load_inertia_kgm2: float = 0.0
     brake: bool | None = None

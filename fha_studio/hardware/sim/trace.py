@@ -11,6 +11,7 @@ from collections import deque
 from collections.abc import Callable, Sequence
 
 # The protocol's own definitions: the drive and the client must never disagree on them.
+from fha_studio.hardware.parameters import MonitorItem
 from fha_studio.hardware.protocol import (
     MONITOR_MASK_BASE,
     MONITOR_MASK_ITEMS,
@@ -108,7 +109,7 @@ class SimTrace:
         if self.trigger in (TriggerKind.RISING_LEVEL, TriggerKind.FALLING_LEVEL):
             items.append(self.trigger_channel)
         elif self.trigger in (TriggerKind.IO_BIT_RISES, TriggerKind.IO_BIT_FALLS):
-            items.append(106)
+            items.append(MonitorItem.IO_STATE)
         return items
 
     def steps_until_sample(self) -> int:
@@ -148,7 +149,7 @@ class SimTrace:
         if kind in (TriggerKind.RISING_LEVEL, TriggerKind.FALLING_LEVEL):
             value = read(self.trigger_channel)
         else:
-            value = read(106) >> self.trigger_channel & 1 if self.trigger_channel < 16 else 0
+            value = read(MonitorItem.IO_STATE) >> self.trigger_channel & 1 if self.trigger_channel < 16 else 0
         previous, self._previous = self._previous, value
         if previous is None:
             return False

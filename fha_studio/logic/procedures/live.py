@@ -16,7 +16,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from fha_studio.hardware.client import DriveClient, IoState
+from fha_studio.catalog.tables import rotary_direction
+from fha_studio.hardware.api import DriveApi, IoState
 from fha_studio.hardware.errors import (
     CommandNotSupported,
     CommandRejected,
@@ -24,12 +25,11 @@ from fha_studio.hardware.errors import (
     LinkError,
     ServoOnRefused,
 )
+from fha_studio.hardware.parameters import MonitorItem
 from fha_studio.logic.procedures.definitions import Step
 from fha_studio.logic.procedures.engine import Observation, normalise_label
 from fha_studio.logic.procedures.sensor_dogs import SENSORS, SensorDogWizard
 
-FEEDBACK_POSITION = 100  # monitor item: feedback position, output pulses (docs/protocol.md)
-IO_STATE = 106  # monitor item: the I/O bits
 LOW_SPEED_RPM = 2.0  # output speed of the moves a live check makes (slow: a person is watching)
 ROTARY_DIRECTION = ("system", 8)  # [parameter mode] -> [8: rotary direction] (1-10)
 
@@ -53,13 +53,13 @@ def unavailable(why: str) -> Observation:
     return Observation(None, False, f"the drive cannot tell: {why}; confirm by hand", available=False)
 
 
-def output_angle_deg(client: DriveClient, ppr: int) -> tuple[float, IoState]:
+def output_angle_deg(client: DriveApi, ppr: int) -> tuple[float, IoState]:
     """The output angle (deg, CW positive seen from the flange) and the I/O bits, in one exchange."""
-    values = client.read_monitors([FEEDBACK_POSITION, IO_STATE])
-    return values[FEEDBACK_POSITION] * 360.0 / ppr, IoState(values[IO_STATE])
+    values = client.read_monitors([MonitorItem.FEEDBACK_POSITION, MonitorItem.IO_STATE])
+    return values[MonitorItem.FEEDBACK_POSITION] * 360.0 / ppr, IoState(values[MonitorItem.IO_STATE])
 
 
-def _check_driver_adjusted_for(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
+def _check_driver_adjusted_for(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
     identity = client.identify()
     if identity is None:
         return unavailable("it does not report its identity (no IDN); read the driver label")
@@ -69,7 +69,7 @@ def _check_driver_adjusted_for(client: DriveClient, step: Step, env: LiveEnv) ->
     )
 
 
-def _check_io_bit(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
+def _check_io_bit(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
     name = str(step.params["bit"])
     state = client.io_state().as_dict()
     if name not in state:
@@ -80,7 +80,7 @@ def _check_io_bit(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
     )
 
 
-def _check_alarm_free(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
+def _check_alarm_free(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
     code = client.alarm()
     codes = [int(c) for c in step.params.get("codes", [])]
     bad = code != 0 and (not codes or code in codes)
@@ -90,7 +90,7 @@ def _check_alarm_free(client: DriveClient, step: Step, env: LiveEnv) -> Observat
 class _SimBrakeReleased:
     """On a simulated drive, power the brake's 24 V for a move and restore it afterwards."""
 
-    def __init__(self, client: DriveClient):
+    def __init__(self, client: DriveApi):
         self.client = client
         self.restore: bool | None = None
 
@@ -108,7 +108,7 @@ class _SimBrakeReleased:
 
 
 def move_and_watch(
-    client: DriveClient,
+    client: DriveApi,
     angle_deg: float,
     env: LiveEnv,
     speed_rpm: float = LOW_SPEED_RPM,
@@ -145,7 +145,7 @@ def move_and_watch(
     return output_angle_deg(client, env.output_ppr)[0]
 
 
-def _check_encoder_counts(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
+def _check_encoder_counts(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
     try:
         start, _ = output_angle_deg(client, env.output_ppr)
     except CommandNotSupported:
@@ -157,13 +157,13 @@ def _check_encoder_counts(client: DriveClient, step: Step, env: LiveEnv) -> Obse
     return Observation(round(moved, 3), abs(moved) > 0.5, f"feedback moved {moved:+.2f}° for a +2° command")
 
 
-def _can_move(client: DriveClient) -> bool:
+def _can_move(client: DriveApi) -> bool:
     from fha_studio.hardware.protocol import Command
 
     return all(client.capabilities.supports(c) for c in (Command.SVO, Command.SPD, Command.MOV))
 
 
-def _check_battery(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
+def _check_battery(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
     code = client.alarm()
     if code == 56:
         return Observation(code, False, "alarm 56: ABS low battery voltage")
@@ -176,16 +176,16 @@ def _check_battery(client: DriveClient, step: Step, env: LiveEnv) -> Observation
     return Observation(counts, True, f"absolute position {counts} counts, no battery alarm")
 
 
-def _check_rotary_direction(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
+def _check_rotary_direction(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
     try:
         value = client.read_parameter(*ROTARY_DIRECTION)
     except (CommandNotSupported, ServoOnRefused) as exc:
         return unavailable(f"parameter 8 cannot be read ({exc})")
-    want = {"CW": 0, "CCW": 1}.get(str(step.expect))
+    want = next((s.value for s in rotary_direction() if s.fwd_direction == str(step.expect)), None)
     return Observation(value, value == want, f"parameter 8 (rotary direction) = {value}")
 
 
-def _check_jog_forward(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
+def _check_jog_forward(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
     if not _can_move(client):
         return unavailable("it takes no move commands; give a FWD command from the controller")
     start, _ = output_angle_deg(client, env.output_ppr)
@@ -197,7 +197,7 @@ def _check_jog_forward(client: DriveClient, step: Step, env: LiveEnv) -> Observa
     )
 
 
-def _check_sensor_test_run(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
+def _check_sensor_test_run(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
     if not _can_move(client):
         return unavailable(
             "it takes no move commands; run the axis from the controller and watch the sensors"
@@ -235,7 +235,7 @@ def _sensor_states(io: IoState) -> dict[str, bool]:
     }
 
 
-CHECKS: dict[str, Callable[[DriveClient, Step, LiveEnv], Observation]] = {
+CHECKS: dict[str, Callable[[DriveApi, Step, LiveEnv], Observation]] = {
     "driver_adjusted_for": _check_driver_adjusted_for,
     "io_bit": _check_io_bit,
     "alarm_free": _check_alarm_free,
@@ -247,7 +247,7 @@ CHECKS: dict[str, Callable[[DriveClient, Step, LiveEnv], Observation]] = {
 }
 
 
-def run_live_check(client: DriveClient, step: Step, env: LiveEnv) -> Observation:
+def run_live_check(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
     """Run the live check of ``step`` on the drive. A command the drive does not know gives an
     unavailable Observation, a refusal a failed one; a link failure raises ``LinkFailure``
     (nothing is recorded)."""

@@ -64,7 +64,6 @@ class ScopeConfig:
 
     servo_rate_hz: float = 5000.0
     servo_rate_assumed: bool = True
-    counts_per_motor_turn: int = 8192
     stale_after_s: float = 0.5
     stale_after_periods: float = 5.0
 
@@ -75,7 +74,6 @@ def load_scope_config() -> ScopeConfig:
     return ScopeConfig(
         servo_rate_hz=float(raw["trace"]["servo_rate_hz"]),
         servo_rate_assumed=bool(raw["trace"].get("servo_rate_assumed", True)),
-        counts_per_motor_turn=int(raw["absolute_encoder"]["counts_per_motor_turn"]),
         stale_after_s=float(raw["live"]["stale_after_s"]),
         stale_after_periods=float(raw["live"]["stale_after_periods"]),
     )
@@ -144,10 +142,11 @@ class LiveStatus:
         return "LIVE" if self.live else f"NOT LIVE: {self.reason}"
 
 
-def dgr_channel(ratio: int, counts_per_motor_turn: int = 8192) -> ScopeChannel:
-    """Output position from DGR (motor encoder counts; physical sense, CW from the flange up)."""
+def dgr_channel(ratio: int) -> ScopeChannel:
+    """Output position from DGR (motor encoder counts, ``protocol.ABSOLUTE_COUNTS_PER_TURN`` per
+    motor turn; physical sense, CW from the flange up)."""
     return ScopeChannel(FEEDBACK_KEY, "Position (DGR, absolute encoder)", "deg", DGR_ITEM,
-                        360.0 / (counts_per_motor_turn * ratio))
+                        360.0 / (p.ABSOLUTE_COUNTS_PER_TURN * ratio))
 
 
 def plan_live(capabilities, channels: Sequence[ScopeChannel], ratio: int | None,
@@ -157,7 +156,7 @@ def plan_live(capabilities, channels: Sequence[ScopeChannel], ratio: int | None,
     if level in (CapabilityLevel.TRACE, CapabilityLevel.POLLING):
         return LiveMode.MONITORS, list(channels), ""
     if level is CapabilityLevel.ABSOLUTE_POSITION and ratio:
-        return (LiveMode.POSITION, [dgr_channel(ratio, config.counts_per_motor_turn)],
+        return (LiveMode.POSITION, [dgr_channel(ratio)],
                 "this drive answers only the documented commands: position by DGR, with the servo off; "
                 "no speed, current or I/O")
     if level is CapabilityLevel.ABSOLUTE_POSITION:
@@ -317,7 +316,7 @@ class Trigger:
         """(TTG kind, TTC channel, TTL level) as sent."""
         k = self.kind
         if k in (p.TriggerKind.RISING_LEVEL, p.TriggerKind.FALLING_LEVEL):
-            if self.channel is None or self.channel.is_bit or self.channel.monitor_item < 100:
+            if self.channel is None or self.channel.is_bit or self.channel.monitor_item < p.MONITOR_MASK_BASE:
                 raise ValueError("a level trigger needs an analog monitor channel")
             return int(k), self.channel.monitor_item, round(self.level / self.channel.scale)
         if k in (p.TriggerKind.IO_BIT_RISES, p.TriggerKind.IO_BIT_FALLS):
@@ -359,7 +358,7 @@ class TraceSettings:
         items = self.items()
         if not self.channels:
             raise ValueError("a trace needs at least one channel")
-        if any(i < 100 for i in items):
+        if any(i < p.MONITOR_MASK_BASE for i in items):
             raise ValueError("a trace takes monitor items 100-115 only")
         if len(items) > p.TRACE_MAX_CHANNELS:
             raise ValueError(f"a trace takes at most {p.TRACE_MAX_CHANNELS} monitor items; these channels "

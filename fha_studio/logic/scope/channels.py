@@ -10,21 +10,22 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from fha_studio.hardware.parameters import Mode, ParameterModel
+from fha_studio.hardware.parameters import Mode, MonitorItem, ParameterModel
+from fha_studio.hardware.protocol import MONITOR_MASK_BASE, IoBit
 
-# I/O bit numbers of the IOS reply / monitor item 106 (docs/protocol.md, "I/O bits").
-IO_BITS: dict[str, tuple[int, str]] = {
-    "servo_on": (0, "Servo on"),
-    "in_position": (3, "In-position"),
-    "alarm": (2, "Alarm"),
-    "fwd_inhibit": (4, "FWD inhibit"),
-    "rev_inhibit": (5, "REV inhibit"),
-    "origin_sensor": (6, "Origin sensor"),
-    "limit_switch_1": (7, "Limit switch 1 (CCW)"),
-    "limit_switch_2": (8, "Limit switch 2 (CW)"),
-    "brake_released": (9, "Brake released"),
+#: The I/O bits the scope offers (protocol.IoBit, the bits of IOS / monitor item 106), with their names.
+IO_BITS: dict[str, tuple[IoBit, str]] = {
+    "servo_on": (IoBit.SERVO_ON, "Servo on"),
+    "in_position": (IoBit.IN_POSITION, "In-position"),
+    "alarm": (IoBit.ALARM, "Alarm"),
+    "fwd_inhibit": (IoBit.FWD_INHIBIT, "FWD inhibit"),
+    "rev_inhibit": (IoBit.REV_INHIBIT, "REV inhibit"),
+    "origin_sensor": (IoBit.ORIGIN_SENSOR, "Origin sensor"),
+    "limit_switch_1": (IoBit.LIMIT_SWITCH_1, "Limit switch 1 (CCW)"),
+    "limit_switch_2": (IoBit.LIMIT_SWITCH_2, "Limit switch 2 (CW)"),
+    "brake_released": (IoBit.BRAKE_RELEASED, "Brake released"),
 }
-IO_STATE_ITEM = 106
+IO_STATE_ITEM = MonitorItem.IO_STATE
 POSITION_KEYS = ("feedback_position", "command_position", "load_position")
 
 
@@ -57,7 +58,7 @@ def scope_channels(model: ParameterModel, output_resolution_ppr: int | None) -> 
     """
     channels: list[ScopeChannel] = []
     for item in model.in_mode(Mode.MONITOR):
-        if item.number < 100:
+        if item.number < MONITOR_MASK_BASE:  # the front panel's items, not on the link
             continue
         if item.number == IO_STATE_ITEM:
             for key, (bit, name) in IO_BITS.items():

@@ -11,14 +11,13 @@ from functools import partial
 
 from PySide6.QtWidgets import QVBoxLayout
 
-from fha_studio.catalog import get_actuator
+from fha_studio.catalog import DEFAULT_ACTUATOR, get_actuator
 from fha_studio.gui.link import POLL_INTERVAL_MS, Cmd, LinkInfo
 from fha_studio.gui.pages.base import BasePage
 
 from .driver import ScopeCmd, ScopeController, ScopeRequest
 from .view import ScopeContext, ScopeView
 
-DEFAULT_ACTUATOR = "FHA-25C-50-US250"
 #: The worker's status poll while the scope is live [ms]: the line is the scope's (its own
 #: channels carry position, speed, current and the I/O bits); the lamps update twice a second.
 STATUS_POLL_WHILE_LIVE_MS = 500

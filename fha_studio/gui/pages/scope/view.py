@@ -38,8 +38,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.hardware import protocol as p
-from fha_studio.hardware.parameters import load_parameter_model
+from fha_studio.hardware.parameters import MonitorItem, load_parameter_model
 from fha_studio.logic.scope.acquisition import LiveMode, MoveTestResult, TraceResult, TraceSettings, Trigger
 from fha_studio.logic.scope.analysis import cursor_delta, spectrum
 from fha_studio.logic.scope.channels import ScopeChannel, scope_channels
@@ -99,7 +100,7 @@ def peak_decimate(rows: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
 class ScopeContext:
     """What the scope must know of the axis: the actuator (resolution, ratio) and the load."""
 
-    actuator: str = "FHA-25C-50-US250"
+    actuator: str = DEFAULT_ACTUATOR
     load_inertia_kgm2: float = 0.0
     supply_voltage: int = 200
     driver: str = "HA-655"
@@ -309,7 +310,7 @@ class ScopeView(QWidget):
         form = QFormLayout(page)
         analog = [c for c in self.all_channels if not c.is_bit]
         bits = [c for c in self.all_channels if c.is_bit]
-        bits.append(ScopeChannel("moving", "Moving", "bit", 106, 1.0, int(p.IoBit.MOVING)))
+        bits.append(ScopeChannel("moving", "Moving", "bit", MonitorItem.IO_STATE, 1.0, p.IoBit.MOVING))
         self._trigger_bits = bits
         self.trace_channels: list[QComboBox] = []
         defaults = ("feedback_position", "command_position", "output_speed", "motor_current")
