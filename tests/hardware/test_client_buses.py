@@ -1,0 +1,178 @@
+"""One client suite over every way to reach a drive, as python-can runs one suite over every bus.
+
+The same tests talk to the simulated drive embedded in this process (``sim://``), to
+``fha-studio sim --tcp`` in another process (``socket://``) and to ``fha-studio sim --pty`` in
+another process (a pseudo-terminal). Each subprocess is started once per module. Every test
+leaves the drive as it found it (servo off, no alarm, inputs released, values restored).
+
+The jog loop repeats JOG every 50 ms like a held jog button; that pacing is the behaviour under
+test (the drive's 100 ms watchdog), not a wait for a condition.
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from fha_studio.hardware import protocol as p
+from fha_studio.hardware.api import (
+    AlarmRecord,
+    CapabilityLevel,
+    CommandRejected,
+    DriveApi,
+    Held,
+    IoState,
+    ServoOnRefused,
+)
+from fha_studio.hardware.client import DriveClient
+from fha_studio.hardware.parameters import Mode, MonitorItem
+
+ROOT = Path(__file__).resolve().parents[2]
+#: An absolute-encoder actuator, so that DGR answers a position.
+ACTUATOR = "FHA-25C-50-S248"
+BUSES = ["sim", pytest.param("tcp", marks=pytest.mark.e2e), pytest.param("pty", marks=pytest.mark.e2e)]
+
+
+def _start(tmp: Path, where: str) -> tuple[subprocess.Popen[bytes], str]:
+    """``fha-studio sim`` in its own process; returns it and the address it printed (within 30 s)."""
+    cmd = [sys.executable, "-m", "fha_studio", "sim", *where.split(), "--unpaced",
+           "--actuator", ACTUATOR, "--eeprom", str(tmp / "eeprom.json")]
+    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert proc.stdout is not None
+    ready, _, _ = select.select([proc.stdout], [], [], 30.0)
+    address = proc.stdout.readline().decode().strip() if ready else ""
+    if not address:
+        _stop(proc)
+        pytest.fail(f"fha-studio sim {where} printed no address within 30 s")
+    return proc, address
+
+
+def _stop(proc: subprocess.Popen[bytes]) -> None:
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(10)
+    for stream in (proc.stdout, proc.stderr):
+        if stream is not None:
+            stream.close()
+
+
+@pytest.fixture(scope="module", params=BUSES)
+def bus(request, tmp_path_factory) -> Iterator[str]:
+    """The URL of a drive on one bus; a subprocess lives as long as the module's tests of its bus."""
+    tmp = tmp_path_factory.mktemp(request.param)
+    if request.param == "sim":
+        yield f"sim://{ACTUATOR}?paced=0&eeprom={tmp / 'eeprom.json'}"
+        return
+    proc, address = _start(tmp, "--tcp 0" if request.param == "tcp" else "--pty")
+    yield address
+    _stop(proc)
+    assert proc.returncode == 0, "SIGTERM ends the simulated drive cleanly"
+
+
+@pytest.fixture
+def drive(bus: str) -> Iterator[DriveApi]:
+    client = DriveClient.open(bus)
+    try:
+        yield client
+    finally:
+        try:
+            client.servo(False)
+        finally:
+            client.close()
+
+
+def _until(condition: Callable[[], bool], timeout_s: float = 15.0) -> None:
+    end = time.monotonic() + timeout_s
+    while not condition():
+        assert time.monotonic() < end, "condition not met in time"
+        time.sleep(0.02)
+
+
+def test_identity_and_capabilities(drive):
+    ident = drive.identify()
+    assert ident is not None and ident.adjusted_for == ACTUATOR and ident.driver_model.startswith("HA-655")
+    caps = drive.capabilities
+    assert caps.level is CapabilityLevel.TRACE and caps.simulated and caps.parameters
+    assert caps.absolute_position is True and caps.can_move and caps.can_monitor
+
+
+def test_a_verified_write_and_its_restore(drive):
+    item = drive.model.by_key("in_position_range")
+    before = drive.read_parameter(item.mode, item.number)
+    result = drive.write_parameter(item.mode, item.number, before + 7)
+    assert result.holds is Held.NEW and result.previous == before and result.value == before + 7
+    assert drive.read_parameter(item.mode, item.number) == before + 7
+    assert drive.write_parameter(item.mode, item.number, before).verified
+
+
+def test_the_servo_on_refuses_parameter_mode_writes_and_dgr(drive):
+    direction = drive.model.by_key("rotary_direction")
+    assert isinstance(drive.absolute_position(), int)
+    drive.servo(True)
+    with pytest.raises(ServoOnRefused):
+        drive.write_parameter(direction.mode, direction.number, 1)
+    with pytest.raises(ServoOnRefused):
+        drive.absolute_position()
+    drive.servo(False)
+    assert drive.read_parameter(direction.mode, direction.number) == 0
+
+
+def test_a_held_jog_moves_the_output_and_the_monitors_see_it(drive):
+    start = drive.read_monitors([MonitorItem.FEEDBACK_POSITION])[MonitorItem.FEEDBACK_POSITION]
+    drive.servo(True)
+    end = time.monotonic() + 0.5
+    while time.monotonic() < end:
+        drive.jog(30.0)
+        time.sleep(0.05)
+    values = drive.read_monitors(
+        [MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.IO_STATE]
+    )
+    drive.stop()
+    assert values[MonitorItem.FEEDBACK_POSITION] > start
+    speed = drive.model.item(Mode.MONITOR, MonitorItem.OUTPUT_SPEED)
+    assert speed.to_unit(values[MonitorItem.OUTPUT_SPEED]) > 1
+    assert IoState(values[MonitorItem.IO_STATE]).servo_on
+
+
+def test_an_alarm_comes_with_its_history_and_clears(drive):
+    drive.inject_alarm(20)
+    assert drive.alarm() == 20 and drive.io_state().alarm
+    history = drive.alarm_history()
+    assert isinstance(history[0], AlarmRecord) and history[0].code == 20
+    drive.clear_alarm()
+    assert drive.alarm() == 0
+
+
+def test_simulated_inputs_show_in_the_io_state(drive):
+    state = drive.set_inputs(fwd_inhibit=True)
+    assert state.fwd_inhibit and not state.rev_inhibit
+    assert drive.io_state().bit(p.IoBit.FWD_INHIBIT)
+    assert not drive.set_inputs(fwd_inhibit=False).fwd_inhibit
+
+
+def test_an_unknown_monitor_item_is_rejected(drive):
+    with pytest.raises(CommandRejected):
+        drive.read_monitor(99)
+
+
+def test_a_trace_is_captured_and_read_out(drive):
+    channels = drive.configure_trace([MonitorItem.FEEDBACK_POSITION, MonitorItem.IO_STATE])
+    assert channels == (MonitorItem.FEEDBACK_POSITION, MonitorItem.IO_STATE)
+    drive.arm_trace(100)
+    _until(lambda: drive.trace_status().state is p.TraceState.DONE)
+    capture = drive.read_trace()
+    assert capture.channels == channels and len(capture.samples) == 100
+    assert all(len(row) == 2 for row in capture.samples)
+    assert all(IoState(bits).ready for bits in capture.column(MonitorItem.IO_STATE))
