@@ -82,7 +82,7 @@ def main() -> int:
     def jog_shot():
         shot("jog")
         window.jog_page.release_jog()
-        window.link._worker._client._transport.inner.sim_drive.raise_alarm(20)
+        window.link._worker._client.transaction.transport.inner.sim_drive.raise_alarm(20)
 
     @step(800)
     def alarms():

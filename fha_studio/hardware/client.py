@@ -294,7 +294,9 @@ class DriveClient:
             except DriveRefused as exc:
                 now = self._transact(Command.PRD, parse=one_int)
                 held = "the old value" if now == previous else "neither the old nor the new value"
-                raise type(exc)(f"{item.label}: not written ({exc}); the drive holds {now}, {held}") from None
+                raise type(exc)(
+                    f"{item.label}: not written ({exc}); the drive holds {item.format(now)}, {held}"
+                ) from None
             except LinkTimeout as exc:
                 failure = str(exc)
             else:
@@ -304,8 +306,8 @@ class DriveClient:
                 now = self._transact(Command.PRD, parse=one_int)
             except LinkTimeout:
                 raise LinkTimeout(
-                    f"{item.label}: the write of {value} and its read-back failed: unknown whether the "
-                    f"drive holds the old ({previous}) or the new value"
+                    f"{item.label}: the write of {item.format(value)} and its read-back failed: unknown "
+                    f"whether the drive holds the old ({item.format(previous)}) or the new value"
                 ) from None
         if now == value:
             holds, message = Held.NEW, f"{item.label} = {item.format(value)}"
@@ -313,10 +315,16 @@ class DriveClient:
                 message += " (takes effect after a power cycle)"
         elif now == previous:
             holds = Held.OLD
-            message = f"{item.label}: write of {value} did not take; the drive still holds {now}"
+            message = (
+                f"{item.label}: the write of {item.format(value)} did not take; "
+                f"the drive still holds {item.format(now)}"
+            )
         else:
             holds = Held.NEITHER
-            message = f"{item.label}: wrote {value} but the drive holds {now} (was {previous})"
+            message = (
+                f"{item.label}: wrote {item.format(value)} but the drive holds {item.format(now)} "
+                f"(was {item.format(previous)})"
+            )
         if failure and holds is not Held.NEW:
             message += f" [{failure}]"
         return WriteResult(item, value, previous, now, holds, message)

@@ -33,6 +33,10 @@ class Mode(StrEnum):
     TEST = "test"
 
 
+#: The modes as the HA-655 manual and its front panel name them.
+MODE_WORDS = {Mode.MONITOR: "monitor", Mode.TUNE: "tune", Mode.SYSTEM: "parameter", Mode.TEST: "test"}
+
+
 class ParameterFileError(ValueError):
     """A parameter or alarm file is malformed; the message names the file and the item."""
 
@@ -101,9 +105,10 @@ class ParameterItem:
             allowed = ", ".join(f"{k} ({v})" for k, v in self.choices.items())
             raise ParameterValueError(f"{self.label}: {wire} is not one of {allowed}")
         if not self.minimum <= wire <= self.maximum:
+            # in the unit the front panel and the table show, not in the wire's steps
             raise ParameterValueError(
-                f"{self.label}: {wire} is outside {self.minimum} ... {self.maximum}"
-                + (f" (x {self.scale:g} {self.unit})" if self.unit else "")
+                f"{self.label}: {self.format(wire)} is outside {self.format(self.minimum)} … "
+                f"{self.format(self.maximum)}"
             )
 
     def format(self, wire: int) -> str:
@@ -116,8 +121,9 @@ class ParameterItem:
 
     @property
     def label(self) -> str:
-        """``"system 8 (rotary_direction)"``: how messages name the item."""
-        return f"{self.mode.value} {self.number} ({self.key})"
+        """``"parameter 8, rotary direction"``: how messages name the item, in the words of the
+        driver's front panel (its "parameter mode" is ``Mode.SYSTEM`` here)."""
+        return f"{MODE_WORDS[self.mode]} {self.number}, {self.name[:1].lower()}{self.name[1:]}"
 
 
 class MonitorItem(IntEnum):

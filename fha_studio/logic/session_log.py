@@ -8,6 +8,8 @@ import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from fha_studio.hardware.parameters import MODE_WORDS, Mode, ParameterItem
+
 
 @dataclass(frozen=True)
 class WriteRecord:
@@ -24,12 +26,23 @@ class WriteRecord:
     verified: bool
     error: str | None = None
 
-    def line(self) -> str:
-        """One line for people: ``17:05:02 system 8 rotary_direction: 0 -> 1 verified``."""
-        old = "?" if self.old is None else str(self.old)
-        outcome = "verified" if self.verified else f"NOT verified ({self.error or 'read-back differs'})"
+    def line(self, item: ParameterItem | None = None) -> str:
+        """One line for people, in the front panel's words and units when ``item`` (this record's
+        parameter item) is given: ``17:05:02 parameter 6, position error allowance: 50000 pulse ->
+        100 pulse, verified``. Without it the values are the drive's raw numbers."""
+        def value(wire: int | None) -> str:
+            if wire is None:
+                return "unknown"
+            return item.format(wire) if item is not None else str(wire)
+
+        if item is not None:
+            what = item.label
+        else:
+            mode = MODE_WORDS[Mode(self.mode)] if self.mode in set(Mode) else self.mode
+            what = f"{mode} {self.number}, {self.name}"
+        outcome = "verified" if self.verified else f"NOT verified ({self.error or 'the read-back differs'})"
         clock = self.time[11:19] if len(self.time) >= 19 else self.time
-        return f"{clock} {self.mode} {self.number} {self.key}: {old} -> {self.new} {outcome}"
+        return f"{clock} {what}: {value(self.old)} -> {value(self.new)}, {outcome}"
 
 
 class SessionLog:

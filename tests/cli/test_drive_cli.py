@@ -218,16 +218,16 @@ def test_params_on_the_full_simulated_drive(tmp_path):
     assert re.search(r"^rotary_direction +\= 0 ", backup.read_text(), re.M)
     # another process: a fresh embedded drive on the same EEPROM file
     code, out, err, _ = fha("drive", "params", "write", "--url", url, "rotary_direction=1")
-    assert code == 0 and "system 8" in out, err
+    assert code == 0 and "parameter 8, rotary direction" in out, err
     code, out, err, _ = fha("drive", "params", "read", "--url", url, "--json")
     rows = {(r["mode"], r["number"]): r for r in json.loads(out)}
     assert rows[("system", 8)]["value"] == 1
     code, out, err, _ = fha("drive", "params", "restore", "--url", url, str(backup))
-    assert code == 0 and "system 8" in out, err
+    assert code == 0 and "parameter 8, rotary direction" in out, err
     code, out, err, _ = fha("drive", "params", "read", "--url", url, "--json")
     assert {(r["mode"], r["number"]): r for r in json.loads(out)}[("system", 8)]["value"] == 0
     code, _, err, _ = fha("drive", "params", "write", "--url", url, "rotary_direction=7")
-    assert code == 2 and "rotary_direction" in one_line(err)
+    assert code == 2 and "parameter 8, rotary direction" in one_line(err)
 
 
 def test_help_lists_gui_and_options_start_the_gui(monkeypatch, capsys):

@@ -74,7 +74,7 @@ def test_read_and_verified_write_of_rotary_direction(client_for, mini):
 def test_bad_value_is_refused_before_anything_is_sent(client_for, mini):
     client, drive = client_for(mini)
     sent = len(drive.requests)
-    with pytest.raises(ParameterValueError, match=r"rotary_direction.*not one of"):
+    with pytest.raises(ParameterValueError, match=r"parameter 8, rotary direction: 7 is not one of"):
         client.write_parameter("system", 8, 7)
     with pytest.raises(ParameterValueError, match="no system item 5"):
         client.write_parameter("system", 5, 0)
@@ -86,7 +86,8 @@ def test_bad_value_is_refused_before_anything_is_sent(client_for, mini):
 def test_write_refused_with_servo_on_says_the_old_value_is_held(client_for, mini):
     client, _ = client_for(mini)
     client.servo(True)
-    with pytest.raises(ServoOnRefused, match=r"system 8 \(rotary_direction\).*holds 0, the old value"):
+    held = r"parameter 8, rotary direction: .*holds 0: FWD turns CW .*, the old value"
+    with pytest.raises(ServoOnRefused, match=held):
         client.write_parameter("system", 8, 1)
     # tune items may be changed with the servo on
     assert client.write_parameter("tune", 4, 20).verified

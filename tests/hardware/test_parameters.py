@@ -65,9 +65,10 @@ def test_scale_converts_between_wire_and_unit(model):
 
 
 def test_check_names_the_item_and_the_range(model):
-    with pytest.raises(ParameterValueError, match=r"system 8 \(rotary_direction\).*not one of"):
+    with pytest.raises(ParameterValueError, match=r"parameter 8, rotary direction: 2 is not one of"):
         model.item("system", 8).check(2)
-    with pytest.raises(ParameterValueError, match=r"tune 0 \(speed_loop_gain\).*outside 1 \.\.\. 500"):
+    outside = r"tune 0, speed loop gain \(Kv\): .* is outside 1 Hz … 500 Hz"
+    with pytest.raises(ParameterValueError, match=outside):
         model.by_key("speed_loop_gain").check(0)
     with pytest.raises(ParameterValueError, match="integer"):
         model.by_key("speed_loop_gain").check(1.5)

@@ -66,7 +66,7 @@ def test_history_diff_find_in_words_and_json(capsys, db):
     assert "parameters  parameters read over the link: 2 values, snapshot 1 [ana]" in out
     code, out, _ = run(capsys, db, "diff", "Line 3/table", "Line 3/table twin")
     assert code == 0
-    assert "system 8 Rotary direction" in out and "1: reversed: FWD command turns CCW" in out
+    assert "system 8 Rotary direction" in out and "1: reversed: FWD turns CCW" in out
     assert "In-position" not in out and "in_position" not in out  # the same on both
     code, out, _ = run(capsys, db, "diff", "1", "2", "--json")
     assert json.loads(out)["differences"] == []  # both snapshots read the delivery values
@@ -100,7 +100,7 @@ def test_open_items_import_and_export(capsys, db, tmp_path):
     [
         (["history", "Line 3/roll"], "machine 'Line 3' has no axis 'roll' (axes: table, table twin)"),
         (["diff", "7", "Line 3/table"], "no parameter snapshot number 7 in the register"),
-        (["find", "rotary_direction=2"], "find: system 8 (rotary_direction): 2 is not one of 0"),
+        (["find", "rotary_direction=2"], "find: parameter 8, rotary direction: 2 is not one of 0"),
         (["find", "speedy=1"], "find: no parameter called 'speedy'"),
         (["add-axis", "table"], "add-axis: 'table': name the axis as MACHINE/AXIS"),
         (["add-axis", "Line 3/roll", "--actuator", "FHA-26C"], "add-axis: --actuator: model code 'FHA-26C'"),

@@ -273,7 +273,7 @@ def test_corrupt_eeprom_names_the_file(make_drive, tmp_path):
         make_drive(eeprom=str(path))
     path.write_text('{"format": "fha-sim-eeprom/1", "parameters": {"system": {"rotary_direction": 7}}}',
                     encoding="utf-8")
-    with pytest.raises(EepromError, match=r"broken\.json.*rotary_direction"):
+    with pytest.raises(EepromError, match=r"broken\.json.*parameter 8, rotary direction"):
         make_drive(eeprom=str(path))
 
 

@@ -325,10 +325,9 @@ class ParametersPage(BasePage):
         self.table.setAlternatingRowColors(True)
         header = self.table.horizontalHeader()
         header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        # the value is what matters: it is shown whole; the name takes the room that is left
         header.setSectionResizeMode(2, QHeaderView.ResizeMode.Stretch)
-        for col, chars in ((COL_VALUE, 30), (6, 26)):  # long choice texts elide; the tooltip has them
-            header.setSectionResizeMode(col, QHeaderView.ResizeMode.Interactive)
-            header.resizeSection(col, self.table.fontMetrics().averageCharWidth() * chars)
+        header.setMinimumSectionSize(self.table.fontMetrics().averageCharWidth() * 4)
         splitter.addWidget(self.table)
         log_box = QWidget()
         lb = QVBoxLayout(log_box)
@@ -547,6 +546,12 @@ class ParametersPage(BasePage):
         )
 
     @Slot(int)
+    def _item_of(self, record):
+        try:
+            return self.session.parameter_model.item(record.mode, record.number)
+        except KeyError:
+            return None
+
     def _edits_changed(self, n: int) -> None:
         if n:
             self.message.setText(f"{n} item(s) edited, not written yet.")
@@ -555,7 +560,7 @@ class ParametersPage(BasePage):
 
     @Slot()
     def _log_changed(self) -> None:
-        self.log_view.setPlainText("\n".join(r.line() for r in self.session.log.records))
+        self.log_view.setPlainText("\n".join(r.line(self._item_of(r)) for r in self.session.log.records))
         self.log_view.verticalScrollBar().setValue(self.log_view.verticalScrollBar().maximum())
 
     # -- files --------------------------------------------------------------------------------------
