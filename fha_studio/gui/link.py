@@ -567,10 +567,17 @@ class LinkWorker(QObject):
                 return f"servo-ON input (CN2) {'on' if value else 'off'}"
             if action is SimPanelAction.COMMAND:
                 drive.controller_command(float(value))
-                return f"controller: {'FWD' if value > 0 else 'REV'} command of {abs(float(value)):g} deg"
+                return f"controller: {'FWD' if value > 0 else 'REV'} command of {abs(float(value)):g}°"
             if action is SimPanelAction.TURN_BY_HAND:
                 drive.turn_by_hand(float(value))
-                return f"output turned by hand by {float(value):+g} deg"
+                text = f"output turned by hand by {float(value):+g}°"
+                if drive.has_sensors:  # what the technician would see on the sensors' indicators
+                    bits = drive.io_bits()
+                    lit = [name for bit, name in ((IoBit.LIMIT_SWITCH_1, "limit switch 1"),
+                                                  (IoBit.LIMIT_SWITCH_2, "limit switch 2"),
+                                                  (IoBit.ORIGIN_SENSOR, "origin sensor")) if bits >> bit & 1]
+                    text += f"; sensor indicators on: {', '.join(lit) if lit else 'none'}"
+                return text
             bit = 1 << IoBit.BRAKE_RELEASED
             drive.set_inputs(drive.io_bits() & INPUT_MASK & ~bit | (bit if value else 0))
             return "brake released (24 V on the brake)" if value else "brake holds (no 24 V)"

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from datetime import datetime
 from typing import Any, Protocol
 
 from fha_studio.catalog import ModelCodeError, parse_model_code
@@ -189,3 +190,98 @@ def set_absolute_origin(client: _Client, ratio: int | None = None) -> OriginResu
     took = time.monotonic() - started
     after = client.absolute_position()
     return OriginResult(before, after, None if not ratio else output_deg(after, ratio), took)
+
+
+# --- checks with DGR while the servo is off (absolute encoders) ---------------------------------
+
+#: How far the counts may differ from the expected change in the encoder check, as a fraction of
+#: it: turning by hand to a mark is good to a few percent, a wrong ratio or encoder is off by far more.
+ENCODER_CHECK_TOLERANCE = 0.1
+
+
+@dataclass(frozen=True)
+class CheckRecord:
+    """One check done with DGR (or answered by the technician where the drive cannot tell).
+
+    ``passed`` None: recorded without a verdict. ``by_hand``: the values were given by the
+    technician, not read from the drive (the reason is in ``detail``).
+    """
+
+    check: str  # "encoder", "rotary_direction", "sensor_dog", "absolute_origin"
+    who: str
+    at: str  # ISO 8601 local time
+    values: dict[str, Any]
+    passed: bool | None
+    detail: str
+    by_hand: bool = False
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"check": self.check, "who": self.who, "at": self.at, "values": dict(self.values),
+                "passed": self.passed, "detail": self.detail, "by_hand": self.by_hand}
+
+
+CHECK_TITLES = {
+    "encoder": "Encoder check (turned by hand)",
+    "rotary_direction": "Rotary direction (1-10)",
+    "sensor_dog": "Sensor dog angle (4-7-2, 4-7-3)",
+    "absolute_origin": "Absolute origin (OWW)",
+}
+
+
+def now_text() -> str:
+    return datetime.now().astimezone().isoformat(timespec="seconds")
+
+
+def encoder_check(before: int, after: int, turned_deg: float, ratio: int
+                  ) -> tuple[bool, str, dict[str, Any]]:
+    """The output was turned by hand by ``turned_deg`` (CW positive seen from the flange): the
+    counts must change by ratio x 8192 per motor turn, in the same sense. (passed, detail, values)."""
+    expected = counts_for_output_deg(turned_deg, ratio)
+    change = after - before
+    close = abs(change - expected) <= ENCODER_CHECK_TOLERANCE * abs(expected)
+    passed = expected != 0 and change * expected > 0 and close
+    seen = output_deg(change, ratio)
+    detail = (f"turned {turned_deg:+g}° by hand: the counts changed by {change:+d} ({seen:+.2f}° at the "
+              f"output), expected {expected:+.0f} (ratio {ratio} x 8192 counts per motor turn)")
+    if not passed:
+        detail += ("; wrong sense: check the encoder wiring (phases) and the model code"
+                   if change * expected < 0
+                   else "; the size differs by more than 10 %: check the ratio and the encoder")
+    return passed, detail, {"before_counts": before, "after_counts": after, "turned_deg": turned_deg,
+                            "expected_counts": round(expected), "ratio": ratio}
+
+
+def turned_sense(change_counts: int) -> str | None:
+    """"CW" / "CCW" seen from the output flange for a DGR change (the counts follow the physical
+    sense, not the rotary-direction setting); None when it did not turn."""
+    if change_counts == 0:
+        return None
+    return "CW" if change_counts > 0 else "CCW"
+
+
+def rotary_direction_check(before: int, after: int, parameter_8: int | None, ratio: int | None
+                           ) -> tuple[bool | None, str, dict[str, Any]]:
+    """FHA-C manual 1-10: a FWD command turns the output CW with parameter 8 = 0 (default), CCW
+    with 1. ``before`` / ``after``: DGR with the servo off before and after the controller's short
+    FWD command. ``parameter_8`` as entered from the panel (None: not entered, no verdict)."""
+    change = after - before
+    sense = turned_sense(change)
+    values: dict[str, Any] = {"before_counts": before, "after_counts": after, "turned": sense,
+                              "rotary_direction": parameter_8}
+    angle = f" ({output_deg(change, ratio):+.2f}°)" if ratio else ""
+    if sense is None:
+        return False, ("the position did not change: no FWD command reached the axis (was the servo on? "
+                       "did the controller send the command?)"), values
+    seen = f"the FWD command turned the output {sense} seen from the flange ({change:+d} counts{angle})"
+    if parameter_8 is None:
+        return None, seen + "; parameter 8 was not entered, so there is nothing to compare with", values
+    expected = "CW" if parameter_8 == 0 else "CCW"
+    if sense == expected:
+        return True, f"{seen}: as parameter 8 = {parameter_8} says", values
+    return False, (f"{seen}, but parameter 8 = {parameter_8} says {expected}: check parameter 8 and "
+                   "the motor wiring"), values
+
+
+def wrap_deg(angle_deg: float) -> float:
+    """An output angle folded into -180 ... +180°."""
+    return (angle_deg + 180.0) % 360.0 - 180.0

@@ -115,3 +115,95 @@ def test_a_silent_drive_turns_the_link_lamp_red_within_2_s(make_window, qtbot):
         assert p.Command.DGR.value in scripted.commands()
     finally:
         scripted.close()
+
+
+SENSOR_URL = "sim://FHA-25C-50-S248?paced=0&profile=documented&oww_clear_s=1&sensors=1"
+
+
+def panel(window, qtbot, action, value):
+    from fha_studio.gui.link import SimPanelAction
+
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SIM_PANEL,
+                          timeout=10000) as done:
+        window.link.send(Cmd.SIM_PANEL, SimPanelAction(action), value)
+    assert done.args[0].ok, done.args[0].error
+    return done.args[0].value
+
+
+def click_and_record(page, qtbot, button):
+    before = len(page.records)
+    assert button.isEnabled(), button.toolTip()
+    button.click()
+    qtbot.waitUntil(lambda: len(page.records) > before, timeout=15000)
+    return page.records[-1]
+
+
+def test_dgr_checks_encoder_direction_dogs_and_origin(make_window, qtbot):
+    window = make_window(connect=SENSOR_URL)
+    window.session.set_actuator("FHA-25C-50-S248-L", acknowledged=True)
+    page = window.show_page("absolute")
+    page.who_edit.setText("A. Tester")
+    qtbot.waitUntil(lambda: page.read_button.isEnabled(), timeout=10000)
+    summary = page.summary_label.text()
+    assert "only the manual's commands" in summary and "ratio 50" in summary
+
+    # encoder check: turn by hand by +10 deg
+    page.encoder_angle.setValue(10.0)
+    page.encoder_start_button.click()
+    qtbot.waitUntil(lambda: page.encoder_end_button.isEnabled(), timeout=10000)
+    assert "turned by hand by +10°" in panel(window, qtbot, "turn", 10.0)
+    record = click_and_record(page, qtbot, page.encoder_end_button)
+    assert record.check == "encoder" and record.passed and record.who == "A. Tester"
+    assert abs(record.values["after_counts"] - record.values["before_counts"] - 11378) <= 2
+
+    # rotary direction 1-10: parameter 8 = 0 entered, servo on + FWD at the controller, servo off
+    page.direction_param.setCurrentIndex(1)
+    page.direction_start_button.click()
+    qtbot.waitUntil(lambda: page._direction_start is not None, timeout=10000)
+    switch_servo(window, qtbot, True)
+    assert not page.direction_end_button.isEnabled()
+    assert SERVO_ON_NOTE in page.reason_label.text()
+    panel(window, qtbot, "command", 5.0)
+    qtbot.wait(1500)  # the controller's command takes its time; nothing to wait on over CN3
+    switch_servo(window, qtbot, False)
+    qtbot.waitUntil(lambda: page.direction_end_button.isEnabled(), timeout=10000)
+    record = click_and_record(page, qtbot, page.direction_end_button)
+    assert record.passed and record.values["turned"] == "CW" and "as parameter 8 = 0 says" in record.detail
+
+    # sensor dog: limit switch 2 sits at +150 deg in the simulated set; turn there by hand
+    angle_now = record.values["after_counts"] * 360 / (8192 * 50)
+    text = panel(window, qtbot, "turn", 151.0 - angle_now)
+    assert "limit switch 2" in text
+    page.dog_sensor.setCurrentIndex(1)
+    record = click_and_record(page, qtbot, page.dog_record_button)
+    assert record.check == "sensor_dog" and record.passed
+    assert abs(record.values["angle_deg"] - 151.0) < 0.1 and "movable range" in record.detail
+    # an angle past the movable range of 4-7-3 is refused
+    panel(window, qtbot, "turn", 30.0)
+    record = click_and_record(page, qtbot, page.dog_record_button)
+    assert not record.passed and "outside the movable range" in record.detail
+
+    # absolute origin: OWW, q after the (shortened) acknowledgement time, read back
+    page.tabs.setCurrentIndex(3)
+    assert "servo off: met" in page.origin_conditions.text()
+    record = click_and_record(page, qtbot, page.origin_button)
+    assert record.check == "absolute_origin" and record.passed
+    assert record.values["position_counts"] == record.values["before_counts"] % 8192
+    assert page.history.rowCount() == 5
+
+
+def test_dgr_checks_on_an_incremental_encoder_ask_and_record_by_hand(make_window, qtbot):
+    window = make_window(connect="sim://FHA-25C-50-US250?paced=0&profile=documented")
+    page = window.show_page("absolute")
+    qtbot.waitUntil(lambda: page.encoder == "incremental", timeout=10000)
+    assert "incremental encoder" in page.reason_label.text()
+    assert not page.read_button.isEnabled() and not page.origin_button.isEnabled()
+    assert "nothing to clear" in page.origin_button.toolTip()
+    page.tabs.setCurrentIndex(1)
+    assert page.direction_hand.isVisible()
+    page.direction_param.setCurrentIndex(2)  # 1: FWD = CCW
+    page.direction_seen.setCurrentText("CCW")
+    page.direction_hand_button.click()
+    record = page.records[-1]
+    assert record.by_hand and record.passed and record.values == {"turned": "CCW", "rotary_direction": 1}
+    assert "by hand" in page.history.item(0, 1).text()

@@ -25,6 +25,7 @@ class PageId(StrEnum):
     DIRECTION = "direction"
     ALARMS = "alarms"
     JOG = "jog"
+    ABSOLUTE = "absolute"
     SIZING = "sizing"
     SCOPE = "scope"
     PROCEDURES = "procedures"

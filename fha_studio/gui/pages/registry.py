@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from PySide6.QtWidgets import QWidget
 
+from fha_studio.gui.pages.absolute import AbsolutePage
 from fha_studio.gui.pages.alarms import AlarmsPage
 from fha_studio.gui.pages.base import Page, PageId
 from fha_studio.gui.pages.connection import ConnectionPage
@@ -81,6 +82,7 @@ PAGES: tuple[PageEntry, ...] = (
     PageEntry(PageId.DIRECTION, "Rotary direction", "R", DirectionPage),
     PageEntry(PageId.ALARMS, "Alarms", "A", AlarmsPage),
     PageEntry(PageId.JOG, "Jog & test run", "J", JogPage),
+    PageEntry(PageId.ABSOLUTE, "DGR checks", "G", AbsolutePage),
     PageEntry(PageId.SIZING, "Sizing", "z", _sizing, lazy=True),
     PageEntry(PageId.SCOPE, "Scope", "S", _scope, lazy=True),
     PageEntry(PageId.PROCEDURES, "Procedures", "u", _procedures, lazy=True),
