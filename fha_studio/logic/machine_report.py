@@ -89,9 +89,8 @@ def _origin(axis: MachineAxis, session: Session | None, register: Any, axis_ref:
 
 
 def _direction_value(axis: MachineAxis, session: Session | None, register: Any, axis_ref: str) -> int | None:
-    value = axis.state.value_of(*ROTARY_DIRECTION)
-    if value is not None:
-        return value
+    # the register knows every read and verified write of the axis; the state what this program
+    # read since it started; the session what was read for its report
     if register is not None:
         try:
             known = register.current_values(axis_ref).values.get("rotary_direction")
@@ -99,6 +98,9 @@ def _direction_value(axis: MachineAxis, session: Session | None, register: Any, 
             known = None
         if known is not None:
             return int(known.value)
+    value = axis.state.value_of(*ROTARY_DIRECTION)
+    if value is not None:
+        return value
     if session is not None:
         stored = (session.parameters or {}).get("values", {}).get("rotary_direction")
         if stored is not None:

@@ -82,6 +82,7 @@ class ProceduresPage(BasePage):
 
     sigStepChanged = Signal()  # the current step or the run's state changed
     sigLiveDone = Signal(object)  # Observation of a live check (after it was recorded or shown)
+    sigReportWritten = Signal(object, object)  # HTML path, PDF path (or None): a report was written
 
     def __init__(self, gui_session, main_window=None):
         super().__init__()
@@ -477,7 +478,9 @@ class ProceduresPage(BasePage):
         if self.session is None:
             raise SessionError("no session: nothing to report")
         self._collect_for_report()
-        return write_report(build_report(self.session, self.context), html_path, pdf_path)
+        html, pdf = write_report(build_report(self.session, self.context), html_path, pdf_path)
+        self.sigReportWritten.emit(html, pdf)
+        return html, pdf
 
     def sign(self, who: str = "") -> bool:
         if self.session is None:

@@ -130,6 +130,7 @@ class ScopeView(QWidget):
     sigTestDone = Signal(object)  # MoveTestResult
     sigTraceDone = Signal(object)  # TraceResult
     sigLiveChanged = Signal(bool)  # live acquisition requested on / off
+    sigRecordingSaved = Signal(object, str)  # Path of a finished fha-recording/1 file, what it holds
 
     def __init__(self, controller: ScopeController, context: ScopeContext | None = None,
                  parent: QWidget | None = None):
@@ -826,6 +827,7 @@ class ScopeView(QWidget):
         if rec is None:
             return None
         rec.close()
+        self.sigRecordingSaved.emit(Path(rec.path), f"live recording, {rec.rows_written} rows")
         return Path(rec.path)
 
     @property
@@ -843,6 +845,7 @@ class ScopeView(QWidget):
             rec.write(s.rows)
         finally:
             rec.close()
+        self.sigRecordingSaved.emit(Path(rec.path), s.label)
         return Path(rec.path)
 
     def export_png(self, path) -> Path:

@@ -1,0 +1,595 @@
+"""A machine of several axes in one window.
+
+The axes are listed at the left, beside the pages; choosing one shows every page for that axis
+(the same page stays on show). Each axis has its own link (one link worker and thread per port),
+its own pages and its own commissioning session, so several axes are connected at once. The
+banner above the pages always says which axis they act on. STOP (the button, or Esc on any page)
+stops every connected axis that can be stopped, not only the one on show.
+
+What happens on each axis goes into the register as it happens (:class:`AxisRecorder`): parameter
+reads and verified writes, alarms, procedure checks, reports, recordings and model-check results.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+from PySide6.QtCore import QObject, QSettings, Qt, Slot
+from PySide6.QtGui import QAction, QColor
+from PySide6.QtWidgets import (
+    QFileDialog,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QListWidget,
+    QListWidgetItem,
+    QMainWindow,
+    QMessageBox,
+    QStackedWidget,
+    QToolBar,
+    QVBoxLayout,
+    QWidget,
+)
+
+from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo, OpenClient
+from fha_studio.gui.main_window import MainWindow
+from fha_studio.gui.messages import Level
+from fha_studio.gui.session import data_dir
+from fha_studio.gui.widgets import StopButton
+from fha_studio.logic.machine import MachineAxis, MachineProject
+from fha_studio.logic.register import ENV_REGISTER, Register, RegisterError, record_session
+
+log = logging.getLogger(__name__)
+
+#: Width of the axis list [px].
+AXIS_LIST_WIDTH_PX = 230
+
+
+def built_pages(window: MainWindow) -> list[QWidget]:
+    """The pages of an axis's window built so far (a page with plots is built when first shown)."""
+    pages = []
+    for index in range(window.tabs.count()):
+        page = window.tabs.widget(index)
+        page = getattr(page, "built", page)  # a lazy page: what it built, None before
+        if page is not None:
+            pages.append(page)
+    return pages
+
+
+def register_path() -> Path:
+    """The register the GUI uses: the site's choice (setting ``register/path`` or
+    ``$FHA_STUDIO_REGISTER``), else ``register.sqlite`` in the user data directory."""
+    chosen = str(QSettings().value("register/path", "") or os.environ.get(ENV_REGISTER, "")).strip()
+    return Path(chosen).expanduser() if chosen else data_dir() / "register.sqlite"
+
+
+class AxisRecorder(QObject):
+    """Writes one axis's commissioning facts into the register as they happen.
+
+    A fact the register cannot take (the file locked for longer than its busy timeout, a full
+    disk) is said in the axis's message area; the commissioning goes on."""
+
+    def __init__(self, register: Register, axis_ref: str, window: MainWindow, who: Callable[[], str]):
+        super().__init__(window)
+        self.register = register
+        self.axis_ref = axis_ref
+        self.window = window
+        self._who = who
+        self._alarm_code = 0
+        self._hooked: set[int] = set()
+        link = window.link
+        link.sigResult.connect(self._on_result)
+        link.sigWrite.connect(self._on_write)
+        link.sigStatus.connect(self._on_status)
+        link.sigConnected.connect(self._on_connected)
+        window.tabs.currentChanged.connect(lambda _index: self.hook_pages())
+        self.hook_pages()
+
+    # -- pages built later (plots, procedures) ------------------------------------------------------
+    def hook_pages(self) -> None:
+        """Connects to the pages built so far (a page is built when first shown)."""
+        from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
+        from fha_studio.gui.pages.procedures.page import ProceduresPage
+        from fha_studio.gui.pages.scope.page import ScopePage
+
+        for page in built_pages(self.window):
+            if id(page) in self._hooked:
+                continue
+            self._hooked.add(id(page))
+            if isinstance(page, ProceduresPage):
+                page.sigStepChanged.connect(lambda p=page: self._on_procedures(p))
+                page.sigReportWritten.connect(lambda html, pdf, p=page: self._on_report(p, html, pdf))
+            elif isinstance(page, ScopePage):
+                page.view.sigRecordingSaved.connect(self._on_recording)
+            elif isinstance(page, ModelCheckPage):
+                page.sigFinished.connect(lambda result, p=page: self._on_model_check(p, result))
+
+    # -- writing, never failing the GUI ---------------------------------------------------------------
+    def _record(self, what: str, action: Callable[[], object]) -> None:
+        try:
+            action()
+        except (RegisterError, OSError, ValueError) as exc:
+            log.warning("register: %s of %s not recorded: %s", what, self.axis_ref, exc)
+            self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
+        except Exception as exc:  # sqlite3 errors (a locked or damaged file): said, not raised
+            log.exception("register: %s of %s not recorded", what, self.axis_ref)
+            self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
+
+    @property
+    def who(self) -> str:
+        return self._who()
+
+    # -- from the link --------------------------------------------------------------------------------
+    @Slot(object)
+    def _on_connected(self, info: LinkInfo) -> None:
+        self._alarm_code = 0
+        if info.driver_model:
+            self._record(
+                "driver",
+                lambda: self.register.update_axis(
+                    self.axis_ref, who=self.who, driver_model=info.driver_model
+                ),
+            )
+
+    @Slot(object)
+    def _on_result(self, result: CommandResult) -> None:
+        if result.cmd is not Cmd.READ_PARAMETERS or not result.ok or not result.value["values"]:
+            return
+        model = self.window.session.parameter_model
+        rows = []
+        for (mode, number), value in result.value["values"].items():
+            try:
+                key = model.item(mode, number).key
+            except KeyError:
+                key = f"{mode}_{number}"
+            rows.append((str(mode), int(number), key, int(value)))
+        info = self.window.link.info
+        self._record(
+            "parameter read",
+            lambda: self.register.record_snapshot(
+                self.axis_ref, rows, "link", who=self.who, driver_model=info.driver_model if info else ""
+            ),
+        )
+
+    @Slot(object)
+    def _on_write(self, entry: dict) -> None:
+        mode, number = str(entry["mode"]), int(entry["number"])
+        try:
+            key = self.window.session.parameter_model.item(mode, number).key
+        except KeyError:
+            key = f"{mode}_{number}"
+        self._record(
+            "parameter write",
+            lambda: self.register.record_write(
+                self.axis_ref,
+                mode,
+                number,
+                key,
+                int(entry["new"]),
+                entry.get("old"),
+                entry.get("read_back"),
+                bool(entry.get("verified")),
+                error=entry.get("error") or "",
+                who=self.who,
+            ),
+        )
+
+    @Slot(object)
+    def _on_status(self, status: DriveStatus) -> None:
+        code = status.alarm_code
+        if code is None or code == self._alarm_code:
+            return
+        self._alarm_code = code
+        if code == 0:
+            return
+        from fha_studio.hardware.parameters import load_alarm_table
+
+        alarm = load_alarm_table(self.window.session.driver).get(code)
+        name = alarm.name if alarm is not None else "unknown code"
+        self._record("alarm", lambda: self.register.record_alarm(self.axis_ref, code, name, who=self.who))
+
+    # -- from the pages -------------------------------------------------------------------------------
+    def _on_procedures(self, page) -> None:
+        session = page.session
+        if session is None:
+            return
+        axis_name = self.axis_ref.split("/", 1)[1]
+        if session.axis != axis_name and not any(s.records for s in session.runs.values()):
+            # a session started on this axis's pages is this axis's
+            session.axis = axis_name
+            if session.path is not None:
+                self._record("session file", session.save)
+        self._record("procedure check", lambda: record_session(self.register, self.axis_ref, session))
+
+    def _on_report(self, page, html: Path, pdf: Path | None) -> None:
+        session = page.session
+        signature = session.signature if session is not None else {}
+        warnings = 0
+        if session is not None:
+            from fha_studio.logic.procedures.report import build_report
+
+            warnings = len(build_report(session, page.context).warnings)
+        for path in (pdf, html):
+            if path is None:
+                continue
+            self._record(
+                "report",
+                lambda path=path: self.register.record_report(
+                    path,
+                    axis=self.axis_ref,
+                    signed_by=signature.get("who", ""),
+                    signed_utc=signature.get("at_utc", ""),
+                    open_warnings=warnings,
+                    who=self.who,
+                ),
+            )
+            break  # the PDF when there is one: the file that is handed over
+
+    @Slot(object, str)
+    def _on_recording(self, path: Path, what: str) -> None:
+        self._record(
+            "recording", lambda: self.register.record_recording(self.axis_ref, path, what, who=self.who)
+        )
+
+    def _on_model_check(self, page, result) -> None:
+        lines = result.summary_lines()
+        summary = "; ".join(lines[:3]) if lines else "model check run"
+        source = page.source_label.text() if hasattr(page, "source_label") else ""
+        self._record(
+            "model check",
+            lambda: self.register.record_model_check(
+                self.axis_ref, summary, recording_file=source, who=self.who
+            ),
+        )
+
+
+class MachineWindow(QMainWindow):
+    """FHA Studio for a machine: the axis list, the banner, one set of pages per axis."""
+
+    def __init__(
+        self,
+        project: MachineProject,
+        register: Register | None = None,
+        open_client: OpenClient | None = None,
+        parent: QWidget | None = None,
+    ):
+        super().__init__(parent)
+        self.setObjectName("machineWindow")
+        self.project = project
+        self.register = register
+        self.axis_windows: list[MainWindow] = []
+        self.recorders: list[AxisRecorder] = []
+        self._shut_down = False
+        self._closing_confirmed = False
+        self._build_toolbar()
+        self._build_body(open_client)
+        if register is not None:
+            project.save_to(register, who=self.operator)
+        self.axis_list.setCurrentRow(0)
+        self.resize(1366, 740)
+
+    # -- building -------------------------------------------------------------------------------------
+    def _build_toolbar(self) -> None:
+        bar = QToolBar("Machine", self)
+        bar.setObjectName("machineToolbar")
+        bar.setMovable(False)
+        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, bar)
+        title = QLabel(f"  {self.project.name}  ")
+        title.setObjectName("machineName")
+        title.setStyleSheet("font-weight: bold; font-size: 12pt;")
+        bar.addWidget(title)
+        self.connect_all_action = QAction("Connect &all axes", self)
+        self.connect_all_action.setToolTip("Connect every axis to its port (one link per port)")
+        self.connect_all_action.triggered.connect(self.connect_all)
+        bar.addAction(self.connect_all_action)
+        self.report_action = QAction("&Machine report…", self)
+        self.report_action.setToolTip(
+            "A summary of every axis, then each axis's commissioning report (PDF, HTML)"
+        )
+        self.report_action.triggered.connect(self._report_clicked)
+        bar.addAction(self.report_action)
+        bar.addSeparator()
+        bar.addWidget(QLabel("Operator: "))
+        self.operator_edit = QLineEdit(str(QSettings().value("machine/operator", "")))
+        self.operator_edit.setObjectName("operator")
+        self.operator_edit.setPlaceholderText("your name (the register records it)")
+        self.operator_edit.setMaximumWidth(200)
+        self.operator_edit.editingFinished.connect(
+            lambda: QSettings().setValue("machine/operator", self.operator_edit.text().strip())
+        )
+        bar.addWidget(self.operator_edit)
+        spacer = QWidget()
+        spacer.setSizePolicy(
+            spacer.sizePolicy().horizontalPolicy().Expanding, spacer.sizePolicy().verticalPolicy().Preferred
+        )
+        bar.addWidget(spacer)
+        self.stop_all_button = StopButton()
+        self.stop_all_button.setText("STOP ALL")
+        self.stop_all_button.setToolTip("STOP every connected axis: each decelerates and holds (Esc)")
+        self.stop_all_button.clicked.connect(self.stop_all)
+        bar.addWidget(self.stop_all_button)
+
+    def _build_body(self, open_client: OpenClient | None) -> None:
+        body = QWidget(self)
+        row = QHBoxLayout(body)
+        row.setContentsMargins(4, 4, 4, 4)
+        self.axis_list = QListWidget()
+        self.axis_list.setObjectName("axisList")
+        self.axis_list.setFixedWidth(AXIS_LIST_WIDTH_PX)
+        self.axis_list.setWordWrap(True)
+        self.axis_list.setSpacing(2)
+        self.axis_list.setToolTip("The axes of the machine: choose one, every page acts on it")
+        row.addWidget(self.axis_list)
+        right = QVBoxLayout()
+        self.banner = QLabel("")
+        self.banner.setObjectName("axisBanner")
+        self.banner.setStyleSheet(
+            "background: #1d3f6e; color: white; font-size: 12pt; font-weight: bold;"
+            " padding: 6px; border-radius: 4px;"
+        )
+        right.addWidget(self.banner)
+        self.stack = QStackedWidget()
+        right.addWidget(self.stack, 1)
+        row.addLayout(right, 1)
+        self.setCentralWidget(body)
+        for axis in self.project:
+            link = LinkController(open_client=open_client)
+            window = MainWindow(link)
+            link.setParent(window)
+            window.setWindowFlags(Qt.WindowType.Widget)  # a page set inside this window
+            window.setObjectName(f"axis:{axis.name}")
+            if axis.actuator_code:
+                window.session.set_actuator(axis.actuator_code)
+            # STOP on any axis's pages (its button, Esc) stops every connected axis
+            window.stop_button.clicked.disconnect()
+            window.stop_button.clicked.connect(self.stop_all)
+            window.stop_shortcut.activated.disconnect()
+            window.stop_shortcut.activated.connect(self.stop_all)
+            self.stack.addWidget(window)
+            self.axis_windows.append(window)
+            item = QListWidgetItem()
+            self.axis_list.addItem(item)
+            index = len(self.axis_windows) - 1
+            for signal in (link.sigConnected, link.sigDisconnected, link.sigStatus):
+                signal.connect(lambda *_args, i=index: self._refresh_axis(i))
+            link.sigResult.connect(lambda result, i=index: self._on_axis_result(i, result))
+            window.session.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
+            if self.register is not None:
+                self.recorders.append(
+                    AxisRecorder(
+                        self.register, f"{self.project.name}/{axis.name}", window, lambda: self.operator
+                    )
+                )
+            self._refresh_axis(index)
+        self.axis_list.currentRowChanged.connect(self._axis_chosen)
+
+    # -- which axis ----------------------------------------------------------------------------------
+    @property
+    def operator(self) -> str:
+        return self.operator_edit.text().strip()
+
+    @property
+    def current_index(self) -> int:
+        return self.stack.currentIndex()
+
+    @property
+    def current_axis(self) -> MachineAxis:
+        return self.project.axes[self.current_index]
+
+    @property
+    def current_window(self) -> MainWindow:
+        return self.axis_windows[self.current_index]
+
+    def axis_window(self, name: str) -> MainWindow:
+        return self.axis_windows[self.project.axes.index(self.project.axis(name))]
+
+    def select_axis(self, name: str) -> MainWindow:
+        """Shows the pages of axis ``name`` (MachineError naming the axes when there is none)."""
+        index = self.project.axes.index(self.project.axis(name))
+        self.axis_list.setCurrentRow(index)
+        return self.axis_windows[index]
+
+    @Slot(int)
+    def _axis_chosen(self, index: int) -> None:
+        if index < 0:
+            return
+        page = self.stack.currentWidget().tabs.currentIndex() if self.stack.currentWidget() else 0
+        self.stack.setCurrentIndex(index)
+        self.axis_windows[index].tabs.setCurrentIndex(page)  # the same page, now for this axis
+        self._refresh_banner()
+
+    def _axis_state(self, index: int) -> tuple[str, QColor]:
+        link = self.axis_windows[index].link
+        if link.connected:
+            if link.status is not None and link.status.alarm_code:
+                return f"ALARM {link.status.alarm_code}", QColor("#b00020")
+            if link.servo_on:
+                return "servo ON", QColor("#b36b00")
+            return "connected", QColor("#176b1d")
+        if link.last_disconnect_reason and "lost" in link.last_disconnect_reason.lower():
+            return "LINK LOST", QColor("#b00020")
+        return "not connected", QColor("#555555")
+
+    def _refresh_axis(self, index: int) -> None:
+        axis = self.project.axes[index]
+        state, colour = self._axis_state(index)
+        item = self.axis_list.item(index)
+        item.setText(f"{axis.name}\n{axis.actuator_code or 'actuator not given'}\n{state}")
+        item.setForeground(colour)
+        item.setToolTip(f"{axis.name}: {axis.actuator_code} at {axis.port_url or 'no port given'} — {state}")
+        if index == self.current_index:
+            self._refresh_banner()
+
+    def _refresh_banner(self) -> None:
+        index = self.current_index
+        if index < 0:
+            return
+        axis = self.project.axes[index]
+        window = self.axis_windows[index]
+        state, _ = self._axis_state(index)
+        driver = window.link.info.driver_model if window.link.info else axis.driver_model
+        where = axis.port_url or "no port given"
+        self.banner.setText(
+            f"Axis {axis.name} — {axis.actuator_code or 'actuator not given'}"
+            f"{' on ' + driver if driver else ''} — {where} — {state}"
+        )
+        self.setWindowTitle(f"FHA Studio — {self.project.name} — axis {axis.name}")
+
+    def _on_actuator(self, index: int, code: str) -> None:
+        axis = self.project.axes[index]
+        try:
+            axis.state.set_actuator(code)
+        except ValueError:
+            return  # the page says what is wrong with the code
+        if self.register is not None:
+            try:
+                self.register.update_axis(
+                    f"{self.project.name}/{axis.name}", who=self.operator, actuator_code=code
+                )
+            except (RegisterError, OSError) as exc:
+                self.current_window.show_message(
+                    f"Register: the actuator was not recorded ({exc}).", Level.WARNING
+                )
+        self._refresh_axis(index)
+
+    def _on_axis_result(self, index: int, result: CommandResult) -> None:
+        if result.cmd is Cmd.READ_PARAMETERS and result.ok:
+            self.project.axes[index].state.record_read(result.value["values"])
+        if result.cmd is Cmd.STOP:
+            self._refresh_axis(index)
+
+    # -- actions --------------------------------------------------------------------------------------
+    def connect_axis(self, name: str) -> bool:
+        axis = self.project.axis(name)
+        if not axis.port_url:
+            self.axis_window(name).show_message(
+                f"Axis {name} has no port: Connect… (Ctrl+K) to choose one.", Level.WARNING
+            )
+            return False
+        return self.axis_window(name).connect_to(axis.port_url)
+
+    @Slot()
+    def connect_all(self) -> list[str]:
+        """Connects every axis that has a port and is not connected; returns their names."""
+        started = []
+        for axis, window in zip(self.project, self.axis_windows, strict=True):
+            if axis.port_url and not window.link.connected and window.connect_to(axis.port_url):
+                started.append(axis.name)
+        return started
+
+    @Slot()
+    def stop_all(self) -> list[str]:
+        """STOP to every connected axis; returns the names of the axes it was sent to."""
+        sent, idle, elsewhere = [], [], []
+        for axis, window in zip(self.project, self.axis_windows, strict=True):
+            window.jog_page.release_jog()
+            info = window.link.info
+            if info is None:
+                idle.append(axis.name)
+            elif not info.can_move:
+                # a drive of the manual's commands only has no STOP over CN3: the controller
+                # (servo-ON, command pulses on CN2) moves and stops that axis
+                elsewhere.append(axis.name)
+            else:
+                window.link.stop_now()
+                sent.append(axis.name)
+        parts = []
+        if sent:
+            parts.append(f"STOP sent to {', '.join(sent)}: each decelerates and holds (servo stays on)")
+        if elsewhere:
+            parts.append(f"{', '.join(elsewhere)}: no STOP over the link, the controller stops it")
+        if idle:
+            parts.append(f"not connected: {', '.join(idle)}")
+        text = ("; ".join(parts) if sent else "STOP: nothing was sent; " + "; ".join(parts)) + "."
+        level = Level.INFO if sent else Level.WARNING
+        for window in self.axis_windows:
+            window.show_message(text, level)
+        return sent
+
+    def sessions(self) -> dict[str, object]:
+        """Each axis's procedure session as its pages hold it (axes without one are left out)."""
+        from fha_studio.gui.pages.procedures.page import ProceduresPage
+
+        out = {}
+        for axis, window in zip(self.project, self.axis_windows, strict=True):
+            for page in built_pages(window):
+                if isinstance(page, ProceduresPage) and page.session is not None:
+                    out[axis.name] = page.session
+                    axis.session_file = page.session.path
+        return out
+
+    def write_machine_report(self, html_path: str | Path, pdf_path: str | Path | None = None):
+        """Writes the machine report (HTML, and PDF when a path is given); records it."""
+        from fha_studio.gui.pages.procedures.report_pdf import write_pdf
+        from fha_studio.logic.machine_report import build_machine_report, render_machine_html
+
+        report = build_machine_report(self.project, self.sessions(), self.register)
+        html = render_machine_html(report)
+        html_path = Path(html_path)
+        html_path.parent.mkdir(parents=True, exist_ok=True)
+        partial = html_path.with_name(f".{html_path.name}.partial")
+        partial.write_text(html, encoding="utf-8")
+        partial.replace(html_path)
+        pdf = write_pdf(html, pdf_path, report.title, html_path.parent) if pdf_path is not None else None
+        if self.register is not None:
+            signed = all(s.is_signed for s in report.summaries)
+            self.register.record_report(
+                pdf or html_path,
+                machine=self.project.name,
+                signed_by="every axis signed" if signed else "",
+                open_warnings=sum(s.open_warnings for s in report.summaries),
+                who=self.operator,
+            )
+        return html_path, pdf
+
+    def _report_clicked(self) -> None:
+        base = Path(QSettings().value("machine/report_dir", str(Path.home()))) / f"{self.project.name}.pdf"
+        path, _ = QFileDialog.getSaveFileName(self, "Machine report (PDF)", str(base), "PDF (*.pdf)")
+        if not path:
+            return
+        try:
+            html, pdf = self.write_machine_report(Path(path).with_suffix(".html"), path)
+        except (OSError, ValueError) as exc:
+            QMessageBox.warning(self, "Machine report", f"The machine report was not written: {exc}")
+            return
+        QSettings().setValue("machine/report_dir", str(Path(path).parent))
+        self.current_window.show_message(f"Machine report written: {pdf} and {html}")
+
+    # -- closing --------------------------------------------------------------------------------------
+    def closeEvent(self, event) -> None:
+        if self._shut_down:
+            event.accept()
+            return
+        live = [
+            a.name
+            for a, w in zip(self.project, self.axis_windows, strict=True)
+            if w.link.servo_on or w.link.moving
+        ]
+        if live and not self._closing_confirmed:
+            answer = QMessageBox.warning(
+                self,
+                "Close while the servo is on?",
+                f"The servo is on at {', '.join(live)}. FHA Studio sends STOP to every axis; each is "
+                "held by its servo, which stays ON. Switch the servos off yourself first if the axes "
+                "should be free.",
+                QMessageBox.StandardButton.Ok | QMessageBox.StandardButton.Cancel,
+                QMessageBox.StandardButton.Cancel,
+            )
+            if answer != QMessageBox.StandardButton.Ok:
+                event.ignore()
+                return
+        self._closing_confirmed = True
+        self.shutdown()
+        event.accept()
+
+    def shutdown(self) -> None:
+        """Stops every axis, closes every port and ends every link thread (idempotent)."""
+        if self._shut_down:
+            return
+        self._shut_down = True
+        for window in self.axis_windows:
+            window._closing_confirmed = True
+            window.shutdown()

@@ -1,0 +1,209 @@
+"""A machine of three axes on three simulated drives (two full, one that speaks only the manual's
+DGR and OWW): the axis list beside the pages, every page switching with the chosen axis, the
+banner naming it, STOP reaching every axis that can be stopped, and the register filled as the
+axes are commissioned (history, a diff against the twin, a find)."""
+
+from __future__ import annotations
+
+import dataclasses
+import gc
+
+import pytest
+from PySide6.QtCore import QCoreApplication
+from PySide6.QtWidgets import QApplication
+
+from fha_studio.gui.link import Cmd
+from fha_studio.logic.machine import MachineProject
+from fha_studio.logic.register import Register
+from tests.procedures.walk import good_answer
+
+MACHINE = "Line 3 positioner"
+TABLE = "FHA-25C-50-US250"
+TILT = "FHA-32C-100-S248-B"
+
+
+def _sim_has_profiles() -> bool:
+    from fha_studio.hardware.sim.options import SimConfig
+
+    return any(f.name == "profile" for f in dataclasses.fields(SimConfig))
+
+
+@pytest.fixture
+def make_machine(qtbot):
+    """Factory: make_machine(project, register) -> a shown MachineWindow; torn down like
+    make_window (every link thread ended, no window left open)."""
+    from fha_studio.gui.machine_window import MachineWindow
+
+    app = QApplication.instance()
+    before = set(app.topLevelWidgets())
+    windows, drives = [], []
+
+    def open_client(url: str, baud: int):
+        from fha_studio.hardware.client import DriveClient, LinkSettings
+
+        if "profile=documented" in url and not _sim_has_profiles():
+            # until the simulated drive has its documented profile: a scripted drive of the manual
+            from fha_studio.hardware.scripted import ScriptedDrive, documented_only
+            from fha_studio.hardware.transport import pipe_pair
+
+            host, end = pipe_pair("documented")
+            drives.append(ScriptedDrive(end, documented_only(position=40960)))
+            return DriveClient.attach(host)
+        return DriveClient.open(url, LinkSettings(baudrate=baud, response_timeout_s=0.25, retries=1))
+
+    def factory(project, register):
+        window = MachineWindow(project, register, open_client=open_client)
+        window.show()
+        windows.append(window)
+        return window
+
+    yield factory
+
+    for window in windows:
+        window._closing_confirmed = True
+        window.shutdown()
+        assert not any(w.link._thread.isRunning() for w in window.axis_windows), (
+            "a link thread is still running"
+        )
+        window.close()
+        window.deleteLater()
+    for drive in drives:
+        drive.close()
+    QApplication.processEvents()
+    QCoreApplication.sendPostedEvents(None, 0)
+    QApplication.processEvents()
+    gc.collect()
+    leaked = [w for w in app.topLevelWidgets() if w not in before and w.isVisible()]
+    for w in leaked:
+        w.close()
+    assert not leaked, f"top-level widgets left open: {[type(w).__name__ for w in leaked]}"
+
+
+def _walk(page, qtbot, procedure_id, limit=80):
+    """Answers a procedure's steps as a technician would on the page."""
+    page.select_procedure(procedure_id)
+    for _ in range(limit):
+        step = page.current_step()
+        if step is None or page.run.stopped:
+            return
+        if step.kind == "confirm":
+            page.yes_button.click()
+        elif step.kind in ("measure", "text"):
+            page.value_edit.setText(str(good_answer(step)))
+            page.value_button.click()
+        elif step.kind == "choose":
+            page.choice_combo.setCurrentText(str(good_answer(step)))
+            page.choice_button.click()
+        else:
+            with qtbot.waitSignal(page.sigLiveDone, timeout=20000):
+                page.live_button.click()
+    raise AssertionError("procedure did not end")
+
+
+def _project(tmp_path) -> MachineProject:
+    project = MachineProject(MACHINE, site="Plant A, hall 2")
+    for name in ("table", "table twin"):
+        eeprom = tmp_path / f"{name.replace(' ', '-')}.eeprom.json"
+        project.add_axis(
+            name, TABLE, port_url=f"sim://{TABLE}?paced=0&eeprom={eeprom}", load_inertia_kgm2=1.5
+        )
+    eeprom = tmp_path / "tilt.eeprom.json"
+    project.add_axis(
+        "tilt",
+        TILT,
+        port_url=f"sim://{TILT}?profile=documented&paced=0&eeprom={eeprom}",
+        load_inertia_kgm2=4.0,
+    )
+    return project
+
+
+def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qtbot, tmp_path):
+    register = Register(tmp_path / "register.sqlite")
+    window = make_machine(_project(tmp_path), register)
+    window.operator_edit.setText("ana")
+    assert window.axis_list.count() == 3
+    assert window.connect_all() == ["table", "table twin", "tilt"]
+    qtbot.waitUntil(lambda: all(w.link.connected for w in window.axis_windows), timeout=15000)
+    table, twin, tilt = window.axis_windows
+    assert not tilt.link.info.can_parameters and not tilt.link.info.can_move
+    # each full drive's parameters are read on connecting: a snapshot per axis, over the link
+    qtbot.waitUntil(
+        lambda: all(register.snapshots(f"{MACHINE}/{n}") for n in ("table", "table twin")), timeout=15000
+    )
+    assert register.snapshots(f"{MACHINE}/tilt") == []
+    assert register.snapshots(f"{MACHINE}/table")[0]["who"] == "ana"
+
+    # the pages act on the chosen axis, and the banner says which
+    assert window.select_axis("table") is table and window.current_window is table
+    assert window.banner.text().startswith(f"Axis table — {TABLE} on HA-655")
+    table.show_page("parameters")
+    window.select_axis("tilt")
+    assert window.current_window is tilt and tilt.tabs.currentIndex() == table.tabs.currentIndex()
+    assert window.banner.text().startswith(f"Axis tilt — {TILT}")
+    assert "axis tilt" in window.windowTitle()
+
+    # commission the table: rotary direction reversed (backed up, written, verified), procedures
+    window.select_axis("table")
+    table.session.write([("system", 8, 1)])
+    twin.session.write([("tune", 4, 20)])  # the twin's in-position range, written from its pages
+    for axis in ("table", "table twin"):
+        qtbot.waitUntil(
+            lambda axis=axis: any(e.kind == "write" for e in register.history(f"{MACHINE}/{axis}")),
+            timeout=15000,
+        )
+    page = table.show_page("procedures")
+    page.operator_edit.setText("ana")
+    page.new_session(tmp_path / "table.fha-session.json")
+    _walk(page, qtbot, "receiving-inspection")
+    page.write_report(tmp_path / "table-report.html", tmp_path / "table-report.pdf")
+
+    # the register: history, diff against the twin, find
+    history = register.history(f"{MACHINE}/table")
+    writes = [e for e in history if e.kind == "write"]
+    assert [w.text for w in writes] == ["system 8 rotary_direction: 0 -> 1 verified"]
+    assert writes[0].who == "ana"
+    checks = [e for e in history if e.kind == "check"]
+    assert len(checks) >= 5 and all("pass" in c.text for c in checks)
+    assert {r["procedure_id"]: r["status"] for r in register.procedure_status(f"{MACHINE}/table")}[
+        "receiving-inspection"
+    ] == "completed"
+    reports = [e for e in history if e.kind == "report"]
+    assert reports and reports[-1].data["file"].endswith("table-report.pdf")
+    assert [e.at_utc for e in history] == sorted(e.at_utc for e in history)
+    diff = Register.diff(
+        register.parameter_set(f"{MACHINE}/table"), register.parameter_set(f"{MACHINE}/table twin")
+    )
+    assert {d.key: (d.a, d.b) for d in diff} == {"rotary_direction": (1, 0), "in_position_range": (10, 20)}
+    assert [f.axis.name for f in register.find("rotary_direction", 1)] == ["table"]
+    assert [f.axis.name for f in register.find("in_position_range", 20)] == ["table twin"]
+    open_items = {(i.axis.name, i.text) for i in register.open_items(MACHINE)}
+    assert ("table", f"report {tmp_path / 'table-report.pdf'} is not signed") in open_items
+    assert ("tilt", "no procedure recorded yet") in open_items
+
+    # STOP reaches every axis that can be stopped: both tables, not the documented-only tilt
+    for w in (table, twin):
+        w.link.send(Cmd.SERVO, True)
+    qtbot.waitUntil(lambda: table.link.servo_on and twin.link.servo_on, timeout=10000)
+    with qtbot.waitSignals(
+        [table.link.sigResult, twin.link.sigResult],
+        timeout=10000,
+        check_params_cbs=[lambda r: r.cmd is Cmd.STOP] * 2,
+    ):
+        twin.stop_button.click()  # the STOP of any axis's pages is the machine's STOP
+    said = [m.text for m in twin.message_area.messages if m.text.startswith("STOP sent")]
+    assert said[-1] == (
+        "STOP sent to table, table twin: each decelerates and holds (servo stays on); "
+        "tilt: no STOP over the link, the controller stops it."
+    )
+    assert window.stop_all() == ["table", "table twin"]
+
+    # the machine report: every axis in the summary, then each axis's report
+    html, pdf = window.write_machine_report(tmp_path / "machine.html", tmp_path / "machine.pdf")
+    text = html.read_text(encoding="utf-8")
+    summary = text[: text.index("Axis table</h1>")]
+    assert "1: FWD command → REV rotation" in summary  # the table, reversed
+    assert "0: FWD command → FWD rotation (default)" in summary  # the twin
+    assert TILT in summary and "not signed" in summary
+    assert pdf.is_file() and pdf.stat().st_size > 1000
+    assert register.export(MACHINE)["machines"][0]["machine_reports"][0]["file"] == str(pdf.resolve())
+    register.close()
