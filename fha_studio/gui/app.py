@@ -29,8 +29,58 @@ def _parser() -> argparse.ArgumentParser:
         default=None,
         help="page to show first (connection, parameters, direction, alarms, jog, sizing)",
     )
+    parser.add_argument(
+        "--machine",
+        metavar="NAME",
+        help="open the machine NAME of the register: its axes beside the pages, each connected to its port",
+    )
+    parser.add_argument(
+        "--machine-file",
+        metavar="FILE",
+        help="open a machine project file (fha-machine/1) and put it in the register",
+    )
+    parser.add_argument(
+        "--register",
+        metavar="FILE",
+        help="the register file (default: $FHA_STUDIO_REGISTER, else register.sqlite in the user data "
+        "directory)",
+    )
     parser.add_argument("--quit-after-ms", type=int, default=None, help=argparse.SUPPRESS)
     return parser
+
+
+def _machine_window(args):
+    """The machine window for --machine / --machine-file, or None; SystemExit(2) with one line
+    when the machine or the register cannot be opened."""
+    if not (args.machine or args.machine_file):
+        return None
+    from pathlib import Path
+
+    from fha_studio.gui.machine_window import MachineWindow, register_path
+    from fha_studio.logic.machine import MachineError, MachineProject
+    from fha_studio.logic.register import Register, RegisterError
+
+    try:
+        register = Register(Path(args.register) if args.register else register_path())
+        try:
+            if args.machine_file:
+                project = MachineProject.load(args.machine_file)
+            else:
+                project = MachineProject.from_register(register, args.machine)
+        except (MachineError, RegisterError, ValueError):
+            register.close()
+            raise
+    except (MachineError, RegisterError, ValueError) as exc:
+        print(f"fha-studio: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
+    if not len(project):
+        register.close()
+        print(
+            f"fha-studio: machine '{project.name}' has no axes (fha-studio register add-axis ...)",
+            file=sys.stderr,
+        )
+        raise SystemExit(2)
+    return MachineWindow(project, register)
 
 
 def make_application(argv: Sequence[str] = ()):
@@ -62,12 +112,22 @@ def run(argv: Sequence[str] = ()) -> int:
     icon = resources_dir() / "icons" / "fha-studio.png"
     if icon.exists():
         app.setWindowIcon(QIcon(str(icon)))
-    window = MainWindow()
-    if args.page:
-        window.show_page(args.page)
-    window.show()
-    if not args.no_connect:
-        window.connect_to(args.url, args.baud)
+    machine = _machine_window(args)
+    if machine is not None:
+        window = machine
+        if args.page:
+            for axis_window in machine.axis_windows:
+                axis_window.show_page(args.page)
+        window.show()
+        if not args.no_connect:
+            machine.connect_all()
+    else:
+        window = MainWindow()
+        if args.page:
+            window.show_page(args.page)
+        window.show()
+        if not args.no_connect:
+            window.connect_to(args.url, args.baud)
     QTimer.singleShot(
         0,
         lambda: logging.getLogger(__name__).info(
@@ -78,4 +138,6 @@ def run(argv: Sequence[str] = ()) -> int:
         QTimer.singleShot(args.quit_after_ms, window.close)
     code = app.exec()
     window.shutdown()
+    if machine is not None and machine.register is not None:
+        machine.register.close()
     return int(code)

@@ -72,10 +72,13 @@ class AxisRecorder(QObject):
     A fact the register cannot take (the file locked for longer than its busy timeout, a full
     disk) is said in the axis's message area; the commissioning goes on."""
 
-    def __init__(self, register: Register, axis_ref: str, window: MainWindow, who: Callable[[], str]):
+    def __init__(
+        self, register: Register, axis_ref: str, window: MainWindow, who: Callable[[], str], site: str = ""
+    ):
         super().__init__(window)
         self.register = register
         self.axis_ref = axis_ref
+        self.site = site
         self.window = window
         self._who = who
         self._alarm_code = 0
@@ -198,8 +201,9 @@ class AxisRecorder(QObject):
             return
         axis_name = self.axis_ref.split("/", 1)[1]
         if session.axis != axis_name and not any(s.records for s in session.runs.values()):
-            # a session started on this axis's pages is this axis's
+            # a session started on this axis's pages is this axis's, on this machine's site
             session.axis = axis_name
+            session.site = session.site or self.site
             if session.path is not None:
                 self._record("session file", session.save)
         self._record("procedure check", lambda: record_session(self.register, self.axis_ref, session))
@@ -353,14 +357,19 @@ class MachineWindow(QMainWindow):
             item = QListWidgetItem()
             self.axis_list.addItem(item)
             index = len(self.axis_windows) - 1
-            for signal in (link.sigConnected, link.sigDisconnected, link.sigStatus):
+            for signal in (link.sigDisconnected, link.sigStatus):
                 signal.connect(lambda *_args, i=index: self._refresh_axis(i))
+            link.sigConnected.connect(lambda info, i=index: self._on_axis_connected(i, info))
             link.sigResult.connect(lambda result, i=index: self._on_axis_result(i, result))
             window.session.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
             if self.register is not None:
                 self.recorders.append(
                     AxisRecorder(
-                        self.register, f"{self.project.name}/{axis.name}", window, lambda: self.operator
+                        self.register,
+                        f"{self.project.name}/{axis.name}",
+                        window,
+                        lambda: self.operator,
+                        self.project.site,
                     )
                 )
             self._refresh_axis(index)
@@ -453,6 +462,11 @@ class MachineWindow(QMainWindow):
                 self.current_window.show_message(
                     f"Register: the actuator was not recorded ({exc}).", Level.WARNING
                 )
+        self._refresh_axis(index)
+
+    def _on_axis_connected(self, index: int, info: LinkInfo) -> None:
+        if info.driver_model:  # what the drive says of itself beats what was typed
+            self.project.axes[index].state.set_driver(info.driver_model, info.adjusted_for)
         self._refresh_axis(index)
 
     def _on_axis_result(self, index: int, result: CommandResult) -> None:

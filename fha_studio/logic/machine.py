@@ -208,6 +208,8 @@ class MachineProject:
             except ValueError:
                 register.add_axis(self.name, axis.name, who=who, **fields)
                 continue
+            if row.load_inertia_kgm2 is None and not axis.load_inertia_kgm2:
+                del fields["load_inertia_kgm2"]  # not declared there, nothing declared here
             register.update_axis(row, who=who, **fields)
 
     @classmethod

@@ -203,8 +203,8 @@ def render_machine_html(report: MachineReport) -> str:
         rows.append(
             [
                 _e(s.axis),
-                _e(s.actuator),
-                _e(s.driver),
+                _e(s.actuator or "not given"),
+                _e(s.driver or "not known"),
                 _e(s.direction),
                 _e(s.origin),
                 str(s.checks_passed),

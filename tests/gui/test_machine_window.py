@@ -207,3 +207,31 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     assert pdf.is_file() and pdf.stat().st_size > 1000
     assert register.export(MACHINE)["machines"][0]["machine_reports"][0]["file"] == str(pdf.resolve())
     register.close()
+
+
+def test_the_gui_opens_a_machine_of_the_register_or_says_why_not(qtbot, tmp_path, capsys):
+    from fha_studio.gui.app import run
+
+    path = tmp_path / "plant.sqlite"
+    with Register(path) as register:
+        register.add_machine("Press 7")
+    for args, message in (
+        (["--machine", "Nope"], "fha-studio: no machine called 'Nope' in the register (machines: Press 7)\n"),
+        (
+            ["--machine", "Press 7"],
+            "fha-studio: machine 'Press 7' has no axes (fha-studio register add-axis ...)\n",
+        ),
+        (
+            ["--machine-file", str(tmp_path / "none.json")],
+            f"fha-studio: {tmp_path / 'none.json'}: no such machine file\n",
+        ),
+    ):
+        with pytest.raises(SystemExit) as exit_info:
+            run([*args, "--register", str(path), "--no-connect"])
+        assert exit_info.value.code == 2
+        assert capsys.readouterr().err == message
+    with Register(path) as register:
+        register.add_axis("Press 7", "feed", "FHA-17C-50-US250", port_url="sim://FHA-17C-50-US250?paced=0")
+    assert (
+        run(["--machine", "Press 7", "--register", str(path), "--no-connect", "--quit-after-ms", "200"]) == 0
+    )

@@ -72,6 +72,11 @@ def test_the_project_goes_into_the_register_and_comes_back(register):
     assert tilt_history[-1].text == "load inertia: 4.0 -> 4.5" and tilt_history[-1].who == "ben"
     back = MachineProject.from_register(register, "Line 3 positioner")
     assert back.to_json() == project.to_json()
+    # an axis added on the command line, without a load inertia: opening and saving changes nothing
+    register.add_axis("Line 3 positioner", "roll", "FHA-17C-50-US250")
+    before = len(register.history("Line 3 positioner/roll"))
+    MachineProject.from_register(register, "Line 3 positioner").save_to(register)
+    assert len(register.history("Line 3 positioner/roll")) == before
 
 
 def _finished_session(code: str, axis: str, path, who="T. Trainee") -> Session:
