@@ -10,7 +10,6 @@ directory, never the user's.
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import subprocess
 import sys
@@ -51,12 +50,10 @@ def main() -> int:
     QCoreApplication.setOrganizationName("FHA Studio Screenshots")
     QCoreApplication.setApplicationName("fha-studio-screenshots")
     from fha_studio.gui.machine_window import MachineWindow
-    from fha_studio.hardware.sim.options import SimConfig
     from fha_studio.logic.machine import MachineProject
     from fha_studio.logic.register import Register
     from tests.procedures.walk import good_answer
 
-    documented = any(f.name == "profile" for f in dataclasses.fields(SimConfig))
     project = MachineProject("Line 3 positioner", site="Plant A, hall 2")
     project.add_axis(
         "table", "FHA-25C-50-US250", port_url="sim://FHA-25C-50-US250?paced=0", load_inertia_kgm2=1.5
@@ -64,7 +61,7 @@ def main() -> int:
     project.add_axis(
         "table twin", "FHA-25C-50-US250", port_url="sim://FHA-25C-50-US250?paced=0", load_inertia_kgm2=1.5
     )
-    tilt = "sim://FHA-32C-100-S248-B?paced=0" + ("&profile=documented" if documented else "")
+    tilt = "sim://FHA-32C-100-S248-B?paced=0&profile=documented"
     project.add_axis("tilt", "FHA-32C-100-S248-B", port_url=tilt, load_inertia_kgm2=4.0)
     register = Register(TMP / "register.sqlite")
     window = MachineWindow(project, register)

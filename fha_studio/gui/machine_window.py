@@ -37,6 +37,7 @@ from PySide6.QtWidgets import (
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo, OpenClient
 from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
+from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.session import data_dir
 from fha_studio.gui.widgets import StopButton
 from fha_studio.logic.machine import MachineAxis, MachineProject
@@ -46,17 +47,6 @@ log = logging.getLogger(__name__)
 
 #: Width of the axis list [px].
 AXIS_LIST_WIDTH_PX = 230
-
-
-def built_pages(window: MainWindow) -> list[QWidget]:
-    """The pages of an axis's window built so far (a page with plots is built when first shown)."""
-    pages = []
-    for index in range(window.tabs.count()):
-        page = window.tabs.widget(index)
-        page = getattr(page, "built", page)  # a lazy page: what it built, None before
-        if page is not None:
-            pages.append(page)
-    return pages
 
 
 def register_path() -> Path:
@@ -93,22 +83,28 @@ class AxisRecorder(QObject):
 
     # -- pages built later (plots, procedures) ------------------------------------------------------
     def hook_pages(self) -> None:
-        """Connects to the pages built so far (a page is built when first shown)."""
-        from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
-        from fha_studio.gui.pages.procedures.page import ProceduresPage
-        from fha_studio.gui.pages.scope.page import ScopePage
+        """Connects to the pages built so far (a page with plots is built when first shown)."""
+        procedures = self.window.built_page(PageId.PROCEDURES)
+        scope = self.window.built_page(PageId.SCOPE)
+        modelcheck = self.window.built_page(PageId.MODELCHECK)
+        for page, hook in (
+            (procedures, self._hook_procedures),
+            (scope, self._hook_scope),
+            (modelcheck, self._hook_modelcheck),
+        ):
+            if page is not None and id(page) not in self._hooked:
+                self._hooked.add(id(page))
+                hook(page)
 
-        for page in built_pages(self.window):
-            if id(page) in self._hooked:
-                continue
-            self._hooked.add(id(page))
-            if isinstance(page, ProceduresPage):
-                page.sigStepChanged.connect(lambda p=page: self._on_procedures(p))
-                page.sigReportWritten.connect(lambda html, pdf, p=page: self._on_report(p, html, pdf))
-            elif isinstance(page, ScopePage):
-                page.view.sigRecordingSaved.connect(self._on_recording)
-            elif isinstance(page, ModelCheckPage):
-                page.sigFinished.connect(lambda result, p=page: self._on_model_check(p, result))
+    def _hook_procedures(self, page) -> None:
+        page.sigStepChanged.connect(lambda: self._on_procedures(page))
+        page.sigReportWritten.connect(lambda html, pdf: self._on_report(page, html, pdf))
+
+    def _hook_scope(self, page) -> None:
+        page.view.sigRecordingSaved.connect(self._on_recording)
+
+    def _hook_modelcheck(self, page) -> None:
+        page.sigFinished.connect(lambda result: self._on_model_check(page, result))
 
     # -- writing, never failing the GUI ---------------------------------------------------------------
     def _record(self, what: str, action: Callable[[], object]) -> None:
@@ -417,6 +413,8 @@ class MachineWindow(QMainWindow):
                 return f"ALARM {link.status.alarm_code}", QColor("#b00020")
             if link.servo_on:
                 return "servo ON", QColor("#b36b00")
+            if link.info is not None and not link.info.can_move:
+                return "connected (the manual's commands only)", QColor("#176b1d")
             return "connected", QColor("#176b1d")
         if link.last_disconnect_reason and "lost" in link.last_disconnect_reason.lower():
             return "LINK LOST", QColor("#b00020")
@@ -525,14 +523,12 @@ class MachineWindow(QMainWindow):
 
     def sessions(self) -> dict[str, object]:
         """Each axis's procedure session as its pages hold it (axes without one are left out)."""
-        from fha_studio.gui.pages.procedures.page import ProceduresPage
-
         out = {}
         for axis, window in zip(self.project, self.axis_windows, strict=True):
-            for page in built_pages(window):
-                if isinstance(page, ProceduresPage) and page.session is not None:
-                    out[axis.name] = page.session
-                    axis.session_file = page.session.path
+            session = getattr(window.built_page(PageId.PROCEDURES), "session", None)
+            if session is not None:
+                out[axis.name] = session
+                axis.session_file = session.path
         return out
 
     def write_machine_report(self, html_path: str | Path, pdf_path: str | Path | None = None):

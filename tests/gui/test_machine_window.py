@@ -5,7 +5,6 @@ axes are commissioned (history, a diff against the twin, a find)."""
 
 from __future__ import annotations
 
-import dataclasses
 import gc
 
 import pytest
@@ -22,12 +21,6 @@ TABLE = "FHA-25C-50-US250"
 TILT = "FHA-32C-100-S248-B"
 
 
-def _sim_has_profiles() -> bool:
-    from fha_studio.hardware.sim.options import SimConfig
-
-    return any(f.name == "profile" for f in dataclasses.fields(SimConfig))
-
-
 @pytest.fixture
 def make_machine(qtbot):
     """Factory: make_machine(project, register) -> a shown MachineWindow; torn down like
@@ -36,23 +29,10 @@ def make_machine(qtbot):
 
     app = QApplication.instance()
     before = set(app.topLevelWidgets())
-    windows, drives = [], []
-
-    def open_client(url: str, baud: int):
-        from fha_studio.hardware.client import DriveClient, LinkSettings
-
-        if "profile=documented" in url and not _sim_has_profiles():
-            # until the simulated drive has its documented profile: a scripted drive of the manual
-            from fha_studio.hardware.scripted import ScriptedDrive, documented_only
-            from fha_studio.hardware.transport import pipe_pair
-
-            host, end = pipe_pair("documented")
-            drives.append(ScriptedDrive(end, documented_only(position=40960)))
-            return DriveClient.attach(host)
-        return DriveClient.open(url, LinkSettings(baudrate=baud, response_timeout_s=0.25, retries=1))
+    windows = []
 
     def factory(project, register):
-        window = MachineWindow(project, register, open_client=open_client)
+        window = MachineWindow(project, register)
         window.show()
         windows.append(window)
         return window
@@ -67,8 +47,6 @@ def make_machine(qtbot):
         )
         window.close()
         window.deleteLater()
-    for drive in drives:
-        drive.close()
     QApplication.processEvents()
     QCoreApplication.sendPostedEvents(None, 0)
     QApplication.processEvents()
