@@ -43,7 +43,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Size an axis by the FHA-C manual's Chapter 2: acceleration and deceleration times, "
         "run time, %%ED, effective torque, average speed, minimum cycle time, regeneration and, with "
         "bearing loads, the cross-roller bearing checks. The duty is one move of --angle degrees at "
-        "--speed every --cycle seconds, accelerated and braked at the maximum torque.",
+        "--speed every --cycle seconds, accelerated and braked at the maximum torque (the manual's "
+        "method) or, with --accel-time, in the time the machine needs.",
     )
     p.add_argument("--actuator", metavar="CODE", help="model code, e.g. FHA-25C-50-US250")
     p.add_argument("--load-inertia", metavar="KGM2", help="load inertia JL in kg m^2 (output side)")
@@ -58,6 +59,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--duty-factors", metavar="KLA,KLR,KLD", help="duty factors from the manual's graphs (2-4-5)"
+    )
+    p.add_argument(
+        "--accel-time",
+        metavar="S",
+        help="acceleration (and braking) time the machine needs, in s (default: at the maximum torque)",
     )
     g = p.add_argument_group("cross-roller bearing (2-3), checked when a load is given")
     g.add_argument("--radial-load-n", metavar="N", help="maximum radial load Frmax in N")
@@ -119,6 +125,7 @@ def _duty(args: argparse.Namespace) -> DutyCycle:
             raise CliError(f"{option} is required")
         numbers[attr] = value
     load_torque = _number(args, "--load-torque", "load_torque", "N m")
+    accel_time = _number(args, "--accel-time", "accel_time", "s")
     bearing = {attr: _number(args, option, attr, unit) for option, attr, unit in _BEARING}
     for option, attr, _unit in _BEARING:
         if bearing[attr] is not None and bearing[attr] < 0:
@@ -149,6 +156,7 @@ def _duty(args: argparse.Namespace) -> DutyCycle:
             load_torque_nm=load_torque or 0.0,
             duty_factors=_duty_factors(args.duty_factors),
             bearing_loads=loads,
+            accel_time_s=accel_time,
         )
     except SizingError as exc:
         raise CliError(_option_message(exc)) from None
@@ -161,6 +169,7 @@ _OPTION_OF_FIELD = {
     "cycle_time_s": "--cycle",
     "load_torque_nm": "--load-torque",
     "duty_factors": "--duty-factors",
+    "accel_time_s": "--accel-time",
 }
 
 
@@ -229,6 +238,7 @@ def format_result(r: SizingResult) -> str:
     lines = [
         f"{r.actuator_code}: load {d.load_inertia_kgm2:g} kg m^2, {d.speed_rpm:g} r/min, "
         f"{d.angle_deg:g} deg every {d.cycle_time_s:g} s, load torque {d.load_torque_nm:g} N m",
+        f"  {r.assumption}",
         "",
     ]
     figures = [

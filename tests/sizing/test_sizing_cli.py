@@ -151,3 +151,14 @@ def test_missing_actuator_and_stray_bearing_options(capsys):
     assert rc == 2 and "--actuator is required" in err
     rc, _, err = run(capsys, *EXAMPLE, "--radial-offset-mm", "5")
     assert rc == 2 and "need --radial-load-n or --axial-load-n" in err
+
+
+def test_accel_time_sizes_for_the_machines_move(capsys):
+    rc, out, _ = run(capsys, *EXAMPLE, "--accel-time", "0.3", "--json")
+    data = json.loads(out)
+    assert rc == 0 and data["accel_time_s"] == data["decel_time_s"] == 0.3
+    assert "in the given 0.3 s" in data["assumption"]
+    assert any(c["name"] == "acceleration torque" for c in data["checks"])
+    rc, out, err = run(capsys, *EXAMPLE, "--accel-time", "0")
+    assert rc == 2 and out == ""
+    assert err.strip() == "fha-studio size: error: --accel-time must be a number > 0 (s), got 0.0"

@@ -4,6 +4,12 @@
 the catalogue first; :func:`suggest_actuators` lists the catalogue actuators a duty passes
 on. The duty cycle is the manual's: one move of ``angle_deg`` per cycle of
 ``cycle_time_s``, accelerated at maximum torque to ``speed_rpm``, run, braked at maximum torque.
+
+Accelerating at each actuator's maximum torque (2-4-4) makes a larger actuator accelerate harder
+and so raises its effective torque: a larger frame can fail a check that a smaller one passes.
+When the machine needs a given acceleration time, ``DutyCycle.accel_time_s`` sizes for that move
+instead (accelerating and braking in that time, at the torque it takes); the result's
+``assumption`` says which method decided.
 """
 
 from __future__ import annotations
@@ -53,6 +59,8 @@ class DutyCycle:
     load_torque_nm: float = 0.0
     duty_factors: tuple[float, float, float] | None = None
     bearing_loads: BearingLoads | None = None
+    #: Acceleration (and braking) time the machine needs [s]; None: at the maximum torque (2-4-4).
+    accel_time_s: float | None = None
 
     def __post_init__(self) -> None:
         def need(name: str, ok: bool, what: str) -> None:
@@ -71,6 +79,8 @@ class DutyCycle:
         need("angle_deg", finite(self.angle_deg) and self.angle_deg > 0, "a number > 0")
         need("cycle_time_s", finite(self.cycle_time_s) and self.cycle_time_s > 0, "a number > 0")
         need("load_torque_nm", finite(self.load_torque_nm), "a number")
+        if self.accel_time_s is not None:
+            need("accel_time_s", finite(self.accel_time_s) and self.accel_time_s > 0, "a number > 0 (s)")
         if self.duty_factors is not None:
             k = self.duty_factors
             need(
@@ -114,6 +124,8 @@ class SizingResult:
     external_resistor_w: float
     bearing: BearingResult | None
     checks: tuple[Check, ...] = field(default=())
+    #: How the move was accelerated, in words: the assumption that decides the torque checks.
+    assumption: str = ""
 
     @property
     def ok(self) -> bool:
@@ -157,6 +169,7 @@ class SizingResult:
                 "static_load_n": b.static_load_n,
                 "static_safety_factor": b.static_safety_factor,
             }
+        out["assumption"] = self.assumption
         out["ok"] = self.ok
         out["checks"] = [c.as_dict() for c in self.checks]
         return _finite(out)
@@ -164,11 +177,15 @@ class SizingResult:
     def operating_points(self) -> list[OperatingPoint]:
         """The duty on the torque-speed plane (output side), for a plot.
 
-        Acceleration runs at TM from 0 to N, the constant-speed part at TL, braking at -TM from
-        N to 0 (the motor's share; friction brakes too); the last point is the effective
-        torque at the average speed, to compare with the continuous rating.
+        Acceleration runs at TM (or, with a given acceleration time, at the torque it takes) from
+        0 to N, the constant-speed part at TL, braking at minus that torque from N to 0 (the
+        motor's share; friction brakes too); the last point is the effective torque at the average
+        speed, to compare with the continuous rating.
         """
-        n, tm, tl = self.duty.speed_rpm, self.ratings.max_torque_nm, self.duty.load_torque_nm
+        n, tl = self.duty.speed_rpm, self.duty.load_torque_nm
+        tm = self.ratings.max_torque_nm
+        if self.duty.accel_time_s is not None:
+            tm = accel_torque_for(self.ratings, self.duty)
         return [
             OperatingPoint("acceleration", 0.0, tm),
             OperatingPoint("acceleration", n, tm),
@@ -199,6 +216,14 @@ def _finite(obj):
     return obj
 
 
+def accel_torque_for(ratings: ActuatorRatings, duty: DutyCycle) -> float:
+    """The torque that accelerates ``duty``'s load to its speed in its ``accel_time_s`` [N m]."""
+    assert duty.accel_time_s is not None
+    return f.accel_torque_nm(
+        ratings.inertia_kgm2, duty.load_inertia_kgm2, duty.speed_rpm, duty.accel_time_s, duty.load_torque_nm
+    )
+
+
 def evaluate(ratings: ActuatorRatings, duty: DutyCycle) -> SizingResult:
     """Chapter 2 for ``duty`` on an actuator with ``ratings``: figures and checks."""
     r, d = ratings, duty
@@ -215,8 +240,33 @@ def evaluate(ratings: ActuatorRatings, duty: DutyCycle) -> SizingResult:
         at_most("speed", n, r.max_speed_rpm, "2-1", "r/min", "the actuator's maximum speed"),
     ]
     tf = r.friction_torque_nm
-    ta = f.accel_time_s(r.inertia_kgm2, jl, n, r.max_torque_nm, tl)
-    td = f.decel_time_s(r.inertia_kgm2, jl, n, r.max_torque_nm, tf, tl)
+    if d.accel_time_s is None:
+        ta = f.accel_time_s(r.inertia_kgm2, jl, n, r.max_torque_nm, tl)
+        td = f.decel_time_s(r.inertia_kgm2, jl, n, r.max_torque_nm, tf, tl)
+        accel_torque = r.max_torque_nm  # the manual accelerates and brakes at the maximum torque
+        assumption = (
+            f"accelerated and braked at the maximum torque TM = {r.max_torque_nm:g} N·m (the manual's "
+            "method, 2-4-4): a larger actuator accelerates harder and its effective torque is higher; "
+            "give the acceleration time the machine needs to size for that move instead"
+        )
+    else:
+        ta = td = d.accel_time_s
+        accel_torque = accel_torque_for(r, d)
+        assumption = (
+            f"accelerated and braked in the given {ta:g} s, at the torque that takes "
+            f"(Ta = {accel_torque:.3g} N·m, 2-4-4 solved for the torque)"
+        )
+        checks.append(
+            at_most(
+                "acceleration torque",
+                accel_torque,
+                r.max_torque_nm,
+                "2-4-4",
+                "N m",
+                f"Ta = (JA + JL) 2π/60 N / ta + TL must not exceed the maximum torque "
+                f"to accelerate in {ta:g} s",
+            )
+        )
     checks.append(
         Check(
             "load torque",
@@ -279,7 +329,7 @@ def evaluate(ratings: ActuatorRatings, duty: DutyCycle) -> SizingResult:
             )
         )
 
-    tm_torque = r.max_torque_nm  # the manual accelerates and brakes at the maximum torque
+    tm_torque = accel_torque
     if accelerates:
         tm = f.effective_torque_nm(tm_torque, tl, ta, tr, td, t)
         nav = f.average_speed_rpm(n, ta, tr, td, t)
@@ -353,6 +403,7 @@ def evaluate(ratings: ActuatorRatings, duty: DutyCycle) -> SizingResult:
         external,
         bearing_result,
         tuple(checks),
+        assumption,
     )
 
 

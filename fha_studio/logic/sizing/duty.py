@@ -62,6 +62,19 @@ def accel_time_s(
     return (actuator_inertia_kgm2 + load_inertia_kgm2) * _RPM_TO_RAD_S * speed_rpm / net
 
 
+def accel_torque_nm(
+    actuator_inertia_kgm2: float,
+    load_inertia_kgm2: float,
+    speed_rpm: float,
+    accel_time_s: float,
+    load_torque_nm: float = 0.0,
+) -> float:
+    """Ta = (JA + JL) 2π/60 N / ta + TL: the torque that reaches N in ta (2-4-4 solved for the
+    torque; TL positive when it opposes the rotation)."""
+    inertia_kgm2 = actuator_inertia_kgm2 + load_inertia_kgm2
+    return inertia_kgm2 * _RPM_TO_RAD_S * speed_rpm / accel_time_s + load_torque_nm
+
+
 DECEL_LOAD_TORQUE_NOTE = (
     "the manual prints td = (JA + JL) 2π/60 N / (TM + 2 TF - TL); a load torque opposing the rotation "
     "(TL > 0) helps braking, so TM + 2 TF + TL is used (the same when TL = 0)"
