@@ -517,12 +517,18 @@ class DriveClient:
         of the characters or fewer) or "text" (TRB, every drive with a trace)."""
         return "packed" if Command.TRP in self._capabilities.commands else "text"
 
-    def read_trace(self, should_abort: Callable[[], bool] | None = None) -> TraceCapture:
-        """Read out the finished capture, block by block (TRB).
+    def read_trace(
+        self,
+        should_abort: Callable[[], bool] | None = None,
+        progress: Callable[[int, int], None] | None = None,
+    ) -> TraceCapture:
+        """Read out the finished capture, block by block (``read_trace_block``: TRP or TRB).
 
         ``should_abort`` is asked before every block (e.g. a STOP's ``threading.Event.is_set``);
         when it says True the read-out gives up there with ``ReadAborted`` (``done`` / ``total``
         samples), so it keeps the link at most one block (~1 s) after being asked.
+        ``progress(done, total)`` is called before the first block and after every block (samples
+        read, samples in all).
         """
         self._require(Command.TST, Command.TRB)
         with self._lock:
@@ -533,11 +539,15 @@ class DriveClient:
             if status.state is not p.TraceState.DONE:
                 raise CommandRejected(f"no finished capture (state {status.state.name.lower()})")
             rows: list[tuple[int, ...]] = []
+            if progress is not None:
+                progress(0, status.count)
             for block in range(math.ceil(status.count / p.TRACE_BLOCK_SAMPLES)):
                 if should_abort is not None and should_abort():
                     raise ReadAborted(f"trace read-out stopped after {len(rows)} of {status.count} samples",
                                       len(rows), status.count)
                 rows += self.read_trace_block(block, status.count)
+                if progress is not None:
+                    progress(len(rows), status.count)
         return TraceCapture(channels, tuple(rows))
 
 

@@ -85,6 +85,28 @@ def test_jog_shows_position_speed_and_current_live(qtbot, scope, sim_client):
     call(view, lambda c: c.servo(False))
 
 
+@pytest.mark.parametrize("packed", [True, False])
+def test_a_trace_read_out_shows_its_progress_and_time_left(qtbot, scope, packed):
+    """On a paced line a read-out takes seconds: the view shows how far it is and how long is
+    left, from a drive with packed blocks (TRP) and from one with text blocks only (TRB)."""
+    view = scope(DriveClient.open(f"sim://{ACTUATOR}?packed_trace={int(packed)}"))
+    view.trigger_kind.setCurrentIndex(view.trigger_kind.findData(p.TriggerKind.IMMEDIATE))
+    view.trace_samples.setValue(512 if packed else 256)
+    view.trace_pre.setValue(0)
+    seen = []
+    view.controller.sigReadoutProgress.connect(lambda done, total, left: seen.append((done, total, left)))
+    with qtbot.waitSignal(view.sigTraceDone, timeout=30000) as done:
+        view.arm_trace()
+        bar = view.readout_progress
+        qtbot.waitUntil(lambda: not bar.isHidden() and "s left" in bar.text(), timeout=20000)
+        text = bar.text()
+    total = 512 if packed else 256
+    assert text.startswith("Reading out the capture: ") and f" of {total} samples, about " in text
+    assert len(done.args[0].t_s) == total
+    assert [d for d, _t, _l in seen] == list(range(0, total + 1, 64)) and seen[-1][2] == 0.0
+    assert view.readout_progress.isHidden()
+
+
 def test_a_stuck_link_is_not_shown_as_live(qtbot, scope, sim_client):
     view = scope(sim_client)
     view.start_live()

@@ -97,18 +97,17 @@ class SimProtocolServer:
             return sum(1 for t, _ in self._out if t <= now)
 
     def next_event_s(self) -> float | None:
-        """Seconds until something may change for the host (a byte becomes readable, a command
-        arrives), or None when nothing is pending. A deferred reply (OWW) is not foreseen here:
-        callers poll at least every few ms while they wait."""
+        """Seconds until a reply byte may become readable, or None when nothing is pending. While
+        a request is still arriving nothing can be read before its last byte is in and one more
+        character time has passed (the reply's first byte), so a reader sleeps through the
+        request instead of waking for each of its characters. A deferred reply (OWW) is not
+        foreseen here: callers poll at least every few ms while they wait."""
         with self._lock:
-            times = []
             if self._out:
-                times.append(self._out[0][0])
+                return max(0.0, self._out[0][0] - self._clock())
             if self._incoming:
-                times.append(self._incoming[0][0])
-            if not times:
-                return None
-            return max(0.0, min(times) - self._clock())
+                return max(0.0, self._incoming[-1][0] + self.char_s - self._clock())
+            return None
 
     def reset_output(self) -> None:
         """Drop reply bytes not yet read (the host flushed its input buffer)."""

@@ -102,11 +102,16 @@ def estimated_rate_hz(item_count: int, digits_per_value: int = 6, baudrate: int 
     return theoretical_rate_hz([10 ** (digits_per_value - 1)] * item_count, baudrate)
 
 
-def readout_time_s(samples: int, items: int, digits_per_value: int = 7, baudrate: int = p.BAUDRATE) -> float:
-    """Line time to read a trace out with TRB (64 samples a block): ``digits_per_value``
-    characters per value (sign included) plus separators, CR per line, and the requests."""
+#: Characters per value of a trace block, for estimates before the read-out: text (TRB) about 7
+#: digits and a separator; packed (TRP) about 2 (a moving position at 1 kHz, docs/protocol.md).
+READOUT_CHARS_PER_VALUE = {"text": 8.0, "packed": 2.0}
+
+
+def readout_time_s(samples: int, items: int, encoding: str = "text", baudrate: int = p.BAUDRATE) -> float:
+    """Line time to read a trace out (64 samples a block) in ``encoding`` ("text": TRB,
+    "packed": TRP): the values' characters, a CR per line, and the requests."""
     blocks = math.ceil(samples / p.TRACE_BLOCK_SAMPLES)
-    chars = samples * (items * (digits_per_value + 1)) + blocks * (p.FRAME_LENGTH + 2)
+    chars = samples * items * READOUT_CHARS_PER_VALUE[encoding] + blocks * (p.FRAME_LENGTH + 2)
     return chars * p.character_time_s(baudrate)
 
 
@@ -452,14 +457,25 @@ class TraceAcquisition:
             return status.count >= (self.settings.pre_trigger if self.settings else 0)
         return status.state in (p.TraceState.CAPTURING, p.TraceState.DONE)
 
-    def read(self, should_abort: Callable[[], bool] | None = None) -> TraceResult:
-        """Read the finished capture out (TRB blocks, ~1 s each for 4 channels). ``should_abort``
-        is asked between blocks; True gives up with ``ReadAborted`` (a STOP must not wait for the
-        whole read-out)."""
+    @property
+    def encoding(self) -> str:
+        """How the blocks come: "packed" (TRP, listed in CAP) or "text" (TRB)."""
+        return "packed" if self.client.capabilities.supports(p.Command.TRP) else "text"
+
+    def readout_estimate_s(self, samples: int) -> float:
+        """Line time of reading ``samples`` of the configured channels out."""
+        items = len(self.settings.items()) if self.settings else p.TRACE_MAX_CHANNELS
+        return readout_time_s(samples, items, self.encoding)
+
+    def read(self, should_abort: Callable[[], bool] | None = None,
+             progress: Callable[[int, int], None] | None = None) -> TraceResult:
+        """Read the finished capture out (TRP or TRB blocks of 64 samples). ``should_abort`` is
+        asked between blocks; True gives up with ``ReadAborted`` (a STOP must not wait for the
+        whole read-out). ``progress(done, total)`` after every block (samples)."""
         settings = self.settings
         if settings is None:
             raise ValueError("no trace configured")
-        capture = self.client.read_trace(should_abort=should_abort)
+        capture = self.client.read_trace(should_abort=should_abort, progress=progress)
         values = convert_rows(settings.channels, capture.channels, capture.samples)
         rate = self.actual_rate_hz(settings)
         t = (np.arange(len(values)) - settings.pre_trigger) / rate
@@ -505,7 +521,8 @@ class MoveTest:
                  kind: str = "move", output_resolution_ppr: int | None = None, use_trace: bool | None = None,
                  settle_s: float = 0.3, config: ScopeConfig | None = None,
                  clock: Callable[[], float] = time.monotonic,
-                 should_abort: Callable[[], bool] | None = None):
+                 should_abort: Callable[[], bool] | None = None,
+                 progress: Callable[[int, int], None] | None = None):
         if kind not in ("move", "step"):
             raise ValueError(f"test kind {kind!r}: 'move' or 'step'")
         if angle_deg == 0 or speed_rpm <= 0:
@@ -522,6 +539,7 @@ class MoveTest:
         self.config = config or load_scope_config()
         self.clock = clock
         self.should_abort = should_abort  # asked between trace blocks (a STOP)
+        self.progress = progress  # (samples read, samples in all) after every trace block
         self.trace = TraceAcquisition(client, self.config)
         self.use_trace = self.trace.available()[0] if use_trace is None else use_trace
         if self.use_trace:
@@ -633,10 +651,9 @@ class MoveTest:
         status = self.trace.status()
         if status.state is p.TraceState.DONE and self.state_text.startswith("moving"):
             self.state_text = (f"reading out {status.count} samples (about "
-                               f"{readout_time_s(status.count, len(self.trace.settings.items())):.0f} s "
-                               "at 19200 bit/s)")
+                               f"{self.trace.readout_estimate_s(status.count):.0f} s at 19200 bit/s)")
         elif status.state is p.TraceState.DONE:
-            self._analyse(self.trace.read(self.should_abort))
+            self._analyse(self.trace.read(self.should_abort, self.progress))
         elif self.clock() > self._deadline:
             raise ValueError(f"the move did not trigger or finish the trace in time (state "
                              f"{status.state.name.lower()}, {status.count} samples)")

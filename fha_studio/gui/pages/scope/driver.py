@@ -32,7 +32,6 @@ from fha_studio.logic.scope.acquisition import (
     TraceAcquisition,
     TraceSettings,
     load_scope_config,
-    readout_time_s,
 )
 
 log = logging.getLogger(__name__)
@@ -90,6 +89,8 @@ class ScopeDriver(QObject):
     sigTestState = Signal(str)  # what the running test is doing
     sigError = Signal(str)
     sigCallDone = Signal(object)  # the value of a CALL
+    #: a trace read-out: samples read, samples in all, seconds left (< 0: not known yet)
+    sigReadoutProgress = Signal(int, int, float)
 
     def __init__(self, config: ScopeConfig | None = None, abort: threading.Event | None = None):
         super().__init__()
@@ -106,6 +107,7 @@ class ScopeDriver(QObject):
         self._step_timer: QTimer | None = None
         self._last_status = 0.0
         self._paused_for_test = False
+        self._readout_started = 0.0
         #: What each request runs (every ScopeCmd has one; a test checks it).
         self.handlers: dict[ScopeCmd, Callable[..., None]] = {
             ScopeCmd.SET_CLIENT: self._do_set_client,
@@ -183,7 +185,8 @@ class ScopeDriver(QObject):
             raise ValueError("not connected to a drive")
         if self._test is not None:
             raise ValueError("a test is already running")
-        self._test = MoveTest(self._client, config=self.config, should_abort=self._should_abort, **kwargs)
+        self._test = MoveTest(self._client, config=self.config, should_abort=self._should_abort,
+                              progress=self._report_progress, **kwargs)
         if not self._test.use_trace and self._poller is not None:
             self._paused_for_test = True  # the test polls itself: give it the whole line
             self._poll_timer.stop()
@@ -202,6 +205,17 @@ class ScopeDriver(QObject):
 
     def _do_call(self, function: Callable[[DriveApi | None], Any]) -> None:
         self.sigCallDone.emit(function(self._client))
+
+    def _report_progress(self, done: int, total: int) -> None:
+        """A trace read-out's progress (runs in the link thread, between blocks): out to the GUI
+        with the time left at the rate of the blocks so far."""
+        now = time.monotonic()
+        if done == 0:
+            self._readout_started = now
+            left = -1.0
+        else:
+            left = (now - self._readout_started) / done * (total - done)
+        self.sigReadoutProgress.emit(done, total, left)
 
     def _abort_test(self, why: str) -> None:
         test = self._test
@@ -254,12 +268,12 @@ class ScopeDriver(QObject):
         trace = self._trace
         status = trace.status()
         if status.state is TraceState.DONE:
-            seconds = readout_time_s(status.count, len(trace.settings.items()))
+            seconds = trace.readout_estimate_s(status.count)
             self.sigTraceState.emit(f"reading out {status.count} samples (about {seconds:.0f} s at "
                                     "19200 bit/s)")
             self._trace = None
             try:
-                result = trace.read(self._should_abort)
+                result = trace.read(self._should_abort, self._report_progress)
             except ReadAborted as exc:
                 self.sigTraceState.emit(f"abandoned by STOP during the read-out ({exc.done} of {exc.total} "
                                         "samples read, none shown); arm again to capture")
@@ -298,6 +312,7 @@ class ScopeController(QObject):
     sigTestState = Signal(str)
     sigError = Signal(str)
     sigCallDone = Signal(object)
+    sigReadoutProgress = Signal(int, int, float)
 
     def __init__(self, thread: QThread | None = None, parent: QObject | None = None,
                  config: ScopeConfig | None = None, abort: threading.Event | None = None):
@@ -312,7 +327,7 @@ class ScopeController(QObject):
         self.driver.moveToThread(thread)
         self.sigRequest.connect(self.driver.handle)
         for name in ("sigLiveStarted", "sigStatus", "sigTraceState", "sigTraceDone", "sigTestDone",
-                     "sigTestState", "sigError", "sigCallDone"):
+                     "sigTestState", "sigError", "sigCallDone", "sigReadoutProgress"):
             getattr(self.driver, name).connect(getattr(self, name))  # queued: into this thread
         self.connected = False
         self._shut = False

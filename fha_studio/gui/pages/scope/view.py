@@ -1,9 +1,16 @@
 """ScopeView: the oscilloscope a technician tunes and verifies an axis with.
 
-A rolling live view drained by a GUI-thread QTimer from the acquisition's ring buffer (the
-acquisition itself runs in the link thread, see ``driver``); a captured trace, a move test
-or an opened recording is shown in the same plot, marked NOT LIVE. The indicator never calls
-old data live: it checks the age of the newest sample itself on every frame.
+The page is composed of panels, each with one job: the toolbar (indicator and view-wide
+actions, ``toolbar``), the channel table (``channel_table``), the time plot (``time_plot``), the
+spectrum (``spectrum_panel``), the trigger (``trigger_panel``) and the tests
+(``move_test_panel``). ScopeView holds what they share: the live acquisition, the data on show,
+the recorder and the files.
+
+Live, a GUI-thread QTimer drains the acquisition's ring buffer (the acquisition itself runs in
+the link thread, see ``driver``; the ring's lock is held only to copy rows, never while drawing)
+into pre-decimated min/max levels and draws the time window from them. A captured trace, a move
+test or an opened recording is shown in the same plot, marked NOT LIVE. The indicator never
+calls old data live: it checks the age of the newest sample itself on every frame.
 """
 
 from __future__ import annotations
@@ -14,86 +21,46 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pyqtgraph as pg
-from pyqtgraph import exporters
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
-    QAbstractItemView,
-    QCheckBox,
-    QComboBox,
-    QDoubleSpinBox,
     QFileDialog,
-    QFormLayout,
-    QGroupBox,
     QHBoxLayout,
     QLabel,
-    QPushButton,
-    QSpinBox,
+    QProgressBar,
     QSplitter,
-    QTableWidget,
-    QTableWidgetItem,
     QTabWidget,
-    QToolBar,
     QVBoxLayout,
     QWidget,
 )
 
 from fha_studio.catalog import DEFAULT_ACTUATOR
-from fha_studio.hardware import protocol as p
-from fha_studio.hardware.parameters import MonitorItem, load_parameter_model
-from fha_studio.logic.scope.acquisition import LiveMode, MoveTestResult, TraceResult, TraceSettings, Trigger
+from fha_studio.hardware.parameters import load_parameter_model
+from fha_studio.logic.scope.acquisition import LiveMode, MoveTestResult, TraceResult, TraceSettings
 from fha_studio.logic.scope.analysis import cursor_delta, spectrum
 from fha_studio.logic.scope.channels import ScopeChannel, scope_channels
+from fha_studio.logic.scope.levels import MinMaxLevels
 from fha_studio.logic.scope.recorder import CONTRACT_SOURCES, ScopeRecorder
 from fha_studio.recording import RecordingMetadata, read_recording
 
+from .channel_table import ChannelTable
 from .driver import LiveStarted, ScopeCmd, ScopeController
+from .move_test_panel import MoveTestPanel
+from .spectrum_panel import SpectrumPanel
+from .time_plot import TimePlot
+from .toolbar import ScopeToolbar
+from .trigger_panel import TriggerPanel
 
 log = logging.getLogger(__name__)
 
-#: Redraw period of the live view [ms] (friture: 10-50 ms).
+#: Redraw period of the live view [ms]: 40 frames/s at most, smooth to the eye.
 REFRESH_MS = 25
-TIME_BASES_S = (0.5, 1.0, 2.0, 5.0, 10.0, 30.0, 60.0)
+#: How often the text under the plot and the cursor read-out follow the live data [s].
+TEXT_INTERVAL_S = 0.25
 DEFAULT_VISIBLE = ("feedback_position", "command_position", "output_speed", "motor_current")
 COLORS = ("#f0c419", "#4fc3f7", "#81c784", "#ff8a65", "#ba68c8", "#e57373", "#90a4ae", "#aed581",
           "#ffd54f", "#4dd0e1", "#f06292", "#a1887f", "#7986cb", "#dce775", "#ffb74d", "#9575cd")
-#: Indicator colours: live, not live, paused.
-INDICATOR_STYLE = {
-    "live": "background:#1b5e20; color:white; font-weight:bold; padding:3px 8px; border-radius:3px;",
-    "not": "background:#b71c1c; color:white; font-weight:bold; padding:3px 8px; border-radius:3px;",
-    "paused": "background:#e65100; color:white; font-weight:bold; padding:3px 8px; border-radius:3px;",
-}
-_TRIGGERS = (
-    ("Immediate", p.TriggerKind.IMMEDIATE),
-    ("Level rises through", p.TriggerKind.RISING_LEVEL),
-    ("Level falls through", p.TriggerKind.FALLING_LEVEL),
-    ("I/O bit rises", p.TriggerKind.IO_BIT_RISES),
-    ("I/O bit falls", p.TriggerKind.IO_BIT_FALLS),
-    ("Alarm", p.TriggerKind.ALARM),
-)
 # Recording columns back to scope channels (opening a file).
 _COLUMN_KEYS = {column: key for column, key in CONTRACT_SOURCES.items()}
-
-
-def peak_decimate(rows: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
-    """At most ``2 * bins`` rows keeping each bin's minimum and maximum per channel (peak
-    detection, as pyqtgraph's 'peak' mode, done once for all channels before ``setData``).
-
-    Returns (time of each output row, rows); short inputs come back unchanged.
-    """
-    n = len(rows)
-    if n <= 4 * bins:
-        return rows[:, 0], rows
-    k = n // bins
-    start = n - k * bins  # keep the newest samples whole; the few oldest go
-    blocks = rows[start:].reshape(bins, k, rows.shape[1])
-    out = np.empty((2 * bins, rows.shape[1]))
-    out[0::2] = blocks.min(axis=1)
-    out[1::2] = blocks.max(axis=1)
-    t = np.empty(2 * bins)
-    t[0::2] = blocks[:, 0, 0]
-    t[1::2] = blocks[:, -1, 0]
-    return t, out
 
 
 @dataclass(frozen=True)
@@ -144,17 +111,16 @@ class ScopeView(QWidget):
         self._visible = {c.key: c.key in DEFAULT_VISIBLE for c in self.all_channels}
         self._scale = {c.key: 1.0 for c in self.all_channels}
         self._live: LiveStarted | None = None
+        self._levels: MinMaxLevels | None = None
         self._status = None  # last LiveStatus from the driver
         self._static: _Static | None = None
         self._paused = False
         self._recorder: ScopeRecorder | None = None
-        self._curves: dict[str, pg.PlotDataItem] = {}
-        self._indicator_text = ""
         self.frames = 0
-        self._last_cursor_update = 0.0
-        self._last_draw = 0.0
+        self._last_text_update = 0.0
         self.last_test: MoveTestResult | None = None
         self.last_trace: TraceResult | None = None
+        self.last_message = ""
         self._build()
         d = controller
         d.sigLiveStarted.connect(self._on_live_started)
@@ -163,8 +129,10 @@ class ScopeView(QWidget):
         d.sigTraceDone.connect(self._on_trace_done)
         d.sigTestDone.connect(self._on_test_done)
         d.sigError.connect(self._on_error)
-        d.sigTestState.connect(lambda text: self.test_message.setText(f"Test: {text} …"))
+        d.sigTestState.connect(lambda text: self.tests.set_message(f"Test: {text} …"))
+        d.sigReadoutProgress.connect(self._on_readout_progress)
         self._timer = QTimer(self)
+        self._timer.setTimerType(Qt.TimerType.PreciseTimer)
         self._timer.setInterval(REFRESH_MS)
         self._timer.timeout.connect(self._refresh)
         self._timer.start()
@@ -173,259 +141,73 @@ class ScopeView(QWidget):
 
     # ------------------------------------------------------------------------------------ layout
     def _build(self) -> None:
-        pg.setConfigOptions(antialias=False)
         outer = QVBoxLayout(self)
         outer.setContentsMargins(4, 4, 4, 4)
-        bar = QToolBar("Scope")
-        self.indicator = QLabel()
-        self.indicator.setObjectName("scopeIndicator")
-        self.indicator.setMinimumWidth(90)
-        bar.addWidget(self.indicator)
-        bar.addSeparator()
-        self.live_button = QPushButton("Start live")
-        self.live_button.setCheckable(True)
-        self.live_button.toggled.connect(self._live_toggled)
-        bar.addWidget(self.live_button)
-        self.back_button = QPushButton("Back to live")
-        self.back_button.setToolTip("Leave the capture or file on show and return to the live view")
-        self.back_button.clicked.connect(self.back_to_live)
-        bar.addWidget(self.back_button)
-        self.pause_button = QPushButton("Pause")
-        self.pause_button.setCheckable(True)
-        self.pause_button.toggled.connect(self.set_paused)
-        bar.addWidget(self.pause_button)
-        bar.addWidget(QLabel(" Time base "))
-        self.time_base = QComboBox()
-        for tb in TIME_BASES_S:
-            self.time_base.addItem(f"{tb:g} s", tb)
-        self.time_base.setCurrentIndex(TIME_BASES_S.index(10.0))
-        bar.addWidget(self.time_base)
-        self.autoscale = QCheckBox("Autoscale Y")
-        self.autoscale.setChecked(True)
-        self.autoscale.toggled.connect(self._autoscale_toggled)
-        bar.addWidget(self.autoscale)
-        fit = QPushButton("Fit")
-        fit.clicked.connect(self.fit)
-        bar.addWidget(fit)
-        self.cursors_box = QCheckBox("Cursors")
-        self.cursors_box.toggled.connect(self._cursors_toggled)
-        bar.addWidget(self.cursors_box)
-        bar.addSeparator()
-        self.record_button = QPushButton("Record…")
-        self.record_button.setCheckable(True)
-        self.record_button.clicked.connect(self._record_clicked)
-        bar.addWidget(self.record_button)
-        self.save_button = QPushButton("Save capture…")
-        self.save_button.clicked.connect(lambda: self._ask_path("save"))
-        bar.addWidget(self.save_button)
-        for text, what in (("PNG…", "png"), ("CSV…", "csv"), ("Open…", "open")):
-            button = QPushButton(text)
-            button.clicked.connect(lambda _=False, w=what: self._ask_path(w))
-            bar.addWidget(button)
+        self.toolbar = bar = ScopeToolbar()
+        bar.sigLiveToggled.connect(self._live_toggled)
+        bar.sigBackToLive.connect(self.back_to_live)
+        bar.sigPaused.connect(self.set_paused)
+        bar.sigAutoscale.connect(lambda on: self.time_plot.set_autoscale(on))
+        bar.sigFit.connect(self.fit)
+        bar.sigCursors.connect(self._cursors_toggled)
+        bar.sigRecord.connect(self._record_clicked)
+        bar.sigFile.connect(self._ask_path)
         outer.addWidget(bar)
 
         split = QSplitter(Qt.Orientation.Horizontal)
-        self.channel_table = QTableWidget(0, 3)
-        self.channel_table.setObjectName("scopeChannels")
-        self.channel_table.setHorizontalHeaderLabels(["Channel", "Unit", "Scale ×"])
-        self.channel_table.verticalHeader().setVisible(False)
-        self.channel_table.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
-        header = self.channel_table.horizontalHeader()
-        header.setSectionResizeMode(0, header.ResizeMode.Stretch)
-        header.setSectionResizeMode(1, header.ResizeMode.ResizeToContents)
-        header.setSectionResizeMode(2, header.ResizeMode.Fixed)
-        self.channel_table.setColumnWidth(2, 78)
-        self.channel_table.setMinimumWidth(300)
-        self.channel_table.itemChanged.connect(self._channel_item_changed)
+        self.channel_table = ChannelTable()
+        self.channel_table.sigVisibleChanged.connect(self.set_channel_visible)
+        self.channel_table.sigScaleChanged.connect(self.set_channel_scale)
         split.addWidget(self.channel_table)
 
         self.plots = QTabWidget()
-        self.plot = pg.PlotWidget()
-        self.plot.setObjectName("scopePlot")
-        self.plot.setBackground("#111")
-        self.plot.showGrid(x=False, y=True, alpha=0.25)  # x grid only when still: scrolling it is costly
-        self.plot.setLabel("bottom", "time", units="s")
-        self.plot.addLegend(offset=(-8, 8), brush=pg.mkBrush(17, 17, 17, 200), labelTextColor="#ddd")
-        self.plot.setClipToView(True)
-        self.plot.setDownsampling(auto=True, mode="peak")
-        self.plot.plotItem.vb.enableAutoRange(axis="y", enable=True)
-        self.cursor1 = pg.InfiniteLine(angle=90, movable=True, pen=pg.mkPen("#ffffff", width=1))
-        self.cursor2 = pg.InfiniteLine(angle=90, movable=True, pen=pg.mkPen("#ffffff", width=1,
-                                                                             style=Qt.PenStyle.DashLine))
-        for c in (self.cursor1, self.cursor2):
-            c.sigPositionChanged.connect(self._update_cursor_readout)
-        time_page = QWidget()
-        tl = QVBoxLayout(time_page)
-        tl.setContentsMargins(0, 0, 0, 0)
-        tl.addWidget(self.plot, 1)
-        self.cursor_label = QLabel("")
-        self.cursor_label.setObjectName("scopeCursorReadout")
-        self.cursor_label.setWordWrap(True)
-        tl.addWidget(self.cursor_label)
-        self.plots.addTab(time_page, "Time")
-        self.plots.addTab(self._build_spectrum(), "Spectrum")
+        self.time_plot = TimePlot()
+        self.time_plot.sigCursorsMoved.connect(self._update_cursor_readout)
+        self.plots.addTab(self.time_plot, "Time")
+        self.spectrum_panel = SpectrumPanel()
+        self.spectrum_panel.sigCompute.connect(self.compute_spectrum)
+        self.plots.addTab(self.spectrum_panel, "Spectrum")
         split.addWidget(self.plots)
 
         side = QTabWidget()
-        side.addTab(self._build_trigger_panel(), "Trigger")
-        side.addTab(self._build_test_panel(), "Tests")
+        self.trigger = TriggerPanel(self.all_channels)
+        self.trigger.sigArm.connect(self.arm_trace)
+        self.trigger.sigCancel.connect(lambda: self.controller.send(ScopeCmd.CANCEL_TRACE))
+        side.addTab(self.trigger, "Trigger")
+        self.tests = MoveTestPanel(self.context.actuator, float(self._actuator.max_speed_rpm),
+                                   self.context.load_inertia_kgm2)
+        self.tests.sigRun.connect(self.run_test)
+        self.tests.sigAbort.connect(lambda: self.controller.send(ScopeCmd.ABORT_TEST))
+        side.addTab(self.tests, "Tests")
         split.addWidget(side)
         split.setSizes([300, 760, 300])
         split.setStretchFactor(1, 1)
         outer.addWidget(split, 1)
+        bottom = QHBoxLayout()
         self.info_label = QLabel("")
         self.info_label.setObjectName("scopeInfo")
-        outer.addWidget(self.info_label)
+        bottom.addWidget(self.info_label, 1)
+        self.readout_progress = QProgressBar()
+        self.readout_progress.setObjectName("scopeReadoutProgress")
+        self.readout_progress.setMaximumWidth(360)
+        self.readout_progress.setVisible(False)
+        bottom.addWidget(self.readout_progress)
+        outer.addLayout(bottom)
 
-    def _build_spectrum(self) -> QWidget:
-        page = QWidget()
-        lay = QVBoxLayout(page)
-        lay.setContentsMargins(0, 0, 0, 0)
-        row = QHBoxLayout()
-        row.addWidget(QLabel("Channel"))
-        self.spectrum_channel = QComboBox()
-        row.addWidget(self.spectrum_channel, 1)
-        row.addWidget(QLabel("Remove"))
-        self.spectrum_detrend = QComboBox()
-        self.spectrum_detrend.addItem("ramp (moves)", "linear")
-        self.spectrum_detrend.addItem("mean", "constant")
-        row.addWidget(self.spectrum_detrend)
-        go = QPushButton("Compute")
-        go.clicked.connect(self.compute_spectrum)
-        row.addWidget(go)
-        lay.addLayout(row)
-        self.spectrum_plot = pg.PlotWidget()
-        self.spectrum_plot.setBackground("#111")
-        self.spectrum_plot.showGrid(x=True, y=True, alpha=0.25)
-        self.spectrum_plot.setLabel("bottom", "frequency", units="Hz")
-        self.spectrum_plot.setLogMode(y=True)
-        self.spectrum_curve = self.spectrum_plot.plot(pen=pg.mkPen("#4fc3f7"))
-        lay.addWidget(self.spectrum_plot, 1)
-        self.spectrum_label = QLabel("Capture a trace (uniform sampling), then compute its spectrum.")
-        self.spectrum_label.setWordWrap(True)
-        lay.addWidget(self.spectrum_label)
-        return page
-
-    def _build_trigger_panel(self) -> QWidget:
-        page = QWidget()
-        form = QFormLayout(page)
-        analog = [c for c in self.all_channels if not c.is_bit]
-        bits = [c for c in self.all_channels if c.is_bit]
-        bits.append(ScopeChannel("moving", "Moving", "bit", MonitorItem.IO_STATE, 1.0, p.IoBit.MOVING))
-        self._trigger_bits = bits
-        self.trace_channels: list[QComboBox] = []
-        defaults = ("feedback_position", "command_position", "output_speed", "motor_current")
-        for k in range(p.TRACE_MAX_CHANNELS):
-            box = QComboBox()
-            box.addItem("—", None)
-            for c in analog + [c for c in bits if c.key != "moving"]:
-                box.addItem(c.name, c.key)
-            box.setCurrentIndex(max(0, box.findData(defaults[k])))
-            self.trace_channels.append(box)
-            form.addRow(f"Channel {k + 1}", box)
-        self.trace_rate = QDoubleSpinBox()
-        self.trace_rate.setRange(1.0, 5000.0)
-        self.trace_rate.setDecimals(0)
-        self.trace_rate.setValue(1000.0)
-        self.trace_rate.setSuffix(" Hz")
-        form.addRow("Sample rate", self.trace_rate)
-        self.trace_samples = QSpinBox()
-        self.trace_samples.setRange(16, p.TRACE_MAX_SAMPLES)
-        self.trace_samples.setValue(2048)
-        form.addRow("Samples", self.trace_samples)
-        self.trace_pre = QSpinBox()
-        self.trace_pre.setRange(0, 90)
-        self.trace_pre.setValue(10)
-        self.trace_pre.setSuffix(" %")
-        form.addRow("Pre-trigger", self.trace_pre)
-        self.trigger_kind = QComboBox()
-        for text, kind in _TRIGGERS:
-            self.trigger_kind.addItem(text, kind)
-        self.trigger_kind.currentIndexChanged.connect(self._trigger_kind_changed)
-        form.addRow("Trigger", self.trigger_kind)
-        self.trigger_channel = QComboBox()
-        form.addRow("on", self.trigger_channel)
-        self.trigger_level = QDoubleSpinBox()
-        self.trigger_level.setRange(-1e6, 1e6)
-        self.trigger_level.setDecimals(3)
-        form.addRow("Level", self.trigger_level)
-        row = QHBoxLayout()
-        self.arm_button = QPushButton("Arm")
-        self.arm_button.clicked.connect(self.arm_trace)
-        cancel = QPushButton("Cancel")
-        cancel.clicked.connect(lambda: self.controller.send(ScopeCmd.CANCEL_TRACE))
-        row.addWidget(self.arm_button)
-        row.addWidget(cancel)
-        form.addRow(row)
-        self.trace_state = QLabel("idle")
-        self.trace_state.setObjectName("scopeTraceState")
-        self.trace_state.setWordWrap(True)
-        form.addRow("State", self.trace_state)
-        self._trigger_kind_changed()
-        return page
-
-    def _build_test_panel(self) -> QWidget:
-        page = QWidget()
-        lay = QVBoxLayout(page)
-        form = QFormLayout()
-        self.test_angle = QDoubleSpinBox()
-        self.test_angle.setRange(-3600.0, 3600.0)
-        self.test_angle.setDecimals(2)
-        self.test_angle.setValue(90.0)
-        self.test_angle.setSuffix(" deg")
-        form.addRow("Move by", self.test_angle)
-        self.test_speed = QDoubleSpinBox()
-        self.test_speed.setRange(0.1, float(self._actuator.max_speed_rpm))
-        self.test_speed.setValue(min(30.0, float(self._actuator.max_speed_rpm)))
-        self.test_speed.setSuffix(" r/min")
-        form.addRow("Speed", self.test_speed)
-        self.step_angle = QDoubleSpinBox()
-        self.step_angle.setRange(-10.0, 10.0)
-        self.step_angle.setDecimals(3)
-        self.step_angle.setValue(0.5)
-        self.step_angle.setSuffix(" deg")
-        form.addRow("Step", self.step_angle)
-        lay.addLayout(form)
-        row = QHBoxLayout()
-        self.move_test_button = QPushButton("Move test")
-        self.move_test_button.clicked.connect(lambda: self.run_test("move"))
-        self.step_test_button = QPushButton("Step test")
-        self.step_test_button.clicked.connect(lambda: self.run_test("step"))
-        abort = QPushButton("Abort")
-        abort.clicked.connect(lambda: self.controller.send(ScopeCmd.ABORT_TEST))
-        for b in (self.move_test_button, self.step_test_button, abort):
-            row.addWidget(b)
-        lay.addLayout(row)
-        box = QGroupBox("Result")
-        res = QFormLayout(box)
-        self.result_labels: dict[str, QLabel] = {}
-        for key, text in (("overshoot", "Overshoot"), ("rise", "Rise time 10-90 %"),
-                          ("settling", "Settling time"), ("in_position", "In-position after command end"),
-                          ("final_error", "Final error"), ("method", "Captured by")):
-            label = QLabel("—")
-            label.setObjectName(f"scopeResult_{key}")
-            label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
-            self.result_labels[key] = label
-            res.addRow(text, label)
-        lay.addWidget(box)
-        files = QGroupBox("Recordings")
-        ff = QFormLayout(files)
-        self.actuator_label = QLabel(self.context.actuator)
-        ff.addRow("Actuator", self.actuator_label)
-        self.load_inertia = QDoubleSpinBox()
-        self.load_inertia.setObjectName("scopeLoadInertia")
-        self.load_inertia.setRange(0.0, 1e4)
-        self.load_inertia.setDecimals(4)
-        self.load_inertia.setValue(self.context.load_inertia_kgm2)
-        self.load_inertia.setSuffix(" kg m²")
-        self.load_inertia.setToolTip("The load inertia written into recordings (the model check needs it)")
-        ff.addRow("Load inertia", self.load_inertia)
-        lay.addWidget(files)
-        self.test_message = QLabel("The servo must be on. The axis moves.")
-        self.test_message.setWordWrap(True)
-        lay.addWidget(self.test_message)
-        lay.addStretch(1)
-        return page
+        # The widgets other code drives directly (tests, screenshots, benchmarks).
+        t = self.trigger
+        self.trace_channels, self.trace_rate = t.trace_channels, t.trace_rate
+        self.trace_samples, self.trace_pre = t.trace_samples, t.trace_pre
+        self.trigger_kind, self.trigger_channel = t.trigger_kind, t.trigger_channel
+        self.trigger_level, self.trace_state = t.trigger_level, t.trace_state
+        self.test_angle, self.test_speed = self.tests.test_angle, self.tests.test_speed
+        self.step_angle, self.result_labels = self.tests.step_angle, self.tests.result_labels
+        self.load_inertia = self.tests.load_inertia
+        self.live_button, self.time_base = bar.live_button, bar.time_base
+        self.cursors_box, self.record_button = bar.cursors_box, bar.record_button
+        self.plot = self.time_plot.plot
+        self.spectrum_channel = self.spectrum_panel.spectrum_channel
+        self.spectrum_label = self.spectrum_panel.spectrum_label
 
     # --------------------------------------------------------------------------------- channels
     def _shown_channels(self) -> tuple[ScopeChannel, ...]:
@@ -437,43 +219,13 @@ class ScopeView(QWidget):
 
     def _fill_channel_table(self) -> None:
         channels = self._shown_channels()
-        t = self.channel_table
-        t.blockSignals(True)
-        t.setRowCount(len(channels))
-        for row, c in enumerate(channels):
-            name = QTableWidgetItem(c.name)
-            name.setData(Qt.ItemDataRole.UserRole, c.key)
-            name.setFlags(Qt.ItemFlag.ItemIsEnabled | Qt.ItemFlag.ItemIsUserCheckable)
-            shown = self._visible.get(c.key, True)
-            name.setCheckState(Qt.CheckState.Checked if shown else Qt.CheckState.Unchecked)
-            name.setForeground(pg.mkColor(self._color(c.key)))
-            t.setItem(row, 0, name)
-            unit = QTableWidgetItem(c.unit)
-            unit.setFlags(Qt.ItemFlag.ItemIsEnabled)
-            t.setItem(row, 1, unit)
-            spin = QDoubleSpinBox()
-            spin.setRange(1e-4, 1e4)
-            spin.setDecimals(3)
-            spin.setToolTip(f"Multiply {c.name} by this factor on the plot (cursors read {c.unit})")
-            spin.setValue(self._scale.get(c.key, 1.0))
-            spin.valueChanged.connect(lambda v, k=c.key: self.set_channel_scale(k, v))
-            t.setCellWidget(row, 2, spin)
-        t.blockSignals(False)
+        self.channel_table.fill(channels, self._visible, self._scale, self._color)
         self._rebuild_curves()
-        self.spectrum_channel.clear()
-        for c in channels:
-            if not c.is_bit:
-                self.spectrum_channel.addItem(f"{c.name} [{c.unit}]", c.key)
+        self.spectrum_panel.set_channels(channels)
 
     def _color(self, key: str) -> str:
         keys = [c.key for c in self.all_channels]
         return COLORS[keys.index(key) % len(COLORS)] if key in keys else COLORS[hash(key) % len(COLORS)]
-
-    def _channel_item_changed(self, item: QTableWidgetItem) -> None:
-        if item.column() != 0:
-            return
-        checked = item.checkState() == Qt.CheckState.Checked
-        self.set_channel_visible(item.data(Qt.ItemDataRole.UserRole), checked)
 
     def set_channel_visible(self, key: str, visible: bool) -> None:
         """Show or hide a channel. Live, the polled items follow the visible channels (restart)."""
@@ -496,18 +248,8 @@ class ScopeView(QWidget):
         self._redraw_static()
 
     def _rebuild_curves(self) -> None:
-        for curve in self._curves.values():
-            self.plot.removeItem(curve)
-        self._curves.clear()
-        for c in self._shown_channels():
-            if not self._visible.get(c.key, True):
-                continue
-            scale = self._scale.get(c.key, 1.0)
-            label = f"{c.name} [{c.unit}]" + (f" ×{scale:g}" if scale != 1 else "")
-            curve = self.plot.plot(pen=pg.mkPen(self._color(c.key), width=1), name=label)
-            curve.setDownsampling(auto=True, method="peak")
-            curve.setClipToView(True)
-            self._curves[c.key] = curve
+        self.time_plot.set_curves(self._shown_channels(), self._visible, self._scale, self._color,
+                                  live=self._static is None)
 
     # ------------------------------------------------------------------------------------- live
     def _live_toggled(self, on: bool) -> None:
@@ -522,11 +264,7 @@ class ScopeView(QWidget):
         wanted = [c for c in self.all_channels if self._visible.get(c.key)]
         if not wanted:
             wanted = [c for c in self.all_channels if c.key in DEFAULT_VISIBLE]
-        if not self.live_button.isChecked():
-            self.live_button.blockSignals(True)
-            self.live_button.setChecked(True)
-            self.live_button.blockSignals(False)
-        self.live_button.setText("Stop live")
+        self.toolbar.set_live(True)
         self.controller.send(ScopeCmd.START, tuple(wanted))
         self.sigLiveChanged.emit(True)
 
@@ -534,26 +272,25 @@ class ScopeView(QWidget):
         self.controller.send(ScopeCmd.STOP)
         self.stop_recording()
         self._live = None
+        self._levels = None
         self._status = None
-        self.live_button.blockSignals(True)
-        self.live_button.setChecked(False)
-        self.live_button.blockSignals(False)
-        self.live_button.setText("Start live")
+        self.toolbar.set_live(False)
         self._update_indicator()
         self.sigLiveChanged.emit(False)
 
     def set_paused(self, paused: bool) -> None:
         """Freeze the drawing; acquisition and recording go on."""
         self._paused = bool(paused)
-        if self.pause_button.isChecked() != self._paused:
-            self.pause_button.setChecked(self._paused)
+        self.toolbar.set_paused(self._paused)
         self._update_indicator()
 
     def _on_live_started(self, started: LiveStarted) -> None:
         self._live = started
+        self._levels = MinMaxLevels(len(started.channels), started.ring.capacity)
+        self._levels.append(started.ring.drain())  # what came before this view learnt of it
         self._static = None
         self._status = None
-        self.plot.showGrid(x=False, y=True, alpha=0.25)
+        self.time_plot.show_x_grid(False)
         self._fill_channel_table()
         self._update_indicator()
 
@@ -568,7 +305,7 @@ class ScopeView(QWidget):
         return time.monotonic() - live.t0 - float(live.ring.window(1)[0, 0])
 
     def indicator_text(self) -> str:
-        return self._indicator_text
+        return self.toolbar.indicator_text()
 
     def _update_indicator(self) -> None:
         kind, text = "not", "NOT LIVE: not started"
@@ -591,51 +328,36 @@ class ScopeView(QWidget):
                 kind = "paused"
         elif self.controller is not None and not self.controller.connected:
             text = "NOT LIVE: no drive connected"
-        if text != self._indicator_text:
-            self._indicator_text = text
-            short = text if len(text) < 48 else text[:46] + "…"
-            self.indicator.setText(short)
-            self.indicator.setToolTip(text)
-            self.indicator.setStyleSheet(INDICATOR_STYLE[kind])
+        if self.toolbar.set_indicator(kind, text):
             self.sigIndicatorChanged.emit(text)
 
     def _refresh(self) -> None:
-        """The GUI timer: drain the ring (to the recorder), redraw the live window, update state."""
-        live = self._live
+        """The GUI timer: drain the ring into the levels (and the recorder), draw the live window."""
+        live, levels = self._live, self._levels
         self._update_indicator()
-        if live is None or self._static is not None:
+        if live is None or levels is None or self._static is not None:
             return
         rows = live.ring.drain()
-        if self._recorder is not None and len(rows):
-            try:
-                self._recorder.write(rows)
-            except OSError as exc:
-                self._message(f"Recording stopped: {exc}")
-                self.stop_recording()
+        if len(rows):
+            levels.append(rows)
+            if self._recorder is not None:
+                try:
+                    self._recorder.write(rows)
+                except OSError as exc:
+                    self._message(f"Recording stopped: {exc}")
+                    self.stop_recording()
         if self._paused:
             return
-        tb = float(self.time_base.currentData())
-        # redraw when the trace has moved by about a pixel (a 60 s time base needs ~16 frames/s)
-        interval_s = min(0.1, max(REFRESH_MS / 1000, tb / max(100, self.plot.width())))
-        clock = time.monotonic()
-        if clock - self._last_draw < interval_s * 0.9:
-            return
-        self._last_draw = clock
-        data = live.ring.window()
-        now = clock - live.t0
-        if len(data):
-            i0 = int(np.searchsorted(data[:, 0], now - tb))
-            t, columns = peak_decimate(data[i0:], max(200, self.plot.width()))
-            for j, c in enumerate(live.channels):
-                curve = self._curves.get(c.key)
-                if curve is not None:
-                    curve.setData(t, columns[:, j + 1] * self._scale.get(c.key, 1.0))
-        self.plot.setXRange(now - tb, now, padding=0)
+        now = time.monotonic() - live.t0
+        self.time_plot.draw_levels(levels, live.channels, now - self.toolbar.time_base_s(), now, self._scale)
         self.frames += 1
         self.sigFrame.emit()
-        if self.cursors_box.isChecked() and time.monotonic() - self._last_cursor_update > 0.2:
-            self._update_cursor_readout()
-        self._update_info()
+        clock = time.monotonic()
+        if clock - self._last_text_update >= TEXT_INTERVAL_S:
+            self._last_text_update = clock
+            if self.time_plot.cursors_on:
+                self._update_cursor_readout()
+            self._update_info()
 
     def _update_info(self) -> None:
         s = self._status
@@ -652,7 +374,7 @@ class ScopeView(QWidget):
                     uniform: bool = True) -> None:
         """Show data that is not live (a capture, a file); live acquisition goes on unseen."""
         self._static = _Static(tuple(channels), np.asarray(rows, dtype=float), label, sample_rate_hz, uniform)
-        self.plot.showGrid(x=True, y=True, alpha=0.25)
+        self.time_plot.show_x_grid(True)
         for c in self._static.channels:
             self._visible[c.key] = True  # a capture shows all it has; hide by hand
         self._fill_channel_table()
@@ -664,65 +386,44 @@ class ScopeView(QWidget):
         s = self._static
         if s is None:
             return
-        for j, c in enumerate(s.channels):
-            curve = self._curves.get(c.key)
-            if curve is not None:
-                curve.setData(s.rows[:, 0], s.rows[:, j + 1] * self._scale.get(c.key, 1.0))
+        self.time_plot.draw_rows(s.channels, s.rows, self._scale)
         self._update_cursor_readout()
 
     def back_to_live(self) -> None:
         self._static = None
-        self.plot.showGrid(x=False, y=True, alpha=0.25)
+        self.time_plot.show_x_grid(False)
         self._fill_channel_table()
         self._update_indicator()
 
     def fit(self) -> None:
         """Show the whole capture (or the live time base) and scale Y to the visible channels."""
-        vb = self.plot.plotItem.vb
-        if self._static is not None and len(self._static.rows):
-            t = self._static.rows[:, 0]
-            vb.setXRange(float(t[0]), float(t[-1]), padding=0.02)  # from the data, not from clipped curves
-            shown = [j + 1 for j, c in enumerate(self._static.channels) if self._visible.get(c.key, True)]
-            if shown:
-                y = self._static.rows[:, shown] * [self._scale.get(self._static.channels[j - 1].key, 1.0)
-                                                   for j in shown]
-                lo, hi = float(np.nanmin(y)), float(np.nanmax(y))
-                vb.setYRange(lo, hi if hi > lo else lo + 1.0, padding=0.05)
+        s = self._static
+        if s is not None and len(s.rows):
+            shown = [j + 1 for j, c in enumerate(s.channels) if self._visible.get(c.key, True)]
+            factors = [self._scale.get(s.channels[j - 1].key, 1.0) for j in shown]
+            self.time_plot.fit(s.rows, shown, factors, self.toolbar.autoscale.isChecked())
         else:
-            vb.autoRange(padding=0.02)
-        if self.autoscale.isChecked():
-            vb.enableAutoRange(axis="y", enable=True)
-
-    def _autoscale_toggled(self, on: bool) -> None:
-        self.plot.plotItem.vb.enableAutoRange(axis="y", enable=bool(on))
+            self.time_plot.fit(None, (), (), self.toolbar.autoscale.isChecked())
 
     # ------------------------------------------------------------------------------------ cursors
     def _cursors_toggled(self, on: bool) -> None:
-        for c in (self.cursor1, self.cursor2):
-            if on:
-                self.plot.addItem(c, ignoreBounds=True)
-            else:
-                self.plot.removeItem(c)
-        if on:
-            (x0, x1), _ = self.plot.plotItem.vb.viewRange()
-            self.set_cursors(x0 + 0.3 * (x1 - x0), x0 + 0.7 * (x1 - x0))
+        self.time_plot.set_cursors_on(on)
         self._update_cursor_readout()
 
     def set_cursors(self, t1_s: float, t2_s: float) -> None:
         if not self.cursors_box.isChecked():
             self.cursors_box.setChecked(True)
-        self.cursor1.setValue(t1_s)
-        self.cursor2.setValue(t2_s)
+        self.time_plot.set_cursors(t1_s, t2_s)
         self._update_cursor_readout()
 
     def cursor_readout(self) -> dict[str, tuple[float, float, float | None]]:
         """{channel key: (dt s, dvalue, slope per s)} for the visible channels between the cursors."""
         out: dict[str, tuple[float, float, float | None]] = {}
         data = self.shown_rows()
-        if data is None or len(data) < 2:
+        if data is None or len(data[1]) < 2:
             return out
         channels, rows = data
-        t1, t2 = float(self.cursor1.value()), float(self.cursor2.value())
+        t1, t2 = self.time_plot.cursor_times()
         for j, c in enumerate(channels):
             if self._visible.get(c.key, True):
                 d = cursor_delta(rows[:, 0], rows[:, j + 1], t1, t2)
@@ -730,13 +431,13 @@ class ScopeView(QWidget):
         return out
 
     def _update_cursor_readout(self, *_args) -> None:
-        self._last_cursor_update = time.monotonic()
-        if not self.cursors_box.isChecked():
-            self.cursor_label.setText("")
+        label = self.time_plot.cursor_label
+        if not self.time_plot.cursors_on:
+            label.setText("")
             return
         readout = self.cursor_readout()
         if not readout:
-            self.cursor_label.setText("Cursors: no data")
+            label.setText("Cursors: no data")
             return
         units = {c.key: c for c in self._shown_channels()}
         dt = next(iter(readout.values()))[0]
@@ -745,7 +446,7 @@ class ScopeView(QWidget):
             c = units[key]
             slope_text = "—" if slope is None else f"{slope:.4g} {c.unit}/s"
             parts.append(f"{c.name}: Δ {dv:.4g} {c.unit}, {slope_text}")
-        self.cursor_label.setText(" | ".join(parts))
+        label.setText(" | ".join(parts))
 
     # ------------------------------------------------------------------------------ data on show
     def shown_rows(self) -> tuple[tuple[ScopeChannel, ...], np.ndarray] | None:
@@ -756,7 +457,7 @@ class ScopeView(QWidget):
         if live is None or len(live.ring) == 0:
             return None
         data = live.ring.window()
-        (x0, x1), _ = self.plot.plotItem.vb.viewRange()
+        x0, x1 = self.time_plot.x_range()
         i0, i1 = np.searchsorted(data[:, 0], [x0, x1])
         return live.channels, np.array(data[max(0, i0 - 1): i1 + 1])
 
@@ -770,14 +471,14 @@ class ScopeView(QWidget):
             path, _ = QFileDialog.getSaveFileName(self, "Save", "", filters[what])
         if not path:
             if what == "record":
-                self.record_button.setChecked(False)
+                self.toolbar.set_recording(False)
             return
         try:
             {"png": self.export_png, "csv": self.export_csv, "save": self.save_capture,
              "open": self.open_recording, "record": self.start_recording}[what](path)
         except (OSError, ValueError) as exc:
             if what == "record":
-                self.record_button.setChecked(False)
+                self.toolbar.set_recording(False)
             self._message(str(exc))
 
     def _metadata(self, sample_rate_hz: float | None, extra: dict | None = None) -> RecordingMetadata:
@@ -794,8 +495,8 @@ class ScopeView(QWidget):
         self._actuator = context.actuator_data()
         self.all_channels = scope_channels(load_parameter_model(context.driver),
                                            self._actuator.output_resolution_ppr)
-        self.actuator_label.setText(context.actuator)
-        self.test_speed.setMaximum(float(self._actuator.max_speed_rpm))
+        self.tests.set_actuator(context.actuator, float(self._actuator.max_speed_rpm))
+        self.trigger.set_channels(self.all_channels)
         self._static = None
         self._fill_channel_table()
 
@@ -814,16 +515,16 @@ class ScopeView(QWidget):
         if self._live is None or self._live.mode is LiveMode.NONE:
             raise ValueError("start the live view first: the recording takes the live samples")
         self.stop_recording()
-        self._live.ring.drain()  # start with the samples that come from now on
+        # start with the samples that come from now on (those before still reach the plot)
+        if self._levels is not None:
+            self._levels.append(self._live.ring.drain())
         self._recorder = ScopeRecorder(path, self._metadata(None, {
             "source": "fha-studio scope, polled monitor items (host time stamps)"}), self._live.channels)
-        self.record_button.setChecked(True)
-        self.record_button.setText("■ Stop recording")
+        self.toolbar.set_recording(True)
 
     def stop_recording(self) -> Path | None:
         rec, self._recorder = self._recorder, None
-        self.record_button.setChecked(False)
-        self.record_button.setText("Record…")
+        self.toolbar.set_recording(False)
         if rec is None:
             return None
         rec.close()
@@ -849,9 +550,7 @@ class ScopeView(QWidget):
         return Path(rec.path)
 
     def export_png(self, path) -> Path:
-        exporter = exporters.ImageExporter(self.plot.plotItem)
-        exporter.parameters()["width"] = max(800, self.plot.width())
-        exporter.export(str(path))
+        self.time_plot.export_png(path)
         return Path(path)
 
     def export_csv(self, path) -> Path:
@@ -883,29 +582,8 @@ class ScopeView(QWidget):
                          recording.metadata.sample_rate_hz, uniform)
 
     # -------------------------------------------------------------------------------------- trace
-    def _trigger_kind_changed(self, *_args) -> None:
-        kind = self.trigger_kind.currentData()
-        self.trigger_channel.clear()
-        if kind in (p.TriggerKind.RISING_LEVEL, p.TriggerKind.FALLING_LEVEL):
-            for c in self.all_channels:
-                if not c.is_bit:
-                    self.trigger_channel.addItem(f"{c.name} [{c.unit}]", c.key)
-        elif kind in (p.TriggerKind.IO_BIT_RISES, p.TriggerKind.IO_BIT_FALLS):
-            for c in self._trigger_bits:
-                self.trigger_channel.addItem(c.name, c.key)
-        self.trigger_channel.setEnabled(self.trigger_channel.count() > 0)
-        self.trigger_level.setEnabled(kind in (p.TriggerKind.RISING_LEVEL, p.TriggerKind.FALLING_LEVEL))
-
     def trace_settings(self) -> TraceSettings:
-        by_key = {c.key: c for c in self.all_channels + self._trigger_bits}
-        keys = [b.currentData() for b in self.trace_channels if b.currentData()]
-        channels = tuple(by_key[k] for k in dict.fromkeys(keys))
-        kind = self.trigger_kind.currentData()
-        trigger_channel = by_key.get(self.trigger_channel.currentData())
-        samples = self.trace_samples.value()
-        return TraceSettings(channels, self.trace_rate.value(), samples,
-                             min(samples - 1, samples * self.trace_pre.value() // 100),
-                             Trigger(kind, trigger_channel, self.trigger_level.value()))
+        return self.trigger.trace_settings()
 
     def arm_trace(self) -> None:
         try:
@@ -914,15 +592,26 @@ class ScopeView(QWidget):
         except ValueError as exc:
             self._message(str(exc))
             return
-        self.trace_state.setText("arming…")
+        self.trigger.set_state("arming…")
         self.controller.send(ScopeCmd.ARM_TRACE, settings)
 
     def _on_trace_state(self, text: str) -> None:
-        self.trace_state.setText(text)
-        self.trace_state.setToolTip(text)
+        self.trigger.set_state(text)
+        if not text.startswith("reading out"):
+            self.readout_progress.setVisible(False)
+
+    def _on_readout_progress(self, done: int, total: int, seconds_left: float) -> None:
+        """A trace read-out (an armed trace or a test's) block by block, with the time left."""
+        bar = self.readout_progress
+        bar.setRange(0, max(1, total))
+        bar.setValue(done)
+        left = "" if seconds_left < 0 else f", about {seconds_left:.0f} s left"
+        bar.setFormat(f"Reading out the capture: {done} of {total} samples{left}")
+        bar.setVisible(done < total)
 
     def _on_trace_done(self, result: TraceResult) -> None:
         self.last_trace = result
+        self.readout_progress.setVisible(False)
         stamp = time.strftime("%H:%M:%S", time.localtime(result.captured_at))
         self.show_static(result.channels, result.rows(), f"trace {stamp}",
                          result.sample_rate_hz, True)
@@ -930,42 +619,19 @@ class ScopeView(QWidget):
 
     # -------------------------------------------------------------------------------------- tests
     def run_test(self, kind: str) -> None:
-        angle = self.step_angle.value() if kind == "step" else self.test_angle.value()
+        angle = self.tests.angle_deg(kind)
         speed = float(self._actuator.max_speed_rpm) if kind == "step" else self.test_speed.value()
-        self.test_message.setText(f"{kind} test running: {angle:g} deg at {speed:g} r/min …")
-        for label in self.result_labels.values():
-            label.setText("…")
+        self.tests.started(kind, angle, speed)
         self.controller.send(ScopeCmd.RUN_TEST, {
             "channels": self.all_channels, "angle_deg": angle, "speed_rpm": speed, "kind": kind,
             "output_resolution_ppr": self._actuator.output_resolution_ppr})
 
     def _on_test_done(self, result: MoveTestResult) -> None:
         self.last_test = result
-        m = result.metrics
-
-        def ms(v):
-            return "not reached" if v is None else f"{v * 1000:.1f} ms"
-
-        if m is None:
-            for label in self.result_labels.values():
-                label.setText("—")
-            self.test_message.setText(result.describe())
-        else:
-            self.result_labels["overshoot"].setText(f"{m.overshoot_percent:.2f} % ({m.overshoot:.4g} deg)")
-            self.result_labels["rise"].setText(ms(m.rise_time_s))
-            band = f" (band ±{m.settling_band:.3g} deg)"
-            self.result_labels["settling"].setText(ms(m.settling_time_s) + band)
-            window = result.in_position_range_deg
-            inpos = "" if window is None else f" (±{window:.3g} deg)"
-            self.result_labels["in_position"].setText(ms(m.in_position_time_s) + inpos)
-            self.result_labels["final_error"].setText(f"{m.final_error:.4g} deg")
-            self.test_message.setText(f"{result.kind} test of {result.angle_deg:g} deg at "
-                                      f"{result.speed_rpm:g} r/min done.")
-        if result.capture is not None:
-            c = result.capture
-            self.result_labels["method"].setText(
-                f"{'drive trace' if c.method == 'trace' else 'polling'}, {len(c.t_s)} samples"
-                + (f" at {c.sample_rate_hz:.0f} Hz" if c.method == "trace" else ""))
+        self.readout_progress.setVisible(False)
+        self.tests.show_result(result)
+        c = result.capture
+        if c is not None:
             self.show_static(c.channels, c.rows(), f"{result.kind} test capture", c.sample_rate_hz,
                              c.method == "trace")
         self.sigTestDone.emit(result)
@@ -973,31 +639,28 @@ class ScopeView(QWidget):
     # ----------------------------------------------------------------------------------- spectrum
     def compute_spectrum(self) -> None:
         s = self._static
-        key = self.spectrum_channel.currentData()
+        key = self.spectrum_panel.channel_key()
+        panel = self.spectrum_panel
         if s is None or key is None:
-            self.spectrum_label.setText("No capture on show: arm a trace (or open a recording) first.")
+            panel.message("No capture on show: arm a trace (or open a recording) first.")
             return
         if not s.uniform:
-            self.spectrum_label.setText("This capture is not uniformly sampled (polled): use a drive trace.")
+            panel.message("This capture is not uniformly sampled (polled): use a drive trace.")
             return
         j = [c.key for c in s.channels].index(key)
         try:
-            spec = spectrum(s.rows[:, 0], s.rows[:, j + 1], detrend=self.spectrum_detrend.currentData())
+            spec = spectrum(s.rows[:, 0], s.rows[:, j + 1], detrend=panel.detrend())
         except ValueError as exc:
-            self.spectrum_label.setText(str(exc))
+            panel.message(str(exc))
             return
-        f, a = spec.frequency_hz[1:], np.maximum(spec.amplitude[1:], 1e-12)
-        self.spectrum_curve.setData(f, a)
-        unit = s.channels[j].unit
-        peaks = spec.prominent_peaks(4, min_hz=f[0] if len(f) else 0.0)
-        text = ", ".join(f"{hz:.2f} Hz ({amp:.3g} {unit})" for hz, amp in peaks) or "none stand out"
-        self.spectrum_label.setText(f"Peaks: {text}. Resolution {f[0]:.3g} Hz." if len(f) else "Peaks: none")
+        panel.show_spectrum(spec, s.channels[j].unit)
         self.last_spectrum = spec
         self.plots.setCurrentIndex(1)
 
     # --------------------------------------------------------------------------------------- misc
     def _on_error(self, text: str) -> None:
-        self.trace_state.setText(f"error: {text}")
+        self.trigger.set_state(f"error: {text}")
+        self.readout_progress.setVisible(False)
         self._message(text)
 
     def _message(self, text: str) -> None:
