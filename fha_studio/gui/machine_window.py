@@ -15,6 +15,7 @@ from __future__ import annotations
 import logging
 import os
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from PySide6.QtCore import QObject, QSettings, Qt, Slot
@@ -56,6 +57,24 @@ def register_path() -> Path:
     return Path(chosen).expanduser() if chosen else data_dir() / "register.sqlite"
 
 
+@dataclass(frozen=True)
+class _DgrCheck:
+    """A check of the DGR checks page in the fields the register takes for a procedure check."""
+
+    step_id: str
+    text: str
+    value: object
+    passed: bool
+    who: str
+    at_utc: str
+    detail: str
+    procedure_id: str = "dgr-checks"
+    kind: str = "dgr"
+    section: str = ""
+    expected: str = ""
+    unit: str = ""
+
+
 class AxisRecorder(QObject):
     """Writes one axis's commissioning facts into the register as they happen.
 
@@ -87,10 +106,12 @@ class AxisRecorder(QObject):
         procedures = self.window.built_page(PageId.PROCEDURES)
         scope = self.window.built_page(PageId.SCOPE)
         modelcheck = self.window.built_page(PageId.MODELCHECK)
+        absolute = self.window.built_page(PageId.ABSOLUTE)
         for page, hook in (
             (procedures, self._hook_procedures),
             (scope, self._hook_scope),
             (modelcheck, self._hook_modelcheck),
+            (absolute, self._hook_absolute),
         ):
             if page is not None and id(page) not in self._hooked:
                 self._hooked.add(id(page))
@@ -105,6 +126,9 @@ class AxisRecorder(QObject):
 
     def _hook_modelcheck(self, page) -> None:
         page.sigFinished.connect(lambda result: self._on_model_check(page, result))
+
+    def _hook_absolute(self, page) -> None:
+        page.sigRecorded.connect(self._on_dgr_check)
 
     # -- writing, never failing the GUI ---------------------------------------------------------------
     def _record(self, what: str, action: Callable[[], object]) -> None:
@@ -233,6 +257,61 @@ class AxisRecorder(QObject):
         self._record(
             "recording", lambda: self.register.record_recording(self.axis_ref, path, what, who=self.who)
         )
+
+    @Slot(object)
+    def _on_dgr_check(self, record) -> None:
+        """A check of the DGR checks page: a check with its verdict (or a note when it has none);
+        the absolute origin as the axis's origin; parameter 8 as entered from the front panel."""
+        from fha_studio.logic.absolute import CHECK_TITLES
+
+        title = CHECK_TITLES.get(record.check, record.check)
+        by_hand = " (given by hand)" if record.by_hand else ""
+        if record.passed is None:
+            self._record(
+                "check",
+                lambda: self.register.add_axis_note(
+                    self.axis_ref, f"{title}{by_hand}: {record.detail}", who=record.who, at_utc=record.at
+                ),
+            )
+        else:
+            check = _DgrCheck(
+                step_id=record.check,
+                text=title + by_hand,
+                value=dict(record.values),
+                passed=bool(record.passed),
+                who=record.who,
+                at_utc=record.at,
+                detail=record.detail,
+            )
+            self._record("check", lambda: self.register.record_checks(self.axis_ref, [check]))
+        if record.check == "absolute_origin" and record.passed:
+            self._record(
+                "origin",
+                lambda: self.register.record_origin(
+                    self.axis_ref, f"absolute origin set: {record.detail}", who=record.who, at_utc=record.at
+                ),
+            )
+        if record.check == "sensor_dog" and record.passed and record.values.get("sensor") == "origin_sensor":
+            angle = float(record.values["angle_deg"])
+            self._record(
+                "origin",
+                lambda: self.register.record_origin(
+                    self.axis_ref, f"origin sensor at {angle:+.2f}° (4-7-2)", who=record.who, at_utc=record.at
+                ),
+            )
+        entered = record.values.get("rotary_direction") if record.check == "rotary_direction" else None
+        if isinstance(entered, int):
+            self._record(
+                "front-panel value",
+                lambda: self.register.record_snapshot(
+                    self.axis_ref,
+                    [("system", 8, "rotary_direction", entered)],
+                    "front_panel",
+                    who=record.who,
+                    at_utc=record.at,
+                    note="parameter 8 as read on the drive's front panel",
+                ),
+            )
 
     def _on_model_check(self, page, result) -> None:
         lines = result.summary_lines()

@@ -89,7 +89,7 @@ def _project(tmp_path) -> MachineProject:
     project.add_axis(
         "tilt",
         TILT,
-        port_url=f"sim://{TILT}?profile=documented&paced=0&eeprom={eeprom}",
+        port_url=f"sim://{TILT}?profile=documented&paced=0&oww_clear_s=0.5&eeprom={eeprom}",
         load_inertia_kgm2=4.0,
     )
     return project
@@ -175,6 +175,22 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     )
     assert window.stop_all() == ["table", "table twin"]
 
+    # the tilt's absolute origin, set with OWW on its DGR checks page, is the axis's origin
+    window.select_axis("tilt")
+    dgr = tilt.show_page("absolute")
+    dgr.who_edit.setText("ana")
+    qtbot.waitUntil(lambda: dgr.origin_button.isEnabled(), timeout=10000)
+    before = len(dgr.records)
+    dgr.origin_button.click()
+    qtbot.waitUntil(lambda: len(dgr.records) > before, timeout=15000)
+    origin = register.latest_origin(f"{MACHINE}/tilt")
+    assert (
+        origin["text"].startswith("absolute origin set: multi-turn data cleared") and origin["who"] == "ana"
+    )
+    assert [e.text.split(":")[0] for e in register.history(f"{MACHINE}/tilt") if e.kind == "check"] == [
+        "dgr-checks / absolute_origin"
+    ]
+
     # the machine report: every axis in the summary, then each axis's report
     html, pdf = window.write_machine_report(tmp_path / "machine.html", tmp_path / "machine.pdf")
     text = html.read_text(encoding="utf-8")
@@ -182,6 +198,7 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     assert "1: FWD command → REV rotation" in summary  # the table, reversed
     assert "0: FWD command → FWD rotation (default)" in summary  # the twin
     assert TILT in summary and "not signed" in summary
+    assert "absolute origin set: multi-turn data cleared" in summary
     assert pdf.is_file() and pdf.stat().st_size > 1000
     assert register.export(MACHINE)["machines"][0]["machine_reports"][0]["file"] == str(pdf.resolve())
     register.close()

@@ -873,12 +873,15 @@ class Register:
             value = json.loads(r["value_json"])
             shown = ("yes" if value else "no") if r["kind"] == "confirm" else f"{value} {r['unit']}".strip()
             verdict = "pass" if r["passed"] else "FAIL"
+            section = f" ({r['section']})" if r["section"] else ""
+            if isinstance(value, dict):  # a check with several readings: its own sentence says them
+                shown = r["detail"] or ", ".join(f"{k} {v}" for k, v in value.items())
             events.append(
                 Event(
                     r["at_utc"],
                     "check",
                     r["who"],
-                    f"{r['procedure_id']} / {r['step_id']} ({r['section']}): {shown} — {verdict}",
+                    f"{r['procedure_id']} / {r['step_id']}{section}: {shown} — {verdict}",
                     r["id"],
                     {
                         "procedure_id": r["procedure_id"],
