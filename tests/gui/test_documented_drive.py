@@ -207,3 +207,25 @@ def test_dgr_checks_on_an_incremental_encoder_ask_and_record_by_hand(make_window
     record = page.records[-1]
     assert record.by_hand and record.passed and record.values == {"turned": "CCW", "rotary_direction": 1}
     assert "by hand" in page.history.item(0, 1).text()
+
+
+def test_alarms_are_typed_from_the_front_panel(window, qtbot):
+    page = window.show_page("alarms")
+    assert page.panel_box.isVisible()
+    assert "front panel" in page.code_label.text() and "not connected" not in page.code_label.text()
+    assert not page.refresh_button.isEnabled() and not page.clear_button.isEnabled()
+    page.panel_code_edit.setText("60")
+    for name in ("B",):
+        page.alm_checks[name].setChecked(True)
+    page.alm_read_check.setChecked(True)  # D C B A = 0010: alarm 60 in the manual's table
+    assert page.enter_from_panel()
+    assert page.code_label.text().startswith("Alarm 60")
+    assert "Cause:" in page.cause_label.text() and "Remedy:" in page.cause_label.text()
+    assert "recorded" in page.panel_result.text()
+    page.panel_code_edit.setText("20")  # the lamps still say 0010: they do not match 20 (0001)
+    assert page.enter_from_panel()
+    assert "do not match alarm 20" in page.panel_result.text() and "60" in page.panel_result.text()
+    assert page.history_table.rowCount() == 2 and page.history_table.item(0, 0).text() == "20"
+    assert page.history_table.item(1, 2).text() == "entered from the panel"
+    page.panel_code_edit.setText("xx")
+    assert not page.enter_from_panel()

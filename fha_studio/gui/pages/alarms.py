@@ -7,10 +7,12 @@ import time
 from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtGui import QColor, QFont
 from PySide6.QtWidgets import (
+    QCheckBox,
     QGroupBox,
     QHBoxLayout,
     QHeaderView,
     QLabel,
+    QLineEdit,
     QPushButton,
     QTableWidget,
     QTableWidgetItem,
@@ -25,13 +27,17 @@ from fha_studio.hardware.api import AlarmRecord
 _TABLES: dict[str, object] = {}
 
 
-def alarm_text(code: int, driver: str = "HA-655") -> dict:
-    """name, cause, remedy, clearable and source of an alarm code, from the driver's alarm table."""
+def _alarm_table(driver: str):
     from fha_studio.hardware.parameters import load_alarm_table
 
     if driver not in _TABLES:
         _TABLES[driver] = load_alarm_table(driver)
-    alarm = _TABLES[driver].get(code)
+    return _TABLES[driver]
+
+
+def alarm_text(code: int, driver: str = "HA-655") -> dict:
+    """name, cause, remedy, clearable and source of an alarm code, from the driver's alarm table."""
+    alarm = _alarm_table(driver).get(code)
     if alarm is None:
         return {
             "name": "unknown code",
@@ -61,6 +67,7 @@ class AlarmsPage(BasePage):
         self.session = session
         self.link = session.link
         self.current_code: int | None = None
+        self.reports_alarms = True
         self.unacknowledged: int | None = None
         self._appeared_at: dict[int, float] = {}
         self._seen_at: dict[tuple[int, int], float | None] = {}
@@ -102,6 +109,49 @@ class AlarmsPage(BasePage):
         c_layout.addWidget(self.result_label)
         layout.addWidget(current_box)
 
+        # a drive that does not report alarms over CN3 (a real HA-655): the technician reads the
+        # front panel's 2-digit code (and the ALM-A..D outputs, if at hand) and types them here
+        self.panel_box = QGroupBox("Alarm on the drive's front panel")
+        self.panel_box.setObjectName("alarmPanelEntry")
+        p_layout = QVBoxLayout(self.panel_box)
+        hint = QLabel(
+            "This drive does not report alarms over CN3. Read the 2-digit code on its front panel "
+            "(and the ALM-A..D outputs on CN2 if you can see them) and enter them: FHA Studio shows the "
+            "manual's cause and remedy and keeps the entry in the history."
+        )
+        hint.setWordWrap(True)
+        p_layout.addWidget(hint)
+        row = QHBoxLayout()
+        row.addWidget(QLabel("Code on the panel:"))
+        self.panel_code_edit = QLineEdit()
+        self.panel_code_edit.setObjectName("panelAlarmCode")
+        self.panel_code_edit.setMaxLength(2)
+        self.panel_code_edit.setPlaceholderText("e.g. 60")
+        self.panel_code_edit.setMaximumWidth(70)
+        row.addWidget(self.panel_code_edit)
+        row.addWidget(QLabel("  ALM lamps on:"))
+        self.alm_checks: dict[str, QCheckBox] = {}
+        for name in ("D", "C", "B", "A"):
+            check = QCheckBox(f"ALM-{name}")
+            check.setTristate(False)
+            self.alm_checks[name] = check
+            row.addWidget(check)
+        self.alm_read_check = QCheckBox("lamps read")
+        self.alm_read_check.setToolTip("Tick when you read the ALM outputs; unticked they are not compared")
+        row.addWidget(self.alm_read_check)
+        self.panel_button = QPushButton("Look &up and record")
+        self.panel_button.clicked.connect(self.enter_from_panel)
+        row.addWidget(self.panel_button)
+        row.addStretch(1)
+        p_layout.addLayout(row)
+        self.panel_result = QLabel("")
+        self.panel_result.setObjectName("panelAlarmResult")
+        self.panel_result.setWordWrap(True)
+        p_layout.addWidget(self.panel_result)
+        self.panel_box.setVisible(False)
+        layout.addWidget(self.panel_box)
+        self.panel_entries: list[dict] = []  # code, alm bits or None, when, who
+
         history_box = QGroupBox("Alarm history (newest first)")
         h_layout = QVBoxLayout(history_box)
         self.history_table = QTableWidget(0, 4)
@@ -132,11 +182,64 @@ class AlarmsPage(BasePage):
     def link_connected(self, info: LinkInfo) -> None:
         self._seen_at.clear()
         self.power_cycle_button.setVisible(info.is_simulated)
-        self.link.send(Cmd.ALARM_HISTORY)
+        self.reports_alarms = not info.documented_only
+        self.panel_box.setVisible(not self.reports_alarms)
+        reason = ("" if self.reports_alarms
+                  else "This drive does not report alarms over CN3: use its front panel")
+        for button in (self.refresh_button, self.clear_button):
+            button.setToolTip(reason or button.toolTip())
+        self.refresh_button.setEnabled(self.reports_alarms)
+        if self.reports_alarms:
+            self.link.send(Cmd.ALARM_HISTORY)
+        self._show(self.current_code)
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
         self.current_code = None
+        self.reports_alarms = True
+        self.panel_box.setVisible(bool(self.panel_entries))
         self._show(None)
+
+    @Slot()
+    def enter_from_panel(self) -> bool:
+        """Look up the code typed from the front panel, compare the ALM lamps, keep it in the
+        history. False (with the reason beside the button) for a code that is not a number."""
+        text = self.panel_code_edit.text().strip()
+        if not text.isdigit():
+            self.panel_result.setText("Enter the 2-digit code the panel shows (e.g. 60).")
+            return False
+        code = int(text)
+        bits = None
+        if self.alm_read_check.isChecked():
+            bits = sum(1 << i for i, name in enumerate("ABCD") if self.alm_checks[name].isChecked())
+        table = _alarm_table(self.session.driver)
+        alarm = table.get(code)
+        lines = []
+        if alarm is None:
+            lines.append(f"{code} is not an alarm code of the {self.session.driver}'s manual: read the "
+                         "display again (a dot or a monitor item can look like a code).")
+        elif bits is not None and bits != alarm.alm_bits:
+            same = [a.code for a in table if a.alm_bits == bits]
+            lines.append(f"The lamps (D C B A = {bits:04b}) do not match alarm {code} ({alarm.alm_code}); "
+                         f"they belong to {', '.join(map(str, same)) or 'no alarm of the table'}. "
+                         "Read both again.")
+        entry = {"code": code, "alm_bits": bits, "time": time.time()}
+        self.panel_entries.insert(0, entry)
+        self.current_code = code
+        self._show(code)
+        self.panel_result.setText(" ".join(lines) or f"Alarm {code} recorded (entered from the panel).")
+        self._fill_panel_history()
+        return True
+
+    def _fill_panel_history(self) -> None:
+        self.history_table.setRowCount(len(self.panel_entries))
+        for row, entry in enumerate(self.panel_entries):
+            code = entry["code"]
+            lamps = "" if entry["alm_bits"] is None else f", lamps D C B A = {entry['alm_bits']:04b}"
+            name = alarm_text(code, self.session.driver)["name"]
+            cells = [str(code), name + lamps, "entered from the panel",
+                     time.strftime("%H:%M:%S", time.localtime(entry["time"]))]
+            for col, text in enumerate(cells):
+                self.history_table.setItem(row, col, QTableWidgetItem(text))
 
     @Slot(object)
     def _on_status(self, status: DriveStatus) -> None:
@@ -172,9 +275,11 @@ class AlarmsPage(BasePage):
     def _show(self, code: int | None) -> None:
         attention = self.unacknowledged is not None and self.unacknowledged == code and bool(code)
         self.ack_button.setEnabled(attention)
-        self.clear_button.setEnabled(bool(code))
+        self.clear_button.setEnabled(bool(code) and self.reports_alarms)
         if code is None:
-            self.code_label.setText("—  (not connected)")
+            connected = self.link.connected
+            self.code_label.setText("—  (read the code on the drive's front panel)" if connected
+                                    and not self.reports_alarms else "—  (not connected)")
             self.code_label.setStyleSheet("")
             self.cause_label.setText("")
             return
@@ -202,7 +307,8 @@ class AlarmsPage(BasePage):
         parts.append(
             "<b>Clear:</b> "
             + (
-                "with <i>Clear alarm</i> once the cause is gone."
+                ("with <i>Clear alarm</i> once the cause is gone." if self.reports_alarms else
+                 "once the cause is gone, with the driver's alarm-clear input (CN2) or a power cycle.")
                 if text["clearable"]
                 else "needs the driver's control power switched off and on."
             )
