@@ -229,3 +229,70 @@ def test_alarms_are_typed_from_the_front_panel(window, qtbot):
     assert page.history_table.item(1, 2).text() == "entered from the panel"
     page.panel_code_edit.setText("xx")
     assert not page.enter_from_panel()
+
+
+def test_procedures_ask_for_what_the_drive_cannot_tell_and_record_the_value(window, qtbot, tmp_path):
+    page = window.show_page("procedures")
+    page.operator_edit.setText("T. Trainee")
+    page.new_session(tmp_path / "axis.json", "FHA-25C-50-S248")
+    page.select_procedure("rotary-direction")
+    page.choice_combo.setCurrentText("CW")
+    page.choice_button.click()
+    assert page.current_step().id == "parameter"
+    with qtbot.waitSignal(page.sigLiveDone, timeout=20000) as live:
+        page.live_button.click()
+    assert live.args[0].available is False
+    assert page.by_hand_box.isVisibleTo(page)
+    assert "parameter 8" in page.by_hand_edit.placeholderText()
+    assert not page.answer_by_hand()  # nothing typed: nothing recorded
+    page.by_hand_edit.setText("0")
+    assert page.answer_by_hand()
+    record = page.run.state.records[-1]
+    assert record.step_id == "parameter" and record.value == "0" and record.value is not True
+    assert "entered by hand" in record.detail and record.who == "T. Trainee"
+    # the FWD jog: the drive takes no motion commands; the technician says which way it turned
+    with qtbot.waitSignal(page.sigLiveDone, timeout=20000):
+        page.live_button.click()
+    assert "controller" in page.by_hand_edit.placeholderText()
+    page.by_hand_edit.setText("CW")
+    assert page.answer_by_hand()
+    assert page.run.state.records[-1].value == "CW"
+
+
+def test_the_sensor_dog_wizard_does_not_claim_to_watch_and_reads_dgr(make_window, qtbot, tmp_path):
+    window = make_window(connect=SENSOR_URL)
+    page = window.show_page("procedures")
+    page.new_session(tmp_path / "axis.json", "FHA-25C-50-S248-L")
+    page.select_procedure("sensor-adjustment")
+    for _ in range(20):
+        step = page.current_step()
+        if step is None or step.kind == "sensor_angle":
+            break
+        _answer(page, step)
+    panel_widget = page.dog_panel
+    assert panel_widget.sensor and not panel_widget.watching
+    assert "Watching" not in panel_widget.found_label.text()
+    assert "does not report its inputs" in panel_widget.found_label.text()
+    assert not panel_widget.jog_cw_button.isEnabled() and not panel_widget.move_button.isEnabled()
+    assert "by hand" in panel_widget.motion_reason.text()
+    angle = {"limit_switch_1": -150.5, "limit_switch_2": 150.5, "origin_sensor": 0.2}[panel_widget.sensor]
+    panel(window, qtbot, "turn", angle)
+    before = len(page.run.state.records)
+    panel_widget.record_button.click()
+    qtbot.waitUntil(lambda: len(page.run.state.records) > before, timeout=10000)
+    assert abs(page.run.state.records[-1].value - angle) < 0.05
+
+
+def _answer(page, step):
+    from tests.procedures.walk import good_answer
+
+    if step.kind == "confirm":
+        page.yes_button.click()
+    elif step.kind in ("measure", "text"):
+        page.value_edit.setText(str(good_answer(step)))
+        page.value_button.click()
+    elif step.kind == "choose":
+        page.choice_combo.setCurrentText(str(good_answer(step)))
+        page.choice_button.click()
+    else:
+        raise AssertionError(step.kind)

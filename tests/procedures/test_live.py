@@ -195,4 +195,4 @@ def test_a_servo_on_refusal_is_not_a_failed_check():
     seen = run_live_check(
         RealDriveServoOn(), wiring.step("encoder-signals").resolve(context, {}), LiveEnv(context)
     )
-    assert not seen.available and "confirm by hand" in seen.detail
+    assert not seen.available and "enter what you saw" in seen.detail

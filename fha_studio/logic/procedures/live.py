@@ -50,7 +50,21 @@ class LiveEnv:
 
 
 def unavailable(why: str) -> Observation:
-    return Observation(None, False, f"the drive cannot tell: {why}; confirm by hand", available=False)
+    return Observation(None, False, f"the drive cannot tell: {why}; enter what you saw", available=False)
+
+
+#: What to enter by hand for each live check when the drive cannot tell (a drive of the manual's
+#: commands only): the value that is recorded instead of a bare "OK".
+BY_HAND = {
+    "driver_adjusted_for": "the ADJUSTED FOR USE WITH line of the driver's label",
+    "io_bit": "what you saw (e.g. 'released: the output turns by hand')",
+    "alarm_free": "the code on the drive's front panel (0 or blank display: no alarm)",
+    "encoder_counts": "the change of the absolute position for the angle turned by hand (DGR checks page)",
+    "battery": "the code on the drive's front panel (alarm 56 = low battery; 0: none)",
+    "rotary_direction": "parameter 8 on the drive's panel ([parameter mode] -> item 8): 0 or 1",
+    "jog_forward": "which way a FWD command from the controller turned the output: CW or CCW",
+    "sensor_test_run": "the angles where each sensor switched during the test run",
+}
 
 
 def output_angle_deg(client: DriveApi, ppr: int) -> tuple[float, IoState]:
@@ -149,7 +163,8 @@ def _check_encoder_counts(client: DriveApi, step: Step, env: LiveEnv) -> Observa
     try:
         start, _ = output_angle_deg(client, env.output_ppr)
     except CommandNotSupported:
-        return unavailable("it reports no feedback position")
+        return unavailable("it reports no feedback position over CN3 (with an absolute encoder, the DGR "
+                           "checks page's encoder check measures it by turning the output by hand)")
     if not _can_move(client):
         return unavailable("it takes no move commands; turn the output by hand and watch the feedback pulses")
     end = move_and_watch(client, float(step.params.get("angle_deg", 2.0)), env)
@@ -164,7 +179,10 @@ def _can_move(client: DriveApi) -> bool:
 
 
 def _check_battery(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
-    code = client.alarm()
+    from fha_studio.hardware.protocol import Command
+
+    # a drive of the manual's commands has no ALM: DGR alone says whether the absolute data is there
+    code = client.alarm() if client.capabilities.supports(Command.ALM) else None
     if code == 56:
         return Observation(code, False, "alarm 56: ABS low battery voltage")
     try:
@@ -173,6 +191,9 @@ def _check_battery(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
         return Observation(None, False, "the servo is on: switch it off to read the absolute position")
     except CommandRejected:
         return Observation(None, False, "the drive answers no absolute position (DGR refused)")
+    if code is None:
+        return Observation(counts, True, f"absolute position {counts} counts (DGR answered; the drive "
+                           "reports no alarms over CN3: see its front panel for alarm 56)")
     return Observation(counts, True, f"absolute position {counts} counts, no battery alarm")
 
 

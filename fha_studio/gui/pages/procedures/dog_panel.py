@@ -79,6 +79,11 @@ class SensorDogPanel(QWidget):
         self.move_button.clicked.connect(lambda: self.move_to(self.target_spin.value()))
         for w in (self.jog_ccw_button, self.jog_cw_button, QLabel("or"), self.target_spin, self.move_button):
             m.addWidget(w)
+        self.motion_reason = QLabel("")
+        self.motion_reason.setObjectName("motion_reason")
+        self.motion_reason.setWordWrap(True)
+        self.motion_reason.setStyleSheet("color: #8a5a00;")
+        m.addWidget(self.motion_reason, 1)
         layout.addWidget(motion)
 
         self.sim_box = QGroupBox("Simulated actuator: turn the dog / disk by hand")
@@ -118,6 +123,9 @@ class SensorDogPanel(QWidget):
         layout.addLayout(typed_row)
         layout.addStretch(1)
         link.sigStatus.connect(self.on_status)
+        link.sigResult.connect(self._on_result)
+        self.ratio = 0
+        self.watching = True
 
     # -- set up for a step --------------------------------------------------------------------
     def start(self, sensor: str, context: Mapping[str, Any]) -> None:
@@ -132,9 +140,31 @@ class SensorDogPanel(QWidget):
             f"Movable range {self.wizard.ccw_limit_deg:+g}° … {self.wizard.cw_limit_deg:+g}° (4-7-3): "
             "moves past it are refused."
         )
-        self.found_label.setText(f"Watching {SENSOR_NAMES[sensor]}: not switched yet")
+        self.ratio = int(context["actuator"].get("ratio", 0) or 0)
         info = self.link.info
         self.sim_box.setVisible(bool(info and info.is_simulated))
+        self.watching = bool(info and info.can_monitor)
+        can_move = bool(info and info.can_move)
+        for button in (self.jog_ccw_button, self.jog_cw_button, self.move_button):
+            button.setEnabled(can_move)
+        self.motion_reason.setText(
+            "" if can_move else "This drive takes no motion commands over CN3: with the servo off, turn "
+            "the axis by hand (or move it from the controller)."
+        )
+        if self.watching:
+            self.found_label.setText(f"Watching {SENSOR_NAMES[sensor]}: not switched yet")
+            self.record_button.setText("Record this angle")
+        else:
+            for lamp in self.lamps.values():
+                lamp.set_state(None)
+            self.angle_label.setText("Output angle: not reported over CN3 (read it with DGR)")
+            self.found_label.setText(
+                f"This drive does not report its inputs over CN3: watch the indicator of "
+                f"{SENSOR_NAMES[sensor]} (or the controller's input) while you turn the axis by hand, "
+                "stop where it switches, then record: the angle comes from the absolute position (DGR)."
+            )
+            self.found_label.setWordWrap(True)
+            self.record_button.setText("Record the angle here (DGR)")
 
     # -- live ---------------------------------------------------------------------------------
     @Slot(object)
@@ -230,10 +260,39 @@ class SensorDogPanel(QWidget):
         return found
 
     def record(self) -> None:
+        if not getattr(self, "watching", True):
+            self._record_from_dgr()
+            return
         angle = self.found_angle()
         if angle is None:
             self.sigMessage.emit(f"{SENSOR_NAMES[self.sensor]} has not switched on yet: nothing to record")
             return
+        self.sigRecord.emit(angle)
+
+    def _record_from_dgr(self) -> None:
+        """A drive that does not report its inputs: the technician stopped where the sensor
+        switched; DGR (servo off) gives the angle, recorded like a live one."""
+        if not self.ratio:
+            self.sigMessage.emit("The actuator's ratio is not known: the counts cannot become an angle")
+            return
+        self._dgr_token = self.link.send(Cmd.CALL, lambda client: client.absolute_position())
+
+    @Slot(object)
+    def _on_result(self, result) -> None:
+        if result.token != getattr(self, "_dgr_token", None):
+            return
+        self._dgr_token = None
+        if not result.ok:
+            from fha_studio.gui.link import SERVO_ON_NOTE
+            from fha_studio.hardware.api import ServoOnRefused
+
+            why = SERVO_ON_NOTE if result.failed_with(ServoOnRefused) else result.error
+            self.sigMessage.emit(f"The angle could not be read: {why}. Enter an angle read elsewhere below.")
+            return
+        from fha_studio.logic.absolute import output_deg, wrap_deg
+
+        angle = wrap_deg(output_deg(result.value, self.ratio))
+        self.angle_label.setText(f"Output angle (DGR, servo off): {angle:+.2f}°")
         self.sigRecord.emit(angle)
 
     def shutdown(self) -> None:

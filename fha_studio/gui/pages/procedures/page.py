@@ -188,12 +188,25 @@ class ProceduresPage(BasePage):
         row = QHBoxLayout()
         self.live_button = QPushButton("&Check on the drive")
         self.live_button.clicked.connect(self.run_live_check)
-        self.by_hand_button = QPushButton("Checked &by hand: OK")
-        self.by_hand_button.clicked.connect(lambda: self.answer(True))
-        self.by_hand_button.setVisible(False)
         row.addWidget(self.live_button)
-        row.addWidget(self.by_hand_button)
+        row.addStretch(1)
         lv.addLayout(row)
+        # the drive cannot tell: the technician enters what they saw, and that value is recorded
+        self.by_hand_box = QWidget()
+        hb = QHBoxLayout(self.by_hand_box)
+        hb.setContentsMargins(0, 0, 0, 0)
+        self.by_hand_edit = QLineEdit()
+        self.by_hand_edit.setObjectName("by_hand_value")
+        self.by_hand_result = QComboBox()
+        self.by_hand_result.addItems(["as it should be", "NOT as it should be"])
+        self.by_hand_button = QPushButton("Record what I &saw")
+        self.by_hand_button.clicked.connect(self.answer_by_hand)
+        hb.addWidget(QLabel("Seen:"))
+        hb.addWidget(self.by_hand_edit, 1)
+        hb.addWidget(self.by_hand_result)
+        hb.addWidget(self.by_hand_button)
+        self.by_hand_box.setVisible(False)
+        lv.addWidget(self.by_hand_box)
         # On the simulated drive the trainee switches the brake's 24 V here (INP), as at the machine.
         self.sim_brake_check = QCheckBox("Simulated drive: brake supply 24 V on")
         self.sim_brake_check.setObjectName("sim_brake")
@@ -368,14 +381,40 @@ class ProceduresPage(BasePage):
         self._refresh()
         return True
 
+    def _ask_by_hand(self, step: Step | None, why: str) -> None:
+        """Show the by-hand entry for a live step the drive cannot answer, saying what to enter."""
+        from fha_studio.logic.procedures.live import BY_HAND
+
+        if step is None:
+            return
+        what = BY_HAND.get(step.check or "", "what you saw")
+        self.by_hand_edit.setPlaceholderText(what)
+        self.by_hand_edit.setToolTip(f"Enter {what}")
+        self._by_hand_why = why
+        self.by_hand_box.setVisible(True)
+
+    def answer_by_hand(self) -> bool:
+        """Record the value the technician entered for a live step the drive cannot answer."""
+        value = self.by_hand_edit.text().strip()
+        if not value:
+            self._message(f"Enter {self.by_hand_edit.placeholderText()} first: it is what the record keeps.")
+            return False
+        passed = self.by_hand_result.currentIndex() == 0
+        why = getattr(self, "_by_hand_why", "") or "the drive cannot tell"
+        observation = Observation(value, passed, f"entered by hand ({why})")
+        if self.answer(observation):
+            self.by_hand_edit.clear()
+            return True
+        return False
+
     def run_live_check(self) -> None:
         """Ask the drive (in the link thread); the answer is recorded when it comes."""
         step = self.current_step()
         if step is None or step.kind != "live" or self._live_token is not None:
             return
         if not self.link.connected:
-            self._message("No drive connected: connect first, or confirm by hand.")
-            self.by_hand_button.setVisible(True)
+            self._message("No drive connected: connect first, or enter what you saw.")
+            self._ask_by_hand(step, "no drive is connected")
             return
         self.live_label.setText("Asking the drive …")
         self.live_button.setEnabled(False)
@@ -400,7 +439,7 @@ class ProceduresPage(BasePage):
             self.answer(observation)
             self.live_label.setText(observation.detail)
         else:
-            self.by_hand_button.setVisible(True)
+            self._ask_by_hand(self.current_step(), observation.detail)
         self.sigLiveDone.emit(observation)
 
     @Slot(object)
@@ -567,7 +606,7 @@ class ProceduresPage(BasePage):
             bool(info and info.is_simulated and self.context and self.context["flags"].get("brake"))
         )
         self.sign_button.setEnabled(has_session)
-        self.by_hand_button.setVisible(False)
+        self.by_hand_box.setVisible(False)
         self.step_box.setEnabled(True)
         if run is None:
             selected = self.procedure_list.currentItem()
