@@ -198,7 +198,7 @@ def test_recording_while_plotting_loads_in_numpy(qtbot, scope, sim_client, tmp_p
     assert set(recording.channels) >= {"t", "pos", "current", "cmd_pos", "vel"}
 
 
-def test_a_documented_only_drive_says_not_live_and_why(qtbot, scope):
+def test_a_documented_only_drive_shows_dgr_position_and_backs_off_with_the_servo_on(qtbot, scope):
     servo = {"on": False}
 
     def documented(request):
@@ -212,12 +212,18 @@ def test_a_documented_only_drive_says_not_live_and_why(qtbot, scope):
         client = DriveClient.attach(host)
         view = scope(client)
         view.start_live()
-        qtbot.waitUntil(lambda: "only the documented commands" in view.indicator_text(), timeout=5000)
+        qtbot.waitUntil(lambda: view.indicator_text() == "LIVE: position only (DGR, servo off)",
+                        timeout=10000)
         assert view._live.channels[0].key == "feedback_position"
         qtbot.waitUntil(lambda: len(view._live.ring) > 0, timeout=5000)
         assert view._live.ring.window(1)[0, 1] == pytest.approx(204800 * 360 / (8192 * 50))
         servo["on"] = True
-        qtbot.waitUntil(lambda: view.indicator_text().startswith("NOT LIVE: the servo is on"), timeout=5000)
+        qtbot.waitUntil(lambda: view.indicator_text().startswith("NOT LIVE: servo on (controller)"),
+                        timeout=10000)
+        qtbot.waitUntil(lambda: view.info_label.text().startswith("—"), timeout=10000)  # rate cleared
+        asked = len(drive.requests)
+        qtbot.wait(3000)  # how often the drive is asked in 3 s is the behaviour under test
+        assert len(drive.requests) - asked <= 4, "more than one DGR a second while the servo is on"
     finally:
         drive.close()
 

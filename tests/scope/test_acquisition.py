@@ -74,7 +74,7 @@ def test_a_silent_drive_is_not_live_and_old_samples_go_stale(client_on, channels
     assert acq.status().label.startswith("NOT LIVE: no answer from the drive")
 
 
-def test_documented_only_drive_shows_position_by_dgr_and_says_not_live(client_on, channels):
+def test_documented_only_drive_shows_position_by_dgr_labelled_as_such(client_on, channels):
     drive = DocumentedDrive(position=8192 * 50 * 3 // 4)  # 3/4 of an output turn on a ratio-50 axis
     client = client_on(drive)
     acq = PollingAcquisition(client, pick(channels, "feedback_position", "motor_current"), ratio=50)
@@ -83,12 +83,17 @@ def test_documented_only_drive_shows_position_by_dgr_and_says_not_live(client_on
     assert acq.step(0) == 1
     assert acq.ring.drain()[0, 1] == pytest.approx(270.0)
     status = acq.status()
-    assert not status.live and "only the documented commands" in status.reason and "DGR" in status.reason
+    assert status.live and status.label == "LIVE: position only (DGR, servo off)"
+    assert acq.retry_interval_s == 0.25
     drive.servo_on = True
     assert acq.step(0) == 0
     status = acq.status()
-    assert status.label.startswith("NOT LIVE: the servo is on") and "(answer s)" in status.reason
+    assert status.label.startswith("NOT LIVE: servo on (controller)") and "until servo off" in status.reason
+    assert status.rate_hz == 0.0  # nothing polled: no rate figure
+    assert acq.retry_interval_s == 1.0  # at most one DGR a second while the drive answers s
     assert len(acq.ring.drain()) == 0  # nothing pretends to be a new sample
+    drive.servo_on = False
+    assert acq.step(0) == 1 and acq.retry_interval_s == 0.25
 
 
 def test_documented_only_drive_without_a_known_ratio_reads_nothing(client_on, channels):

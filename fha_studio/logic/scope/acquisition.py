@@ -144,6 +144,8 @@ class LiveStatus:
 
     @property
     def label(self) -> str:
+        if self.live and self.mode is LiveMode.POSITION:
+            return "LIVE: position only (DGR, servo off)"
         return "LIVE" if self.live else f"NOT LIVE: {self.reason}"
 
 
@@ -178,6 +180,9 @@ class PollingAcquisition:
     """
 
     retry_interval_s = 0.25
+    #: After an "s" (servo on, a drive of the manual's commands) the next try waits this long: the
+    #: drive answers nothing over CN3 until the controller switches the servo off.
+    servo_on_retry_s = 1.0
 
     def __init__(self, client, channels: Sequence[ScopeChannel], *, ratio: int | None = None,
                  capacity: int = 65536, config: ScopeConfig | None = None,
@@ -232,8 +237,9 @@ class PollingAcquisition:
             try:
                 wire = self._read_once()
             except ServoOnRefused:
-                self._not_live("the servo is on and this drive refuses CN3 commands while it is "
-                               "(answer s); position by DGR comes back with the servo off")
+                self._not_live("servo on (controller): the drive does not answer over CN3 until servo "
+                               "off; the position (DGR) comes back then")
+                self.retry_interval_s = self.servo_on_retry_s
                 break
             except (CommandNotSupported, CommandRejected) as exc:
                 self._not_live(f"the drive refused the read: {exc}")
@@ -246,6 +252,7 @@ class PollingAcquisition:
                 self._not_live(f"no answer from the drive ({exc})")
                 break
             after = self.clock()
+            self.retry_interval_s = type(self).retry_interval_s
             rows.append([(before + after) / 2 - self.t0, *self._row(wire)])
             self._last_sample = after
             self._recent.append(after)
@@ -298,11 +305,10 @@ class PollingAcquisition:
         live, reason = self._live, self._reason
         if live and (age is None or age > self.stale_after_s()):
             live, reason = False, f"no new sample for {age:.1f} s" if age is not None else "no sample yet"
-        if live and self.mode is LiveMode.POSITION:
-            # DGR works, but only the position of a stopped servo: say so, it is not the full scope
-            live, reason = False, self._mode_note
-        return LiveStatus(live, "" if live else reason, self.mode, self.samples, self.rate_hz,
-                          self._limit_hz, self.ring.dropped, age)
+        # DGR works only for the position of a stopped servo: the label says so (LiveStatus.label).
+        # Nothing polled (not live): no rate figure, not the last one
+        return LiveStatus(live, "" if live else reason, self.mode, self.samples,
+                          self.rate_hz if live else 0.0, self._limit_hz, self.ring.dropped, age)
 
 
 # --- drive-side trace capture ----------------------------------------------------------------------

@@ -322,7 +322,7 @@ class ScopeView(QWidget):
             elif age is None or age > stale_after:
                 text = "NOT LIVE: no new sample for " + ("a while" if age is None else f"{age:.1f} s")
             else:
-                kind, text = "live", "LIVE"
+                kind, text = "live", status.label
             if self._paused:
                 text = "PAUSED (acquisition goes on)" if kind == "live" else f"PAUSED · {text}"
                 kind = "paused"
@@ -363,7 +363,8 @@ class ScopeView(QWidget):
         s = self._status
         parts = []
         if s is not None and s.mode is not LiveMode.NONE:
-            parts.append(f"{s.rate_hz:.1f} samples/s (line limit {s.limit_hz:.1f}/s)")
+            rate = f"{s.rate_hz:.1f}" if s.live else "—"  # nothing polled: no figure, not the last one
+            parts.append(f"{rate} samples/s (line limit {s.limit_hz:.1f}/s)")
             parts.append(f"{s.samples} samples, {s.dropped} dropped")
         if self._recorder is not None:
             parts.append(f"● REC {self._recorder.rows_written} rows → {Path(self._recorder.path).name}")
