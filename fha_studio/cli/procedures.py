@@ -64,10 +64,10 @@ def _context(code: str):
 
 
 def _load_session(path: Path):
-    from fha_studio.logic.procedures import Session, SessionError
+    from fha_studio.logic.procedures import ProcedureSession, SessionError
 
     try:
-        return Session.load(path)
+        return ProcedureSession.load(path)
     except SessionError as exc:
         raise CliError(str(exc)) from None
 
@@ -131,7 +131,7 @@ def _run(args) -> int:
     from fha_studio.logic.procedures import (
         ProcedureError,
         ProcedureRun,
-        Session,
+        ProcedureSession,
         StepInputError,
         load_procedure,
     )
@@ -144,7 +144,7 @@ def _run(args) -> int:
         if not args.actuator:
             raise CliError(f"{args.session} does not exist: give --actuator CODE to start a new session")
         _context(args.actuator)
-        session = Session(actuator_code=args.actuator.strip().upper(), operator=args.operator)
+        session = ProcedureSession(actuator_code=args.actuator.strip().upper(), operator=args.operator)
         session.save(args.session)
     context = _context(session.actuator_code)
     try:

@@ -3,8 +3,9 @@ back what was typed: in the item's unit, or as a choice with its meaning."""
 
 from __future__ import annotations
 
-#: The manual's word for each mode the editor shows (system items are "parameter" mode).
-MODE_WORDS = {"tune": "tune", "system": "parameter"}
+from fha_studio.hardware.parameters import MODE_WORDS  # the manual's word for each mode
+
+__all__ = ["MODE_WORDS", "parse_value", "range_text", "value_text"]
 
 
 def parse_value(item, text: str) -> int:

@@ -37,7 +37,7 @@ class Mode(StrEnum):
 MODE_WORDS = {Mode.MONITOR: "monitor", Mode.TUNE: "tune", Mode.SYSTEM: "parameter", Mode.TEST: "test"}
 
 
-class ParameterFileError(ValueError):
+class ParameterTableError(ValueError):
     """A parameter or alarm file is malformed; the message names the file and the item."""
 
 
@@ -198,8 +198,8 @@ def split_low_high(count: int) -> tuple[int, int]:
     return sign * low, sign * high
 
 
-def _fail(path: str, where: str, what: str) -> ParameterFileError:
-    return ParameterFileError(f"{path}: {where}: {what}")
+def _fail(path: str, where: str, what: str) -> ParameterTableError:
+    return ParameterTableError(f"{path}: {where}: {what}")
 
 
 def _item_from_table(path: str, index: int, raw: dict[str, Any], all_uncertain: bool) -> ParameterItem:
@@ -281,7 +281,7 @@ def _read_toml(name: str) -> tuple[str, dict[str, Any]]:
         try:
             return str(path), tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
-            raise ParameterFileError(f"{path}: {exc}") from None
+            raise ParameterTableError(f"{path}: {exc}") from None
 
 
 def _driver_file(driver: str) -> str:
@@ -294,7 +294,7 @@ def _driver_file(driver: str) -> str:
 def load_parameter_model(driver: str = "HA-655") -> ParameterModel:
     """The items of ``driver`` ("HA-655" or "HA-675") from ``resources/drive/``.
 
-    Raises ParameterFileError naming the file and item when the data is malformed.
+    Raises ParameterTableError naming the file and item when the data is malformed.
     """
     path, data = _read_toml(_driver_file(driver))
     all_uncertain = bool(data.get("all_uncertain", False))
@@ -308,9 +308,9 @@ def load_parameter_model(driver: str = "HA-655") -> ParameterModel:
     seen_keys: set[str] = set()
     for item in items:
         if (item.mode, item.number) in seen_numbers:
-            raise ParameterFileError(f"{path}: {item.mode.value} item {item.number} appears twice")
+            raise ParameterTableError(f"{path}: {item.mode.value} item {item.number} appears twice")
         if item.key in seen_keys:
-            raise ParameterFileError(f"{path}: key '{item.key}' appears twice")
+            raise ParameterTableError(f"{path}: key '{item.key}' appears twice")
         seen_numbers.add((item.mode, item.number))
         seen_keys.add(item.key)
     return ParameterModel(driver, items)
@@ -393,5 +393,5 @@ def load_alarm_table(driver: str = "HA-655") -> AlarmTable:
             raise _fail(path, where, "code must be 1 ... 99")
         alarms.append(alarm)
     if len({a.code for a in alarms}) != len(alarms):
-        raise ParameterFileError(f"{path}: an alarm code appears twice")
+        raise ParameterTableError(f"{path}: an alarm code appears twice")
     return AlarmTable(driver, alarms)

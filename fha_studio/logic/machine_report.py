@@ -16,7 +16,7 @@ from typing import Any
 
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures.report import CommissioningReport, build_report, render_html
-from fha_studio.logic.procedures.session import Session, SessionError, utc_now
+from fha_studio.logic.procedures.session import ProcedureSession, SessionError, utc_now
 
 #: (mode, number) of the rotary direction item (HA-655 manual, parameter mode 8; FHA-C manual 1-10).
 ROTARY_DIRECTION = ("system", 8)
@@ -63,7 +63,7 @@ def direction_text(value: int | None) -> str:
     return f"{value}: not a value of the 1-10 table"
 
 
-def _checks(session: Session | None) -> tuple[int, int]:
+def _checks(session: ProcedureSession | None) -> tuple[int, int]:
     if session is None:
         return 0, 0
     latest: dict[tuple[str, str], bool] = {}
@@ -74,7 +74,7 @@ def _checks(session: Session | None) -> tuple[int, int]:
     return passed, len(latest) - passed
 
 
-def _origin(axis: MachineAxis, session: Session | None, register: Any, axis_ref: str) -> str:
+def _origin(axis: MachineAxis, session: ProcedureSession | None, register: Any, axis_ref: str) -> str:
     angles = session.sensor_angles_deg if session is not None else {}
     if "origin_sensor" in angles:
         return f"origin sensor at {float(angles['origin_sensor']):+.2f}° (4-7-2)"
@@ -88,7 +88,9 @@ def _origin(axis: MachineAxis, session: Session | None, register: Any, axis_ref:
     return "not recorded"
 
 
-def _direction_value(axis: MachineAxis, session: Session | None, register: Any, axis_ref: str) -> int | None:
+def _direction_value(
+    axis: MachineAxis, session: ProcedureSession | None, register: Any, axis_ref: str
+) -> int | None:
     # the register knows every read and verified write of the axis; the state what this program
     # read since it started; the session what was read for its report
     if register is not None:
@@ -110,7 +112,7 @@ def _direction_value(axis: MachineAxis, session: Session | None, register: Any, 
 
 def build_machine_report(
     project: MachineProject,
-    sessions: Mapping[str, Session | None] | None = None,
+    sessions: Mapping[str, ProcedureSession | None] | None = None,
     register: Any = None,
 ) -> MachineReport:
     """The report of ``project``. ``sessions`` maps axis names to their procedure sessions (an
@@ -122,7 +124,7 @@ def build_machine_report(
         session = sessions.get(axis.name)
         if axis.name not in sessions and axis.session_file is not None:
             try:
-                session = Session.load(axis.session_file)
+                session = ProcedureSession.load(axis.session_file)
             except SessionError as exc:
                 problems.append(f"axis {axis.name}: {exc}")
         ref = f"{project.name}/{axis.name}"
@@ -230,6 +232,6 @@ def render_machine_html(report: MachineReport) -> str:
 
 def _fallback_style() -> str:
     # no axis has a report: the axis report's style, taken from an empty session's report
-    sample = render_html(build_report(Session(actuator_code="FHA-25C-50-US250")))
+    sample = render_html(build_report(ProcedureSession(actuator_code="FHA-25C-50-US250")))
     match = _STYLE.search(sample)
     return match.group(1) if match else ""

@@ -120,7 +120,7 @@ def test_malformed_item_is_reported_with_file_and_item(tmp_path, monkeypatch):
         'description = ""\nsource = ""\nassumed = []\n'
     )
     monkeypatch.setattr(P, "resource", lambda *parts: tmp_path.joinpath(*parts))
-    with pytest.raises(P.ParameterFileError, match=r"ha655-parameters.toml: item #1 \(tune 0 k\).*minimum"):
+    with pytest.raises(P.ParameterTableError, match=r"ha655-parameters.toml: item #1 \(tune 0 k\).*minimum"):
         P.load_parameter_model()
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import io
 
 from fha_studio.cli import main
-from fha_studio.logic.procedures import Session
+from fha_studio.logic.procedures import ProcedureSession
 
 CODE = "FHA-17C-50-US250-B"
 
@@ -45,7 +45,7 @@ def test_run_in_the_terminal_pause_resume_and_report(tmp_path, monkeypatch, caps
         )
         == 0
     )
-    assert Session.load(path).runs["receiving-inspection"].status == "paused"
+    assert ProcedureSession.load(path).runs["receiving-inspection"].status == "paused"
     answers = io.StringIO(f"{CODE}\nHA-655-2-200\n200\n\ny\n")  # live step: no drive, confirmed by hand
     monkeypatch.setattr("sys.stdin", answers)
     assert (
@@ -62,7 +62,7 @@ def test_run_in_the_terminal_pause_resume_and_report(tmp_path, monkeypatch, caps
         )
         == 0
     )
-    run = Session.load(path).runs["receiving-inspection"]
+    run = ProcedureSession.load(path).runs["receiving-inspection"]
     assert run.status == "completed" and run.records[-1].value == CODE  # seen on the drive
     assert main(["procedures", "report", str(path), "-o", str(tmp_path / "r.html")]) == 0
     html = (tmp_path / "r.html").read_text()
@@ -78,6 +78,6 @@ def test_a_failed_check_stops_until_put_right(tmp_path, monkeypatch, capsys):
     assert "Service temperature must be 0 °C to 40 °C" in capsys.readouterr().out
     monkeypatch.setattr("sys.stdin", io.StringIO("air conditioning on\n25\n"))
     assert main(["procedures", "run", "installation", "--session", str(path)]) == 0
-    session = Session.load(path)
+    session = ProcedureSession.load(path)
     assert [r.value for r in session.runs["installation"].records] == [41.0, 25.0]
     assert "air conditioning on" in session.notes[0]["text"]

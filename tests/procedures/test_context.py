@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from fha_studio.catalog import ModelCodeError, all_model_codes
-from fha_studio.logic.procedures import ProcedureRun, Session, load_all, load_procedure
+from fha_studio.logic.procedures import ProcedureRun, ProcedureSession, load_all, load_procedure
 from fha_studio.logic.procedures.context import build_context
 from tests.procedures.conftest import _context
 from tests.procedures.walk import walk
@@ -52,7 +52,7 @@ def test_the_options_choose_the_tables():
 @pytest.mark.parametrize("code", ["FHA-17C-50-US250-B-L", "FHA-32C-160-S248-B-L", "FHA-40C-100-US250"])
 def test_every_procedure_walks_for_catalogue_actuators(code, tmp_path):
     context = build_context(code)
-    session = Session(actuator_code=code, operator="T")
+    session = ProcedureSession(actuator_code=code, operator="T")
     session.save(tmp_path / "s.json")
     for procedure in load_all(context):
         if procedure.applies:

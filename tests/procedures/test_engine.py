@@ -10,7 +10,7 @@ from fha_studio.logic.procedures import (
     Observation,
     ProcedureError,
     ProcedureRun,
-    Session,
+    ProcedureSession,
     SessionError,
     StepInputError,
     load_all,
@@ -34,7 +34,7 @@ def test_every_procedure_file_loads(context):
 
 @pytest.mark.parametrize("procedure_id", PROCEDURES)
 def test_walk_each_procedure_to_the_end(context, tmp_path, procedure_id):
-    session = Session(actuator_code=context["actuator"]["model_code"], operator="T. Trainee")
+    session = ProcedureSession(actuator_code=context["actuator"]["model_code"], operator="T. Trainee")
     session.save(tmp_path / "axis1.json")
     run = ProcedureRun(session, load_procedure(procedure_id, context))
     answered = walk(run)
@@ -65,14 +65,15 @@ def test_options_choose_the_steps(make_context):
     assert not any(s.id.startswith("encoder-lead-abs") for s in wiring.steps)
     assert not load_procedure("sensor-adjustment", plain).applies
     with pytest.raises(ProcedureError, match="does not apply"):
-        ProcedureRun(Session(actuator_code="FHA-25C-50-US250"), load_procedure("sensor-adjustment", plain))
+        ProcedureRun(ProcedureSession(actuator_code="FHA-25C-50-US250"),
+                     load_procedure("sensor-adjustment", plain))
     absolute = make_context(brake=False, absolute=True, sensor_set=False)
     ids = load_procedure("wiring", absolute).step_ids()
     assert "encoder-lead-abs.1" in ids and "absolute-battery" in ids and "encoder-leads" not in ids
 
 
 def test_an_answer_chooses_the_encoder_table(context):
-    run = ProcedureRun(Session(actuator_code="x"), load_procedure("wiring", context), autosave=False)
+    run = ProcedureRun(ProcedureSession(actuator_code="x"), load_procedure("wiring", context), autosave=False)
     seen = []
     while (step := run.current()) is not None:
         seen.append(step.id)
@@ -81,7 +82,7 @@ def test_an_answer_chooses_the_encoder_table(context):
 
 
 def test_a_mismatch_stops_with_the_manuals_warning_and_retry_goes_on(context, tmp_path):
-    session = Session(actuator_code=context["actuator"]["model_code"], operator="T. Trainee")
+    session = ProcedureSession(actuator_code=context["actuator"]["model_code"], operator="T. Trainee")
     session.save(tmp_path / "s.json")
     run = ProcedureRun(session, load_procedure("receiving-inspection", context))
     run.submit(True)
@@ -101,21 +102,23 @@ def test_a_mismatch_stops_with_the_manuals_warning_and_retry_goes_on(context, tm
     run.submit("HA-655-2-200")
     assert run.submit("100").passed is False  # site supplies 100 V to a 200 V driver
     assert "Do not connect a supply voltage other than" in run.state.stop_warning
-    saved = Session.load(tmp_path / "s.json")
+    saved = ProcedureSession.load(tmp_path / "s.json")
     failed = [r for r in saved.runs["receiving-inspection"].records if not r.passed]
     assert [r.step_id for r in failed] == ["driver-adjusted-for", "driver-type-label", "site-supply-voltage"]
     assert any("retried" in n["text"] and n["who"] == "Supervisor" for n in saved.notes)
 
 
 def test_a_measured_value_outside_its_limits_fails(context):
-    run = ProcedureRun(Session(actuator_code="x"), load_procedure("installation", context), autosave=False)
+    run = ProcedureRun(ProcedureSession(actuator_code="x"), load_procedure("installation", context),
+                       autosave=False)
     record = run.submit("41,5")  # comma decimal accepted
     assert record.value == 41.5 and not record.passed and record.unit == "°C"
     assert "less than 40 °C" in run.state.stop_warning
 
 
 def test_bad_input_records_nothing(context):
-    run = ProcedureRun(Session(actuator_code="x"), load_procedure("installation", context), autosave=False)
+    run = ProcedureRun(ProcedureSession(actuator_code="x"), load_procedure("installation", context),
+                       autosave=False)
     for bad in ("warm", "nan", True, ""):
         with pytest.raises(StepInputError):
             run.submit(bad)
@@ -129,25 +132,25 @@ def test_bad_input_records_nothing(context):
 
 def test_pause_and_resume_after_a_restart(context, tmp_path):
     path = tmp_path / "axis1.json"
-    session = Session(actuator_code=context["actuator"]["model_code"], operator="A")
+    session = ProcedureSession(actuator_code=context["actuator"]["model_code"], operator="A")
     session.save(path)
     run = ProcedureRun(session, load_procedure("wiring", context))
     for _ in range(5):
         run.submit(good_answer(run.current()), who="A")
     here = run.current().id
     run.pause()
-    assert Session.load(path).runs["wiring"].status == "paused"
+    assert ProcedureSession.load(path).runs["wiring"].status == "paused"
     del run, session  # "restart"
-    resumed = ProcedureRun(Session.load(path), load_procedure("wiring", context))
+    resumed = ProcedureRun(ProcedureSession.load(path), load_procedure("wiring", context))
     assert resumed.current().id == here and resumed.state.status == "running"
     walk(resumed, who="B")
-    final = Session.load(path).runs["wiring"]
+    final = ProcedureSession.load(path).runs["wiring"]
     assert final.status == "completed"
     assert {r.who for r in final.records} == {"A", "B"}
 
 
 def test_resume_refuses_a_changed_procedure(context, tmp_path, make_context):
-    session = Session(actuator_code="x")
+    session = ProcedureSession(actuator_code="x")
     run = ProcedureRun(session, load_procedure("wiring", context), autosave=False)
     run.submit(True)
     other = load_procedure("wiring", make_context(brake=False))
@@ -156,7 +159,7 @@ def test_resume_refuses_a_changed_procedure(context, tmp_path, make_context):
 
 
 def test_sensor_angles_are_checked_against_the_movable_range(context):
-    session = Session(actuator_code="x")
+    session = ProcedureSession(actuator_code="x")
     run = ProcedureRun(session, load_procedure("sensor-adjustment", context), autosave=False)
     run.submit(True)
     run.submit(True)
@@ -199,6 +202,6 @@ def test_session_file_errors_name_the_file(tmp_path):
     path = tmp_path / "x.json"
     path.write_text("{}")
     with pytest.raises(SessionError, match=r"x\.json: not an fha-session/1"):
-        Session.load(path)
+        ProcedureSession.load(path)
     with pytest.raises(SessionError, match="no such session"):
-        Session.load(tmp_path / "none.json")
+        ProcedureSession.load(tmp_path / "none.json")

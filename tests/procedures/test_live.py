@@ -5,7 +5,13 @@ from __future__ import annotations
 import pytest
 
 from fha_studio.hardware.client import DriveClient
-from fha_studio.logic.procedures import Observation, ProcedureRun, Session, StepInputError, load_procedure
+from fha_studio.logic.procedures import (
+    Observation,
+    ProcedureRun,
+    ProcedureSession,
+    StepInputError,
+    load_procedure,
+)
 from fha_studio.logic.procedures.context import build_context
 from fha_studio.logic.procedures.live import LiveEnv, move_and_watch, output_angle_deg, run_live_check
 from fha_studio.logic.procedures.sensor_dogs import SensorDogWizard
@@ -38,7 +44,7 @@ def _walk_live(run: ProcedureRun, client: DriveClient, env: LiveEnv, before=None
 
 def test_receiving_inspection_asks_the_drive_what_it_was_adjusted_for(drive, tmp_path):
     context = build_context(CODE)
-    session = Session(actuator_code=CODE, operator="T. Trainee")
+    session = ProcedureSession(actuator_code=CODE, operator="T. Trainee")
     run = ProcedureRun(session, load_procedure("receiving-inspection", context), autosave=False)
     seen = _walk_live(run, drive, LiveEnv(context))
     assert run.completed
@@ -49,7 +55,7 @@ def test_a_drive_adjusted_for_another_actuator_stops_the_inspection(drive):
     other = "FHA-25C-100-US250-B-L"  # the order and the labels say 1:100, the drive was tuned for 1:50
     context = build_context(other)
     run = ProcedureRun(
-        Session(actuator_code=other), load_procedure("receiving-inspection", context), autosave=False
+        ProcedureSession(actuator_code=other), load_procedure("receiving-inspection", context), autosave=False
     )
     _walk_live(run, drive, LiveEnv(context))
     assert run.stopped and run.state.stop_step_id == "drive-identity"
@@ -59,7 +65,7 @@ def test_a_drive_adjusted_for_another_actuator_stops_the_inspection(drive):
 
 def test_wiring_with_brake_and_encoder_checked_live(drive):
     context = build_context(CODE)
-    session = Session(actuator_code=CODE, operator="T. Trainee")
+    session = ProcedureSession(actuator_code=CODE, operator="T. Trainee")
     run = ProcedureRun(session, load_procedure("wiring", context), autosave=False)
 
     def trainee(step):  # the trainee switches the brake's 24 V as the step says
@@ -78,7 +84,8 @@ def test_wiring_with_brake_and_encoder_checked_live(drive):
 
 def test_a_brake_that_does_not_release_stops_the_wiring_check(drive):
     context = build_context(CODE)
-    run = ProcedureRun(Session(actuator_code=CODE), load_procedure("wiring", context), autosave=False)
+    run = ProcedureRun(ProcedureSession(actuator_code=CODE), load_procedure("wiring", context),
+                       autosave=False)
     _walk_live(run, drive, LiveEnv(context))  # nobody switches the 24 V on
     assert run.stopped and run.state.stop_step_id == "brake-releases"
     assert "did not release" in run.state.stop_warning
@@ -87,7 +94,7 @@ def test_a_brake_that_does_not_release_stops_the_wiring_check(drive):
 def test_rotary_direction_sees_the_axis_turn(drive):
     context = build_context(CODE)
     run = ProcedureRun(
-        Session(actuator_code=CODE), load_procedure("rotary-direction", context), autosave=False
+        ProcedureSession(actuator_code=CODE), load_procedure("rotary-direction", context), autosave=False
     )
     seen = dict(_walk_live(run, drive, LiveEnv(context)))
     assert run.completed
@@ -95,7 +102,7 @@ def test_rotary_direction_sees_the_axis_turn(drive):
     assert seen["jog-fwd"].value == pytest.approx(5.0, abs=0.3) and "CW" in seen["jog-fwd"].detail
     # the other direction wanted: parameter 8 still 0 stops it
     run2 = ProcedureRun(
-        Session(actuator_code=CODE), load_procedure("rotary-direction", context), autosave=False
+        ProcedureSession(actuator_code=CODE), load_procedure("rotary-direction", context), autosave=False
     )
     run2.submit("CCW")
     run2.submit(run_live_check(drive, run2.current(), LiveEnv(context)))
@@ -107,7 +114,7 @@ def test_sensor_dog_adjustment_on_the_simulated_drive(drive, tmp_path):
     """The whole 4-7-2 procedure: dogs moved on the simulated actuator, angles found live, test run."""
     context = build_context(CODE)
     path = tmp_path / "axis.json"
-    session = Session(actuator_code=CODE, operator="T. Trainee")
+    session = ProcedureSession(actuator_code=CODE, operator="T. Trainee")
     session.save(path)
     run = ProcedureRun(session, load_procedure("sensor-adjustment", context))
     wizard = SensorDogWizard.for_context(context)
@@ -141,7 +148,7 @@ def test_sensor_dog_adjustment_on_the_simulated_drive(drive, tmp_path):
     assert wizard.found("limit_switch_1") == pytest.approx(-15.0, abs=1.0)
     assert run.submit(wizard.found("limit_switch_1")).passed
     run.pause()  # coffee; the app is closed and opened again
-    session = Session.load(path)
+    session = ProcedureSession.load(path)
     run = ProcedureRun(session, load_procedure("sensor-adjustment", context))
     assert run.current().sensor == "origin_sensor"
     drive.set_sensor_angle("origin", 3.0)
@@ -157,7 +164,7 @@ def test_sensor_dog_adjustment_on_the_simulated_drive(drive, tmp_path):
     assert seen.passed, seen.detail
     run.submit(seen)
     assert run.completed
-    saved = Session.load(path)
+    saved = ProcedureSession.load(path)
     assert set(saved.sensor_angles_deg) == {"limit_switch_1", "limit_switch_2", "origin_sensor"}
     assert saved.runs["sensor-adjustment"].records[-1].value["limit_switch_2"]
 
@@ -165,7 +172,7 @@ def test_sensor_dog_adjustment_on_the_simulated_drive(drive, tmp_path):
 def test_a_drive_that_cannot_tell_is_confirmed_by_hand(drive):
     context = build_context(CODE)
     run = ProcedureRun(
-        Session(actuator_code=CODE), load_procedure("receiving-inspection", context), autosave=False
+        ProcedureSession(actuator_code=CODE), load_procedure("receiving-inspection", context), autosave=False
     )
     while run.current().kind != "live":
         run.submit(good_answer(run.current()))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from fha_studio.logic.procedures import ProcedureRun, Session, load_procedure
+from fha_studio.logic.procedures import ProcedureRun, ProcedureSession, load_procedure
 from fha_studio.logic.procedures.report import SignError, build_report, render_html, sign
 from tests.procedures.walk import walk
 
@@ -12,7 +12,8 @@ ALL = ["receiving-inspection", "installation", "wiring", "sensor-adjustment", "r
 
 
 def _finished_session(context, path):
-    session = Session(actuator_code=context["actuator"]["model_code"], operator="T. Trainee", site="Line 3")
+    session = ProcedureSession(actuator_code=context["actuator"]["model_code"], operator="T. Trainee",
+                               site="Line 3")
     session.driver = {"model": "HA-655-2-200", "adjusted_for": "FHA-25C-50-US250-B-L", "version": "sim 1"}
     session.save(path)
     for procedure_id in ALL:
@@ -31,8 +32,8 @@ def test_report_of_a_finished_session_signs_and_reproduces(context, tmp_path):
     report = build_report(session, context)
     assert report.warnings == ()
     sign(session, "T. Trainee", context)
-    html = render_html(build_report(Session.load(path), context))
-    assert html == render_html(build_report(Session.load(path), context))  # reproducible
+    html = render_html(build_report(ProcedureSession.load(path), context))
+    assert html == render_html(build_report(ProcedureSession.load(path), context))  # reproducible
     for text in (
         "FHA-25C-50-US250-B-L",
         "HA-655-2-200",
@@ -52,7 +53,7 @@ def test_report_of_a_finished_session_signs_and_reproduces(context, tmp_path):
 
 
 def test_open_warnings_block_the_signature(context, tmp_path):
-    session = Session(actuator_code=context["actuator"]["model_code"], operator="T. Trainee")
+    session = ProcedureSession(actuator_code=context["actuator"]["model_code"], operator="T. Trainee")
     run = ProcedureRun(session, load_procedure("receiving-inspection", context), autosave=False)
     run.submit(True)
     run.submit("FHA-25C-50-US250")  # the label lacks -B-L: not what was ordered
@@ -66,7 +67,7 @@ def test_open_warnings_block_the_signature(context, tmp_path):
 
 
 def test_a_failure_put_right_stays_in_the_history(context):
-    session = Session(actuator_code="x")
+    session = ProcedureSession(actuator_code="x")
     run = ProcedureRun(session, load_procedure("installation", context), autosave=False)
     run.submit(45)
     run.retry(note="air conditioning repaired")
@@ -80,7 +81,7 @@ def test_a_failure_put_right_stays_in_the_history(context):
 
 def test_options_that_do_not_apply_say_so(make_context):
     context = make_context(brake=False, sensor_set=False)
-    report = build_report(Session(actuator_code="x"), context)
+    report = build_report(ProcedureSession(actuator_code="x"), context)
     sensor = next(p for p in report.procedures if p.id == "sensor-adjustment")
     assert sensor.status == "not applicable"
     assert not any("Rotary position sensor" in w for w in report.warnings)

@@ -78,9 +78,9 @@ def test_history_diff_find_in_words_and_json(capsys, db):
 
 
 def test_open_items_import_and_export(capsys, db, tmp_path):
-    from fha_studio.logic.procedures import Session
+    from fha_studio.logic.procedures import ProcedureSession
 
-    session = Session(actuator_code="FHA-25C-50-US250", axis="table", operator="ana")
+    session = ProcedureSession(actuator_code="FHA-25C-50-US250", axis="table", operator="ana")
     session.save(tmp_path / "table.json")
     code, out, _ = run(capsys, db, "import", str(tmp_path / "table.json"), "--machine", "Line 3")
     assert code == 0 and "-> Line 3/table: 0 new check(s), 5 procedure(s)" in out

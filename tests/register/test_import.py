@@ -9,7 +9,7 @@ import pytest
 
 from fha_studio.hardware.parameters import load_parameter_model
 from fha_studio.logic.paramfile import dump_parameter_file
-from fha_studio.logic.procedures import ProcedureRun, Session, load_procedure
+from fha_studio.logic.procedures import ProcedureRun, ProcedureSession, load_procedure
 from fha_studio.logic.procedures.context import build_context
 from fha_studio.logic.register import RegisterError, import_parameter_file, import_session_file
 from tests.procedures.walk import walk
@@ -18,7 +18,7 @@ CODE = "FHA-25C-50-US250"
 
 
 def _session(path, operator="T. Trainee"):
-    session = Session(actuator_code=CODE, axis="table", operator=operator, site="Plant A")
+    session = ProcedureSession(actuator_code=CODE, axis="table", operator=operator, site="Plant A")
     session.driver = {"model": "HA-655-2-200", "adjusted_for": CODE, "version": "sim 1"}
     session.parameters = {
         "values": {"rotary_direction": 1, "in_position_range": 20},

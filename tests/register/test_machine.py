@@ -10,7 +10,7 @@ import pytest
 from fha_studio.catalog import ModelCodeError
 from fha_studio.logic.machine import MachineError, MachineProject
 from fha_studio.logic.machine_report import build_machine_report, direction_text, render_machine_html
-from fha_studio.logic.procedures import ProcedureRun, Session, load_procedure
+from fha_studio.logic.procedures import ProcedureRun, ProcedureSession, load_procedure
 from fha_studio.logic.procedures.context import build_context
 from fha_studio.logic.procedures.report import sign
 from tests.procedures.walk import walk
@@ -79,8 +79,8 @@ def test_the_project_goes_into_the_register_and_comes_back(register):
     assert len(register.history("Line 3 positioner/roll")) == before
 
 
-def _finished_session(code: str, axis: str, path, who="T. Trainee") -> Session:
-    session = Session(actuator_code=code, axis=axis, operator=who, site="Plant A")
+def _finished_session(code: str, axis: str, path, who="T. Trainee") -> ProcedureSession:
+    session = ProcedureSession(actuator_code=code, axis=axis, operator=who, site="Plant A")
     session.driver = {"model": "HA-655-2-200", "adjusted_for": code, "version": "sim"}
     session.save(path)
     context = build_context(code)
@@ -102,7 +102,7 @@ def test_machine_report_summarises_every_axis_then_each_report(register, tmp_pat
     project.save_to(register)
     table = _finished_session("FHA-25C-50-US250-L", "table", tmp_path / "table.json")
     sign(table, "T. Trainee")
-    twin = Session(actuator_code="FHA-25C-50-US250-L", axis="table twin", operator="ben")
+    twin = ProcedureSession(actuator_code="FHA-25C-50-US250-L", axis="table twin", operator="ben")
     run = ProcedureRun(
         twin, load_procedure("receiving-inspection", build_context(twin.actuator_code)), autosave=False
     )

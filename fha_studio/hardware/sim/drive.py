@@ -51,7 +51,7 @@ from fha_studio.hardware.sim.axis import (
 from fha_studio.hardware.sim.commands import COMMANDS, DEFERRED, DOCUMENTED_ONLY, Handler
 from fha_studio.hardware.sim.constants import SimConstants, load_sim_constants
 from fha_studio.hardware.sim.eeprom import EepromFile, default_eeprom_dir
-from fha_studio.hardware.sim.io import IoState
+from fha_studio.hardware.sim.io import SimIo
 from fha_studio.hardware.sim.memory import ItemId, ParameterMemory, PersistentState
 from fha_studio.hardware.sim.options import SimConfig, SimConfigError
 from fha_studio.hardware.sim.recorder import SimRecorder
@@ -116,7 +116,7 @@ class SimDrive:
         self.alarm_table = load_alarm_table(family)
 
         c = self.constants
-        self.io = IoState(
+        self.io = SimIo(
             c,
             has_sensors=self.has_sensors,
             has_brake=self.has_brake,

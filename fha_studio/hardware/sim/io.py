@@ -32,7 +32,7 @@ def _wrap_deg(angle: float) -> float:
     return (angle + 180.0) % 360.0 - 180.0
 
 
-class IoState:
+class SimIo:
     """Inputs, sensors and brake of one drive. Angles are physical (CW positive seen from the
     flange), in degrees of the output; the sensor disk turns with the output."""
 

@@ -166,7 +166,7 @@ class Trial:
 
 
 @dataclass
-class Step:
+class SelectionStep:
     """One forward (or backward) selection step."""
 
     kind: str  # "nominal", "forward", "backward"
@@ -198,7 +198,7 @@ class ChannelResult:
     floor: float
     n: int
     terms: list[FittedTerm]
-    steps: list[Step]
+    steps: list[SelectionStep]
     ar_order: int
     fitted: np.ndarray  # fitted residual (decimated)
     y: np.ndarray  # the residual (decimated)
@@ -379,9 +379,9 @@ class ChannelSelector:
         return bool(np.all(np.sign(np.cumsum(beta)) == cand.sign))
 
     # --- selection
-    def select(self, nominal_first: tuple[str, ...] = ()) -> tuple[list[Term], list[Step]]:
+    def select(self, nominal_first: tuple[str, ...] = ()) -> tuple[list[Term], list[SelectionStep]]:
         terms: list[Term] = []
-        steps: list[Step] = []
+        steps: list[SelectionStep] = []
         # re-fit the nominal parameters before blaming a missing effect
         for cid in nominal_first:
             cand = next((c for c in self.candidates if c.id == cid), None)
@@ -389,7 +389,7 @@ class ChannelSelector:
                 continue
             trial, term = self.try_add(cand, terms)
             steps.append(
-                Step(
+                SelectionStep(
                     "nominal",
                     len(self._ar_for(self.design([*terms, term]))),
                     [trial],
@@ -404,7 +404,8 @@ class ChannelSelector:
             trials = [self.try_add(cand, terms) for cand in self.candidates if cand.id not in chosen]
             good = [(tr, tm) for tr, tm in trials if tr.accepted]
             best = min(good, key=lambda p: p[0].delta_bic) if good else None
-            steps.append(Step("forward", len(phi), [tr for tr, _ in trials], best[0].id if best else None))
+            chosen = best[0].id if best else None
+            steps.append(SelectionStep("forward", len(phi), [tr for tr, _ in trials], chosen))
             if best is None:
                 break
             terms.append(best[1])
@@ -437,7 +438,7 @@ class ChannelSelector:
             weakest = min(trials, key=lambda tr: -tr.delta_bic if not tr.accepted else math.inf)
             if not weakest.accepted:
                 terms = [t for t in terms if t.id != weakest.id]
-                steps.append(Step("backward", len(phi), trials, weakest.id))
+                steps.append(SelectionStep("backward", len(phi), trials, weakest.id))
                 changed = True
         return terms, steps
 

@@ -33,7 +33,7 @@ from fha_studio.logic.modelcheck.selection import (
     BIC_MIN,
     ChannelSelector,
     FittedTerm,
-    Step,
+    SelectionStep,
     block_cv,
     block_edges,
 )
@@ -192,7 +192,7 @@ class ChannelReport:
     channel: str
     unit: str
     floor: float
-    steps: list[Step]
+    steps: list[SelectionStep]
     ar_order: int
     n_samples: int
 

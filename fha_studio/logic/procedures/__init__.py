@@ -17,7 +17,7 @@ from fha_studio.logic.procedures.definitions import (
     load_procedure,
 )
 from fha_studio.logic.procedures.engine import Observation, ProcedureRun, StepInputError
-from fha_studio.logic.procedures.session import CheckRecord, RunState, Session, SessionError
+from fha_studio.logic.procedures.session import CheckRecord, ProcedureSession, RunState, SessionError
 
 __all__ = [
     "CheckRecord",
@@ -25,8 +25,8 @@ __all__ = [
     "Procedure",
     "ProcedureError",
     "ProcedureRun",
+    "ProcedureSession",
     "RunState",
-    "Session",
     "SessionError",
     "Step",
     "StepInputError",

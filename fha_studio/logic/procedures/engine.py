@@ -31,8 +31,8 @@ from fha_studio.logic.procedures.session import (
     RUNNING,
     STOPPED,
     CheckRecord,
+    ProcedureSession,
     RunState,
-    Session,
     utc_now,
 )
 
@@ -59,7 +59,7 @@ def normalise_label(text: str) -> str:
 class ProcedureRun:
     """One procedure walked in one session. State lives in ``session.runs[procedure.id]``."""
 
-    def __init__(self, session: Session, procedure: Procedure, autosave: bool = True):
+    def __init__(self, session: ProcedureSession, procedure: Procedure, autosave: bool = True):
         if not procedure.applies:
             raise ProcedureError(f"procedure '{procedure.id}' does not apply to {session.actuator_code}")
         self.session = session

@@ -15,7 +15,7 @@ from typing import Any
 
 from fha_studio.logic.procedures.definitions import Procedure, load_all
 from fha_studio.logic.procedures.sensor_dogs import SENSOR_NAMES
-from fha_studio.logic.procedures.session import COMPLETED, STOPPED, CheckRecord, Session, utc_now
+from fha_studio.logic.procedures.session import COMPLETED, STOPPED, CheckRecord, ProcedureSession, utc_now
 
 
 class SignError(ValueError):
@@ -80,13 +80,13 @@ class CommissioningReport:
         return tuple(p for p in self.parameters if p.changed)
 
 
-def _context_for(session: Session) -> Mapping[str, Any]:
+def _context_for(session: ProcedureSession) -> Mapping[str, Any]:
     from fha_studio.logic.procedures.context import build_context
 
     return build_context(session.actuator_code)
 
 
-def open_warnings(session: Session, procedures: list[Procedure]) -> list[str]:
+def open_warnings(session: ProcedureSession, procedures: list[Procedure]) -> list[str]:
     """What stands between this session and a signed report, one line each."""
     warnings = []
     for procedure in procedures:
@@ -109,7 +109,7 @@ def open_warnings(session: Session, procedures: list[Procedure]) -> list[str]:
     return warnings
 
 
-def _parameter_rows(session: Session) -> tuple[str, tuple[ParameterRow, ...], list[str]]:
+def _parameter_rows(session: ProcedureSession) -> tuple[str, tuple[ParameterRow, ...], list[str]]:
     params = session.parameters or {}
     values: Mapping[str, Any] = params.get("values", {})
     if not values:
@@ -144,7 +144,7 @@ def _parameter_rows(session: Session) -> tuple[str, tuple[ParameterRow, ...], li
     return str(params.get("file", "")), tuple(rows), problems
 
 
-def build_report(session: Session, context: Mapping[str, Any] | None = None) -> CommissioningReport:
+def build_report(session: ProcedureSession, context: Mapping[str, Any] | None = None) -> CommissioningReport:
     """The report of ``session``; ``context`` defaults to the catalogue's for its actuator."""
     context = context if context is not None else _context_for(session)
     procedures = load_all(context)
@@ -196,7 +196,7 @@ def build_report(session: Session, context: Mapping[str, Any] | None = None) -> 
     )
 
 
-def sign(session: Session, who: str, context: Mapping[str, Any] | None = None) -> None:
+def sign(session: ProcedureSession, who: str, context: Mapping[str, Any] | None = None) -> None:
     """Sign the session's report; refused (SignError listing what is open) while anything is open."""
     if not who.strip():
         raise SignError("a report is signed with a name")

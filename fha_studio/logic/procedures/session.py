@@ -70,7 +70,7 @@ class RunState:
 
 
 @dataclass
-class Session:
+class ProcedureSession:
     """Everything recorded while commissioning one axis."""
 
     actuator_code: str
@@ -117,7 +117,7 @@ class Session:
         return target
 
     @classmethod
-    def load(cls, path: str | Path) -> Session:
+    def load(cls, path: str | Path) -> ProcedureSession:
         """Read a session file; raises :class:`SessionError` naming the file and the problem."""
         path = Path(path)
         try:

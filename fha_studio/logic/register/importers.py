@@ -115,10 +115,10 @@ def import_session_file(
     """Imports a session file into ``machine`` (added when missing) as the axis ``axis`` (default:
     the axis name the session holds; added when missing, with the session's actuator and driver).
     Raises RegisterError for a file that is not a session file or an axis of another actuator."""
-    from fha_studio.logic.procedures.session import Session, SessionError
+    from fha_studio.logic.procedures.session import ProcedureSession, SessionError
 
     try:
-        session = Session.load(path)
+        session = ProcedureSession.load(path)
     except SessionError as exc:
         raise RegisterError(str(exc)) from None
     name = (axis or session.axis or "axis 1").strip()

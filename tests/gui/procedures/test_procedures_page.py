@@ -10,7 +10,7 @@ import pytest
 
 from fha_studio.gui.link import Cmd
 from fha_studio.hardware.protocol import IoBit
-from fha_studio.logic.procedures import Session
+from fha_studio.logic.procedures import ProcedureSession
 from tests.procedures.walk import good_answer
 
 CODE = "FHA-25C-50-US250-B-L"
@@ -86,7 +86,7 @@ def test_trainee_walks_inspection_and_wiring_with_a_failed_check_and_a_resume(wi
         _answer_by_hand(page)
     here = page.current_step().id
     page.pause_button.click()
-    assert Session.load(path).runs["wiring"].status == "paused"
+    assert ProcedureSession.load(path).runs["wiring"].status == "paused"
 
     page.open_session(path)  # as after a restart
     page.select_procedure("wiring")
@@ -99,7 +99,7 @@ def test_trainee_walks_inspection_and_wiring_with_a_failed_check_and_a_resume(wi
             qtbot.waitUntil(lambda: window.link.status.bit(IoBit.BRAKE_RELEASED) is want, timeout=15000)
 
     _walk(page, qtbot, "wiring", before=trainee)
-    wiring = Session.load(path).runs["wiring"]
+    wiring = ProcedureSession.load(path).runs["wiring"]
     assert wiring.status == "completed", page.warning_label.text()
     assert {r.who for r in wiring.records} == {"T. Trainee"}
     assert "done" in page.procedure_list.item(2).text()
@@ -195,7 +195,7 @@ def test_from_boxed_actuator_to_signed_report(make_window, qtbot, tmp_path):
     ):
         assert wanted in text, wanted
     assert pdf.stat().st_size > 5000
-    assert Session.load(tmp_path / "axis1.json").signature["who"] == "T. Trainee"
+    assert ProcedureSession.load(tmp_path / "axis1.json").signature["who"] == "T. Trainee"
 
 
 def test_a_restarted_app_reopens_the_session_where_it_was_left(make_window, tmp_path):

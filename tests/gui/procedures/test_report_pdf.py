@@ -8,7 +8,7 @@ import subprocess
 import pytest
 
 from fha_studio.gui.pages.procedures.report_pdf import write_report
-from fha_studio.logic.procedures import ProcedureRun, Session, load_procedure
+from fha_studio.logic.procedures import ProcedureRun, ProcedureSession, load_procedure
 from fha_studio.logic.procedures.context import build_context
 from fha_studio.logic.procedures.report import build_report
 from tests.procedures.walk import walk
@@ -18,7 +18,7 @@ CODE = "FHA-32C-100-US250-B"
 
 def test_report_prints_to_pdf(qapp, tmp_path):
     context = build_context(CODE)
-    session = Session(actuator_code=CODE, operator="T. Trainee", site="Hall 2")
+    session = ProcedureSession(actuator_code=CODE, operator="T. Trainee", site="Hall 2")
     session.driver = {"model": "HA-655-4-200", "adjusted_for": CODE, "version": "sim"}
     from PySide6.QtGui import QColor, QImage
 
@@ -60,7 +60,7 @@ def test_page_breaks_never_cut_a_row_and_every_page_is_numbered(qapp, tmp_path):
     from fha_studio.gui.pages.procedures.report_pdf import _unbreakable_spans, page_breaks
 
     context = build_context(CODE)
-    session = Session(actuator_code=CODE, operator="T. Trainee", site="Hall 2")
+    session = ProcedureSession(actuator_code=CODE, operator="T. Trainee", site="Hall 2")
     for procedure_id in ("receiving-inspection", "installation", "wiring"):
         walk(ProcedureRun(session, load_procedure(procedure_id, context), autosave=False))
     report = build_report(session, context)

@@ -44,7 +44,7 @@ from fha_studio.logic.procedures import (
     Procedure,
     ProcedureError,
     ProcedureRun,
-    Session,
+    ProcedureSession,
     SessionError,
     Step,
     StepInputError,
@@ -89,7 +89,7 @@ class ProceduresPage(BasePage):
         self.gui_session = gui_session
         self.link = gui_session.link
         self.main_window = main_window
-        self.session: Session | None = None
+        self.session: ProcedureSession | None = None
         self.context: dict | None = None
         self.procedures: list[Procedure] = []
         self.run: ProcedureRun | None = None
@@ -298,7 +298,7 @@ class ProceduresPage(BasePage):
         if not code:
             raise ProcedureError("the actuator model code (from the order) is needed to start a session")
         context = build_context(code)  # ModelCodeError (a ValueError) says what is wrong with the code
-        session = Session(actuator_code=code, operator=operator, driver=self._identity())
+        session = ProcedureSession(actuator_code=code, operator=operator, driver=self._identity())
         session.save(path)
         self._use(session, context)
 
@@ -306,10 +306,10 @@ class ProceduresPage(BasePage):
         """Open a saved session (resume where it was left)."""
         from fha_studio.logic.procedures.context import build_context
 
-        session = Session.load(path)
+        session = ProcedureSession.load(path)
         self._use(session, build_context(session.actuator_code))
 
-    def _use(self, session: Session, context: dict) -> None:
+    def _use(self, session: ProcedureSession, context: dict) -> None:
         self.session, self.context = session, context
         self.procedures = load_all(context)
         self.run = None
