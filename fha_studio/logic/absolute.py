@@ -200,7 +200,7 @@ ENCODER_CHECK_TOLERANCE = 0.1
 
 
 @dataclass(frozen=True)
-class CheckRecord:
+class DgrCheckRecord:
     """One check done with DGR (or answered by the technician where the drive cannot tell).
 
     ``passed`` None: recorded without a verdict. ``by_hand``: the values were given by the

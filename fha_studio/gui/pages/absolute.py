@@ -75,14 +75,14 @@ def _wrap(label: QLabel) -> QLabel:
 class AbsolutePage(BasePage):
     """Checks with DGR and OWW, for a drive that answers only its manual's commands."""
 
-    sigRecorded = Signal(object)  # CheckRecord
+    sigRecorded = Signal(object)  # DgrCheckRecord
 
     def __init__(self, gui_session, main_window=None):
         super().__init__()
         self.setObjectName("absolutePage")
         self.gui_session = gui_session
         self.link = gui_session.link
-        self.records: list[ab.CheckRecord] = []
+        self.records: list[ab.DgrCheckRecord] = []
         self.servo_on: bool | None = None
         self.encoder: str = "unknown"  # "absolute" | "incremental" | "unknown"
         self.last_counts: int | None = None
@@ -404,8 +404,8 @@ class AbsolutePage(BasePage):
 
     # -- the checks ----------------------------------------------------------------------------
     def _record(self, check: str, values: dict[str, Any], passed: bool | None, detail: str,
-                by_hand: bool = False) -> ab.CheckRecord:
-        record = ab.CheckRecord(check, self.who or "not given", ab.now_text(), values, passed, detail,
+                by_hand: bool = False) -> ab.DgrCheckRecord:
+        record = ab.DgrCheckRecord(check, self.who or "not given", ab.now_text(), values, passed, detail,
                                 by_hand)
         self.records.append(record)
         self._save(record)
@@ -420,7 +420,7 @@ class AbsolutePage(BasePage):
         self.sigRecorded.emit(record)
         return record
 
-    def _save(self, record: ab.CheckRecord) -> None:
+    def _save(self, record: ab.DgrCheckRecord) -> None:
         folder = data_dir() / "checks"
         folder.mkdir(parents=True, exist_ok=True)
         with (folder / "dgr-checks.jsonl").open("a", encoding="utf-8") as f:
