@@ -509,8 +509,9 @@ class RecordingWriter:
         self.close()
 
     def __del__(self):  # pragma: no cover - a writer dropped without close
-        if getattr(self, "_file", None) is not None:
-            self._file.close()
+        file = getattr(self, "_file", None)
+        if file is not None:
+            file.close()
 
 
 def write_recording(path: str | os.PathLike, recording: Recording, *, digits: int = 12) -> None:

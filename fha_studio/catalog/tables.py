@@ -33,7 +33,8 @@ def load_toml(name: str) -> dict[str, Any]:
         return tomllib.load(fh)
 
 
-def _per_ratio(values: Any, where: str) -> tuple[float, ...]:
+def _per_ratio(values: Any, where: str) -> tuple[Any, ...]:
+    """One value per ratio: a number, or a list of numbers (a row per ratio)."""
     if not isinstance(values, list) or len(values) != len(RATIOS):
         raise CatalogDataError(f"{where}: expected {len(RATIOS)} values (ratios {RATIOS}), got {values!r}")
     return tuple(v if isinstance(v, list) else float(v) for v in values)

@@ -114,7 +114,7 @@ def _duty_factors(text: str | None) -> tuple[float, float, float] | None:
         values = ()
     if len(values) != 3 or not all(math.isfinite(v) and v >= 0 for v in values):
         raise CliError(f"--duty-factors: {text!r} must be three numbers >= 0 as KLA,KLR,KLD (e.g. 7,1,7)")
-    return values  # type: ignore[return-value]
+    return values[0], values[1], values[2]
 
 
 def _duty(args: argparse.Namespace) -> DutyCycle:
@@ -128,7 +128,8 @@ def _duty(args: argparse.Namespace) -> DutyCycle:
     accel_time = _number(args, "--accel-time", "accel_time", "s")
     bearing = {attr: _number(args, option, attr, unit) for option, attr, unit in _BEARING}
     for option, attr, _unit in _BEARING:
-        if bearing[attr] is not None and bearing[attr] < 0:
+        given = bearing[attr]
+        if given is not None and given < 0:
             raise CliError(f"{option} must be >= 0, got {getattr(args, attr)}")
     loads = None
     if bearing["radial_load_n"] is not None or bearing["axial_load_n"] is not None:
@@ -241,7 +242,7 @@ def format_result(r: SizingResult) -> str:
         f"  {r.assumption}",
         "",
     ]
-    figures = [
+    figures: list[tuple[str, float | None, str]] = [
         ("acceleration time ta", r.accel_time_s, "s"),
         ("deceleration time td", r.decel_time_s, "s"),
         ("friction torque TF", r.friction_torque_nm, "N m"),

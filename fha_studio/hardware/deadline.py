@@ -57,25 +57,28 @@ class DeadlineTransport:
 
     def read(self, size: int = 1) -> bytes:
         self._check()
-        data = self.inner.read(size)
+        data: bytes = self.inner.read(size)
         self.received_bytes += len(data)
         return data
 
     def write(self, data: bytes) -> int | None:
         self._check()
-        return self.inner.write(data)
+        written: int | None = self.inner.write(data)
+        return written
 
     @property
     def in_waiting(self) -> int:
         self._check()
-        return self.inner.in_waiting
+        waiting: int = self.inner.in_waiting
+        return waiting
 
     def reset_input_buffer(self) -> None:
         self.inner.reset_input_buffer()
 
     @property
     def timeout(self) -> float | None:
-        return self.inner.timeout
+        timeout: float | None = self.inner.timeout
+        return timeout
 
     @timeout.setter
     def timeout(self, value: float | None) -> None:

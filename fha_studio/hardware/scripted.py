@@ -48,7 +48,9 @@ class ScriptedDrive:
         self.garbage: list[p.Garbage] = []
         self.errors: list[Exception] = []  # exceptions of the handler (answered with silence)
         self._stop = threading.Event()
-        self._decoder = p.StreamDecoder(p.decode_request)
+        self._decoder: p.StreamDecoder[p.Request | p.UnknownRequest | p.Garbage] = p.StreamDecoder(
+            p.decode_request
+        )
         self.end.timeout = 0.01
         self._thread = threading.Thread(target=self._run, name=f"scripted drive {end.port}", daemon=True)
         self._thread.start()

@@ -75,20 +75,23 @@ class GuardedTransport:
 
     def write(self, data: bytes) -> int | None:
         try:
-            return self.inner.write(data)
+            written: int | None = self.inner.write(data)
+            return written
         except _PORT_ERRORS as exc:
             raise self._lost(exc) from exc
 
     def read(self, size: int = 1) -> bytes:
         try:
-            return self.inner.read(size)
+            data: bytes = self.inner.read(size)
+            return data
         except _PORT_ERRORS as exc:
             raise self._lost(exc) from exc
 
     @property
     def in_waiting(self) -> int:
         try:
-            return self.inner.in_waiting
+            waiting: int = self.inner.in_waiting
+            return waiting
         except _PORT_ERRORS as exc:
             raise self._lost(exc) from exc
 
@@ -100,7 +103,8 @@ class GuardedTransport:
 
     @property
     def timeout(self) -> float | None:
-        return self.inner.timeout
+        timeout: float | None = self.inner.timeout
+        return timeout
 
     @timeout.setter
     def timeout(self, value: float | None) -> None:

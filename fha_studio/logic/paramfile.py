@@ -21,7 +21,10 @@ from __future__ import annotations
 import datetime as _dt
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+
+from fha_studio.hardware.parameters import ParameterItem, ParameterModel
 
 FORMAT = "fha-parameters/1"
 MODES = ("tune", "system")
@@ -44,7 +47,11 @@ class LoadedParameterFile:
 
 
 def dump_parameter_file(
-    model, values: dict, actuator: str, driver_model: str, saved: _dt.datetime | None = None
+    model: ParameterModel,
+    values: Mapping[tuple[str, int], int],
+    actuator: str,
+    driver_model: str,
+    saved: _dt.datetime | None = None,
 ) -> str:
     """The TOML text of `values` ({(mode, number): wire int}) for the items of `model`."""
     saved = saved or _dt.datetime.now(_dt.UTC)
@@ -72,7 +79,9 @@ def dump_parameter_file(
     return "\n".join(lines) + "\n"
 
 
-def read_parameter_file(text: str, model, name: str = "parameter file") -> LoadedParameterFile:
+def read_parameter_file(
+    text: str, model: ParameterModel, name: str = "parameter file"
+) -> LoadedParameterFile:
     """Parses `text` and maps it onto `model`. Raises ParameterFileError (with the line) for a
     file that is not a valid FHA Studio parameter file."""
     try:
@@ -132,7 +141,7 @@ def read_parameter_file(text: str, model, name: str = "parameter file") -> Loade
     )
 
 
-def _item_by_key(model, mode: str, key: str):
+def _item_by_key(model: ParameterModel, mode: str, key: str) -> ParameterItem | None:
     for item in model:
         if item.mode == mode and item.key == key:
             return item

@@ -114,7 +114,8 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     alpha = p.speed_filter_alpha
     if quant and s.fb_prev is None:
         s.fb_prev = floor(s.xm / pq + 0.5) * pq
-    fb_prev, v_filt = s.fb_prev, s.v_filt
+    # fb_prev is set whenever feedback is quantised, and only used then
+    fb_prev, v_filt = (s.fb_prev if s.fb_prev is not None else 0.0), s.v_filt
 
     xm, vm, xl, vl = s.xm, s.vm, s.xl, s.vl
     integ, cprev, cur, vref = s.integ, s.cprev, s.current, s.vref

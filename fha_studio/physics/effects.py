@@ -229,7 +229,8 @@ class Effects:
             allowed = ", ".join(f.name for f in dataclasses.fields(cls))
             raise ValueError(
                 f"effect {effect_id}: bad parameters {sorted(params)}; allowed: {allowed}") from exc
-        return dataclasses.replace(self, **{effect_id: effect})
+        changes: dict[str, Any] = {effect_id: effect}
+        return dataclasses.replace(self, **changes)
 
     def without(self, effect_id: str) -> Effects:
         """A copy with one effect switched off."""

@@ -93,11 +93,12 @@ class AxisModel:
         if not isinstance(self.output_resolution_ppr, int) or self.output_resolution_ppr <= 0:
             raise ValueError(f"axis model: output_resolution_ppr must be a positive integer, "
                              f"got {self.output_resolution_ppr!r}")
-        if self.flange_inertia_kgm2 is None:
+        flange = self.flange_inertia_kgm2
+        if flange is None:
             flange = FLANGE_INERTIA_FRACTION * self.actuator_inertia_kgm2
             object.__setattr__(self, "flange_inertia_kgm2", flange)
         positive("flange_inertia_kgm2")
-        if self.flange_inertia_kgm2 >= self.actuator_inertia_kgm2:
+        if flange >= self.actuator_inertia_kgm2:
             raise ValueError("axis model: flange_inertia_kgm2 must be a part of actuator_inertia_kgm2")
         if not isinstance(self.effects, Effects):
             raise TypeError("axis model: effects must be an Effects")

@@ -135,7 +135,7 @@ def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelPa
     jm, jl = model.motor_side_inertia_kgm2, model.load_side_inertia_kgm2
     stiff = model.gear_stiffness
     compliant = stiff is not None
-    if compliant:
+    if stiff is not None:
         k1, k2, k3 = stiff.k1_nm_per_rad, stiff.k2_nm_per_rad, stiff.k3_nm_per_rad
         t1, t2, th1, th2 = stiff.t1_nm, stiff.t2_nm, stiff.theta1_rad, stiff.theta2_rad
         j_eq = jm * jl / (jm + jl)

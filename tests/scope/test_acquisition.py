@@ -140,3 +140,12 @@ def test_a_drive_without_trace_says_so(client_on):
     client = client_on(MonitorDrive(caps="MON MMR IOS"))
     ok, why = TraceAcquisition(client).available()
     assert not ok and "no trace capture" in why
+
+
+def test_every_phase_of_the_move_test_has_a_handler(channels):
+    from fha_studio.logic.scope.acquisition import MoveTest, _Phase
+    from tests.gui.fake_drive import FakeDriveClient
+
+    picked = pick(channels, "feedback_position", "command_position")
+    test = MoveTest(FakeDriveClient(), picked, 10.0, 5.0, use_trace=False)
+    assert set(test._phases) == set(_Phase)

@@ -30,11 +30,11 @@ class ResolvedActuator:
 
     @property
     def code(self) -> str:
-        return self.actuator.model_code
+        return str(self.actuator.model_code)
 
     @property
     def absolute_encoder(self) -> bool:
-        return self.actuator.encoder == "absolute"
+        return bool(self.actuator.encoder == "absolute")
 
     @property
     def brake_holding_torque_nm(self) -> float | None:

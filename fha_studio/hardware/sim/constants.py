@@ -5,6 +5,7 @@ from __future__ import annotations
 import tomllib
 from dataclasses import dataclass, fields
 from functools import cache
+from typing import Any
 
 from fha_studio.paths import resource
 
@@ -34,7 +35,7 @@ def load_sim_constants() -> SimConstants:
     path = resource("drive", "sim-drive.toml")
     with path.open("rb") as f:
         data = tomllib.load(f)
-    values = {}
+    values: dict[str, Any] = {}
     for field in fields(SimConstants):
         entry = data.get(field.name)
         if not isinstance(entry, dict) or "value" not in entry:

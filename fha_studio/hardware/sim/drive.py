@@ -111,6 +111,8 @@ class SimDrive:
         self.has_brake: bool = self.brake_holding_torque_nm is not None
         self.has_sensors: bool = resolved.has_sensors
         self.model = build_model(resolved, config)
+        # a catalogue actuator always has its ratio (only a custom axis model lacks one)
+        self.ratio: float = float(resolved.actuator.ratio)
         family = "HA-675" if self.driver.startswith("HA-675") else "HA-655"
         self.parameters = load_parameter_model(family)
         self.alarm_table = load_alarm_table(family)
@@ -308,7 +310,7 @@ class SimDrive:
     @property
     def absolute_counts(self) -> int:
         """Multi-turn x 8192 + single-turn of the absolute motor encoder (DGR), physical sense."""
-        turns = (self.axis.output_pos_rad - self._absolute_zero_rad) / TWO_PI * self.model.ratio
+        turns = (self.axis.output_pos_rad - self._absolute_zero_rad) / TWO_PI * self.ratio
         return math.floor(turns * ABSOLUTE_COUNTS_PER_TURN + 0.5)
 
     @property
@@ -523,7 +525,7 @@ class SimDrive:
 
     def _finish_oww(self) -> None:
         multi = math.floor(self.absolute_counts / ABSOLUTE_COUNTS_PER_TURN)
-        delta = multi * TWO_PI / self.model.ratio  # output angle of the cleared motor turns
+        delta = multi * TWO_PI / self.ratio  # output angle of the cleared motor turns
         self._absolute_zero_rad += delta
         self._feedback_zero_rad = self._absolute_zero_rad
         self._oww_done_at = None
@@ -708,7 +710,7 @@ class SimDrive:
         if item == MonitorItem.OUTPUT_TORQUE:
             return round(d * axis.torque_nm * 100)
         if item == 0:
-            return round(d * axis.output_speed_rad_s / RPM * self.model.ratio)
+            return round(d * axis.output_speed_rad_s / RPM * self.ratio)
         if item == 1:
             return round(100 * d * axis.current_a / self.model.max_current_a)
         if item in (3, 4, 7, 8, 9, 10):

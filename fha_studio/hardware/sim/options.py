@@ -167,8 +167,9 @@ def config_from_url(url: str) -> SimConfig:
     if inertia is not None:
         values["load_inertia_kgm2"] = _finite("load_inertia", inertia, minimum=0.0)
     for key in ("brake", "sensors", "paced", "quantised", "packed_trace"):
-        if last(key) is not None:
-            values[key] = _flag(key, last(key))
+        flag = last(key)
+        if flag is not None:
+            values[key] = _flag(key, flag)
     for key in ("origin_deg", "ls1_deg", "ls2_deg", "oww_clear_s"):
         if last(key) is not None:
             values[key] = _finite(key, last(key))
@@ -177,6 +178,7 @@ def config_from_url(url: str) -> SimConfig:
         values["effects"] = parse_effects(specs)
     if last("eeprom") is not None:
         values["eeprom"] = last("eeprom")
-    if last("profile") is not None:
-        values["profile"] = last("profile").strip().lower()
+    profile = last("profile")
+    if profile is not None:
+        values["profile"] = profile.strip().lower()
     return SimConfig(**values)

@@ -12,6 +12,7 @@ registers it; :func:`fha_studio.hardware.sim.register_url_handler` does it too).
 from __future__ import annotations
 
 import time
+from typing import Any
 
 from serial.serialutil import PortNotOpenError, SerialBase, SerialException, to_bytes
 
@@ -26,7 +27,9 @@ _POLL_S = 0.005  # longest wait between looks at the drive (a deferred reply is 
 class Serial(SerialBase):
     """A serial port whose other end is a simulated HA-655 (see the module docstring)."""
 
-    def __init__(self, *args, **kwargs):
+    is_open: bool  # set by SerialBase
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         self.sim_drive: SimDrive | None = None
         self.sim_server: SimProtocolServer | None = None
         super().__init__(*args, **kwargs)

@@ -141,8 +141,8 @@ def build_context(code: str) -> dict[str, Any]:
             "test_tolerance_deg": float(sensor_set["sensor_set"]["test_tolerance_deg"]),
         },
     }
-    if brake:
-        b = actuator.brake
+    b = actuator.brake
+    if brake and b is not None:
         volts, pct = float(b.supply_voltage_v), float(b.supply_tolerance_percent)
         context["brake"] = {
             "supply_v": f"{volts:g}",

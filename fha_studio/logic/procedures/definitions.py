@@ -29,7 +29,7 @@ from __future__ import annotations
 import re
 import string
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -64,14 +64,14 @@ class _Formatter(string.Formatter):
         self.context = context
         self.where = where
 
-    def get_field(self, field_name, args, kwargs):
+    def get_field(self, field_name: str, args: Sequence[Any], kwargs: Mapping[str, Any]) -> tuple[Any, str]:
         return _lookup(field_name, self.context, self.where), field_name
 
-    def format_field(self, value, format_spec):
+    def format_field(self, value: Any, format_spec: str) -> str:
         # Numbers in text as people write them: 40, 24.5, not 40.0.
         if isinstance(value, float) and not format_spec:
             return f"{value:g}"
-        return super().format_field(value, format_spec)
+        return str(super().format_field(value, format_spec))
 
 
 def render(template: Any, context: Mapping[str, Any], where: str) -> Any:
@@ -342,14 +342,14 @@ def load_procedure(source: str | Path, context: Mapping[str, Any]) -> Procedure:
     return procedure
 
 
-class _Placeholders(dict):
+class _Placeholders(dict[str, Any]):
     def __contains__(self, key: object) -> bool:
         return True
 
     def __missing__(self, key: str) -> str:
         return "?"
 
-    def copy(self):
+    def copy(self) -> _Placeholders:
         return self
 
 

@@ -108,14 +108,14 @@ class _SimBrakeReleased:
         self.client = client
         self.restore: bool | None = None
 
-    def __enter__(self):
+    def __enter__(self) -> _SimBrakeReleased:
         if self.client.capabilities.simulated:
             self.restore = self.client.io_state().brake_released
             if not self.restore:
                 self.client.set_inputs(brake_released=True)
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: object) -> None:
         if self.restore is False:
             with contextlib.suppress(LinkError):
                 self.client.set_inputs(brake_released=False)

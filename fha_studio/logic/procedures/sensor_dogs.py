@@ -9,7 +9,7 @@ reports (:meth:`SensorDogWizard.observe`) and asks it before commanding a move.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -127,7 +127,9 @@ class SensorDogWizard:
             self.clamp_target(recorded["limit_switch_1"] - self.tolerance_deg),
         ]
 
-    def test_run_result(self, recorded: Mapping[str, float], seen: Mapping[str, list[float]]):
+    def test_run_result(
+        self, recorded: Mapping[str, float], seen: Mapping[str, Sequence[float | tuple[float, float]]]
+    ) -> tuple[bool, str]:
         """Compare the switching angles seen during the test run with the recorded ones.
 
         ``seen[sensor]`` lists where the sensor switched on during the run: an angle, or the
@@ -136,12 +138,12 @@ class SensorDogWizard:
         """
         problems, lines = [], []
 
-        def distance(edge, want: float) -> float:
-            low, high = edge if isinstance(edge, tuple | list) else (edge, edge)
+        def distance(edge: float | tuple[float, float], want: float) -> float:
+            low, high = edge if isinstance(edge, tuple) else (edge, edge)
             return 0.0 if low <= want <= high else min(abs(low - want), abs(high - want))
 
-        def where(edge) -> float:
-            return edge[-1] if isinstance(edge, tuple | list) else edge
+        def where(edge: float | tuple[float, float]) -> float:
+            return edge[-1] if isinstance(edge, tuple) else edge
 
         for sensor in SENSORS:
             edges = seen.get(sensor, [])

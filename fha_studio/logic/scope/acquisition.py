@@ -33,7 +33,7 @@ from enum import Enum
 import numpy as np
 
 from fha_studio.hardware import protocol as p
-from fha_studio.hardware.client import CapabilityLevel
+from fha_studio.hardware.api import Capabilities, CapabilityLevel, DriveApi, TraceStatus
 from fha_studio.hardware.errors import (
     CommandNotSupported,
     CommandRejected,
@@ -156,7 +156,7 @@ def dgr_channel(ratio: int) -> ScopeChannel:
                         360.0 / (p.ABSOLUTE_COUNTS_PER_TURN * ratio))
 
 
-def plan_live(capabilities, channels: Sequence[ScopeChannel], ratio: int | None,
+def plan_live(capabilities: Capabilities, channels: Sequence[ScopeChannel], ratio: int | None,
               config: ScopeConfig) -> tuple[LiveMode, list[ScopeChannel], str]:
     """(mode, the channels that mode delivers, a sentence for the user when it is not monitors)."""
     level = capabilities.level
@@ -184,7 +184,7 @@ class PollingAcquisition:
     #: drive answers nothing over CN3 until the controller switches the servo off.
     servo_on_retry_s = 1.0
 
-    def __init__(self, client, channels: Sequence[ScopeChannel], *, ratio: int | None = None,
+    def __init__(self, client: DriveApi, channels: Sequence[ScopeChannel], *, ratio: int | None = None,
                  capacity: int = 65536, config: ScopeConfig | None = None,
                  clock: Callable[[], float] = time.monotonic):
         self.client = client
@@ -333,7 +333,9 @@ class Trigger:
         if k in (p.TriggerKind.IO_BIT_RISES, p.TriggerKind.IO_BIT_FALLS):
             if self.channel is None or not self.channel.is_bit:
                 raise ValueError("an edge trigger needs an I/O bit channel")
-            return int(k), int(self.channel.io_bit), 0
+            bit = self.channel.io_bit
+            assert bit is not None  # is_bit
+            return int(k), int(bit), 0
         return int(k), 0, 0
 
     def describe(self) -> str:
@@ -424,7 +426,7 @@ def convert_rows(channels: Sequence[ScopeChannel], items: Sequence[int],
 class TraceAcquisition:
     """Drive-side capture (TCH/TDV/TTG/TTC/TTL/TPR/TAR/TST/TRB) through the client."""
 
-    def __init__(self, client, config: ScopeConfig | None = None):
+    def __init__(self, client: DriveApi, config: ScopeConfig | None = None):
         self.client = client
         self.config = config or load_scope_config()
         self.settings: TraceSettings | None = None
@@ -453,14 +455,14 @@ class TraceAcquisition:
             raise ValueError("configure the trace before arming it")
         self.client.arm_trace(self.settings.samples)
 
-    def status(self):
+    def status(self) -> TraceStatus:
         """The drive's ``TraceStatus`` (state, samples held)."""
         return self.client.trace_status()
 
-    def ready_for_trigger(self, status) -> bool:
+    def ready_for_trigger(self, status: TraceStatus) -> bool:
         """True once the pre-trigger part is full (a trigger before that would shorten it)."""
         if status.state is p.TraceState.ARMED:
-            return status.count >= (self.settings.pre_trigger if self.settings else 0)
+            return bool(status.count >= (self.settings.pre_trigger if self.settings else 0))
         return status.state in (p.TraceState.CAPTURING, p.TraceState.DONE)
 
     @property
@@ -511,6 +513,15 @@ class MoveTestResult:
         return f"{self.kind} test ({how}): {self.metrics.describe('deg')}"
 
 
+class _Phase(Enum):
+    """Where a move test is: setting up, waiting for the trace's pre-trigger, capturing, polling."""
+
+    START = "start"
+    ARMING = "arming"
+    CAPTURING = "capturing"
+    POLLING = "polling"
+
+
 class MoveTest:
     """Command a move of ``angle_deg`` at ``speed_rpm`` and capture it; ``step()`` until True.
 
@@ -523,8 +534,9 @@ class MoveTest:
 
     trace_samples = 1024
 
-    def __init__(self, client, channels: Sequence[ScopeChannel], angle_deg: float, speed_rpm: float, *,
-                 kind: str = "move", output_resolution_ppr: int | None = None, use_trace: bool | None = None,
+    def __init__(self, client: DriveApi, channels: Sequence[ScopeChannel], angle_deg: float,
+                 speed_rpm: float, *, kind: str = "move", output_resolution_ppr: int | None = None,
+                 use_trace: bool | None = None,
                  settle_s: float = 0.3, config: ScopeConfig | None = None,
                  clock: Callable[[], float] = time.monotonic,
                  should_abort: Callable[[], bool] | None = None,
@@ -551,7 +563,14 @@ class MoveTest:
         if self.use_trace:
             self.channels = tuple(c for c in self.channels if c.monitor_item != IO_STATE_ITEM)[:4]
         self.result: MoveTestResult | None = None
-        self._phase = "start"
+        self._phase = _Phase.START
+        #: What each phase of the test runs (every _Phase has one; a test checks it).
+        self._phases: dict[_Phase, Callable[[], None]] = {
+            _Phase.START: self._phase_start,
+            _Phase.ARMING: self._phase_arming,
+            _Phase.CAPTURING: self._phase_capturing,
+            _Phase.POLLING: self._phase_polling,
+        }
         self._deadline = 0.0
         self._rows: list[list[float]] = []
         self._poller: PollingAcquisition | None = None
@@ -578,7 +597,7 @@ class MoveTest:
         if self.result is not None:
             return True
         try:
-            getattr(self, f"_phase_{self._phase}")()
+            self._phases[self._phase]()
         except (LinkError, ValueError) as exc:
             self._finish(error=self._explain(exc))
         return self.result is not None
@@ -634,21 +653,21 @@ class MoveTest:
             self.trace.configure(TraceSettings(self.channels, rate, samples, samples // 10,
                                                Trigger(p.TriggerKind.IO_BIT_RISES, moving)))
             self.trace.arm()
-            self._phase = "arming"
+            self._phase = _Phase.ARMING
             self.state_text = "trace armed, filling the pre-trigger"
         else:
             self._poller = PollingAcquisition(self.client, self.channels, config=self.config,
                                               clock=self.clock)
             self._poller.step(0.1)  # a few samples before the move
             self.client.move_by(self.angle_deg)
-            self._phase = "polling"
+            self._phase = _Phase.POLLING
             self.state_text = f"moving {self.angle_deg:g} deg, polling"
         self._deadline = self.clock() + 3 * duration + 5.0
 
     def _phase_arming(self) -> None:
         if self.trace.ready_for_trigger(self.trace.status()):
             self.client.move_by(self.angle_deg)
-            self._phase = "capturing"
+            self._phase = _Phase.CAPTURING
             self.state_text = f"moving {self.angle_deg:g} deg, capturing"
         elif self.clock() > self._deadline:
             raise ValueError("the trace did not get ready (pre-trigger never filled)")

@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 
 @dataclass(frozen=True)
@@ -49,8 +50,8 @@ def _stays_within(t: np.ndarray, inside: np.ndarray, after_index: int) -> float 
     return float(t[first])
 
 
-def move_metrics(t_s, command, feedback, *, in_position_range: float | None = None,
-                 settling_fraction: float = 0.02) -> MoveMetrics:
+def move_metrics(t_s: ArrayLike, command: ArrayLike, feedback: ArrayLike, *,
+                 in_position_range: float | None = None, settling_fraction: float = 0.02) -> MoveMetrics:
     """Overshoot, rise, settling and in-position time of a move captured with its command.
 
     The move starts where the command first leaves its initial value and ends where it reaches
@@ -143,7 +144,7 @@ class Spectrum:
         return [(float(self.frequency_hz[i]), float(a[i])) for _, i in ranked[:count]]
 
 
-def spectrum(t_s, values, *, detrend: str = "linear") -> Spectrum:
+def spectrum(t_s: ArrayLike, values: ArrayLike, *, detrend: str = "linear") -> Spectrum:
     """Amplitude spectrum of a uniformly sampled channel (Hann window, amplitude-corrected).
 
     ``detrend`` removes a mean ("constant") or a ramp ("linear", right for a position during a
@@ -174,7 +175,7 @@ class CursorDelta:
     slope_per_s: float | None  # dvalue / dt, None when dt == 0
 
 
-def cursor_delta(t_s, values, t1_s: float, t2_s: float) -> CursorDelta:
+def cursor_delta(t_s: ArrayLike, values: ArrayLike, t1_s: float, t2_s: float) -> CursorDelta:
     """Difference between two cursors on a channel (values interpolated at the cursor times)."""
     t = np.asarray(t_s, dtype=float)
     y = np.asarray(values, dtype=float)

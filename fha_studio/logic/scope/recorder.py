@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 
@@ -28,7 +29,7 @@ CONTRACT_SOURCES = {
 class ScopeRecorder:
     """Writes rows of ``[t_s, channel values...]`` (the scope's sample layout) to a recording."""
 
-    def __init__(self, path: str | os.PathLike, metadata: RecordingMetadata,
+    def __init__(self, path: str | os.PathLike[str], metadata: RecordingMetadata,
                  channels: Sequence[ScopeChannel]):
         keys = [c.key for c in channels]
         for column in ("pos", "current"):
@@ -40,7 +41,7 @@ class ScopeRecorder:
             if channel.key in POSITION_KEYS and channel.unit != "deg":
                 raise ValueError(f"channel '{channel.key}' is in {channel.unit}, the recording wants deg")
         columns = ["t"]
-        index = [None]  # sample column (0 = time) for each file column
+        index: list[int | None] = [None]  # sample column (0 = time) for each file column
         for column, key in CONTRACT_SOURCES.items():
             if key in keys:
                 columns.append(column)
@@ -56,7 +57,7 @@ class ScopeRecorder:
         self._writer = RecordingWriter(path, metadata, columns)
 
     @property
-    def path(self):
+    def path(self) -> Path:
         return self._writer.path
 
     @property

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 from fha_studio import catalog
 from fha_studio.logic.sizing import duty as f
@@ -67,7 +68,7 @@ class DutyCycle:
             if not ok:
                 raise SizingError(f"{name} must be {what}, got {getattr(self, name)!r}")
 
-        def finite(v) -> bool:
+        def finite(v: object) -> bool:
             return isinstance(v, int | float) and math.isfinite(v)
 
         need(
@@ -137,9 +138,9 @@ class SizingResult:
         """The checks that fail."""
         return tuple(c for c in self.checks if not c.ok)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """The JSON form (the ``fha-studio size --json`` contract); non-finite numbers become None."""
-        out: dict = {
+        out: dict[str, Any] = {
             "actuator": self.actuator_code,
             "accel_time_s": self.accel_time_s,
             "decel_time_s": self.decel_time_s,
@@ -172,7 +173,8 @@ class SizingResult:
         out["assumption"] = self.assumption
         out["ok"] = self.ok
         out["checks"] = [c.as_dict() for c in self.checks]
-        return _finite(out)
+        finite: dict[str, Any] = _finite(out)
+        return finite
 
     def operating_points(self) -> list[OperatingPoint]:
         """The duty on the torque-speed plane (output side), for a plot.
@@ -206,7 +208,7 @@ class SizingResult:
         }
 
 
-def _finite(obj):
+def _finite(obj: Any) -> Any:
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     if isinstance(obj, dict):

@@ -72,7 +72,7 @@ def average_load_n(loads_n: Sequence[float], speeds_rpm: Sequence[float], times_
     if total <= 0:
         raise ValueError("the segments contain no motion (Σ n t = 0): no average load")
     mean = sum(w * abs(f) ** _LIFE_EXPONENT for w, f in zip(weights, loads_n, strict=True)) / total
-    return mean ** (1 / _LIFE_EXPONENT)
+    return float(mean ** (1 / _LIFE_EXPONENT))
 
 
 def average_output_speed_rpm(speeds_rpm: Sequence[float], times_s: Sequence[float]) -> float:
@@ -141,7 +141,7 @@ def life_h(
     """L10 = 10^6 / (60 Nav) (C / (fw Pc))^(10/3) hours (2-3 (7)); inf when nothing turns or loads."""
     if average_speed_rpm <= 0 or dynamic_load_n <= 0:
         return math.inf
-    return (
+    return float(
         1e6
         / (60 * average_speed_rpm)
         * (dynamic_load_rating_n / (load_factor_fw * dynamic_load_n)) ** _LIFE_EXPONENT
@@ -163,7 +163,7 @@ def sway_life_h(
         return math.inf
     if half_sway_angle_deg <= 0:
         raise ValueError(f"half_sway_angle_deg must be > 0, got {half_sway_angle_deg!r}")
-    return (
+    return float(
         1e6
         / (60 * oscillations_per_min)
         * 90

@@ -55,7 +55,10 @@ def _positive(**values: float) -> None:
             raise ValueError(f"{name} must be a positive number, got {value!r}")
 
 
-def _shape(name: str, m: float, ix, iy, iz, centroid: tuple[float, ...] = ()) -> ShapeInertia:
+def _shape(
+    name: str, m: float, ix: float | None, iy: float | None, iz: float | None,
+    centroid: tuple[float, ...] = (),
+) -> ShapeInertia:
     return ShapeInertia(name, m, ix, iy, iz, centroid, PRINTED_FORMULA_NOTES.get(name, ""))
 
 
