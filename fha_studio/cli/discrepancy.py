@@ -1,4 +1,4 @@
-"""``fha-studio discrepancy``: find where a recording and the catalogue model disagree (issue 4).
+"""``fha-studio discrepancy``: find where a recording and the catalogue model disagree.
 
 Prints a human summary (each missing effect with its fitted parameters and the gap on held-out
 data), optionally writes the JSON report and the updated model file (fha-axis-model/1 TOML).

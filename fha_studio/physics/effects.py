@@ -4,7 +4,7 @@ Every effect is a small frozen dataclass; `Effects` holds one optional instance 
 switched off). All values SI and output-referred unless the name says otherwise. Each effect's
 docstring states what the motor must supply in addition to the nominal model (rigid,
 frictionless, actuator + declared load inertia, torque = Kt x current), which is the model
-check's contract (issue 4):
+check's contract (what the model check fits and names):
 
     coulomb_friction      torque_nm x sign(velocity)
     viscous_friction      coefficient_nm_s_per_rad x velocity

@@ -1,4 +1,4 @@
-"""The model check (issue 4): where simulation and measurement disagree, which effect is missing,
+"""The model check: where simulation and measurement disagree, which effect is missing,
 its parameters, the updated model, and the gap on held-out data. numpy/scipy only, no Qt.
 
 Entry point: :func:`run_modelcheck(recording) <run_modelcheck>` -> :class:`ModelCheckResult`, whose

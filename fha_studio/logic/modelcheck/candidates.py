@@ -1,6 +1,7 @@
 """The candidate effects: how each one shows in a residual channel (its regressor columns).
 
-Ids and parameter names are the contract of issue 4 (the same as fha_studio.physics.Effects).
+Ids and parameter names are those of fha_studio.physics.Effects, so that a found effect can be
+switched on in the updated model and in the simulated drive by the same name.
 Torque channel (N m): what the motor supplied (Kt x current) minus what the nominal model needs
 ((J_actuator + J_load_declared) x acceleration). Position channel (arcsec): load_pos - pos.
 

@@ -331,7 +331,8 @@ class ModelCheckResult:
         ] or ([f"Nothing is checked: {'; '.join(st.reason for st in skipped)}."] if not checked else [])
 
     def to_json(self) -> dict[str, Any]:
-        """The JSON report (issue 4 contract: effects [{id, params, channel}], gap {channel: {...}})."""
+        """The JSON report (``fha-modelcheck-report/1``: effects [{id, params, channel}], gap
+        {channel: {...}}); other tools read it, so its keys change only with the format id."""
         return {
             "format": "fha-modelcheck-report/1",
             "recording": self.source,

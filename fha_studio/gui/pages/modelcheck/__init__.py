@@ -1,1 +1,2 @@
-"""The model check as a page of the main window (issue 4's GUI view)."""
+"""The model check as a page of the main window: the same workflow as ``fha-studio discrepancy``,
+with each step's plots."""
