@@ -128,6 +128,23 @@ class DirectionPage(BasePage):
         self.check_result = QLabel("")
         self.check_result.setWordWrap(True)
         c_layout.addWidget(self.check_result)
+        # a drive of the manual's commands: no jog over CN3; the 1-10 check goes with DGR and the
+        # controller's servo-ON and FWD command (the DGR checks page)
+        self.documented_box = QGroupBox("This drive: check with the controller and DGR")
+        d_layout = QVBoxLayout(self.documented_box)
+        self.documented_note = QLabel(
+            "This drive takes no jog and gives no parameter access over CN3. Read [parameter mode] → "
+            "[8: rotary direction] on the drive's front panel, then check 1-10 on the <b>DGR checks</b> "
+            "page: the position is read with the servo off, the controller switches the servo on and "
+            "gives a short FWD command, and the change of the position says CW or CCW."
+        )
+        self.documented_note.setWordWrap(True)
+        d_layout.addWidget(self.documented_note)
+        self.open_dgr_button = QPushButton("Open the DGR checks: rotary direction")
+        self.open_dgr_button.clicked.connect(self._open_dgr_check)
+        d_layout.addWidget(self.open_dgr_button)
+        self.documented_box.setVisible(False)
+        right.addWidget(self.documented_box)
         right.addWidget(check)
         right.addStretch(1)
 
@@ -174,8 +191,24 @@ class DirectionPage(BasePage):
             self.drive_label.setText(
                 f"On the drive: <b>{value}</b> — FWD turns the flange {_fwd_words(value)}"
             )
+        info = self.link.info
+        no_parameters = connected and info is not None and not info.can_parameters
+        no_jog = connected and info is not None and not info.can_move
+        if no_parameters and value is None:
+            self.drive_label.setText("On the drive: read it on the front panel, [parameter mode] → item 8 "
+                                     "(no parameter access over CN3)")
         self.write_button.setEnabled(connected and value is not None and self.chosen() != value)
-        self.check_button.setEnabled(connected and self.link.servo_on and not self._check_running)
+        self.write_button.setToolTip(
+            "This drive gives no parameter access over CN3: set item 8 in parameter mode on its front panel"
+            if no_parameters else "")
+        self.check_button.setEnabled(connected and self.link.servo_on and not self._check_running
+                                     and not no_jog)
+        self.check_button.setToolTip(
+            "This drive takes no jog over CN3: use the DGR checks page with the controller" if no_jog else "")
+        for b in (self.seen_cw, self.seen_ccw, self.seen_none):
+            b.setToolTip("Jog FWD briefly first" if not no_jog else
+                         "This drive takes no jog over CN3: use the DGR checks page")
+        self.documented_box.setVisible(bool(no_jog or no_parameters))
 
     @Slot(int, bool)
     def _choice_changed(self, button_id: int, checked: bool) -> None:
@@ -303,7 +336,8 @@ class DirectionPage(BasePage):
                 sign = 1 if self.drive_value() in (0, None) else -1  # draw what the flange does
                 self.flange.set_angle_deg(sign * status.position_pulse * 360.0 / ppr)
         if not self._check_running:
-            self.check_button.setEnabled(self.link.connected and bool(status.servo_on))
+            can_jog = bool(self.link.info and self.link.info.can_move)
+            self.check_button.setEnabled(self.link.connected and bool(status.servo_on) and can_jog)
 
     def _ppr(self) -> int | None:
         try:
@@ -315,6 +349,12 @@ class DirectionPage(BasePage):
 
     def link_connected(self, info: LinkInfo) -> None:
         self._update()
+
+    def _open_dgr_check(self) -> None:
+        window = self.main_window
+        if window is not None and hasattr(window, "show_page"):
+            page = window.show_page("absolute")
+            page.tabs.setCurrentIndex(1)
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
         self._update()
