@@ -125,6 +125,7 @@ class MainWindow(QMainWindow):
             self.tabs.addTab(tab, entry.tab_text)
         self.setCentralWidget(self.tabs)
         for page in self._pages():  # the eager ones; a lazy page does it when it is built
+            assert isinstance(page, QWidget)
             resolve_mnemonics(page, self.window_mnemonics())
         self.alarms_page.sigAlarmAttention.connect(self._on_alarm_attention)
 
@@ -450,8 +451,8 @@ class LazyPage(QWidget):
         self._window = window
         self._entry = entry
         self.built: Page | None = None
-        layout = QVBoxLayout(self)
-        layout.setContentsMargins(0, 0, 0, 0)
+        self._layout = QVBoxLayout(self)
+        self._layout.setContentsMargins(0, 0, 0, 0)
 
     @property
     def page(self) -> Page:
@@ -461,7 +462,7 @@ class LazyPage(QWidget):
             assert isinstance(page, QWidget)
             self.built = page
             resolve_mnemonics(page, self._window.window_mnemonics())
-            self.layout().addWidget(page)
+            self._layout.addWidget(page)
             page.restore_settings(QSettings())
             if window.link.connected and window.link.info is not None:
                 page.link_connected(window.link.info)
