@@ -90,6 +90,15 @@ def main() -> int:
     window.grab().save(str(path))
     print("saved", path)
 
+    window.select_axis("table")
+    dialog = window.show_register()
+    dialog.tabs.setCurrentIndex(1)  # compare: the table against its twin
+    settle(500)
+    path = OUT / "machine-register.png"
+    dialog.grab().save(str(path))
+    print("saved", path)
+    dialog.close()
+
     _html, pdf = window.write_machine_report(TMP / "machine.html", TMP / "machine.pdf")
     # the PDF's first page, as the person receiving it sees it
     subprocess.run(

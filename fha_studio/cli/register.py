@@ -25,6 +25,14 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio.cli import CliError
+from fha_studio.logic.register.words import (
+    KIND_WORDS,
+    SOURCE_WORDS,
+    parameter_item,
+    parameter_name,
+    value_text,
+    when_text,
+)
 
 ORDER = 70
 
@@ -143,43 +151,14 @@ def _print_json(data: Any) -> None:
     print(json.dumps(data, indent=2, ensure_ascii=False))
 
 
-def _when(at_utc: str) -> str:
-    return at_utc[:19].replace("T", " ") if at_utc else ""
-
-
 def _table(rows: list[list[str]], headers: list[str]) -> None:
     widths = [max(len(str(r[i])) for r in [headers, *rows]) for i in range(len(headers))]
     for row in [headers, *rows]:
         print("  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
 
 
-_PARAMETER_MODELS: dict[str, Any] = {}
-
-
 def _item(key: str, driver_model: str = ""):
-    """The parameter model's item for a key (None when the driver has no such item)."""
-    from fha_studio.hardware.parameters import load_parameter_model
-    from fha_studio.logic.register.importers import driver_family
-
-    family = driver_family(driver_model)
-    if family not in _PARAMETER_MODELS:
-        _PARAMETER_MODELS[family] = load_parameter_model(family)
-    try:
-        return _PARAMETER_MODELS[family].by_key(key)
-    except KeyError:
-        return None
-
-
-def _shown(key: str, value: int | None, driver_model: str = "") -> str:
-    if value is None:
-        return "(not in it)"
-    item = _item(key, driver_model)
-    return item.format(value) if item is not None else str(value)
-
-
-def _name(key: str, driver_model: str = "") -> str:
-    item = _item(key, driver_model)
-    return f"{item.mode.value} {item.number} {item.name}" if item is not None else key
+    return parameter_item(key, driver_model)
 
 
 # -- actions --------------------------------------------------------------------------------------------
@@ -285,19 +264,9 @@ def _history(args) -> int:
         f"{axis.ref}: {axis.actuator_code or 'actuator not given'}{driver}"
         f" — {len(events)} {entries} (times UTC)"
     )
-    kinds = {
-        "axis": "axis",
-        "snapshot": "parameters",
-        "write": "write",
-        "check": "check",
-        "alarm": "alarm",
-        "report": "report",
-        "recording": "recording",
-        "model_check": "model check",
-    }
     for e in events:
         who = f" [{e.who}]" if e.who else ""
-        print(f"{_when(e.at_utc)}  {kinds[e.kind]:<11} {e.text}{who}")
+        print(f"{when_text(e.at_utc)}  {KIND_WORDS[e.kind]:<11} {e.text}{who}")
     return 0
 
 
@@ -314,14 +283,17 @@ def _diff(args) -> int:
         print(f"No difference in the {len(set(a.values) | set(b.values))} parameters they hold.")
         return 0
     _table(
-        [[_name(d.key, driver), _shown(d.key, d.a, driver), _shown(d.key, d.b, driver)] for d in differences],
+        [
+            [parameter_name(d.key, driver), value_text(d.key, d.a, driver), value_text(d.key, d.b, driver)]
+            for d in differences
+        ],
         ["Parameter", "A", "B"],
     )
     return 0
 
 
 def _parse_query(reg, query: str) -> tuple[str, int | None, Any]:
-    key_text, _, value_text = query.partition("=")
+    key_text, _, value_part = query.partition("=")
     wanted = key_text.strip().lower().replace(" ", "_").replace("-", "_")
     if not wanted:
         raise CliError("find: give a parameter, e.g. rotary_direction=1")
@@ -336,10 +308,10 @@ def _parse_query(reg, query: str) -> tuple[str, int | None, Any]:
         raise CliError(
             f"find: no parameter called '{key_text.strip()}' (e.g. rotary_direction, in_position_range)"
         )
-    if not value_text.strip():
+    if not value_part.strip():
         return key, None, item
     try:
-        value = int(value_text.strip())
+        value = int(value_part.strip())
     except ValueError:
         allowed = (
             ", ".join(f"{k} = {v}" for k, v in item.choices.items())
@@ -347,7 +319,7 @@ def _parse_query(reg, query: str) -> tuple[str, int | None, Any]:
             else ""
         )
         raise CliError(
-            f"find: '{value_text.strip()}' for {item.name if item else key} is not the drive's"
+            f"find: '{value_part.strip()}' for {item.name if item else key} is not the drive's"
             " whole-number value" + (f" ({allowed})" if allowed else "")
         ) from None
     if item is not None:
@@ -369,22 +341,16 @@ def _find(args) -> int:
         return 0
     what = item.name if item is not None else key
     if not found:
-        wanted = f" = {_shown(key, value)}" if value is not None else ""
+        wanted = f" = {value_text(key, value)}" if value is not None else ""
         print(f"No axis has {what}{wanted}.")
         return 0
-    sources = {
-        "link": "read over the link",
-        "front_panel": "front panel",
-        "file": "from a file",
-        "write": "verified write",
-    }
     _table(
         [
             [
                 f.axis.ref,
-                _shown(key, f.value.value, f.axis.driver_model),
-                sources[f.value.source],
-                _when(f.value.at_utc),
+                value_text(key, f.value.value, f.axis.driver_model),
+                SOURCE_WORDS[f.value.source],
+                when_text(f.value.at_utc),
             ]
             for f in found
         ],

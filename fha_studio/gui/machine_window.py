@@ -343,6 +343,7 @@ class MachineWindow(QMainWindow):
         self.recorders: list[AxisRecorder] = []
         self._shut_down = False
         self._closing_confirmed = False
+        self._register_dialog = None
         self._build_toolbar()
         self._build_body(open_client)
         if register is not None:
@@ -370,6 +371,13 @@ class MachineWindow(QMainWindow):
         )
         self.report_action.triggered.connect(self._report_clicked)
         bar.addAction(self.report_action)
+        self.register_action = QAction("&Register…", self)
+        self.register_action.setToolTip(
+            "The register: an axis's history, compare axes or snapshots, find a value, open items"
+        )
+        self.register_action.triggered.connect(self.show_register)
+        self.register_action.setEnabled(self.register is not None)
+        bar.addAction(self.register_action)
         bar.addSeparator()
         bar.addWidget(QLabel("Operator: "))
         self.operator_edit = QLineEdit(str(QSettings().value("machine/operator", "")))
@@ -634,6 +642,24 @@ class MachineWindow(QMainWindow):
             )
         return html_path, pdf
 
+    @Slot()
+    def show_register(self):
+        """Opens the register's questions for this machine, on the axis on show (not modal: the
+        pages stay usable); returns the dialog."""
+        from fha_studio.gui.register_dialog import RegisterDialog
+
+        if self.register is None:
+            return None
+        if self._register_dialog is None:
+            self._register_dialog = RegisterDialog(
+                self.register, self.project.name, self.current_axis.name, self
+            )
+        else:
+            self._register_dialog.refresh(self.current_axis.name)
+        self._register_dialog.show()
+        self._register_dialog.raise_()
+        return self._register_dialog
+
     def _report_clicked(self) -> None:
         base = Path(QSettings().value("machine/report_dir", str(Path.home()))) / f"{self.project.name}.pdf"
         path, _ = QFileDialog.getSaveFileName(self, "Machine report (PDF)", str(base), "PDF (*.pdf)")
@@ -679,6 +705,8 @@ class MachineWindow(QMainWindow):
         if self._shut_down:
             return
         self._shut_down = True
+        if self._register_dialog is not None:
+            self._register_dialog.close()
         for window in self.axis_windows:
             window._closing_confirmed = True
             window.shutdown()

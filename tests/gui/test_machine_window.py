@@ -14,6 +14,7 @@ from PySide6.QtWidgets import QApplication
 from fha_studio.gui.link import Cmd
 from fha_studio.logic.machine import MachineProject
 from fha_studio.logic.register import Register
+from fha_studio.logic.register.words import value_text
 from tests.procedures.walk import good_answer
 
 MACHINE = "Line 3 positioner"
@@ -157,6 +158,31 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     open_items = {(i.axis.name, i.text) for i in register.open_items(MACHINE)}
     assert ("table", f"report {tmp_path / 'table-report.pdf'} is not signed") in open_items
     assert ("tilt", "no procedure recorded yet") in open_items
+
+    # the same questions in the GUI, on the axis on show
+    dialog = window.show_register()
+    history = [dialog.history_table.item(r, 3).text() for r in range(dialog.history_table.rowCount())]
+    assert "system 8 rotary_direction: 0 -> 1 verified" in history
+    assert dialog.compare_a.currentText() == "table: latest known values"
+    assert dialog.compare_b.currentText() == "table twin: latest known values"  # its twin
+    compared = {
+        dialog.compare_table.item(r, 0).text(): (
+            dialog.compare_table.item(r, 1).text(),
+            dialog.compare_table.item(r, 2).text(),
+        )
+        for r in range(dialog.compare_table.rowCount())
+    }
+    assert compared == {
+        "system 8 Rotary direction": (value_text("rotary_direction", 1), value_text("rotary_direction", 0)),
+        "tune 4 In-position range": ("10 pulse", "20 pulse"),
+    }
+    dialog.tabs.setCurrentIndex(2)
+    dialog.find_parameter.setCurrentIndex(dialog.find_parameter.findData("rotary_direction"))
+    dialog.find_value.setCurrentIndex(dialog.find_value.findData(1))
+    dialog.find_button.click()
+    assert [dialog.find_table.item(r, 0).text() for r in range(dialog.find_table.rowCount())] == ["table"]
+    opened = {dialog.open_table.item(r, 2).text() for r in range(dialog.open_table.rowCount())}
+    assert "no procedure recorded yet" in opened
 
     # STOP reaches every axis that can be stopped: both tables, not the documented-only tilt
     for w in (table, twin):

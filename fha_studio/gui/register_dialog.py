@@ -1,0 +1,306 @@
+"""The register's questions in the GUI, for one machine: the history of an axis, what differs
+between two axes (or two snapshots), which axes have a parameter value, what is still open.
+
+The same questions as ``fha-studio register history|diff|find|open``, in the same words.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt, Slot
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QFormLayout,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QPushButton,
+    QTableWidget,
+    QTableWidgetItem,
+    QTabWidget,
+    QVBoxLayout,
+    QWidget,
+)
+
+from fha_studio.logic.register import Register, RegisterError
+from fha_studio.logic.register.words import (
+    KIND_WORDS,
+    SOURCE_WORDS,
+    parameter_item,
+    parameter_items,
+    parameter_name,
+    value_text,
+    when_text,
+)
+
+
+def _fill(table: QTableWidget, rows: list[list[str]]) -> None:
+    table.setRowCount(len(rows))
+    for r, row in enumerate(rows):
+        for c, text in enumerate(row):
+            item = QTableWidgetItem(text)
+            item.setToolTip(text)
+            item.setFlags(item.flags() & ~Qt.ItemFlag.ItemIsEditable)
+            table.setItem(r, c, item)
+
+
+def _table(headers: list[str], stretch: int) -> QTableWidget:
+    table = QTableWidget(0, len(headers))
+    table.setHorizontalHeaderLabels(headers)
+    table.verticalHeader().setVisible(False)
+    table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
+    table.setSelectionBehavior(QTableWidget.SelectionBehavior.SelectRows)
+    header = table.horizontalHeader()
+    header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+    header.setSectionResizeMode(stretch, QHeaderView.ResizeMode.Stretch)
+    return table
+
+
+class RegisterDialog(QDialog):
+    """History, compare, find and open items of one machine's axes."""
+
+    def __init__(
+        self, register: Register, machine: str, axis: str | None = None, parent: QWidget | None = None
+    ):
+        super().__init__(parent)
+        self.setObjectName("registerDialog")
+        self.setWindowTitle(f"Register — {machine}")
+        self.register = register
+        self.machine = machine
+        self.resize(1100, 620)
+        layout = QVBoxLayout(self)
+        where = QLabel(f"Register file: {register.path}")
+        where.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        layout.addWidget(where)
+        self.tabs = QTabWidget()
+        layout.addWidget(self.tabs, 1)
+        self.tabs.addTab(self._history_tab(), "&History")
+        self.tabs.addTab(self._compare_tab(), "&Compare")
+        self.tabs.addTab(self._find_tab(), "&Find")
+        self.tabs.addTab(self._open_tab(), "&Open items")
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Close)
+        buttons.rejected.connect(self.reject)
+        refresh = buttons.addButton("&Refresh", QDialogButtonBox.ButtonRole.ActionRole)
+        refresh.clicked.connect(self.refresh)
+        layout.addWidget(buttons)
+        self.refresh(axis)
+
+    # -- tabs ---------------------------------------------------------------------------------------
+    def _history_tab(self) -> QWidget:
+        tab = QWidget()
+        v = QVBoxLayout(tab)
+        row = QHBoxLayout()
+        self.history_axis = QComboBox()
+        self.history_axis.currentIndexChanged.connect(self._show_history)
+        row.addWidget(QLabel("Axis:"))
+        row.addWidget(self.history_axis, 1)
+        v.addLayout(row)
+        self.history_table = _table(["When (UTC)", "What", "Who", "Entry"], 3)
+        self.history_table.setObjectName("historyTable")
+        v.addWidget(self.history_table, 1)
+        return tab
+
+    def _compare_tab(self) -> QWidget:
+        tab = QWidget()
+        v = QVBoxLayout(tab)
+        form = QFormLayout()
+        self.compare_a = QComboBox()
+        self.compare_b = QComboBox()
+        for combo in (self.compare_a, self.compare_b):
+            combo.currentIndexChanged.connect(self._show_compare)
+        form.addRow("A:", self.compare_a)
+        form.addRow("B:", self.compare_b)
+        v.addLayout(form)
+        self.compare_label = QLabel("")
+        self.compare_label.setWordWrap(True)
+        v.addWidget(self.compare_label)
+        self.compare_table = _table(["Parameter", "A", "B"], 0)
+        self.compare_table.setObjectName("compareTable")
+        v.addWidget(self.compare_table, 1)
+        return tab
+
+    def _find_tab(self) -> QWidget:
+        tab = QWidget()
+        v = QVBoxLayout(tab)
+        row = QHBoxLayout()
+        self.find_parameter = QComboBox()
+        for item in parameter_items():
+            self.find_parameter.addItem(f"{item.mode.value} {item.number} {item.name}", item.key)
+        self.find_parameter.currentIndexChanged.connect(self._parameter_chosen)
+        self.find_value = QComboBox()
+        self.find_value.setEditable(True)
+        self.find_button = QPushButton("Fin&d axes")
+        self.find_button.clicked.connect(self._show_find)
+        row.addWidget(QLabel("Parameter:"))
+        row.addWidget(self.find_parameter, 2)
+        row.addWidget(QLabel("Value:"))
+        row.addWidget(self.find_value, 2)
+        row.addWidget(self.find_button)
+        v.addLayout(row)
+        self.find_label = QLabel("")
+        self.find_label.setWordWrap(True)
+        v.addWidget(self.find_label)
+        self.find_table = _table(["Axis", "Value", "Known from", "When (UTC)"], 1)
+        self.find_table.setObjectName("findTable")
+        v.addWidget(self.find_table, 1)
+        key = "rotary_direction"
+        index = self.find_parameter.findData(key)
+        self.find_parameter.setCurrentIndex(max(index, 0))
+        self._parameter_chosen()
+        return tab
+
+    def _open_tab(self) -> QWidget:
+        tab = QWidget()
+        v = QVBoxLayout(tab)
+        self.open_label = QLabel("")
+        v.addWidget(self.open_label)
+        self.open_table = _table(["Axis", "What", "Open"], 2)
+        self.open_table.setObjectName("openTable")
+        v.addWidget(self.open_table, 1)
+        return tab
+
+    # -- filling ------------------------------------------------------------------------------------
+    @Slot()
+    def refresh(self, axis: str | None = None) -> None:
+        """Reads the register again (another window may have written to it)."""
+        axes = self.register.axes(self.machine)
+        chosen = axis or self.history_axis.currentData()
+        self.history_axis.blockSignals(True)
+        self.history_axis.clear()
+        for a in axes:
+            self.history_axis.addItem(f"{a.name} — {a.actuator_code or 'actuator not given'}", a.ref)
+        self.history_axis.setCurrentIndex(
+            max(0, self.history_axis.findData(f"{self.machine}/{chosen}"), self.history_axis.findData(chosen))
+        )
+        self.history_axis.blockSignals(False)
+        self._fill_compare_choices(axes, chosen)
+        self._show_history()
+        self._show_compare()
+        self._show_open()
+
+    def _fill_compare_choices(self, axes, chosen: str | None) -> None:
+        current = next((a for a in axes if chosen in (a.name, a.ref)), axes[0] if axes else None)
+        # the twin: the next axis with the same actuator, else the next axis
+        twin = next(
+            (
+                a
+                for a in axes
+                if current and a.ref != current.ref and a.actuator_code == current.actuator_code
+            ),
+            next((a for a in axes if current and a.ref != current.ref), current),
+        )
+        for combo, default in ((self.compare_a, current), (self.compare_b, twin)):
+            combo.blockSignals(True)
+            combo.clear()
+            for a in axes:
+                combo.addItem(f"{a.name}: latest known values", a.ref)
+            for a in axes:
+                for s in self.register.snapshots(a):
+                    source = SOURCE_WORDS.get(s["source"], s["source"])
+                    combo.addItem(
+                        f"{a.name}: snapshot {s['id']} ({source}, {when_text(s['at_utc'])})", str(s["id"])
+                    )
+            if default is not None:
+                combo.setCurrentIndex(max(0, combo.findData(default.ref)))
+            combo.blockSignals(False)
+
+    @Slot()
+    def _show_history(self) -> None:
+        ref = self.history_axis.currentData()
+        if not ref:
+            _fill(self.history_table, [])
+            return
+        events = self.register.history(ref)
+        rows = [[when_text(e.at_utc), KIND_WORDS[e.kind], e.who, e.text] for e in reversed(events)]
+        _fill(self.history_table, rows)  # newest first
+
+    @Slot()
+    def _show_compare(self) -> None:
+        a_ref, b_ref = self.compare_a.currentData(), self.compare_b.currentData()
+        if not a_ref or not b_ref:
+            return
+        try:
+            a, b = self.register.parameter_set(a_ref), self.register.parameter_set(b_ref)
+        except RegisterError as exc:
+            self.compare_label.setText(str(exc))
+            return
+        differences = Register.diff(a, b)
+        driver = a.axis.driver_model or b.axis.driver_model
+        held = len(set(a.values) | set(b.values))
+        if not held:
+            self.compare_label.setText(
+                "Neither holds a parameter value yet (read the parameters of the axes first)."
+            )
+        elif not differences:
+            self.compare_label.setText(f"No difference in the {held} parameters they hold.")
+        else:
+            self.compare_label.setText(f"{len(differences)} of the {held} parameters they hold differ.")
+        rows = [
+            [parameter_name(d.key, driver), value_text(d.key, d.a, driver), value_text(d.key, d.b, driver)]
+            for d in differences
+        ]
+        _fill(self.compare_table, rows)
+
+    @Slot()
+    def _parameter_chosen(self) -> None:
+        item = parameter_item(self.find_parameter.currentData() or "")
+        self.find_value.clear()
+        if item is None:
+            return
+        if item.choices:
+            for wire, meaning in item.choices.items():
+                self.find_value.addItem(f"{wire}: {meaning}", wire)
+            self.find_value.setEditable(False)
+        else:
+            self.find_value.setEditable(True)
+            self.find_value.setEditText("")
+            self.find_value.lineEdit().setPlaceholderText(
+                f"the drive's value, {item.minimum} … {item.maximum} (empty: every axis)"
+            )
+
+    @Slot()
+    def _show_find(self) -> None:
+        key = self.find_parameter.currentData()
+        item = parameter_item(key)
+        if item is not None and item.choices:
+            value = self.find_value.currentData()
+        else:
+            text = self.find_value.currentText().strip()
+            if not text:
+                value = None
+            else:
+                try:
+                    value = int(text)
+                    if item is not None:
+                        item.check(value)
+                except ValueError as exc:
+                    why = str(exc) if "outside" in str(exc) else f"'{text}' is not a whole number"
+                    self.find_label.setText(f"Nothing searched: {why}.")
+                    _fill(self.find_table, [])
+                    return
+        found = self.register.find(key, value, machine=self.machine)
+        name = item.name if item is not None else key
+        wanted = f" = {value_text(key, value)}" if value is not None else ""
+        self.find_label.setText(f"{len(found)} axis/axes with {name}{wanted} (their latest known value).")
+        rows = [
+            [
+                f.axis.name,
+                value_text(key, f.value.value, f.axis.driver_model),
+                SOURCE_WORDS[f.value.source],
+                when_text(f.value.at_utc),
+            ]
+            for f in found
+        ]
+        _fill(self.find_table, rows)
+
+    @Slot()
+    def _show_open(self) -> None:
+        items = self.register.open_items(self.machine)
+        self.open_label.setText(
+            "Nothing open: every check passed and every report is signed."
+            if not items
+            else f"{len(items)} open item(s): checks not done or failed, reports missing or not signed."
+        )
+        rows = [[i.axis.name, "report" if i.kind == "report" else "check", i.text] for i in items]
+        _fill(self.open_table, rows)
