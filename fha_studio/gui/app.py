@@ -8,6 +8,7 @@ import sys
 import time
 from collections.abc import Sequence
 
+from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.session import DEFAULT_SIM_URL
 
 ORGANISATION = "FHA Studio"
@@ -27,7 +28,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--page",
         default=None,
-        help="page to show first (connection, parameters, direction, alarms, jog, sizing)",
+        choices=[page.value for page in PageId],
+        metavar="PAGE",
+        help=f"page to show first: {', '.join(PageId)}",
     )
     parser.add_argument(
         "--machine",

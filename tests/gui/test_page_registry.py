@@ -61,3 +61,12 @@ def test_pages_hear_of_the_link_also_when_built_after_it_came_up(make_window, qt
     with qtbot.waitSignal(window.link.sigDisconnected, timeout=10000):
         window.link.close_link()
     assert eager.calls[-1] == lazy.calls[-1] == ("disconnected", False)
+
+
+def test_the_page_option_offers_every_page_and_refuses_another(capsys):
+    from fha_studio.gui.app import _parser
+
+    assert _parser().parse_args(["--page", "modelcheck"]).page == "modelcheck"
+    with pytest.raises(SystemExit):
+        _parser().parse_args(["--page", "plots"])
+    assert "invalid choice: 'plots'" in capsys.readouterr().err
