@@ -42,7 +42,7 @@ def usable():
     out["usable_s"] = time.perf_counter() - t0
 window.link.sigConnected.connect(lambda _i: out.setdefault("link_s", time.perf_counter() - t0))
 def check():
-    if len(window.session.drive_values) >= 14 and "usable_s" in out:
+    if len(window.state.drive_values) >= 14 and "usable_s" in out:
         out["connected_s"] = time.perf_counter() - t0
         window._closing_confirmed = True
         window.close()

@@ -19,9 +19,9 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="fha-studio [gui]", description="FHA Studio, the commissioning GUI")
     parser.add_argument(
         "--url",
-        default=DEFAULT_SIM_URL,
-        help=f"drive to connect to at start (default: the embedded simulated drive, {DEFAULT_SIM_URL}); "
-        "a serial device, a pty path or socket://host:port",
+        default=None,
+        help=f"drive to connect to at start (default: the embedded simulated drive, {DEFAULT_SIM_URL}, "
+        "with the declared load inertia); a serial device, a pty path or socket://host:port",
     )
     parser.add_argument("--baud", type=int, default=19200, help="baud rate of a serial link (default 19200)")
     parser.add_argument("--no-connect", action="store_true", help="start without connecting")

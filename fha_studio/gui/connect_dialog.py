@@ -54,11 +54,22 @@ def catalogue_codes() -> list[str]:
     ]
 
 
-class ConnectDialog(QDialog):
-    """Asks where the drive is. `url()` and `baud_rate()` give the answer after exec()."""
+def sim_url(actuator_code: str, load_inertia_kgm2: float = 0.0) -> str:
+    """The embedded simulated drive for ``actuator_code`` with the declared load inertia [kg m^2]
+    on its output (none when 0)."""
+    url = f"sim://{actuator_code.strip().upper()}"
+    return f"{url}?load_inertia={load_inertia_kgm2!r}" if load_inertia_kgm2 > 0 else url
 
-    def __init__(self, parent: QWidget | None = None, ports: list[tuple[str, str]] | None = None):
+
+class ConnectDialog(QDialog):
+    """Asks where the drive is. `url()` and `baud_rate()` give the answer after exec().
+
+    ``load_inertia_kgm2``: the axis's declared load inertia, put on the simulated drive's output."""
+
+    def __init__(self, parent: QWidget | None = None, ports: list[tuple[str, str]] | None = None,
+                 load_inertia_kgm2: float = 0.0):
         super().__init__(parent)
+        self.load_inertia_kgm2 = load_inertia_kgm2
         self.setWindowTitle("Connect to a drive")
         self.form = load_form("connect_dialog.ui", self)
         layout = QVBoxLayout(self)
@@ -150,7 +161,7 @@ class ConnectDialog(QDialog):
             return str(self.port_combo.currentData())
         if self.address_radio.isChecked():
             return self.address_edit.text().strip()
-        return f"sim://{self.sim_actuator.currentText().strip().upper()}"
+        return sim_url(self.sim_actuator.currentText(), self.load_inertia_kgm2)
 
     def baud_rate(self) -> int:
         return int(self.baud_combo.currentData() or DEFAULT_BAUD)

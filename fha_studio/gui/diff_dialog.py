@@ -39,9 +39,10 @@ class ParameterDiffDialog(QDialog):
             f"saved {loaded.saved or '?'}."
         )
         warnings = []
-        if self.session.actuator_code and loaded.actuator and loaded.actuator != self.session.actuator_code:
+        axis_code = self.session.state.actuator_code
+        if axis_code and loaded.actuator and loaded.actuator != axis_code:
             warnings.append(
-                f"The file was made for {loaded.actuator}, this axis is {self.session.actuator_code}."
+                f"The file was made for {loaded.actuator}, this axis is {axis_code}."
             )
         if info and loaded.driver_model and info.driver_model and loaded.driver_model != info.driver_model:
             warnings.append(
@@ -67,7 +68,7 @@ class ParameterDiffDialog(QDialog):
         for row, item in enumerate(items):
             key = (item.mode, item.number)
             values = {
-                "drive": session.drive_values.get(key),
+                "drive": session.state.drive_values.get(key),
                 "file": loaded.values.get(key),
                 "default": item.default,
             }

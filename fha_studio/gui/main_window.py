@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo
 from fha_studio.gui.messages import Level, MessageArea
 from fha_studio.gui.mnemonics import mnemonic, resolve_mnemonics
@@ -29,7 +30,7 @@ from fha_studio.gui.pages.direction import DirectionPage
 from fha_studio.gui.pages.jog import JogPage
 from fha_studio.gui.pages.parameters import ParametersPage
 from fha_studio.gui.pages.registry import PAGES, PageEntry
-from fha_studio.gui.session import DEFAULT_SIM_URL, Session
+from fha_studio.gui.session import Session, new_axis_state
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton
 
 log = logging.getLogger(__name__)
@@ -48,7 +49,10 @@ class MainWindow(QMainWindow):
         self.setWindowTitle("FHA Studio")
         self.setObjectName("mainWindow")
         self.link = link or LinkController(self)
-        self.session = Session(self.link, self)
+        # the axis being commissioned: every page reads and edits it through this one object
+        self.state = new_axis_state(self)
+        self.state.restore_settings(QSettings())
+        self.session = Session(self.link, self.state, self)
         self._closing_confirmed = False
         self._shut_down = False
         self._status_note = ""
@@ -231,6 +235,7 @@ class MainWindow(QMainWindow):
         settings.setValue("window/state", self.saveState())
         current = self.tabs.currentWidget()
         settings.setValue("window/page", next(str(i) for i, tab in self._tabs.items() if tab is current))
+        self.state.save_settings(settings)
         for page in self._pages():
             page.save_settings(settings)
 
@@ -269,8 +274,13 @@ class MainWindow(QMainWindow):
         # the session says "Nothing written: ..." when a write it was asked for did not happen
         self.show_message(text, Level.WARNING if text.startswith("Nothing written") else Level.INFO)
 
-    def connect_to(self, url: str = DEFAULT_SIM_URL, baud_rate: int = 19200) -> bool:
-        """Connects (after asking, when the axis is live); False when the user said no."""
+    def connect_to(self, url: str | None = None, baud_rate: int = 19200) -> bool:
+        """Connects (after asking, when the axis is live); False when the user said no. Without a
+        URL: the embedded simulated drive, carrying the axis's declared load inertia."""
+        if url is None:
+            from fha_studio.gui.connect_dialog import sim_url
+
+            url = sim_url(DEFAULT_ACTUATOR, self.state.load_inertia_kgm2)
         if self.link.connected and not self.confirm_axis_release("switch to another drive"):
             return False
         self.link.open(url, baud_rate)
@@ -282,7 +292,7 @@ class MainWindow(QMainWindow):
     def show_connect_dialog(self) -> None:
         from fha_studio.gui.connect_dialog import ConnectDialog
 
-        dialog = ConnectDialog(self)
+        dialog = ConnectDialog(self, load_inertia_kgm2=self.state.load_inertia_kgm2)
         if dialog.exec():
             self.connect_to(dialog.url(), dialog.baud_rate())
 

@@ -1,5 +1,7 @@
-"""What one commissioning session knows, shared by the pages: the link, the actuator, the drive's
-parameter values, the automatic backup and the session log of every write."""
+"""The commissioning workflow the pages share: the link, the driver's parameter model, reading and
+writing parameters with the automatic backup before the first write. What is known of the axis
+(actuator, load, the drive's values, the backup, the write log) lives in the commissioning state
+(`state`, an `AxisState`), never here."""
 
 from __future__ import annotations
 
@@ -11,6 +13,8 @@ from PySide6.QtCore import QObject, QStandardPaths, Signal, Slot
 
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.link import Cmd, CommandResult, LinkController, LinkInfo
+from fha_studio.gui.state import AxisState
+from fha_studio.logic.commissioning import CommissioningState
 from fha_studio.logic.paramfile import dump_parameter_file
 from fha_studio.logic.session_log import SessionLog, WriteRecord
 
@@ -27,29 +31,24 @@ def data_dir() -> Path:
     return path
 
 
-def driver_family(driver_model: str) -> str:
-    """ "HA-655-2-200" -> "HA-655" (the parameter model to use); HA-655 when unknown."""
-    return "HA-675" if driver_model.upper().startswith("HA-675") else "HA-655"
+def new_axis_state(parent: QObject | None = None) -> AxisState:
+    """A commissioning state whose write log goes to a new file in the data directory."""
+    stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    log = SessionLog(data_dir() / "sessions" / f"session-{stamp}.jsonl")
+    return AxisState(CommissioningState(write_log=log), parent)
 
 
 class Session(QObject):
-    """State of the session, on the GUI thread."""
+    """The parameter workflow of the session, on the GUI thread. ``state`` is the axis's
+    commissioning state (one per window; the pages read and edit the axis through it)."""
 
-    sigActuatorChanged = Signal(str)
-    sigValuesChanged = Signal()  # the drive's parameter values (as last read or written) changed
-    sigLogChanged = Signal()  # a write went into the session log
     sigWritesDone = Signal(object)  # list of write entries of one request
     sigMessage = Signal(str)  # something for the status bar
 
-    def __init__(self, link: LinkController, parent: QObject | None = None):
+    def __init__(self, link: LinkController, state: AxisState | None = None, parent: QObject | None = None):
         super().__init__(parent)
         self.link = link
-        self.actuator_code = ""
-        self.actuator_acknowledged = False
-        self.drive_values: dict[tuple[str, int], int] = {}
-        stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-        self.log = SessionLog(data_dir() / "sessions" / f"session-{stamp}.jsonl")
-        self.backup_path: Path | None = None
+        self.state = state if state is not None else new_axis_state(self)
         self._models: dict[str, object] = {}
         self._pending_writes: list[tuple[str, int, int]] | None = None
         self._backup_read_token: int | None = None
@@ -61,8 +60,8 @@ class Session(QObject):
     # -- the driver's parameter model ---------------------------------------------------------------
     @property
     def driver(self) -> str:
-        info = self.link.info
-        return driver_family(info.driver_model if info else "")
+        """The driver family of the connected drive (HA-655 when unknown)."""
+        return self.state.driver
 
     @property
     def parameter_model(self):
@@ -81,15 +80,6 @@ class Session(QObject):
     def item(self, key: str):
         return self.parameter_model.by_key(key)
 
-    # -- actuator -----------------------------------------------------------------------------------
-    def set_actuator(self, code: str, acknowledged: bool = False) -> None:
-        code = code.strip().upper()
-        changed = code != self.actuator_code
-        self.actuator_code = code
-        self.actuator_acknowledged = acknowledged
-        if changed:
-            self.sigActuatorChanged.emit(code)
-
     # -- reading and writing ------------------------------------------------------------------------
     def read_all(self) -> int:
         return self.link.send(Cmd.READ_PARAMETERS, [(i.mode, i.number) for i in self.editable_items()])
@@ -98,8 +88,8 @@ class Session(QObject):
         info = self.link.info
         return dump_parameter_file(
             self.parameter_model,
-            self.drive_values if values is None else values,
-            self.actuator_code,
+            dict(self.state.drive_values) if values is None else values,
+            self.state.actuator_code,
             info.driver_model if info else "",
         )
 
@@ -108,11 +98,12 @@ class Session(QObject):
         write of a session the drive's values are read and saved as a backup."""
         if not writes:
             return
-        if self.backup_path is None:
+        if self.state.needs_backup:
             self._pending_writes = list(writes)
             self._backup_read_token = self.read_all()
             self.sigMessage.emit("Reading the drive's parameters for the backup before the first write …")
             return
+        self.state.require_backup()
         self._write_tokens.add(self.link.send(Cmd.WRITE_PARAMETERS, list(writes)))
 
     def write_backup(self) -> Path:
@@ -120,32 +111,33 @@ class Session(QObject):
         stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
         directory = data_dir() / "backups"
         directory.mkdir(parents=True, exist_ok=True)
-        base = f"backup-{self.actuator_code or 'unknown-actuator'}-{stamp}"
+        base = f"backup-{self.state.actuator_code or 'unknown-actuator'}-{stamp}"
         path = directory / f"{base}.toml"
         n = 1
         while path.exists():
             n += 1
             path = directory / f"{base}-{n}.toml"
         path.write_text(self.parameter_file_text(), encoding="utf-8")
-        self.backup_path = path
+        self.state.record_backup(path)
         self.sigMessage.emit(f"Backup of the drive's parameters saved before the first write: {path}")
         return path
 
     # -- from the link ------------------------------------------------------------------------------
     @Slot(object)
     def _on_connected(self, info: LinkInfo) -> None:
-        self.drive_values.clear()
-        self.backup_path = None  # a new drive: a new backup before its first write
         self._pending_writes = None
-        if not self.actuator_code and info.adjusted_for:
-            self.set_actuator(info.adjusted_for)
-        self.sigValuesChanged.emit()
+        self.state.set_driver(info.driver_model or "", info.adjusted_for or "")
+        self.state.forget_drive()  # a new drive: its values read anew, a new backup before its first write
+        if not self.state.actuator_code and info.adjusted_for:
+            try:
+                self.state.set_actuator(info.adjusted_for)
+            except ValueError as exc:  # the label's line is not a model code: the technician types it
+                self.sigMessage.emit(f"ADJUSTED FOR USE WITH {info.adjusted_for}: not a model code ({exc})")
 
     @Slot(object)
     def _on_result(self, result: CommandResult) -> None:
         if result.cmd is Cmd.READ_PARAMETERS and result.ok:
-            self.drive_values.update(result.value["values"])
-            self.sigValuesChanged.emit()
+            self.state.record_read(result.value["values"])
         if result.token == self._backup_read_token:
             self._backup_read_token = None
             writes, self._pending_writes = self._pending_writes, None
@@ -189,12 +181,6 @@ class Session(QObject):
             error=entry.get("error"),
         )
         try:
-            self.log.append(record)
+            self.state.record_write(record)
         except OSError as exc:  # the log file is a copy; the write itself happened
             log.warning("session log file not written (the record is kept in memory): %s", exc)
-        if record.read_back is not None:
-            self.drive_values[key] = record.read_back
-        elif record.verified:
-            self.drive_values[key] = record.new
-        self.sigLogChanged.emit()
-        self.sigValuesChanged.emit()

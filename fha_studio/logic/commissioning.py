@@ -162,7 +162,8 @@ class CommissioningState:
 
     @property
     def actuator_acknowledged(self) -> bool:
-        """True when the pairing with the driver was found right or its warning acknowledged."""
+        """True when the pairing with the driver was found right or its warning acknowledged
+        (for this driver: another one undoes it)."""
         return self._acknowledged
 
     @property
@@ -175,9 +176,11 @@ class CommissioningState:
         """Position pulses per output revolution; None without an actuator."""
         return int(self._actuator.output_resolution_ppr) if self._actuator is not None else None
 
-    def set_actuator(self, code: str, acknowledged: bool = False) -> bool:
+    def set_actuator(self, code: str, acknowledged: bool | None = None) -> bool:
         """Sets the actuator (``""`` forgets it). Nothing changes when the code is invalid: the
-        catalogue's ``ModelCodeError`` says what is wrong. Returns True when the code changed."""
+        catalogue's ``ModelCodeError`` says what is wrong. ``acknowledged``: whether the pairing is
+        right or its warning acknowledged; None keeps it for the same code and clears it for
+        another. Returns True when the code changed."""
         from fha_studio.catalog import get_actuator, parse_model_code
 
         text = "".join(code.split()).upper()
@@ -187,6 +190,8 @@ class CommissioningState:
         else:
             parsed, actuator = None, None
         changed = text != self._code
+        if acknowledged is None:
+            acknowledged = self._acknowledged and not changed
         if not changed and acknowledged == self._acknowledged:
             return False
         self._code, self._model_code, self._actuator = text, parsed, actuator
@@ -217,11 +222,16 @@ class CommissioningState:
         return driver_family(self._driver_model)
 
     def set_driver(self, driver_model: str, adjusted_for: str = "") -> None:
+        """The driver's TYPE and ADJUSTED FOR USE WITH lines. Another driver undoes the
+        acknowledgement of a pairing warning: it was given for the other pair."""
         driver_model, adjusted_for = driver_model.strip().upper(), adjusted_for.strip().upper()
         if (driver_model, adjusted_for) == (self._driver_model, self._adjusted_for):
             return
         self._driver_model, self._adjusted_for = driver_model, adjusted_for
         self._notify(Change.DRIVER)
+        if self._acknowledged:
+            self._acknowledged = False
+            self._notify(Change.ACTUATOR)
 
     @property
     def supply_voltage_v(self) -> int:
@@ -327,15 +337,17 @@ class CommissioningState:
         """Every write of this session, oldest first (a copy)."""
         return list(self.write_log.records)
 
-    def record_write(self, record: WriteRecord) -> None:
-        """Logs a write and takes its outcome as the drive's value (the read-back, or the new value
-        when verified). Raises BackupRequired when no backup was made before. The log file is a
-        copy: when it cannot be written, OSError is raised after the record is kept in memory."""
+    def require_backup(self, what: str = "a write") -> None:
+        """Raises BackupRequired unless the drive's values were backed up: call it before sending
+        a write to the drive."""
         if self._backup_path is None:
-            raise BackupRequired(
-                f"{record.mode} {record.number} {record.key}: "
-                "no backup of the drive was made before this write"
-            )
+            raise BackupRequired(f"{what}: back up the drive's parameters before the first write")
+
+    def record_write(self, record: WriteRecord) -> None:
+        """Logs a write that was made and takes its outcome as the drive's value (the read-back, or
+        the new value when verified). A write is a fact: it is logged even without a backup
+        (:meth:`require_backup` is what stops one before it is sent). The log file is a copy: when
+        it cannot be written, OSError is raised after the record is kept in memory."""
         error: OSError | None = None
         try:
             self.write_log.append(record)  # keeps the record in memory before writing the file

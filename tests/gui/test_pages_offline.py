@@ -10,7 +10,13 @@ from fha_studio.gui.connect_dialog import ConnectDialog
 def test_sizing_page_adds_parts_checks_and_suggests(make_window, qtbot):
     window = make_window()
     page = window.show_page("sizing")
-    qtbot.waitUntil(lambda: page.result is not None, timeout=5000)
+    # no drive, no actuator yet: what the duty passes on is listed, nothing is sized
+    qtbot.waitUntil(lambda: bool(page.suggested), timeout=10000)
+    assert page.result is None and "No actuator" in page.verdict.text()
+    page.actuator_combo.setCurrentText("FHA-25C-50-US250")
+    page.actuator_combo.lineEdit().returnPressed.emit()
+    assert window.state.actuator_code == "FHA-25C-50-US250"  # the axis's actuator, for every page
+    qtbot.waitUntil(lambda: page.result is not None, timeout=10000)
     page.shape_combo.setCurrentIndex(page.shape_combo.findData("cylinder"))
     page.dim_spins["radius_m"].setValue(150.0)
     page.dim_spins["length_m"].setValue(20.0)
@@ -70,6 +76,6 @@ def test_pairing_warning_must_be_acknowledged(make_window, qtbot):
     assert page.warning_pending
     text = page.warning_label.text()
     assert "ADJUSTED FOR USE WITH FHA-25C-50-US250" in text and "HA-655-4-200" in text
-    assert not window.session.actuator_acknowledged
+    assert not window.state.actuator_acknowledged
     page.acknowledge()
-    assert not page.warning_pending and window.session.actuator_acknowledged
+    assert not page.warning_pending and window.state.actuator_acknowledged

@@ -22,7 +22,7 @@ def fake():
 @pytest.fixture
 def window(make_window, fake, qtbot):
     w = make_window(open_client=lambda url, baud: fake, connect="fake://drive")
-    qtbot.waitUntil(lambda: bool(w.session.drive_values), timeout=5000)
+    qtbot.waitUntil(lambda: bool(w.state.drive_values), timeout=5000)
     return w
 
 
@@ -30,7 +30,7 @@ def test_connects_and_reads_parameters(window):
     assert window.link_lamp.state is True
     assert "HA-655-2-200" in window.connection_page.driver_label.text()
     assert window.parameters_page.model.rowCount() > 5
-    assert window.session.drive_values[("system", 8)] == 0
+    assert window.state.drive_values[("system", 8)] == 0
 
 
 def test_out_of_range_value_is_refused_at_the_field(window, qtbot):
@@ -54,8 +54,8 @@ def test_edit_write_changed_verifies_and_logs_with_backup_first(window, fake, qt
         page.write_changed_button.click()
     assert done.args[0][0]["verified"]
     assert fake.values[("tune", 4)] == 25
-    assert window.session.backup_path is not None and window.session.backup_path.exists()
-    assert re.search(r"^in_position_range\s*= 10\b", window.session.backup_path.read_text(), re.M)  # before
+    assert window.state.backup_path is not None and window.state.backup_path.exists()
+    assert re.search(r"^in_position_range\s*= 10\b", window.state.backup_path.read_text(), re.M)  # before
     assert not model.edits
     assert "tune 4, in-position range: 10 pulse -> 25 pulse, verified" in page.log_view.toPlainText()
 

@@ -19,7 +19,7 @@ def sim_drive(window):
 @pytest.fixture
 def window(make_window, qtbot):
     w = make_window(connect=SIM_URL)
-    qtbot.waitUntil(lambda: len(w.session.drive_values) >= 14, timeout=10000)
+    qtbot.waitUntil(lambda: len(w.state.drive_values) >= 14, timeout=10000)
     return w
 
 
@@ -54,12 +54,12 @@ def test_rotary_direction_written_power_cycled_and_read_back(window, qtbot):
     ):
         page.power_cycle_button.click()
     # read back from the drive after the power cycle: the value is still there (EEPROM)
-    window.session.drive_values.clear()
+    window.state.forget_drive()  # what was read before is forgotten: the value must come from the drive
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.READ_PARAMETERS):
         window.session.read_all()
     assert page.drive_value() == 1
     assert "counter-clockwise" in page.drive_label.text()
-    log = window.session.log.records
+    log = window.state.writes
     assert log[-1].key == "rotary_direction" and log[-1].old == 0 and log[-1].new == 1 and log[-1].verified
 
 
@@ -94,8 +94,8 @@ def test_save_load_and_diff_a_parameter_file(window, qtbot, tmp_path):
     dialog.set_choice("in_position_range", "file")
     with qtbot.waitSignal(window.session.sigWritesDone, timeout=5000):
         dialog.accept()
-    assert window.session.drive_values[("tune", 4)] == 33
-    assert window.session.backup_path.exists()
+    assert window.state.drive_values[("tune", 4)] == 33
+    assert window.state.backup_path.exists()
     dialog.deleteLater()
 
 

@@ -59,7 +59,10 @@ def test_listeners_hear_each_change_once_and_not_a_repeat():
     state.set_load_inertia(0.25)
     state.set_driver("HA-655-2-200", "FHA-17C-50-US250")
     state.set_driver("ha-655-2-200", "fha-17c-50-us250")
-    assert changes == [Change.ACTUATOR, Change.ACTUATOR, Change.LOAD_INERTIA, Change.DRIVER]
+    assert changes == [Change.ACTUATOR, Change.ACTUATOR, Change.LOAD_INERTIA, Change.DRIVER, Change.ACTUATOR]
+    assert not state.actuator_acknowledged  # acknowledged for no driver, not for this one
+    state.acknowledge_actuator()
+    state.set_driver("HA-655-2-200", "FHA-17C-50-US250")  # the same drive again: still acknowledged
     assert state.actuator_acknowledged
 
 
@@ -121,14 +124,14 @@ def test_values_read_and_entered_from_the_front_panel_are_kept_apart():
     assert state.front_panel == {}
 
 
-def test_no_write_is_logged_before_a_backup_and_a_new_drive_needs_its_own(tmp_path: Path):
+def test_writes_wait_for_a_backup_are_logged_and_a_new_drive_needs_its_own(tmp_path: Path):
     log = SessionLog(tmp_path / "session.jsonl")
     state = CommissioningState("FHA-25C-50-US250", write_log=log)
     assert state.needs_backup
-    with pytest.raises(BackupRequired):
-        state.record_write(write_record())
-    assert state.writes == [] and state.drive_values == {}
+    with pytest.raises(BackupRequired, match="rotary direction: back up"):
+        state.require_backup("rotary direction")
     state.record_backup(tmp_path / "backup.toml")
+    state.require_backup()
     changes = heard(state)
     state.record_write(write_record(new=1, read_back=1))
     state.record_write(write_record(number=9, new=2, read_back=None, verified=False))

@@ -113,18 +113,18 @@ class ConnectionPage(BasePage):
         self.actuator_combo.lineEdit().returnPressed.connect(self.check_pairing)
         self.actuator_combo.activated.connect(lambda _i: self.check_pairing())
         self.ack_button.clicked.connect(self.acknowledge)
-        session.sigActuatorChanged.connect(self._on_actuator_changed)
+        session.state.sigActuatorChanged.connect(self._on_actuator_changed)
         self.link_disconnected("not connected", False)
 
     # -- settings ---------------------------------------------------------------------------------
     def restore_settings(self, settings: QSettings) -> None:
         code = settings.value("session/actuator", "")
-        if code and not self.session.actuator_code:
+        if code and not self.session.state.actuator_code:
             self.actuator_combo.setCurrentText(str(code))
 
     def save_settings(self, settings: QSettings) -> None:
-        if self.session.actuator_code:
-            settings.setValue("session/actuator", self.session.actuator_code)
+        if self.session.state.actuator_code:
+            settings.setValue("session/actuator", self.session.state.actuator_code)
 
     # -- behaviour --------------------------------------------------------------------------------
     def link_connected(self, info: LinkInfo) -> None:
@@ -146,27 +146,39 @@ class ConnectionPage(BasePage):
 
     @Slot(str)
     def _on_actuator_changed(self, code: str) -> None:
+        # another page (or a resumed procedure session) changed the actuator: show it, check again
         if self.actuator_combo.currentText().strip().upper() != code:
             self.actuator_combo.setCurrentText(code)
+            if code:
+                self.check_pairing()
+            else:
+                self.actuator_summary.setText("")
+                self._show_warning("")
 
     @Slot()
     def check_pairing(self) -> None:
         from fha_studio.logic.pairing import check_pairing
 
         code = self.actuator_combo.currentText().strip().upper()
-        info = self.session.link.info
+        state = self.session.state
         if not code:
             self._show_warning("")
             return
         try:
-            result = check_pairing(code, info.driver_model if info else "", info.adjusted_for if info else "")
+            result = check_pairing(code, state.driver_model, state.adjusted_for)
         except (ValueError, ImportError) as exc:
             self.actuator_summary.setText("")
             self._show_warning(f"<b>{code}</b> is not a model code the catalogue knows: {exc}", can_ack=False)
             return
         self.pairing = result
         self.actuator_summary.setText(self._summary(code, result))
-        self.session.set_actuator(code, acknowledged=result.ok)
+        # a warning acknowledged for this actuator stays acknowledged when the check is repeated
+        acknowledged = result.ok or (state.actuator_code == code and state.actuator_acknowledged)
+        self.session.state.set_actuator(code, acknowledged=acknowledged)
+        if acknowledged and not result.ok:
+            self._show_warning("<br>".join(f"⚠ {w}" for w in result.warnings))
+            self._show_acknowledged()
+            return
         if result.ok:
             self._show_pairing_ok(code, info)
         else:
@@ -227,7 +239,10 @@ class ConnectionPage(BasePage):
 
     @Slot()
     def acknowledge(self) -> None:
-        self.session.set_actuator(self.actuator_combo.currentText(), acknowledged=True)
+        self.session.state.set_actuator(self.actuator_combo.currentText(), acknowledged=True)
+        self._show_acknowledged()
+
+    def _show_acknowledged(self) -> None:
         self.ack_button.setEnabled(False)
         self.ack_button.setText("Acknowledged for this session")
         self.warning_label.setStyleSheet(

@@ -155,7 +155,7 @@ class DirectionPage(BasePage):
         self.seen_cw.clicked.connect(lambda: self.answer("cw"))
         self.seen_ccw.clicked.connect(lambda: self.answer("ccw"))
         self.seen_none.clicked.connect(lambda: self.answer("none"))
-        session.sigValuesChanged.connect(self._values_changed)
+        session.state.sigParametersChanged.connect(self._values_changed)
         session.sigWritesDone.connect(self._writes_done)
         self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status)
@@ -173,7 +173,7 @@ class DirectionPage(BasePage):
 
     def drive_value(self) -> int | None:
         try:
-            return self.session.drive_values.get(self._key())
+            return self.session.state.drive_values.get(self._key())
         except Exception:
             return None
 
@@ -340,12 +340,8 @@ class DirectionPage(BasePage):
             self.check_button.setEnabled(self.link.connected and bool(status.servo_on) and can_jog)
 
     def _ppr(self) -> int | None:
-        try:
-            from fha_studio.catalog import get_actuator
-
-            return int(get_actuator(self.session.actuator_code).output_resolution_ppr)
-        except Exception:
-            return None
+        """Position pulses per output revolution of the axis's actuator (None: not given)."""
+        return self.session.state.output_resolution_ppr
 
     def link_connected(self, info: LinkInfo) -> None:
         self._update()

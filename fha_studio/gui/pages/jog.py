@@ -88,7 +88,6 @@ class JogPage(BasePage):
         self.session = session
         self.link = session.link
         self.main_window = main_window
-        self._output_ppr: int | None = None
         layout = QHBoxLayout(self)
         left = QVBoxLayout()
         layout.addLayout(left, 3)
@@ -243,14 +242,6 @@ class JogPage(BasePage):
         self._set_enabled(False, False)
 
     def link_connected(self, info: LinkInfo) -> None:
-        self._output_ppr = None
-        try:
-            from fha_studio.catalog import get_actuator
-
-            code = info.adjusted_for or self.session.actuator_code
-            self._output_ppr = int(get_actuator(code).output_resolution_ppr) if code else None
-        except Exception:
-            self._output_ppr = None
         self._set_enabled(True, False)
         if not info.can_move:
             self.message.setText(
@@ -266,8 +257,9 @@ class JogPage(BasePage):
             lamp.set_state(status.bit(bit))
         if status.position_pulse is not None:
             text = f"{status.position_pulse:,} pulse"
-            if self._output_ppr:
-                text = f"{status.position_pulse * 360.0 / self._output_ppr:.2f} °   ({text})"
+            ppr = self.session.state.output_resolution_ppr  # the axis's actuator, at every status
+            if ppr:
+                text = f"{status.position_pulse * 360.0 / ppr:.2f} °   ({text})"
             self.position_label.setText(text)
         if status.speed_rpm is not None:
             self.speed_label.setText(f"{status.speed_rpm:.2f} r/min")

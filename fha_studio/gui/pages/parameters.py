@@ -57,7 +57,7 @@ class ParameterTableModel(QAbstractTableModel):
         self.edits: dict[tuple[str, int], int] = {}
         self.restart_pending: set[tuple[str, int]] = set()
         self.reload_items()
-        session.sigValuesChanged.connect(self._values_changed)
+        session.state.sigParametersChanged.connect(self._values_changed)
 
     def reload_items(self) -> None:
         self.beginResetModel()
@@ -91,12 +91,12 @@ class ParameterTableModel(QAbstractTableModel):
 
     def shown_value(self, row: int) -> int | None:
         key = self.key(row)
-        return self.edits.get(key, self.session.drive_values.get(key))
+        return self.edits.get(key, self.session.state.drive_values.get(key))
 
     def state_text(self, row: int) -> str:
         item = self.items[row]
         key = self.key(row)
-        drive = self.session.drive_values.get(key)
+        drive = self.session.state.drive_values.get(key)
         words = []
         if key in self.edits:
             words.append("edited, not written")
@@ -182,7 +182,7 @@ class ParameterTableModel(QAbstractTableModel):
     # -- edits --------------------------------------------------------------------------------------
     def set_edit(self, mode: str, number: int, wire: int) -> None:
         key = (mode, number)
-        if self.session.drive_values.get(key) == wire:
+        if self.session.state.drive_values.get(key) == wire:
             self.edits.pop(key, None)
         else:
             self.edits[key] = wire
@@ -209,7 +209,7 @@ class ParameterTableModel(QAbstractTableModel):
     @Slot()
     def _values_changed(self) -> None:
         # an edit equal to what the drive now holds is no longer an edit
-        for key in [k for k, v in self.edits.items() if self.session.drive_values.get(k) == v]:
+        for key in [k for k, v in self.edits.items() if self.session.state.drive_values.get(k) == v]:
             del self.edits[key]
         self._all_changed()
         self.sigEditsChanged.emit(len(self.edits))
@@ -368,7 +368,7 @@ class ParametersPage(BasePage):
         self.power_cycle_button.clicked.connect(self.power_cycle)
         self.model.sigRefused.connect(self._refused)
         self.model.sigEditsChanged.connect(self._edits_changed)
-        session.sigLogChanged.connect(self._log_changed)
+        session.state.sigWriteLogChanged.connect(self._log_changed)
         session.sigWritesDone.connect(self._writes_done)
         self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status_for_buttons)
@@ -405,7 +405,7 @@ class ParametersPage(BasePage):
         self.servo_note.setVisible(bool(changed_blocked and connected))
         self._servo_was_on = self.link.servo_on
         self.revert_button.setEnabled(bool(self.model.edits))
-        self.save_button.setEnabled(bool(self.session.drive_values))
+        self.save_button.setEnabled(bool(self.session.state.drive_values))
 
     @Slot()
     def read_all(self) -> None:
@@ -560,7 +560,7 @@ class ParametersPage(BasePage):
 
     @Slot()
     def _log_changed(self) -> None:
-        self.log_view.setPlainText("\n".join(r.line(self._item_of(r)) for r in self.session.log.records))
+        self.log_view.setPlainText("\n".join(r.line(self._item_of(r)) for r in self.session.state.writes))
         self.log_view.verticalScrollBar().setValue(self.log_view.verticalScrollBar().maximum())
 
     # -- files --------------------------------------------------------------------------------------
@@ -568,11 +568,11 @@ class ParametersPage(BasePage):
         return str(QSettings().value("parameters/last_dir", str(Path.home())))
 
     def save_file(self, path: str | None = None) -> Path | None:
-        if not self.session.drive_values:
+        if not self.session.state.drive_values:
             self.message.setText("Nothing to save: read the drive first.")
             return None
         if path is None:
-            suggested = Path(self._default_dir()) / f"{self.session.actuator_code or 'parameters'}.toml"
+            suggested = Path(self._default_dir()) / f"{self.session.state.actuator_code or 'parameters'}.toml"
             path, _ = QFileDialog.getSaveFileName(
                 self, "Save parameter file", str(suggested), "Parameter files (*.toml);;All files (*)"
             )

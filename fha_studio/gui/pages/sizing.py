@@ -31,7 +31,6 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.connect_dialog import catalogue_codes
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
@@ -62,6 +61,7 @@ class SizingPage(BasePage):
         from fha_studio.logic.sizing.inertia import SHAPES, materials
 
         self.session = session
+        self.state = session.state  # the axis: its actuator and declared load inertia are sized here
         self.shapes = SHAPES
         self.materials = materials()
         self.parts: list[tuple[str, float]] = []  # (description, inertia about the output axis)
@@ -124,9 +124,14 @@ class SizingPage(BasePage):
         self.actuator_combo = QComboBox()
         self.actuator_combo.setEditable(True)
         self.actuator_combo.addItems(catalogue_codes())
-        self.actuator_combo.setCurrentText(DEFAULT_ACTUATOR)
-        self.inertia_spin = _spin(1.0, 0.0, 10000.0, 4, " kg·m²")
-        self.inertia_spin.setToolTip("Load inertia JL about the output axis (the parts above add up here)")
+        self.actuator_combo.setCurrentText(self.state.actuator_code)
+        self.actuator_combo.lineEdit().setPlaceholderText("model code, e.g. FHA-25C-50-US250")
+        self.actuator_combo.setToolTip("The actuator of the axis (the same as on the Connection page)")
+        self.inertia_spin = _spin(self.state.load_inertia_kgm2, 0.0, 10000.0, 4, " kg·m²")
+        self.inertia_spin.setToolTip(
+            "Load inertia JL about the output axis (the parts above add up here); the axis's declared load "
+            "inertia, the same on the Scope and Model check pages"
+        )
         self.speed_spin = _spin(30.0, 0.1, 1000.0, 1, " r/min")
         self.angle_spin = _spin(90.0, 0.1, 100000.0, 1, " °")
         self.cycle_spin = _spin(2.0, 0.01, 100000.0, 2, " s")
@@ -188,10 +193,15 @@ class SizingPage(BasePage):
         self.add_part_button.clicked.connect(self.add_part)
         self.remove_part_button.clicked.connect(self.remove_part)
         self.calculate_button.clicked.connect(self.calculate)
-        for spin in (self.inertia_spin, self.speed_spin, self.angle_spin, self.cycle_spin, self.torque_spin):
+        for spin in (self.speed_spin, self.angle_spin, self.cycle_spin, self.torque_spin):
             spin.editingFinished.connect(self.calculate)
-        self.actuator_combo.activated.connect(lambda _i: self.calculate())
-        session.sigActuatorChanged.connect(self._actuator_changed)
+        # the actuator and the load inertia are the axis's: edited here, they change for every page,
+        # and a change from anywhere sizes again (never the previous actuator's result on show)
+        self.inertia_spin.valueChanged.connect(self._inertia_edited)
+        self.actuator_combo.activated.connect(lambda _i: self._actuator_edited())
+        self.actuator_combo.lineEdit().returnPressed.connect(self._actuator_edited)
+        self.state.sigActuatorChanged.connect(self._axis_changed)
+        self.state.sigLoadInertiaChanged.connect(self._axis_changed)
         self._build_dimensions()
         self._calculated_once = False
 
@@ -219,8 +229,8 @@ class SizingPage(BasePage):
             settings.setValue(f"sizing/{key}", spin.value())
 
     def _duty_spins(self) -> dict[str, QDoubleSpinBox]:
+        # the load inertia is not among them: the axis's state keeps it
         return {
-            "load_inertia_kgm2": self.inertia_spin,
             "speed_rpm": self.speed_spin,
             "angle_deg": self.angle_spin,
             "cycle_time_s": self.cycle_spin,
@@ -308,15 +318,47 @@ class SizingPage(BasePage):
             self._parts_changed()
 
     def _parts_changed(self) -> None:
-        if self.parts:
-            self.inertia_spin.setValue(sum(i for _, i in self.parts))
+        total_kgm2 = sum(i for _, i in self.parts)
+        if self.parts and total_kgm2 != self.state.load_inertia_kgm2:
+            self.state.set_load_inertia(total_kgm2)  # the axis's load: every page, and sized again
+            return
         self.calculate()
 
     # -- the calculation --------------------------------------------------------------------------------
-    @Slot(str)
-    def _actuator_changed(self, code: str) -> None:
-        if code:
+    @Slot()
+    def _actuator_edited(self) -> None:
+        code = self.actuator_combo.currentText().strip()
+        try:
+            changed = self.state.set_actuator(code)
+        except ValueError as exc:  # the catalogue says what is wrong; the axis keeps its actuator
+            self._clear_result(f"Actuator: {exc}")
+            return
+        if not changed:
+            self.calculate()
+
+    @Slot(float)
+    def _inertia_edited(self, value_kgm2: float) -> None:
+        self.state.set_load_inertia(value_kgm2)
+
+    def _axis_changed(self, *_args) -> None:
+        code = self.state.actuator_code
+        if self.actuator_combo.currentText().strip().upper() != code:
             self.actuator_combo.setCurrentText(code)
+        if self.inertia_spin.value() != self.state.load_inertia_kgm2:
+            self.inertia_spin.blockSignals(True)
+            self.inertia_spin.setValue(self.state.load_inertia_kgm2)
+            self.inertia_spin.blockSignals(False)
+        if self.isVisible():
+            self.calculate()
+        else:  # sized when next shown; until then nothing of the previous axis is kept
+            self._calculated_once = False
+            self._clear_result("")
+
+    def _clear_result(self, why: str) -> None:
+        self.result = None
+        self.verdict.setText(f"<span style='color:#b00020'>{why}</span>" if why else "")
+        self.checks_table.setRowCount(0)
+        self.plot.clear()
 
     def duty(self):
         from fha_studio.logic.sizing import DutyCycle
@@ -333,29 +375,25 @@ class SizingPage(BasePage):
     def calculate(self) -> None:
         from fha_studio.logic.sizing import SizingError, size_axis, suggest_actuators
 
-        code = self.actuator_combo.currentText().strip().upper()
+        code = self.state.actuator_code
         try:
             duty = self.duty()
-            result = size_axis(code, duty)
         except (SizingError, ValueError) as exc:
-            self.result = None
-            self.verdict.setText(f"<span style='color:#b00020'>Cannot size: {exc}</span>")
-            self.checks_table.setRowCount(0)
-            self.plot.clear()
+            self._clear_result(f"Cannot size: {exc}")
             return
-        self.result = result
-        failed = result.failed
-        if result.ok:
+        if not code:
+            self._clear_result("")
             self.verdict.setText(
-                f"<b style='color:#2e7d32'>{code} passes every check</b> of Chapter 2 for this duty."
+                "No actuator on the axis yet: type its model code here (or on the Connection page), "
+                "or pick one this duty passes on (below)."
             )
         else:
-            names = ", ".join(c.name for c in failed)
-            self.verdict.setText(
-                f"<b style='color:#b00020'>{code} fails {len(failed)} check(s)</b>: {names}."
-            )
-        self._fill_checks(result)
-        self._draw(result)
+            try:
+                result = size_axis(code, duty)
+            except (SizingError, ValueError) as exc:
+                self._clear_result(f"Cannot size {code}: {exc}")
+                return
+            self._show_result(code, result)
         try:
             self.suggested = [r.actuator_code for r in suggest_actuators(duty)]
         except (SizingError, ValueError):
@@ -371,6 +409,21 @@ class SizingPage(BasePage):
                 "<b style='color:#b00020'>No catalogue actuator passes this duty.</b> "
                 "Lengthen the cycle, lower the speed or the load inertia."
             )
+
+    def _show_result(self, code: str, result) -> None:
+        self.result = result
+        failed = result.failed
+        if result.ok:
+            self.verdict.setText(
+                f"<b style='color:#2e7d32'>{code} passes every check</b> of Chapter 2 for this duty."
+            )
+        else:
+            names = ", ".join(c.name for c in failed)
+            self.verdict.setText(
+                f"<b style='color:#b00020'>{code} fails {len(failed)} check(s)</b>: {names}."
+            )
+        self._fill_checks(result)
+        self._draw(result)
 
     def _fill_checks(self, result) -> None:
         checks = list(result.checks)

@@ -20,7 +20,7 @@ SIM_URL = f"sim://{CODE}?paced=0&ls1_deg=-30&ls2_deg=30&origin_deg=0"
 @pytest.fixture
 def window(make_window, qtbot):
     w = make_window(connect=SIM_URL)
-    qtbot.waitUntil(lambda: len(w.session.drive_values) >= 14, timeout=10000)
+    qtbot.waitUntil(lambda: len(w.state.drive_values) >= 14, timeout=10000)
     return w
 
 
@@ -157,9 +157,11 @@ def test_from_boxed_actuator_to_signed_report(make_window, qtbot, tmp_path):
     """Every procedure that applies, in the app only, then the signed report (brake, no sensor set)."""
     code = "FHA-25C-50-US250-B"
     window = make_window(connect=f"sim://{code}?paced=0")
-    qtbot.waitUntil(lambda: len(window.session.drive_values) >= 14, timeout=10000)
+    qtbot.waitUntil(lambda: len(window.state.drive_values) >= 14, timeout=10000)
+    window.connection_page.actuator_combo.setCurrentText(code)  # the label's code, typed once
+    window.connection_page.check_pairing()
     page = window.show_page("procedures")
-    page.actuator_edit.setText(code)
+    assert code in page.actuator_label.text()  # not asked again
     page.operator_edit.setText("T. Trainee")
     page.new_session(tmp_path / "axis1.json")
     assert "does not apply" in page.procedure_list.item(3).text()

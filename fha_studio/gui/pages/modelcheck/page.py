@@ -32,6 +32,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.gui.pages.base import BasePage, PageId
+from fha_studio.gui.state import AxisState
 from fha_studio.logic.modelcheck import ModelCheckError, ModelCheckResult, run_modelcheck
 from fha_studio.recording import Recording, RecordingError, read_recording
 
@@ -89,8 +90,11 @@ class ModelCheckPage(BasePage):
     def __init__(self, session=None, main_window=None):
         super().__init__(main_window)
         self.session = session
+        # the declared load inertia is the axis's (a page without a main window keeps its own state)
+        self.state = session.state if session is not None else AxisState(parent=self)
         self.main_window = main_window
         self.recording: Recording | None = None
+        self._recording_label = ""
         self.result: ModelCheckResult | None = None
         self._running = False
         self._build()
@@ -116,8 +120,12 @@ class ModelCheckPage(BasePage):
         self.inertia_spin.setDecimals(4)
         self.inertia_spin.setRange(0.0, 10000.0)
         self.inertia_spin.setSuffix(" kg m²")
-        self.inertia_spin.setToolTip("The load inertia declared for this recording (its metadata); "
-                                     "change it to check another declaration")
+        self.inertia_spin.setKeyboardTracking(False)
+        self.inertia_spin.setValue(self.state.load_inertia_kgm2)
+        self.inertia_spin.setToolTip("The axis's declared load inertia (the same on the Sizing and Scope "
+                                     "pages); the model check uses it, whatever the recording declares")
+        self.inertia_spin.valueChanged.connect(self.state.set_load_inertia)
+        self.state.sigLoadInertiaChanged.connect(self._declared_inertia_changed)
         self.run_button = QPushButton("Run model check")
         self.run_button.setDefault(True)
         self.run_button.clicked.connect(self.run)
@@ -212,7 +220,7 @@ class ModelCheckPage(BasePage):
 
     def _update_buttons(self) -> None:
         self.run_button.setEnabled(self.recording is not None and not self._running)
-        self.inertia_spin.setEnabled(self.recording is not None and not self._running)
+        self.inertia_spin.setEnabled(not self._running)
         self.save_model_button.setEnabled(self.result is not None and not self._running)
         self.save_report_button.setEnabled(self.result is not None and not self._running)
         self.open_button.setEnabled(not self._running)
@@ -226,20 +234,35 @@ class ModelCheckPage(BasePage):
         self._set_recording(recording, f"{Path(path).name}")
         return recording
 
+    def _declared_inertia_changed(self, value_kgm2: float) -> None:
+        if self.inertia_spin.value() != value_kgm2:
+            self.inertia_spin.blockSignals(True)
+            self.inertia_spin.setValue(value_kgm2)
+            self.inertia_spin.blockSignals(False)
+        if self.recording is not None:
+            self._describe_recording()
+
     def _set_recording(self, recording: Recording, label: str) -> None:
         self.recording = recording
+        self._recording_label = label
         self.result = None
+        self._describe_recording()
+        self.summary.setPlainText("Not run yet: press Run model check.")
+        self._update_buttons()
+
+    def _describe_recording(self) -> None:
+        recording, label = self.recording, self._recording_label
         m = recording.metadata
-        self.inertia_spin.setValue(m.load_inertia_kgm2)
+        declared = self.state.load_inertia_kgm2
         columns = ", ".join(["t", "pos", "current"] + [c for c in ("cmd_pos", "load_pos", "vel")
                                                         if getattr(recording, f"{c}_deg", None) is not None
                                                         or (c == "vel" and recording.vel_rpm is not None)])
         self.source_label.setText(
             f"Recording: {label} — {m.actuator}, {len(recording)} samples over {recording.duration_s:.2f} s, "
             f"columns {columns}. Declared load inertia {m.load_inertia_kgm2:g} kg m²."
+            + ("" if abs(declared - m.load_inertia_kgm2) <= 1e-12 else
+               f" The model check uses the axis's declared load inertia, {declared:g} kg m².")
         )
-        self.summary.setPlainText("Not run yet: press Run model check.")
-        self._update_buttons()
 
     def _open_clicked(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self, "Open a recording", "",
@@ -276,16 +299,23 @@ class ModelCheckPage(BasePage):
             self._show_error(str(exc))
 
     # ---------------------------------------------------------------- run
-    def run(self) -> None:
-        """Start the workflow on the loaded recording (in the page's thread); sigFinished follows."""
-        if self.recording is None or self._running:
-            return
+    def declared_recording(self) -> Recording | None:
+        """The loaded recording with the axis's declared load inertia (what the check runs on)."""
         recording = self.recording
-        declared = self.inertia_spin.value()
+        if recording is None:
+            return None
+        declared = self.state.load_inertia_kgm2
         if abs(declared - recording.metadata.load_inertia_kgm2) > 1e-12:
             recording = dataclasses.replace(
                 recording, metadata=dataclasses.replace(recording.metadata, load_inertia_kgm2=declared)
             )
+        return recording
+
+    def run(self) -> None:
+        """Start the workflow on the loaded recording (in the page's thread); sigFinished follows."""
+        if self.recording is None or self._running:
+            return
+        recording = self.declared_recording()
         self._running = True
         self._update_buttons()
         self.summary.setPlainText("Running the model check…")

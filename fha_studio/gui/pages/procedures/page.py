@@ -87,6 +87,7 @@ class ProceduresPage(BasePage):
     def __init__(self, gui_session, main_window=None):
         super().__init__()
         self.gui_session = gui_session
+        self.state = gui_session.state  # the axis: its actuator is the one on the Connection page
         self.link = gui_session.link
         self.main_window = main_window
         self.session: ProcedureSession | None = None
@@ -98,6 +99,7 @@ class ProceduresPage(BasePage):
         self._build()
         self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status)
+        self.state.sigActuatorChanged.connect(self._axis_changed)
         self._relay.sigSample.connect(
             lambda angle, bits: self.dog_panel.observe(angle, bits) if self.dog_panel.wizard else None
         )
@@ -107,8 +109,9 @@ class ProceduresPage(BasePage):
     def _build(self) -> None:
         layout = QVBoxLayout(self)
         top = QHBoxLayout()
-        self.actuator_edit = QLineEdit()
-        self.actuator_edit.setPlaceholderText("model code on the order, e.g. FHA-25C-50-US250-B-L")
+        self.actuator_label = QLabel()
+        self.actuator_label.setObjectName("procedureActuator")
+        self.actuator_label.setToolTip("The actuator of the axis, given on the Connection page")
         self.operator_edit = QLineEdit()
         self.operator_edit.setPlaceholderText("your name (every check records it)")
         self.new_button = QPushButton("&New session…")
@@ -117,7 +120,7 @@ class ProceduresPage(BasePage):
         self.open_button.clicked.connect(self._open_clicked)
         for w in (
             QLabel("Actuator:"),
-            self.actuator_edit,
+            self.actuator_label,
             QLabel("Operator:"),
             self.operator_edit,
             self.new_button,
@@ -290,13 +293,18 @@ class ProceduresPage(BasePage):
         }
 
     def new_session(self, path: str | Path, actuator_code: str = "", operator: str = "") -> None:
-        """Start a commissioning session for ``actuator_code`` (the ordered model) saved at ``path``."""
+        """Start a commissioning session for the axis's actuator saved at ``path``; an
+        ``actuator_code`` given here becomes the axis's (ModelCodeError when it is not valid)."""
         from fha_studio.logic.procedures.context import build_context
 
-        code = (actuator_code or self.actuator_edit.text() or self.gui_session.actuator_code).strip().upper()
+        if actuator_code:
+            self.state.set_actuator(actuator_code)
+        code = self.state.actuator_code
         operator = (operator or self.operator_edit.text()).strip()
         if not code:
-            raise ProcedureError("the actuator model code (from the order) is needed to start a session")
+            raise ProcedureError(
+                "the actuator's model code is needed to start a session: give it on the Connection page"
+            )
         context = build_context(code)  # ModelCodeError (a ValueError) says what is wrong with the code
         session = ProcedureSession(actuator_code=code, operator=operator, driver=self._identity())
         session.save(path)
@@ -307,13 +315,15 @@ class ProceduresPage(BasePage):
         from fha_studio.logic.procedures.context import build_context
 
         session = ProcedureSession.load(path)
-        self._use(session, build_context(session.actuator_code))
+        context = build_context(session.actuator_code)
+        # resuming the commissioning of that axis: its actuator is the axis's again
+        self.state.set_actuator(session.actuator_code)
+        self._use(session, context)
 
     def _use(self, session: ProcedureSession, context: dict) -> None:
         self.session, self.context = session, context
         self.procedures = load_all(context)
         self.run = None
-        self.actuator_edit.setText(session.actuator_code)
         if session.operator and not self.operator_edit.text():
             self.operator_edit.setText(session.operator)
         self.procedure_list.blockSignals(True)
@@ -365,6 +375,9 @@ class ProceduresPage(BasePage):
         """Answer the current step (what the buttons do). False with a message when not accepted."""
         if self.run is None:
             return False
+        if self.axis_mismatch():
+            self._message(self.axis_mismatch())
+            return False
         step = self.run.current()
         if step is None:
             return False
@@ -411,6 +424,9 @@ class ProceduresPage(BasePage):
         """Ask the drive (in the link thread); the answer is recorded when it comes."""
         step = self.current_step()
         if step is None or step.kind != "live" or self._live_token is not None:
+            return
+        if self.axis_mismatch():
+            self._message(self.axis_mismatch())
             return
         if not self.link.connected:
             self._message("No drive connected: connect first, or enter what you saw.")
@@ -471,7 +487,7 @@ class ProceduresPage(BasePage):
         identity = self._identity()
         if identity:
             self.session.driver = identity
-        values = getattr(self.gui_session, "drive_values", {}) or {}
+        values = self.state.drive_values
         if values:
             model = self.gui_session.parameter_model
             by_key = {}
@@ -574,6 +590,22 @@ class ProceduresPage(BasePage):
         self.sign()
 
     # -- view ---------------------------------------------------------------------------------
+    def axis_mismatch(self) -> str:
+        """Why the open session cannot go on with the axis's actuator ("" when it can)."""
+        if self.session is None or self.session.actuator_code == self.state.actuator_code:
+            return ""
+        return (
+            f"This session is for {self.session.actuator_code}, but the axis's actuator is now "
+            f"{self.state.actuator_code or 'not given'} (Connection page): start a new session for it, "
+            "or open its session."
+        )
+
+    def _axis_changed(self, _code: str) -> None:
+        if self.run is not None and self.axis_mismatch():
+            self.pause()  # the answers so far are saved; nothing is recorded against the other actuator
+        self._message(self.axis_mismatch())
+        self._refresh()
+
     def _message(self, text: str) -> None:
         self.message_label.setText(text)
 
@@ -592,7 +624,10 @@ class ProceduresPage(BasePage):
             self.session_label.setText(
                 f"Session {self.session.path} — {self.session.actuator_code}"
                 + (f" — signed by {signed['who']}" if signed else "")
+                + (" — NOT the axis's actuator" if self.axis_mismatch() else "")
             )
+        code = self.state.actuator_code
+        self.actuator_label.setText(f"<b>{code}</b>" if code else "not given yet (Connection page)")
         step = self.current_step()
         run = self.run
         self.stop_box.setVisible(bool(run and run.stopped))

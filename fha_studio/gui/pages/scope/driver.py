@@ -52,6 +52,7 @@ STEP_INTERVAL_MS = 20
 
 class ScopeCmd(enum.Enum):
     SET_CLIENT = enum.auto()  # args: client or None, ratio (int | None)
+    SET_RATIO = enum.auto()  # args: ratio (int | None): the actuator on the axis changed
     START = enum.auto()  # args: channels (sequence of ScopeChannel), capacity
     STOP = enum.auto()
     ARM_TRACE = enum.auto()  # args: TraceSettings
@@ -145,6 +146,10 @@ class ScopeDriver(QObject):
         self._abort_test("the drive was disconnected")
         self._trace = None
         self._client, self._ratio = client, ratio
+
+    def _do_set_ratio(self, ratio: int | None) -> None:
+        # the next START scales DGR counts with it; a running acquisition was stopped by the view
+        self._ratio = ratio
 
     def _do_start(self, channels, capacity: int = 65536) -> None:
         if self._client is None:
@@ -339,6 +344,10 @@ class ScopeController(QObject):
         """Hand the driver a client (it uses it only in its thread); None detaches."""
         self.connected = client is not None
         self.send(ScopeCmd.SET_CLIENT, client, ratio)
+
+    def set_ratio(self, ratio: int | None) -> None:
+        """The actuator's ratio (None = not known), for scaling DGR counts from the next start."""
+        self.send(ScopeCmd.SET_RATIO, ratio)
 
     def shutdown(self, timeout_ms: int = 3000) -> bool:
         """Stop acquiring and delete the driver in its thread; end the thread when it is the

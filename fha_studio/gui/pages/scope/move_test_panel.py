@@ -81,9 +81,12 @@ class MoveTestPanel(QWidget):
         self.load_inertia.setObjectName("scopeLoadInertia")
         self.load_inertia.setRange(0.0, 1e4)
         self.load_inertia.setDecimals(4)
+        self.load_inertia.setKeyboardTracking(False)
         self.load_inertia.setValue(load_inertia_kgm2)
         self.load_inertia.setSuffix(" kg m²")
-        self.load_inertia.setToolTip("The load inertia written into recordings (the model check needs it)")
+        self.load_inertia.setToolTip("The declared load inertia of the axis, written into recordings (the "
+                                     "model check needs it); the same value as on the Sizing and Model check "
+                                     "pages")
         ff.addRow("Load inertia", self.load_inertia)
         lay.addWidget(files)
         self.test_message = QLabel("The servo must be on. The axis moves.")

@@ -11,7 +11,7 @@ from functools import partial
 
 from PySide6.QtWidgets import QVBoxLayout
 
-from fha_studio.catalog import DEFAULT_ACTUATOR, get_actuator
+from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.link import POLL_INTERVAL_MS, Cmd, LinkInfo
 from fha_studio.gui.pages.base import BasePage
 
@@ -36,12 +36,24 @@ class ScopePage(BasePage):
         self.session = session
         link = session.link
         self.controller = ScopeController(thread=link._thread, parent=self, abort=link.abort_event)
+        self.state = session.state
         self.view = ScopeView(self.controller, self._context())
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.view)
-        session.sigActuatorChanged.connect(lambda _code: self.view.set_context(self._context()))
+        # the axis's actuator, driver and load decide the scaling and what is recorded, at every moment
+        state = self.state
+        for signal in (state.sigActuatorChanged, state.sigDriverChanged, state.sigLoadInertiaChanged):
+            signal.connect(self._axis_changed)
+        self.view.sigLoadInertiaEdited.connect(self._load_inertia_edited)
         self.view.sigLiveChanged.connect(self._on_live_changed)
+
+    def _axis_changed(self, *_args) -> None:
+        self.view.set_context(self._context())
+        self.controller.set_ratio(self.state.ratio)
+
+    def _load_inertia_edited(self, value_kgm2: float) -> None:
+        self.state.set_load_inertia(value_kgm2)
 
     def _on_live_changed(self, live: bool) -> None:
         if self.session.link.connected:
@@ -49,17 +61,15 @@ class ScopePage(BasePage):
             self.session.link.send(Cmd.SET_POLL_INTERVAL, interval_ms)
 
     def _context(self) -> ScopeContext:
-        code = self.session.actuator_code
-        try:
-            get_actuator(code)
-        except (ValueError, KeyError):
-            code = DEFAULT_ACTUATOR
-        return ScopeContext(code, load_inertia_kgm2=0.0, driver=self.session.driver)
+        state = self.state
+        return ScopeContext(state.actuator_code or DEFAULT_ACTUATOR,
+                            load_inertia_kgm2=state.load_inertia_kgm2, supply_voltage=state.supply_voltage_v,
+                            driver=state.driver, actuator_declared=bool(state.actuator_code))
 
     def link_connected(self, info: LinkInfo) -> None:
         self.view.set_context(self._context())
         self.controller.connected = True
-        self.session.link.send(Cmd.CALL, partial(_attach_in_link_thread, self.controller, self.view.ratio))
+        self.session.link.send(Cmd.CALL, partial(_attach_in_link_thread, self.controller, self.state.ratio))
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
         self.view.stop_live()

@@ -15,6 +15,7 @@ calls old data live: it checks the age of the newest sample itself on every fram
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from dataclasses import dataclass
@@ -65,17 +66,27 @@ _COLUMN_KEYS = {column: key for column, key in CONTRACT_SOURCES.items()}
 
 @dataclass(frozen=True)
 class ScopeContext:
-    """What the scope must know of the axis: the actuator (resolution, ratio) and the load."""
+    """What the scope must know of the axis: the actuator (resolution, ratio) and the load.
+
+    ``actuator_declared`` is False when nobody said which actuator is on the axis and
+    ``actuator`` is only assumed (the view says so)."""
 
     actuator: str = DEFAULT_ACTUATOR
     load_inertia_kgm2: float = 0.0
     supply_voltage: int = 200
     driver: str = "HA-655"
+    actuator_declared: bool = True
 
     def actuator_data(self):
         from fha_studio.catalog import get_actuator
 
         return get_actuator(self.actuator)
+
+
+def _actuator_text(context: ScopeContext) -> str:
+    if context.actuator_declared:
+        return context.actuator
+    return f"{context.actuator} (assumed: no actuator given on the Connection page)"
 
 
 @dataclass
@@ -98,6 +109,7 @@ class ScopeView(QWidget):
     sigTraceDone = Signal(object)  # TraceResult
     sigLiveChanged = Signal(bool)  # live acquisition requested on / off
     sigRecordingSaved = Signal(object, str)  # Path of a finished fha-recording/1 file, what it holds
+    sigLoadInertiaEdited = Signal(float)  # the user typed the declared load inertia [kg m^2]
 
     def __init__(self, controller: ScopeController, context: ScopeContext | None = None,
                  parent: QWidget | None = None):
@@ -174,8 +186,9 @@ class ScopeView(QWidget):
         self.trigger.sigArm.connect(self.arm_trace)
         self.trigger.sigCancel.connect(lambda: self.controller.send(ScopeCmd.CANCEL_TRACE))
         side.addTab(self.trigger, "Trigger")
-        self.tests = MoveTestPanel(self.context.actuator, float(self._actuator.max_speed_rpm),
+        self.tests = MoveTestPanel(_actuator_text(self.context), float(self._actuator.max_speed_rpm),
                                    self.context.load_inertia_kgm2)
+        self.tests.load_inertia.valueChanged.connect(self._load_inertia_edited)
         self.tests.sigRun.connect(self.run_test)
         self.tests.sigAbort.connect(lambda: self.controller.send(ScopeCmd.ABORT_TEST))
         side.addTab(self.tests, "Tests")
@@ -484,19 +497,32 @@ class ScopeView(QWidget):
 
     def _metadata(self, sample_rate_hz: float | None, extra: dict | None = None) -> RecordingMetadata:
         c = self.context
-        return RecordingMetadata(c.actuator, self.load_inertia.value(), c.supply_voltage, sample_rate_hz,
+        return RecordingMetadata(c.actuator, c.load_inertia_kgm2, c.supply_voltage, sample_rate_hz,
                                  extra=dict(extra or {}))
 
+    def _load_inertia_edited(self, value: float) -> None:
+        if value != self.context.load_inertia_kgm2:
+            self.context = dataclasses.replace(self.context, load_inertia_kgm2=value)
+            self.sigLoadInertiaEdited.emit(value)
+
     def set_context(self, context: ScopeContext) -> None:
-        """Another actuator (resolution, ratio, speed range): channels are rebuilt, live stops."""
+        """Another actuator or driver (resolution, ratio, speed range): channels are rebuilt and
+        live stops. Another load inertia or supply voltage only goes into what is recorded next."""
         if context == self.context:
             return
-        self.stop_live()
+        same_axis = dataclasses.replace(context, load_inertia_kgm2=self.context.load_inertia_kgm2,
+                                        supply_voltage=self.context.supply_voltage) == self.context
         self.context = context
+        self.load_inertia.blockSignals(True)
+        self.load_inertia.setValue(context.load_inertia_kgm2)
+        self.load_inertia.blockSignals(False)
+        if same_axis:
+            return
+        self.stop_live()
         self._actuator = context.actuator_data()
         self.all_channels = scope_channels(load_parameter_model(context.driver),
                                            self._actuator.output_resolution_ppr)
-        self.tests.set_actuator(context.actuator, float(self._actuator.max_speed_rpm))
+        self.tests.set_actuator(_actuator_text(context), float(self._actuator.max_speed_rpm))
         self.trigger.set_channels(self.all_channels)
         self._static = None
         self._fill_channel_table()
