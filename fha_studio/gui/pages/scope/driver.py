@@ -112,6 +112,7 @@ class ScopeDriver(QObject):
         #: What each request runs (every ScopeCmd has one; a test checks it).
         self.handlers: dict[ScopeCmd, Callable[..., None]] = {
             ScopeCmd.SET_CLIENT: self._do_set_client,
+            ScopeCmd.SET_RATIO: self._do_set_ratio,
             ScopeCmd.START: self._do_start,
             ScopeCmd.STOP: self._do_stop,
             ScopeCmd.ARM_TRACE: self._do_arm_trace,
