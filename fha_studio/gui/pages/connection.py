@@ -180,7 +180,7 @@ class ConnectionPage(BasePage):
             self._show_acknowledged()
             return
         if result.ok:
-            self._show_pairing_ok(code, info)
+            self._show_pairing_ok(code, state.driver_model, state.adjusted_for)
         else:
             self._show_warning("<br>".join(f"⚠ {w}" for w in result.warnings))
 
@@ -199,16 +199,16 @@ class ConnectionPage(BasePage):
             text += f" Drivers for it (manual 1-3): {', '.join(result.compatible_drivers)}."
         return text
 
-    def _show_pairing_ok(self, code: str, info: LinkInfo | None) -> None:
+    def _show_pairing_ok(self, code: str, driver_model: str, adjusted_for: str) -> None:
         """A pair that passes says so (green); without the driver's label lines it says what was
         checked and what is still to check by eye."""
-        if info is not None and info.driver_model and info.adjusted_for:
+        if driver_model and adjusted_for:
             text = (
-                f"✓ The pair is right: {info.driver_model} is adjusted for {info.adjusted_for} and is a "
+                f"✓ The pair is right: {driver_model} is adjusted for {adjusted_for} and is a "
                 f"driver for {code} in the manual's combination table (1-3)."
             )
-        elif info is not None and (info.driver_model or info.adjusted_for):
-            told = info.driver_model or f"adjusted for {info.adjusted_for}"
+        elif driver_model or adjusted_for:
+            told = driver_model or f"adjusted for {adjusted_for}"
             text = (
                 f"✓ Nothing wrong found: the drive reports {told}. Compare the other line of the "
                 "driver's label (TYPE and ADJUSTED FOR USE WITH) with the actuator by eye (manual 3-1)."
