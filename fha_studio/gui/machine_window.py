@@ -424,12 +424,10 @@ class MachineWindow(QMainWindow):
         self.setCentralWidget(body)
         for axis in self.project:
             link = LinkController(open_client=open_client)
-            window = MainWindow(link)
+            window = MainWindow(link, state=axis.state)  # the axis's own commissioning state
             link.setParent(window)
             window.setWindowFlags(Qt.WindowType.Widget)  # a page set inside this window
             window.setObjectName(f"axis:{axis.name}")
-            if axis.actuator_code:
-                window.session.set_actuator(axis.actuator_code)
             # STOP on any axis's pages (its button, Esc) stops every connected axis
             window.stop_button.clicked.disconnect()
             window.stop_button.clicked.connect(self.stop_all)
@@ -444,7 +442,7 @@ class MachineWindow(QMainWindow):
                 signal.connect(lambda *_args, i=index: self._refresh_axis(i))
             link.sigConnected.connect(lambda info, i=index: self._on_axis_connected(i, info))
             link.sigResult.connect(lambda result, i=index: self._on_axis_result(i, result))
-            window.session.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
+            window.state.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
             if self.register is not None:
                 self.recorders.append(
                     AxisRecorder(

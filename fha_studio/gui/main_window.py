@@ -31,7 +31,9 @@ from fha_studio.gui.pages.jog import JogPage
 from fha_studio.gui.pages.parameters import ParametersPage
 from fha_studio.gui.pages.registry import PAGES, PageEntry
 from fha_studio.gui.session import Session, new_axis_state
+from fha_studio.gui.state import AxisState
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton
+from fha_studio.logic.commissioning import CommissioningState
 
 log = logging.getLogger(__name__)
 
@@ -44,14 +46,19 @@ CAPS_WIDTH_PX = 420
 class MainWindow(QMainWindow):
     """FHA Studio's main window."""
 
-    def __init__(self, link: LinkController | None = None, parent: QWidget | None = None):
+    def __init__(self, link: LinkController | None = None, parent: QWidget | None = None,
+                 state: CommissioningState | None = None):
+        """``state``: the axis's commissioning state when it lives elsewhere (an axis of a machine
+        project); by default the window has its own, whose declared load is kept in the settings."""
         super().__init__(parent)
         self.setWindowTitle("FHA Studio")
         self.setObjectName("mainWindow")
         self.link = link or LinkController(self)
         # the axis being commissioned: every page reads and edits it through this one object
-        self.state = new_axis_state(self)
-        self.state.restore_settings(QSettings())
+        self._own_state = state is None
+        self.state = new_axis_state(self) if state is None else AxisState(state, self)
+        if self._own_state:
+            self.state.restore_settings(QSettings())
         self.session = Session(self.link, self.state, self)
         self._closing_confirmed = False
         self._shut_down = False
@@ -235,7 +242,8 @@ class MainWindow(QMainWindow):
         settings.setValue("window/state", self.saveState())
         current = self.tabs.currentWidget()
         settings.setValue("window/page", next(str(i) for i, tab in self._tabs.items() if tab is current))
-        self.state.save_settings(settings)
+        if self._own_state:
+            self.state.save_settings(settings)
         for page in self._pages():
             page.save_settings(settings)
 

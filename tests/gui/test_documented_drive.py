@@ -140,7 +140,7 @@ def click_and_record(page, qtbot, button):
 
 def test_dgr_checks_encoder_direction_dogs_and_origin(make_window, qtbot):
     window = make_window(connect=SENSOR_URL)
-    window.session.set_actuator("FHA-25C-50-S248-L", acknowledged=True)
+    window.state.set_actuator("FHA-25C-50-S248-L", acknowledged=True)
     page = window.show_page("absolute")
     page.who_edit.setText("A. Tester")
     qtbot.waitUntil(lambda: page.read_button.isEnabled(), timeout=10000)

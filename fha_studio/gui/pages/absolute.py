@@ -93,7 +93,7 @@ class AbsolutePage(BasePage):
         self._build()
         self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status)
-        gui_session.sigActuatorChanged.connect(lambda _code: self._refresh())
+        gui_session.state.sigActuatorChanged.connect(lambda _code: self._refresh())
         self._refresh()
 
     # -- building ------------------------------------------------------------------------------
@@ -281,7 +281,7 @@ class AbsolutePage(BasePage):
     @property
     def ratio(self) -> int | None:
         info = self.link.info
-        return ab.ratio_of(self.gui_session.actuator_code) or ab.ratio_of(info.adjusted_for if info else None)
+        return self.gui_session.state.ratio or ab.ratio_of(info.adjusted_for if info else None)
 
     def link_connected(self, info: LinkInfo) -> None:
         self.encoder = {True: "absolute", False: "incremental", None: "unknown"}[info.absolute_position]
@@ -323,7 +323,7 @@ class AbsolutePage(BasePage):
                     "servo off, and clearing the multi-turn data (OWW)." if info.documented_only else
                     "This drive has FHA Studio's extension commands too; these checks use only DGR and OWW, "
                     "as on a real HA-655.")
-            code = self.gui_session.actuator_code or info.adjusted_for
+            code = self.gui_session.state.actuator_code or info.adjusted_for
             scale = (f" Angles use the ratio {ratio} of {code}."
                      if ratio else " Enter the actuator's model code on the Connection page: its ratio "
                      "scales the angles.")
@@ -513,7 +513,7 @@ class AbsolutePage(BasePage):
         self._record("sensor_dog", values, not problem, detail, by_hand=by_hand)
 
     def _context(self) -> dict | None:
-        code = self.gui_session.actuator_code or (self.link.info.adjusted_for if self.link.info else "")
+        code = self.gui_session.state.actuator_code or (self.link.info.adjusted_for if self.link.info else "")
         if not code:
             return None
         from fha_studio.logic.procedures.context import build_context
