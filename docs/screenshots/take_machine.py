@@ -71,7 +71,7 @@ def main() -> int:
     window.connect_all()
     wait_until(lambda: all(w.link.connected for w in window.axis_windows))
     table, twin, _ = window.axis_windows
-    wait_until(lambda: len(table.session.drive_values) >= 14 and len(twin.session.drive_values) >= 14)
+    wait_until(lambda: len(table.state.drive_values) >= 14 and len(twin.state.drive_values) >= 14)
     table.session.write([("system", 8, 1)])
     wait_until(lambda: any(e.kind == "write" for e in register.history("Line 3 positioner/table")))
     page = table.show_page("procedures")
