@@ -118,7 +118,7 @@ def position_text(counts: int, angle_deg: float | None) -> str:
     multi, single = p.split_absolute_position(counts)
     text = f"{counts} counts (multi-turn {multi}, single-turn {single})"
     if angle_deg is not None:
-        text += f" = {angle_deg:.4f} deg at the output flange"
+        text += f" = {angle_deg:.4f}° at the output flange"
     return text
 
 

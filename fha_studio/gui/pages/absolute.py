@@ -130,7 +130,11 @@ class AbsolutePage(BasePage):
         self.history = QTableWidget(0, 5)
         self.history.setObjectName("dgrHistory")
         self.history.setHorizontalHeaderLabels(["Check", "Result", "What was seen", "Who", "When"])
-        self.history.horizontalHeader().setSectionResizeMode(2, QHeaderView.ResizeMode.Stretch)
+        header = self.history.horizontalHeader()
+        for column in (0, 1, 3, 4):
+            header.setSectionResizeMode(column, QHeaderView.ResizeMode.ResizeToContents)
+        header.setSectionResizeMode(2, QHeaderView.ResizeMode.Stretch)
+        self.history.setWordWrap(True)
         self.history.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
         split.addWidget(self.history)
         split.setSizes([420, 200])
@@ -412,11 +416,13 @@ class AbsolutePage(BasePage):
         row = self.history.rowCount()
         self.history.insertRow(row)
         verdict = {True: "pass", False: "FAIL", None: "recorded"}[passed]
+        when = record.at[11:19] if len(record.at) >= 19 else record.at  # the time; the date in the tooltip
         for column, text in enumerate((ab.CHECK_TITLES[check], verdict + (" (by hand)" if by_hand else ""),
-                                       detail, record.who, record.at)):
+                                       detail, record.who, when)):
             item = QTableWidgetItem(text)
-            item.setToolTip(text)
+            item.setToolTip(record.at if column == 4 else text)
             self.history.setItem(row, column, item)
+        self.history.resizeRowToContents(row)
         self.sigRecorded.emit(record)
         return record
 

@@ -240,6 +240,8 @@ class AlarmsPage(BasePage):
                      time.strftime("%H:%M:%S", time.localtime(entry["time"]))]
             for col, text in enumerate(cells):
                 self.history_table.setItem(row, col, QTableWidgetItem(text))
+        for col in (0, 2, 3):
+            self.history_table.resizeColumnToContents(col)
 
     @Slot(object)
     def _on_status(self, status: DriveStatus) -> None:

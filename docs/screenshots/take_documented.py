@@ -1,0 +1,132 @@
+"""Takes the README's screenshots of commissioning a drive that answers only DGR and OWW.
+
+    xvfb-run -a -s "-screen 0 1366x768x24" python docs/screenshots/take_documented.py [OUTDIR]
+
+The embedded simulated drive's documented profile (as a real HA-655: DGR and OWW only), with its
+panel playing the controller's servo-ON and FWD command and the technician's hands. Settings and
+data go to a temporary directory, never the user's.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+TMP = tempfile.mkdtemp(prefix="fha-shots-")
+os.environ["XDG_CONFIG_HOME"] = f"{TMP}/config"
+os.environ["XDG_DATA_HOME"] = f"{TMP}/data"
+
+from PySide6.QtCore import QCoreApplication  # noqa: E402
+from PySide6.QtWidgets import QApplication  # noqa: E402
+
+OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
+URL = f"sim://FHA-25C-50-S248?paced=0&profile=documented&sensors=1&oww_clear_s=5&eeprom={TMP}/eeprom.json"
+
+
+def main() -> int:
+    app = QApplication(sys.argv[:1])
+    QCoreApplication.setOrganizationName("FHA Studio Screenshots")
+    QCoreApplication.setApplicationName("fha-studio-screenshots")
+    from fha_studio.gui.link import Cmd, SimPanelAction
+    from fha_studio.gui.main_window import MainWindow
+
+    window = MainWindow()
+    window.resize(1366, 740)
+    window.show()
+
+    def wait_until(condition, timeout_s: float = 20.0) -> None:
+        end = time.monotonic() + timeout_s
+        while not condition():
+            if time.monotonic() > end:
+                raise TimeoutError("screenshot script: a step did not finish")
+            app.processEvents()
+            time.sleep(0.01)
+
+    def settle(seconds: float = 0.3) -> None:
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            app.processEvents()
+            time.sleep(0.01)
+
+    def shot(name: str) -> None:
+        settle(0.2)
+        path = OUT / f"{name}.png"
+        window.grab().save(str(path))
+        print("saved", path)
+
+    def panel(action: str, value) -> None:
+        token = window.link.send(Cmd.SIM_PANEL, SimPanelAction(action), value)
+        done = []
+        window.link.sigResult.connect(lambda r: done.append(r) if r.token == token else None)
+        wait_until(lambda: done)
+
+    window.connect_to(URL)
+    wait_until(lambda: window.link.status is not None and window.link.status.absolute_counts is not None)
+    window.session.set_actuator("FHA-25C-50-S248-L", acknowledged=True)
+
+    page = window.show_page("absolute")
+    page.who_edit.setText("J. Field")
+    settle()
+    # encoder check: +10 deg by hand
+    page.encoder_start_button.click()
+    wait_until(lambda: page._encoder_start is not None)
+    panel("turn", 10.0)
+    n = len(page.records)
+    page.encoder_end_button.click()
+    wait_until(lambda: len(page.records) > n)
+    # rotary direction 1-10: parameter 8 = 0 from the panel; servo on, FWD 5 deg, servo off
+    page.tabs.setCurrentIndex(1)
+    page.direction_param.setCurrentIndex(1)
+    page.direction_start_button.click()
+    wait_until(lambda: page._direction_start is not None)
+    window.sim_panel.servo_check.setChecked(True)
+    wait_until(lambda: window.link.status.servo_on)
+    panel("command", 5.0)
+    settle(1.5)
+    window.sim_panel.servo_check.setChecked(False)
+    wait_until(lambda: window.link.status.servo_on is False)
+    wait_until(lambda: page.direction_end_button.isEnabled())
+    n = len(page.records)
+    page.direction_end_button.click()
+    wait_until(lambda: len(page.records) > n)
+    shot("dgr-checks")
+
+    # sensor dogs: limit switch 2 near +150 deg
+    page.tabs.setCurrentIndex(2)
+    angle = page.records[-1].values["after_counts"] * 360 / (8192 * 50)
+    panel("turn", 150.5 - angle)
+    page.dog_sensor.setCurrentIndex(1)
+    n = len(page.records)
+    page.dog_record_button.click()
+    wait_until(lambda: len(page.records) > n)
+
+    # absolute origin: OWW, about 5 s, read back
+    page.tabs.setCurrentIndex(3)
+    n = len(page.records)
+    page.origin_button.click()
+    wait_until(lambda: len(page.records) > n, timeout_s=30.0)
+    shot("origin-wizard")
+
+    alarms = window.show_page("alarms")
+    alarms.panel_code_edit.setText("60")
+    alarms.alm_checks["B"].setChecked(True)
+    alarms.alm_read_check.setChecked(True)
+    alarms.enter_from_panel()
+    shot("alarms-front-panel")
+
+    window.show_page("direction")
+    shot("rotary-direction-documented")
+
+    window._closing_confirmed = True
+    window.close()
+    window.shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
