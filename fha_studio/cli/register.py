@@ -7,6 +7,7 @@
   known values (``MACHINE/AXIS``: this axis against its twin).
 - ``find KEY[=VALUE] [--machine M]``: the axes whose latest known value of a parameter is VALUE.
 - ``open [MACHINE]``: open checks and unsigned reports.
+- ``report MACHINE [-o FILE.html]``: the machine report (the GUI writes it as PDF too).
 - ``export [--machine M] [-o FILE]``: everything as JSON.
 - ``add-machine NAME``, ``add-axis MACHINE/AXIS``, ``import FILE... --machine M``: fill it.
 
@@ -97,6 +98,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument("--machine", metavar="MACHINE")
     s.add_argument("-o", "--output", type=Path, metavar="FILE", help="write to FILE instead of printing")
     s.set_defaults(func=_export)
+    s = sub.add_parser(
+        "report",
+        parents=[common],
+        help="the machine report as HTML: every axis summarised, then each axis's report",
+        description="The machine report from the register: a summary of every axis (actuator, driver, "
+        "rotary direction, origin, checks passed/failed, signed or not), then each axis's commissioning "
+        "report from its procedure session file (the one last recorded). The PDF is written by the GUI.",
+    )
+    s.add_argument("machine", metavar="MACHINE")
+    s.add_argument("-o", "--output", type=Path, metavar="FILE", help="HTML file (default: MACHINE.html here)")
+    s.set_defaults(func=_report)
     s = sub.add_parser("add-machine", parents=[common], help="add a machine")
     s.add_argument("name", metavar="NAME")
     s.add_argument("--site", default="")
@@ -385,6 +397,44 @@ def _export(args) -> int:
         print(f"{args.output}: {len(data['machines'])} machine(s)", file=sys.stderr)
     else:
         sys.stdout.write(text)
+    return 0
+
+
+def _report(args) -> int:
+    from fha_studio.logic.machine import MachineError, MachineProject
+    from fha_studio.logic.machine_report import build_machine_report, render_machine_html
+
+    with _open_register(args) as reg:
+        try:
+            project = MachineProject.from_register(reg, args.machine)
+        except MachineError as exc:
+            raise CliError(str(exc)) from None
+        for axis in project:
+            recorded = reg.session_file(f"{project.name}/{axis.name}")
+            axis.session_file = Path(recorded) if recorded else None
+        report = build_machine_report(project, register=reg)
+        output = args.output or Path(f"{project.name}.html")
+        output.parent.mkdir(parents=True, exist_ok=True)
+        tmp = output.with_name(f".{output.name}.partial")
+        tmp.write_text(render_machine_html(report), encoding="utf-8")
+        tmp.replace(output)  # a reader never sees half a report
+        reg.record_report(
+            output, machine=project.name, open_warnings=sum(s.open_warnings for s in report.summaries)
+        )
+    if args.json:
+        _print_json(
+            {
+                "file": str(output),
+                "axes": [asdict(s) for s in report.summaries],
+                "problems": list(report.problems),
+            }
+        )
+        return 0
+    print(f"{output}: {len(report.summaries)} axes")
+    for s in report.summaries:
+        print(f"  {s.axis}: {s.checks_passed} passed, {s.checks_failed} failed, {s.signed}")
+    for problem in report.problems:
+        print(f"  - {problem}", file=sys.stderr)
     return 0
 
 

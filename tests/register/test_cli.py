@@ -143,3 +143,33 @@ def test_the_default_register_is_the_sites_choice(tmp_path):
     with Register(site) as reg:
         assert [m.name for m in reg.machines()] == ["Press 7"]
     assert not (tmp_path / "data").exists()
+
+
+def test_machine_report_from_the_register(capsys, db, tmp_path):
+    from fha_studio.logic.procedures import ProcedureRun, ProcedureSession, load_procedure
+    from fha_studio.logic.procedures.context import build_context
+    from tests.procedures.walk import walk
+
+    session = ProcedureSession(actuator_code="FHA-25C-50-US250", axis="table", operator="ana")
+    session.save(tmp_path / "table.json")
+    walk(
+        ProcedureRun(session, load_procedure("receiving-inspection", build_context("FHA-25C-50-US250"))),
+        "ana",
+    )
+    assert run(capsys, db, "import", str(tmp_path / "table.json"), "--machine", "Line 3")[0] == 0
+    output = tmp_path / "reports" / "line3.html"
+    code, out, _ = run(capsys, db, "report", "Line 3", "-o", str(output))
+    assert code == 0
+    assert out.splitlines()[1].startswith("  table: 6 passed, 0 failed, not signed")
+    assert "  table twin: 0 passed, 0 failed, not signed" in out
+    html = output.read_text(encoding="utf-8")
+    assert "Machine report — Line 3" in html and "Commissioning report — table — FHA-25C-50-US250" in html
+    assert "No procedure session for this axis yet" in html  # the twin
+    with Register(db) as reg:
+        assert reg.export("Line 3")["machines"][0]["machine_reports"][0]["file"] == str(output.resolve())
+    code, _, err = run(capsys, db, "report", "Line 9")
+    assert (
+        code == 2
+        and err.strip()
+        == "fha-studio register: error: no machine called 'Line 9' in the register (machines: Line 3)"
+    )

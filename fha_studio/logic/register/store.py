@@ -817,13 +817,29 @@ class Register:
 
     def find(self, key: str, value: int | None = None, machine: str | None = None) -> list[Found]:
         """The axes whose latest known value of parameter ``key`` is ``value`` (every axis that
-        has a value for it when ``value`` is None)."""
-        found = []
-        for axis in self.axes(machine):
-            known = self.current_values(axis).values.get(key)
-            if known is not None and (value is None or known.value == value):
-                found.append(Found(axis, known))
-        return found
+        has a value for it when ``value`` is None). Latest known: as in :meth:`current_values`."""
+        axes = {a.id: a for a in self.axes(machine)}
+        latest: dict[int, ParameterValue] = {}
+        # SQLite takes the other columns of an aggregate query from the row with the MAX
+        queries = (
+            "SELECT s.axis_id, v.mode, v.number, v.key, v.value, MAX(s.at_utc), s.source, s.id"
+            " FROM snapshot_value v JOIN snapshot s ON s.id = v.snapshot_id"
+            " WHERE v.key = ? GROUP BY s.axis_id",
+            "SELECT axis_id, mode, number, key, COALESCE(read_back, new), MAX(at_utc), 'write', id"
+            " FROM parameter_write WHERE key = ? AND verified = 1 GROUP BY axis_id",
+        )
+        for query in queries:
+            for row in self._db.execute(query, (key,)):
+                axis_id, *fields = tuple(row)
+                known = ParameterValue(*fields)
+                best = latest.get(axis_id)
+                if best is None or (known.at_utc, known.ref) > (best.at_utc, best.ref):
+                    latest[axis_id] = known
+        return [
+            Found(axis, latest[axis_id])
+            for axis_id, axis in axes.items()
+            if axis_id in latest and (value is None or latest[axis_id].value == value)
+        ]
 
     def known_keys(self) -> set[str]:
         """Every parameter key the register has a value for."""
@@ -959,6 +975,16 @@ class Register:
         current = self.axis(axis)
         rows = self._db.execute("SELECT * FROM procedure_run WHERE axis_id = ? ORDER BY rowid", (current.id,))
         return [dict(r) for r in rows]
+
+    def session_file(self, axis: Axis | str | int) -> str:
+        """The procedure session file last recorded for the axis ("" when none was)."""
+        current = self.axis(axis)
+        row = self._db.execute(
+            "SELECT session_file FROM procedure_run WHERE axis_id = ? AND session_file != ''"
+            " ORDER BY updated_utc DESC LIMIT 1",
+            (current.id,),
+        ).fetchone()
+        return str(row[0]) if row else ""
 
     def check_counts(self, axis: Axis | str | int) -> tuple[int, int]:
         """(passed, failed) of the latest answer to each check of the axis."""
