@@ -1,16 +1,17 @@
 """Screenshots of the scope page in the real main window against the embedded simulated drive.
 
-Run: xvfb-run -a -s "-screen 0 1366x768x24" python scripts/scope_screenshots.py OUTDIR
-(the images in docs/screenshots/scope-*.png come from it)."""
+Run: xvfb-run -a -s "-screen 0 1366x768x24" python scripts/scope_screenshots.py [OUTDIR]
+(the images in docs/screenshots/scope-*.png come from it; OUTDIR defaults to docs/screenshots)."""
 import sys
 import time
+from pathlib import Path
 
 from PySide6.QtCore import QCoreApplication, QEventLoop, QTimer
 from PySide6.QtWidgets import QApplication
 
 from fha_studio.hardware import protocol as p
 
-OUT = sys.argv[1] if len(sys.argv) > 1 else "/tmp/scope-shots"
+OUT = sys.argv[1] if len(sys.argv) > 1 else str(Path(__file__).resolve().parents[1] / "docs" / "screenshots")
 app = QApplication([])
 QCoreApplication.setOrganizationName("FHA Studio Shots")
 from fha_studio.gui.link import Cmd, LinkController  # noqa: E402
@@ -58,9 +59,9 @@ link.jog_press(-15.0)
 run(2.0)
 link.jog_release()
 run(2.0)
-view.set_cursors(*(lambda r: (r[0] + 2.0, r[0] + 4.0))(view.plot.plotItem.vb.viewRange()[0]))
+view.set_cursors(*(lambda r: (r[0] + 4.0, r[0] + 6.5))(view.time_plot.x_range()))
 run(0.3)
-w.grab().save(f"{OUT}/scope_live.png")
+w.grab().save(f"{OUT}/scope-live.png")
 view.cursors_box.setChecked(False)
 
 # a triggered move
@@ -76,7 +77,7 @@ wait_until(lambda: view.last_trace is not None, timeout=120)
 run(0.5)
 view.set_cursors(0.0, 0.3)
 run(0.3)
-w.grab().save(f"{OUT}/scope_trace.png")
+w.grab().save(f"{OUT}/scope-trace.png")
 view.cursors_box.setChecked(False)
 
 # the move test
@@ -88,7 +89,7 @@ run(0.5)
 side = next(t for t in view.findChildren(type(view.plots)) if t is not view.plots)
 side.setCurrentIndex(1)
 run(0.3)
-w.grab().save(f"{OUT}/scope_move_test.png")
+w.grab().save(f"{OUT}/scope-move-test.png")
 
 # spectrum of a constant-speed trace (kinematic error)
 view.trigger_kind.setCurrentIndex(view.trigger_kind.findData(p.TriggerKind.IMMEDIATE))
@@ -104,10 +105,10 @@ view.arm_trace()
 wait_until(lambda: view.last_trace is not None, timeout=180)
 link.jog_release()
 view.spectrum_channel.setCurrentIndex(view.spectrum_channel.findData("load_position"))
-view.spectrum_detrend.setCurrentIndex(0)
+view.spectrum_panel.spectrum_detrend.setCurrentIndex(0)
 view.compute_spectrum()
 run(0.5)
-w.grab().save(f"{OUT}/scope_spectrum.png")
+w.grab().save(f"{OUT}/scope-spectrum.png")
 print("peaks:", view.spectrum_label.text())
 print("test:", view.last_test.describe())
 w._closing_confirmed = True
