@@ -56,3 +56,32 @@ def test_import_linter_contracts_hold():
     assert result.returncode == 0, result.stdout + result.stderr
     assert "Contracts: " in result.stdout and " broken" in result.stdout
     assert "0 broken" in result.stdout
+
+
+def test_the_window_starts_without_the_heavy_modules_of_pages_not_shown(tmp_path):
+    """Start-up stays short: scipy, pyqtgraph, numpy's users and the model check load with the
+    page that needs them, not with the first window (the scope, sizing or model-check page)."""
+    script = """
+import sys
+from PySide6.QtCore import QCoreApplication
+from PySide6.QtWidgets import QApplication
+app = QApplication([])
+QCoreApplication.setOrganizationName("FHA Studio Tests")
+from fha_studio.gui.main_window import MainWindow
+window = MainWindow()
+window.show()
+app.processEvents()
+heavy = sorted({m.split('.')[0] if not m.startswith('fha_studio') else m for m in sys.modules
+                if m.split('.')[0] in ('scipy', 'pyqtgraph')
+                or m.startswith(('fha_studio.logic.modelcheck', 'fha_studio.gui.pages.scope',
+                                 'fha_studio.gui.pages.modelcheck'))})
+print('heavy:', heavy)
+window._closing_confirmed = True
+window.shutdown()
+"""
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "XDG_CONFIG_HOME": str(tmp_path / "config"),
+           "XDG_DATA_HOME": str(tmp_path / "data"), "PYTHONPATH": str(ROOT)}
+    result = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True,
+                            env=env, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "heavy: []" in result.stdout, result.stdout
