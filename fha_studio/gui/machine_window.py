@@ -316,7 +316,7 @@ class AxisRecorder(QObject):
     def _on_model_check(self, page, result) -> None:
         lines = result.summary_lines()
         summary = "; ".join(lines[:3]) if lines else "model check run"
-        source = page.source_label.text() if hasattr(page, "source_label") else ""
+        source = page.recording_path or ""
         self._record(
             "model check",
             lambda: self.register.record_model_check(

@@ -256,3 +256,49 @@ def test_the_gui_opens_a_machine_of_the_register_or_says_why_not(qtbot, tmp_path
     assert (
         run(["--machine", "Press 7", "--register", str(path), "--no-connect", "--quit-after-ms", "200"]) == 0
     )
+
+
+@pytest.mark.slow
+def test_alarms_recordings_and_model_checks_go_into_the_register(make_machine, qtbot, tmp_path):
+    from fha_studio.hardware import protocol as p
+    from tests.gui.test_modelcheck_page import URL, _back_and_forth
+
+    register = Register(tmp_path / "register.sqlite")
+    project = MachineProject("Press 7")
+    project.add_axis("feed", TABLE, port_url=URL, load_inertia_kgm2=0.5)
+    window = make_machine(project, register)
+    window.operator_edit.setText("ben")
+    window.connect_all()
+    feed = window.axis_windows[0]
+    qtbot.waitUntil(lambda: feed.link.connected, timeout=15000)
+    ref = "Press 7/feed"
+
+    # an alarm on the drive
+    feed.link._worker._client.transaction.transport.inner.sim_drive.raise_alarm(20)
+    qtbot.waitUntil(lambda: any(e.kind == "alarm" for e in register.history(ref)), timeout=15000)
+    alarm = next(e for e in register.history(ref) if e.kind == "alarm")
+    assert alarm.text.startswith("alarm 20: ") and alarm.who == "ben"
+    feed.link.send(Cmd.CLEAR_ALARM)
+    qtbot.waitUntil(lambda: feed.link.status is not None and feed.link.status.alarm_code == 0, timeout=15000)
+
+    # a move captured in the scope, handed to the model check
+    scope = feed.show_page("scope").view
+    scope.trace_rate.setValue(1000)
+    scope.trace_samples.setValue(p.TRACE_MAX_SAMPLES)
+    scope.trace_pre.setValue(2)
+    scope.trigger_kind.setCurrentIndex(scope.trigger_kind.findData(p.TriggerKind.IO_BIT_RISES))
+    scope.trigger_channel.setCurrentIndex(scope.trigger_channel.findData("moving"))
+    scope.arm_trace()
+    qtbot.waitUntil(lambda: "waiting for the trigger" in scope.trace_state.text(), timeout=10000)
+    with qtbot.waitSignal(scope.sigTraceDone, timeout=30000):
+        feed.link.send(Cmd.CALL, _back_and_forth)
+    page = feed.show_page("modelcheck")
+    path = page.take_scope_capture()
+    recordings = [e for e in register.history(ref) if e.kind == "recording"]
+    assert [e.data["file"] for e in recordings] == [str(path.resolve())]
+    with qtbot.waitSignal(page.sigFinished, timeout=60000):
+        page.run_button.click()
+    checks = [e for e in register.history(ref) if e.kind == "model_check"]
+    assert len(checks) == 1 and "Coulomb friction" in checks[0].text and checks[0].who == "ben"
+    assert checks[0].data["recording_file"] == str(path)
+    register.close()

@@ -94,6 +94,7 @@ class ModelCheckPage(BasePage):
         self.state = session.state if session is not None else AxisState(parent=self)
         self.main_window = main_window
         self.recording: Recording | None = None
+        self.recording_path: Path | None = None  # the file the loaded recording came from
         self._recording_label = ""
         self.result: ModelCheckResult | None = None
         self._running = False
@@ -232,6 +233,7 @@ class ModelCheckPage(BasePage):
         on failure."""
         recording = read_recording(path)
         self._set_recording(recording, f"{Path(path).name}")
+        self.recording_path = Path(path)
         return recording
 
     def _declared_inertia_changed(self, value_kgm2: float) -> None:
@@ -290,6 +292,7 @@ class ModelCheckPage(BasePage):
         folder.mkdir(parents=True, exist_ok=True)
         path = view.save_capture(folder / f"capture-{time.strftime('%Y%m%d-%H%M%S')}.csv")
         self._set_recording(read_recording(path), f"the scope's capture ({path})")
+        self.recording_path = Path(path)
         return path
 
     def _scope_clicked(self) -> None:
