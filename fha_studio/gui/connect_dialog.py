@@ -16,7 +16,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.catalog import DEFAULT_ACTUATOR
+from fha_studio.catalog import DEFAULT_ACTUATOR, all_model_codes
 from fha_studio.gui.forms import child, load_form
 
 BAUD_RATES = (9600, 19200, 38400, 57600, 115200)
@@ -37,21 +37,8 @@ def list_serial_ports() -> list[tuple[str, str]]:
 
 
 def catalogue_codes() -> list[str]:
-    """Model codes to offer: the catalogue's, when it can list them, else a few common ones."""
-    try:
-        from fha_studio import catalog
-
-        lister = getattr(catalog, "list_model_codes", None) or getattr(catalog, "all_model_codes", None)
-        if lister is not None:
-            return list(lister())
-    except Exception:
-        pass
-    return [
-        f"FHA-{frame}-{ratio}-{enc}"
-        for enc in ("US250", "S248")
-        for frame in ("17C", "25C", "32C", "40C")
-        for ratio in (50, 100, 160)
-    ]
+    """The model codes of the catalogue (FHA-C manual 1-3), to offer in the actuator boxes."""
+    return all_model_codes()
 
 
 def sim_url(actuator_code: str, load_inertia_kgm2: float = 0.0) -> str:
