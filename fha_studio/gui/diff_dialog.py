@@ -68,7 +68,8 @@ class ParameterDiffDialog(QDialog):
         for row, item in enumerate(items):
             key = (item.mode, item.number)
             values = {
-                "drive": session.state.drive_values.get(key),
+                # read over the link, else as entered from the drive's front panel
+                "drive": session.state.value_of(*key),
                 "file": loaded.values.get(key),
                 "default": item.default,
             }
@@ -77,7 +78,7 @@ class ParameterDiffDialog(QDialog):
             self.differing += differs
             cells = [
                 f"{MODE_WORDS.get(str(item.mode))} {item.number}: {item.name}",
-                value_text(item, values["drive"]) if values["drive"] is not None else "not read",
+                value_text(item, values["drive"]) if values["drive"] is not None else "not known",
                 value_text(item, values["file"]) if values["file"] is not None else "not in file",
                 value_text(item, values["default"]),
                 "yes" if differs else "",

@@ -84,13 +84,23 @@ class Session(QObject):
     def read_all(self) -> int:
         return self.link.send(Cmd.READ_PARAMETERS, [(i.mode, i.number) for i in self.editable_items()])
 
+    def known_values(self) -> dict[tuple[str, int], int]:
+        """The items' values as known: read from the drive, else entered from its front panel."""
+        values = {key: entry.value for key, entry in self.state.front_panel.items()}
+        values.update(self.state.drive_values)
+        return values
+
     def parameter_file_text(self, values: dict | None = None) -> str:
+        """The parameter file of the known values (those entered from the front panel marked so)."""
         info = self.link.info
+        values = self.known_values() if values is None else values
+        panel = {k: e for k, e in self.state.front_panel.items() if k not in self.state.drive_values}
         return dump_parameter_file(
             self.parameter_model,
-            dict(self.state.drive_values) if values is None else values,
+            values,
             self.state.actuator_code,
             info.driver_model if info else "",
+            front_panel=panel,
         )
 
     def write(self, writes: list[tuple[str, int, int]]) -> None:

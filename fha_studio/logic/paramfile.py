@@ -23,6 +23,7 @@ import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 from fha_studio.hardware.parameters import ParameterItem, ParameterModel
 
@@ -44,6 +45,11 @@ class LoadedParameterFile:
     saved: str
     values: dict[tuple[str, int], int]  # (mode, number) -> wire value, only items that fit
     not_mapped: list[str] = field(default_factory=list)  # one line each: what and why
+    source: str = ""  # FRONT_PANEL_SOURCE when the values were entered from the front panel
+
+
+#: The ``source`` line of a file whose values were (all or partly) entered from the front panel.
+FRONT_PANEL_SOURCE = "entered from the drive's front panel"
 
 
 def dump_parameter_file(
@@ -52,9 +58,15 @@ def dump_parameter_file(
     actuator: str,
     driver_model: str,
     saved: _dt.datetime | None = None,
+    front_panel: Mapping[tuple[str, int], Any] | None = None,
 ) -> str:
-    """The TOML text of `values` ({(mode, number): wire int}) for the items of `model`."""
+    """The TOML text of `values` ({(mode, number): wire int}) for the items of `model`.
+
+    ``front_panel`` ({(mode, number): entry with ``who`` and ``time``}) marks the values that were
+    entered from the drive's front panel (a drive without parameter access over CN3): the file
+    says so in its ``source`` line and beside each such value."""
     saved = saved or _dt.datetime.now(_dt.UTC)
+    front_panel = front_panel or {}
     lines = [
         "# FHA Studio parameter file: the tune and parameter (system) values of a HA-655/HA-675 driver.",
         "# Values are the drive's wire integers; the comment gives the item and its meaning.",
@@ -64,6 +76,8 @@ def dump_parameter_file(
         f"driver = {_quote(getattr(model, 'driver', ''))}",
         f"saved = {_quote(saved.isoformat(timespec='seconds'))}",
     ]
+    if any(key in values for key in front_panel):
+        lines.append(f"source = {_quote(FRONT_PANEL_SOURCE)}")
     for mode in MODES:
         items = [i for i in model if i.mode == mode and (i.mode, i.number) in values]
         if not items:
@@ -73,8 +87,10 @@ def dump_parameter_file(
         for item in sorted(items, key=lambda i: i.number):
             wire = int(values[(item.mode, item.number)])
             meaning = item.format(wire)
+            entry = front_panel.get((item.mode, item.number))
+            by = f" (front panel: {entry.who}, {entry.time})" if entry is not None else ""
             lines.append(
-                f"{item.key.ljust(width)} = {wire:<6d} # {mode} {item.number}: {item.name} = {meaning}"
+                f"{item.key.ljust(width)} = {wire:<6d} # {mode} {item.number}: {item.name} = {meaning}{by}"
             )
     return "\n".join(lines) + "\n"
 
@@ -138,6 +154,7 @@ def read_parameter_file(
         saved=str(data.get("saved", "")),
         values=values,
         not_mapped=not_mapped,
+        source=str(data.get("source", "")),
     )
 
 

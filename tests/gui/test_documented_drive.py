@@ -8,6 +8,7 @@ import itertools
 import time
 
 import pytest
+from PySide6.QtCore import Qt
 
 from fha_studio.gui.link import PROBE_INTERVAL_MS, SERVO_ON_NOTE, SERVO_ON_PROBE_MS, Cmd
 from fha_studio.hardware import protocol as p
@@ -331,7 +332,7 @@ def test_walk_every_page_with_the_servo_off_and_on(window, qtbot):
     """Every page on the documented-only profile, servo off then on; nothing but DGR goes out."""
     from fha_studio.gui.pages.registry import PAGES
 
-    window.session.set_actuator("FHA-25C-50-S248", acknowledged=True)
+    window.state.set_actuator("FHA-25C-50-S248", acknowledged=True)
     sent: list[bytes] = []
     client = window.link._worker._client
     client.trace_packet = lambda sending, data: sending and sent.append(bytes(data))
@@ -354,3 +355,54 @@ def test_walk_every_page_with_the_servo_off_and_on(window, qtbot):
         client.trace_packet = None
     frames = {bytes(data) for data in sent}
     assert frames <= {b"DGR+00000\r", b"OWW+00000\r"}, frames
+
+
+def test_front_panel_worksheet_parameters_direction_file_and_report(window, qtbot, tmp_path):
+    from fha_studio.logic.paramfile import FRONT_PANEL_SOURCE, read_parameter_file
+    from fha_studio.logic.procedures.report import build_report
+
+    window.state.set_actuator("FHA-25C-50-S248", acknowledged=True)
+    page = window.show_page("parameters")
+    model = page.model
+    assert page.panel_bar.isVisible() and model.panel_mode
+    assert model.headerData(3, Qt.Orientation.Horizontal) == "Value on the drive's panel"
+    row = model.row_of("position_loop_gain")
+    assert "not entered" in model.state_text(row) and "item" in model.state_text(row)
+    refused = []
+    model.sigRefused.connect(lambda why, _index: refused.append(why))
+    assert not model.setData(model.index(row, 3), "60")  # nobody named: nothing recorded
+    assert "Entered by" in refused[-1] and not window.state.front_panel
+    page.who_edit.setText("J. Field")
+    assert model.setData(model.index(row, 3), "60")
+    item = window.session.parameter_model.by_key("position_loop_gain")
+    entry = window.state.front_panel[(item.mode, item.number)]
+    assert (entry.value, entry.who) == (60, "J. Field")
+    assert "from the panel: J. Field" in model.state_text(row)
+    assert "≠ default" in model.state_text(row) or item.default == 60
+    assert page.save_button.isEnabled()
+    path = page.save_file(str(tmp_path / "panel.toml"))
+    text = path.read_text()
+    assert FRONT_PANEL_SOURCE in text and "(front panel: J. Field," in text
+    loaded = read_parameter_file(text, window.session.parameter_model)
+    assert loaded.source == FRONT_PANEL_SOURCE and loaded.values[(item.mode, item.number)] == 60
+    # a file with another value: nothing can be written; the page lists what to set on the panel
+    page.apply_choices({(item.mode, item.number): 70})
+    assert "Set on the drive's front panel" in page.message.text() and "= 70" in page.message.text()
+
+    # rotary direction: item 8 entered on the page; the DGR check compares with it
+    direction = window.show_page("direction")
+    direction.panel_combo.setCurrentIndex(1)
+    assert not direction.enter_from_panel()  # no name yet
+    direction.panel_who.setText("J. Field")
+    assert direction.enter_from_panel()
+    assert "On the drive's panel: <b>1</b>" in direction.drive_label.text()
+    assert window.show_page("absolute").parameter_8() == 1
+
+    # the report: the values entered from the panel, marked so
+    procedures = window.show_page("procedures")
+    procedures.new_session(tmp_path / "axis.json", "FHA-25C-50-S248")
+    procedures._collect_for_report()
+    report = build_report(procedures.session)
+    rows = {r.key: r for r in report.parameters}
+    assert "entered from the front panel by J. Field" in rows["position_loop_gain"].value
+    assert rows["rotary_direction"].value.startswith("1")

@@ -94,6 +94,8 @@ class AbsolutePage(BasePage):
         self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status)
         gui_session.state.sigActuatorChanged.connect(lambda _code: self._refresh())
+        gui_session.state.sigFrontPanelChanged.connect(self._panel_value_changed)
+        gui_session.state.sigParametersChanged.connect(self._panel_value_changed)
         self._refresh()
 
     # -- building ------------------------------------------------------------------------------
@@ -456,6 +458,14 @@ class AbsolutePage(BasePage):
         self.encoder_result.setText(detail)
         self._record("encoder", {"turned_deg": self.encoder_angle.value(), "seen": seen}, passed, detail,
                      by_hand=True)
+
+    def _panel_value_changed(self) -> None:
+        """Parameter 8 as known (read, or entered from the panel on the Rotary direction or
+        Parameters page) preselects the 1-10 check's comparison."""
+        item = self.gui_session.parameter_model.by_key("rotary_direction")
+        value = self.gui_session.state.value_of(item.mode, item.number)
+        if value in (0, 1):
+            self.direction_param.setCurrentIndex(value + 1)
 
     def parameter_8(self) -> int | None:
         index = self.direction_param.currentIndex()

@@ -6,9 +6,11 @@ from __future__ import annotations
 from PySide6.QtCore import Qt, QTimer, Slot
 from PySide6.QtWidgets import (
     QButtonGroup,
+    QComboBox,
     QGroupBox,
     QHBoxLayout,
     QLabel,
+    QLineEdit,
     QPushButton,
     QRadioButton,
     QVBoxLayout,
@@ -140,6 +142,21 @@ class DirectionPage(BasePage):
         )
         self.documented_note.setWordWrap(True)
         d_layout.addWidget(self.documented_note)
+        prow = QHBoxLayout()
+        prow.addWidget(QLabel("Item 8 on the drive's panel:"))
+        self.panel_combo = QComboBox()
+        self.panel_combo.setObjectName("panelRotaryDirection")
+        self.panel_combo.addItems(["0 (FWD turns CW)", "1 (FWD turns CCW)"])
+        prow.addWidget(self.panel_combo)
+        prow.addWidget(QLabel("entered by"))
+        self.panel_who = QLineEdit()
+        self.panel_who.setPlaceholderText("your name")
+        prow.addWidget(self.panel_who)
+        self.panel_enter_button = QPushButton("Enter")
+        self.panel_enter_button.clicked.connect(self.enter_from_panel)
+        prow.addWidget(self.panel_enter_button)
+        prow.addStretch(1)
+        d_layout.addLayout(prow)
         self.open_dgr_button = QPushButton("Open the DGR checks: rotary direction")
         self.open_dgr_button.clicked.connect(self._open_dgr_check)
         d_layout.addWidget(self.open_dgr_button)
@@ -156,6 +173,7 @@ class DirectionPage(BasePage):
         self.seen_ccw.clicked.connect(lambda: self.answer("ccw"))
         self.seen_none.clicked.connect(lambda: self.answer("none"))
         session.state.sigParametersChanged.connect(self._values_changed)
+        session.state.sigFrontPanelChanged.connect(self._values_changed)
         session.sigWritesDone.connect(self._writes_done)
         self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status)
@@ -171,9 +189,23 @@ class DirectionPage(BasePage):
         item = self.session.item(KEY)
         return (item.mode, item.number)
 
-    def drive_value(self) -> int | None:
+    def enter_from_panel(self) -> bool:
+        """Record item 8 as the drive's front panel shows it (who and when kept)."""
+        mode, number = self._key()
         try:
-            return self.session.state.drive_values.get(self._key())
+            self.session.state.enter_front_panel(mode, number, self.panel_combo.currentIndex(),
+                                                 self.panel_who.text())
+        except ValueError:
+            self.status_label.setText("Enter your name first: a value from the panel is recorded with who "
+                                      "and when.")
+            return False
+        self.status_label.setText("")
+        return True
+
+    def drive_value(self) -> int | None:
+        """Item 8 as known: read over the link, else as entered from the front panel."""
+        try:
+            return self.session.state.value_of(*self._key())
         except Exception:
             return None
 
@@ -196,8 +228,14 @@ class DirectionPage(BasePage):
         no_jog = connected and info is not None and not info.can_move
         if no_parameters and value is None:
             self.drive_label.setText("On the drive: read it on the front panel, [parameter mode] → item 8 "
-                                     "(no parameter access over CN3)")
-        self.write_button.setEnabled(connected and value is not None and self.chosen() != value)
+                                     "(no parameter access over CN3), and enter it below")
+        elif no_parameters:
+            entry = self.session.state.front_panel.get(self._key())
+            by = f" (entered from the panel by {entry.who} at {entry.time[11:16]})" if entry else ""
+            self.drive_label.setText(f"On the drive's panel: <b>{value}</b> — FWD turns the flange "
+                                     f"{_fwd_words(value)}{by}")
+        self.write_button.setEnabled(connected and value is not None and self.chosen() != value
+                                     and not no_parameters)
         self.write_button.setToolTip(
             "This drive gives no parameter access over CN3: set item 8 in parameter mode on its front panel"
             if no_parameters else "")

@@ -56,8 +56,21 @@ class ParameterTableModel(QAbstractTableModel):
         self.items: list = []
         self.edits: dict[tuple[str, int], int] = {}
         self.restart_pending: set[tuple[str, int]] = set()
+        #: a drive without parameter access: the Value column holds what the front panel shows,
+        #: entered by ``who`` (the front-panel worksheet)
+        self.panel_mode = False
+        self.who = ""
         self.reload_items()
         session.state.sigParametersChanged.connect(self._values_changed)
+        session.state.sigFrontPanelChanged.connect(self._all_changed)
+
+    def set_panel_mode(self, on: bool) -> None:
+        if on != self.panel_mode:
+            self.panel_mode = on
+            self.edits.clear()
+            self.headerDataChanged.emit(Qt.Orientation.Horizontal, COL_VALUE, COL_VALUE)
+            self._all_changed()
+            self.sigEditsChanged.emit(0)
 
     def reload_items(self) -> None:
         self.beginResetModel()
@@ -76,6 +89,8 @@ class ParameterTableModel(QAbstractTableModel):
 
     def headerData(self, section, orientation, role=Qt.ItemDataRole.DisplayRole):
         if role == Qt.ItemDataRole.DisplayRole and orientation == Qt.Orientation.Horizontal:
+            if section == COL_VALUE and self.panel_mode:
+                return "Value on the drive's panel"
             return COLUMNS[section]
         return None
 
@@ -91,6 +106,8 @@ class ParameterTableModel(QAbstractTableModel):
 
     def shown_value(self, row: int) -> int | None:
         key = self.key(row)
+        if self.panel_mode:
+            return self.session.state.value_of(*key)
         return self.edits.get(key, self.session.state.drive_values.get(key))
 
     def state_text(self, row: int) -> str:
@@ -98,7 +115,12 @@ class ParameterTableModel(QAbstractTableModel):
         key = self.key(row)
         drive = self.session.state.drive_values.get(key)
         words = []
-        if key in self.edits:
+        panel = self.session.state.front_panel.get(key)
+        if self.panel_mode and drive is None:
+            words.append(f"from the panel: {panel.who}, {panel.time[11:16]}" if panel is not None
+                         else f"not entered: {MODE_WORDS.get(str(item.mode), str(item.mode))} mode, "
+                         f"item {item.number} on the panel")
+        elif key in self.edits:
             words.append("edited, not written")
         elif drive is None:
             words.append("not read")
@@ -176,6 +198,13 @@ class ParameterTableModel(QAbstractTableModel):
         except ValueError as exc:
             self.sigRefused.emit(f"Refused: {exc}. Allowed: {range_text(item)} {item.unit}".rstrip(), index)
             return False
+        if self.panel_mode:
+            if not self.who.strip():
+                self.sigRefused.emit("Enter your name (Entered by) first: every value from the panel is "
+                                     "recorded with who and when.", index)
+                return False
+            self.session.state.enter_front_panel(item.mode, item.number, wire, self.who)
+            return True
         self.set_edit(item.mode, item.number, wire)
         return True
 
@@ -290,6 +319,28 @@ class ParametersPage(BasePage):
         buttons.addWidget(self.load_button)
         layout.addLayout(buttons)
 
+        # the front-panel worksheet: a drive without parameter access over CN3
+        self.panel_bar = QWidget()
+        pb = QHBoxLayout(self.panel_bar)
+        pb.setContentsMargins(6, 4, 6, 4)
+        self.panel_note = QLabel(
+            "This drive gives no parameter access over CN3. On its front panel, choose the mode and "
+            "the item number shown in the table, read (or set) the value and type it into <b>Value on "
+            "the drive's panel</b>: it is recorded with who and when, compared with the default and a "
+            "parameter file, saved to files marked as entered from the panel, and goes into the report."
+        )
+        self.panel_note.setWordWrap(True)
+        self.who_edit = QLineEdit()
+        self.who_edit.setObjectName("panelWho")
+        self.who_edit.setPlaceholderText("your name")
+        self.who_edit.textChanged.connect(lambda text: setattr(self.model, "who", text))
+        pb.addWidget(self.panel_note, 1)
+        pb.addWidget(QLabel("Entered by:"))
+        pb.addWidget(self.who_edit)
+        self.panel_bar.setStyleSheet("background: #e8f0fe; border-radius: 4px;")
+        self.panel_bar.setVisible(False)
+        layout.addWidget(self.panel_bar)
+
         self.restart_banner = QWidget()
         rb = QHBoxLayout(self.restart_banner)
         rb.setContentsMargins(6, 4, 6, 4)
@@ -369,6 +420,7 @@ class ParametersPage(BasePage):
         self.model.sigRefused.connect(self._refused)
         self.model.sigEditsChanged.connect(self._edits_changed)
         session.state.sigWriteLogChanged.connect(self._log_changed)
+        session.state.sigFrontPanelChanged.connect(self._update_buttons)
         session.sigWritesDone.connect(self._writes_done)
         self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status_for_buttons)
@@ -405,7 +457,11 @@ class ParametersPage(BasePage):
         self.servo_note.setVisible(bool(changed_blocked and connected))
         self._servo_was_on = self.link.servo_on
         self.revert_button.setEnabled(bool(self.model.edits))
-        self.save_button.setEnabled(bool(self.session.state.drive_values))
+        self.save_button.setEnabled(bool(self.session.state.drive_values or self.session.state.front_panel))
+        if self.model.panel_mode:
+            reason = "This drive gives no parameter access over CN3: use its front panel"
+            for b in (self.read_button, self.write_all_button, self.write_changed_button):
+                b.setToolTip(reason)
 
     @Slot()
     def read_all(self) -> None:
@@ -523,11 +579,14 @@ class ParametersPage(BasePage):
         self.model.restart_pending.clear()
         self.restart_banner.setVisible(False)
         self._update_buttons()
+        self.model.set_panel_mode(not info.can_parameters)
+        self.panel_bar.setVisible(not info.can_parameters)
         if not info.can_parameters:
             self.message.setText(
                 "This drive does not give parameter access over CN3 (it answers only the commands of "
-                "its manual): read and set the parameters on its front panel."
+                "its manual): read and set the parameters on its front panel, and enter them here."
             )
+            self._update_buttons()
             return
         self.session.read_all()
 
@@ -568,8 +627,8 @@ class ParametersPage(BasePage):
         return str(QSettings().value("parameters/last_dir", str(Path.home())))
 
     def save_file(self, path: str | None = None) -> Path | None:
-        if not self.session.state.drive_values:
-            self.message.setText("Nothing to save: read the drive first.")
+        if not (self.session.state.drive_values or self.session.state.front_panel):
+            self.message.setText("Nothing to save: read the drive (or enter its panel's values) first.")
             return None
         if path is None:
             suggested = Path(self._default_dir()) / f"{self.session.state.actuator_code or 'parameters'}.toml"
@@ -581,7 +640,9 @@ class ParametersPage(BasePage):
         target = Path(path)
         target.write_text(self.session.parameter_file_text(), encoding="utf-8")
         QSettings().setValue("parameters/last_dir", str(target.parent))
-        self.message.setText(f"Saved the drive's values to {target}")
+        panel = (" (values entered from the front panel are marked so)"
+                 if self.session.state.front_panel else "")
+        self.message.setText(f"Saved the drive's values to {target}{panel}")
         self.message.setStyleSheet("")
         return target
 
@@ -614,7 +675,20 @@ class ParametersPage(BasePage):
         return dialog
 
     def apply_choices(self, values: dict) -> None:
-        """Puts the chosen values as edits and writes the ones that differ from the drive."""
+        """Puts the chosen values as edits and writes the ones that differ from the drive. On a
+        drive without parameter access nothing can be written: it lists what to set on the panel."""
+        if self.model.panel_mode:
+            todo = []
+            for (mode, number), wire in sorted(values.items()):
+                if self.session.state.value_of(mode, number) != wire:
+                    item = self.session.parameter_model.item(mode, number)
+                    where = f"{MODE_WORDS.get(str(mode), mode)} {number} ({item.name})"
+                    todo.append(f"{where} = {value_text(item, wire)}")
+            self.message.setText(
+                ("Set on the drive's front panel, then enter here: " + "; ".join(todo)) if todo
+                else "The panel's values (as entered) already match the chosen values."
+            )
+            return
         for (mode, number), wire in values.items():
             self.model.set_edit(mode, number, wire)
         if self.link.connected and self.model.edits:

@@ -128,13 +128,17 @@ def _parameter_rows(session: ProcedureSession) -> tuple[str, tuple[ParameterRow,
             continue
         wire = int(wire)
         default = item.default
+        panel = params.get("front_panel", {}).get(key)
+        shown = item.format(wire)
+        if panel:
+            shown += f" (entered from the front panel by {panel.get('who', '?')}, {panel.get('time', '')})"
         rows.append(
             ParameterRow(
                 mode=item.mode.value,
                 number=item.number,
                 key=item.key,
                 name=item.name,
-                value=item.format(wire),
+                value=shown,
                 default="" if default is None else item.format(default),
                 changed=default is not None and wire != default,
                 certain=item.certain,

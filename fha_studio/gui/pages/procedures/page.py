@@ -487,7 +487,7 @@ class ProceduresPage(BasePage):
         identity = self._identity()
         if identity:
             self.session.driver = identity
-        values = self.state.drive_values
+        values = self.gui_session.known_values()
         if values:
             model = self.gui_session.parameter_model
             by_key = {}
@@ -503,7 +503,15 @@ class ProceduresPage(BasePage):
                 except Exception as exc:  # the report still goes out, saying the file is missing
                     log.warning("parameter file not written: %s", exc)
                     path = None
-            self.session.parameters = {"file": str(path or ""), "values": by_key}
+            panel = {}
+            for (mode, number), entry in self.state.front_panel.items():
+                if (mode, number) in self.state.drive_values:
+                    continue
+                try:
+                    panel[model.item(mode, number).key] = {"who": entry.who, "time": entry.time}
+                except (KeyError, ValueError):
+                    continue
+            self.session.parameters = {"file": str(path or ""), "values": by_key, "front_panel": panel}
         if self.session.path:
             self.session.save()
 
