@@ -18,7 +18,7 @@ from PySide6.QtWidgets import (
 
 from fha_studio.catalog.tables import default_rotary_direction, rotary_direction_setting
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
-from fha_studio.gui.pages.base import BasePage
+from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.session import Session
 from fha_studio.gui.widgets import FlangeWidget, space_jogs_only
 
@@ -385,9 +385,8 @@ class DirectionPage(BasePage):
         self._update()
 
     def _open_dgr_check(self) -> None:
-        window = self.main_window
-        if window is not None and hasattr(window, "show_page"):
-            page = window.show_page("absolute")
+        if self.main_window is not None:
+            page = self.main_window.show_page(PageId.ABSOLUTE)
             page.tabs.setCurrentIndex(1)
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
