@@ -313,6 +313,10 @@ class FakeDriveClient:
         self._check(Command.TRB)
         return []
 
-    def read_trace(self, should_abort: Callable[[], bool] | None = None) -> TraceCapture:
+    def read_trace(
+        self,
+        should_abort: Callable[[], bool] | None = None,
+        progress: Callable[[int, int], None] | None = None,
+    ) -> TraceCapture:
         self._check(Command.TRB)
         return TraceCapture((), ())

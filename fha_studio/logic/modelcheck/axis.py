@@ -46,10 +46,13 @@ def declared_axis(rec: Recording) -> DeclaredAxis:
     if meta.is_custom:
         peak = float(np.max(np.abs(rec.current_a)))
         ppr = _guess_ppr(rec.pos_deg)
+        kt, inertia = meta.torque_constant_nm_per_a, meta.actuator_inertia_kgm2
+        if kt is None or inertia is None:  # the recording reader refuses such a file already
+            raise ModelCheckError("a custom axis needs torque_constant_nm_per_a and actuator_inertia_kgm2")
         model = AxisModel(
-            torque_constant_nm_per_a=float(meta.torque_constant_nm_per_a),
+            torque_constant_nm_per_a=float(kt),
             max_current_a=max(1.5 * peak, 1e-3),
-            actuator_inertia_kgm2=float(meta.actuator_inertia_kgm2),
+            actuator_inertia_kgm2=float(inertia),
             load_inertia_kgm2=float(meta.load_inertia_kgm2),
             ratio=meta.motor_turns_per_output_rev,
             output_resolution_ppr=ppr,
@@ -202,6 +205,6 @@ def _check_resolution(pos: np.ndarray, q_deg: float, code: str, ppr: int, custom
         )
 
 
-def rms(x: np.ndarray) -> float:
-    """Root mean square."""
-    return float(math.sqrt(np.mean(np.square(x)))) if len(x) else 0.0
+def rms(x: np.ndarray | None) -> float:
+    """Root mean square (0 for no signal)."""
+    return float(math.sqrt(np.mean(np.square(x)))) if x is not None and len(x) else 0.0

@@ -37,7 +37,7 @@ class ChannelContext:
     gear_torque_nm: np.ndarray | None = None
     # torque breakpoints of the wind-up curve (catalogue T1, T2) the data reaches beyond
     breakpoints_nm: tuple[float, ...] = ()
-    cache: dict = field(default_factory=dict)
+    cache: dict[tuple[object, ...], np.ndarray] = field(default_factory=dict)
 
     def full_sign_speed(self, memory: bool = False) -> np.ndarray:
         """Direction of motion on the whole record: 0 while standing, or (memory) the last direction."""
@@ -109,8 +109,8 @@ def _sd(cov: np.ndarray, i: int) -> float:
     return math.sqrt(max(float(cov[i, i]), 0.0))
 
 
-def _rms(x: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(np.square(x)))) if len(x) else 0.0
+def _rms(x: np.ndarray | None) -> float:
+    return float(np.sqrt(np.mean(np.square(x)))) if x is not None and len(x) else 0.0
 
 
 # ------------------------------------------------------------------------------------ torque channel

@@ -400,12 +400,12 @@ class ChannelSelector:
                 terms.append(term)
         while len(terms) < MAX_EFFECTS:
             phi = fit_ar(self.residual(terms))
-            chosen = [t.id for t in terms]
-            trials = [self.try_add(cand, terms) for cand in self.candidates if cand.id not in chosen]
-            good = [(tr, tm) for tr, tm in trials if tr.accepted]
+            in_model = [t.id for t in terms]
+            tried = [self.try_add(cand, terms) for cand in self.candidates if cand.id not in in_model]
+            good = [(tr, tm) for tr, tm in tried if tr.accepted]
             best = min(good, key=lambda p: p[0].delta_bic) if good else None
             chosen = best[0].id if best else None
-            steps.append(SelectionStep("forward", len(phi), [tr for tr, _ in trials], chosen))
+            steps.append(SelectionStep("forward", len(phi), [tr for tr, _ in tried], chosen))
             if best is None:
                 break
             terms.append(best[1])
@@ -416,7 +416,7 @@ class ChannelSelector:
             phi = self._ar_for(self.design(terms))
             full = self.score(terms, phi)
             cv_full, _ = block_cv(self.y, self.design(terms))
-            trials = []
+            trials: list[Trial] = []
             for term in terms:
                 rest = [t for t in terms if t is not term]
                 drop_bic = self.score(rest, phi)

@@ -228,6 +228,7 @@ def build_signals(
 ) -> Signals:
     """Step 1: derivatives and smoothed channels. ``window`` overrides the automatic choice."""
     t, (pos, cur, load, cmd), resampled = uniform(t_s, pos_rad, current_a, load_pos_rad, cmd_pos_rad)
+    assert pos is not None and cur is not None  # given, so resampled too
     dt = float(np.median(np.diff(t)))
     pos_noise = noise_sigma(pos)
     cur_noise = noise_sigma(cur)

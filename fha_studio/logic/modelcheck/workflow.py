@@ -34,6 +34,7 @@ from fha_studio.logic.modelcheck.selection import (
     ChannelSelector,
     FittedTerm,
     SelectionStep,
+    Term,
     block_cv,
     block_edges,
 )
@@ -488,7 +489,7 @@ def run_modelcheck(
     # ---- step 3 on the torque channel
     status: dict[str, ChannelStatus] = {TORQUE: _torque_status(sig, axis, torque_nominal, floor_t)}
     channels: dict[str, ChannelReport] = {}
-    selectors: dict[str, tuple[ChannelSelector, list, list[FittedTerm], np.ndarray]] = {}
+    selectors: dict[str, tuple[ChannelSelector, list[Term], list[FittedTerm], np.ndarray]] = {}
     ctx_t = ChannelContext(sig, TORQUE)
     fitted_t: list[FittedTerm] = []
     delay_ms = 0.0
