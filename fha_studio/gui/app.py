@@ -90,9 +90,10 @@ def make_application(argv: Sequence[str] = ()):
     """The QApplication (created once), with the names QSettings uses."""
     from PySide6.QtWidgets import QApplication
 
-    app = QApplication.instance()
-    if app is None:
-        app = QApplication([sys.argv[0] if sys.argv else "fha-studio", *argv])
+    existing = QApplication.instance()
+    app = existing if isinstance(existing, QApplication) else QApplication(
+        [sys.argv[0] if sys.argv else "fha-studio", *argv]
+    )
     if not app.organizationName() or app.organizationName() == "":
         app.setOrganizationName(ORGANISATION)
         app.setApplicationName(APPLICATION)

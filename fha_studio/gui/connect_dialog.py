@@ -103,7 +103,7 @@ class ConnectDialog(QDialog):
 
     def _restore(self) -> None:
         settings = QSettings()
-        kind = settings.value("connect/kind", "sim")
+        kind = str(settings.value("connect/kind", "sim"))
         actuator = settings.value("connect/actuator", DEFAULT_ACTUATOR)
         self.sim_actuator.setCurrentText(str(actuator))
         port = settings.value("connect/port", "")
@@ -111,7 +111,7 @@ class ConnectDialog(QDialog):
         if index >= 0:
             self.port_combo.setCurrentIndex(index)
         self.address_edit.setText(str(settings.value("connect/address", "")))
-        baud = int(settings.value("connect/baud", DEFAULT_BAUD))
+        baud = int(str(settings.value("connect/baud", DEFAULT_BAUD)))
         self.baud_combo.setCurrentIndex(max(0, self.baud_combo.findData(baud)))
         {"serial": self.serial_radio, "address": self.address_radio}.get(kind, self.sim_radio).setChecked(
             True

@@ -116,7 +116,7 @@ class ParameterDiffDialog(QDialog):
             layout.addWidget(
                 QLabel(f"<b>Not mapped ({len(loaded.not_mapped)})</b>: in the file, but not applicable here:")
             )
-            self.not_mapped_view = QPlainTextEdit("\n".join(loaded.not_mapped))
+            self.not_mapped_view: QPlainTextEdit | None = QPlainTextEdit("\n".join(loaded.not_mapped))
             self.not_mapped_view.setReadOnly(True)
             self.not_mapped_view.setMaximumHeight(90)
             layout.addWidget(self.not_mapped_view)

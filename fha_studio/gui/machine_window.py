@@ -42,6 +42,7 @@ from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.session import data_dir
 from fha_studio.gui.widgets import StopButton
 from fha_studio.logic.machine import MachineAxis, MachineProject
+from fha_studio.logic.procedures import ProcedureSession
 from fha_studio.logic.register import ENV_REGISTER, Register, RegisterError, record_session
 
 log = logging.getLogger(__name__)
@@ -241,7 +242,7 @@ class AxisRecorder(QObject):
                 continue
             self._record(
                 "report",
-                lambda path=path: self.register.record_report(
+                lambda path=path: self.register.record_report(  # type: ignore[misc]  # default binds path
                     path,
                     axis=self.axis_ref,
                     signed_by=signature.get("who", ""),
@@ -606,9 +607,9 @@ class MachineWindow(QMainWindow):
             window.show_message(text, level)
         return sent
 
-    def sessions(self) -> dict[str, object]:
+    def sessions(self) -> dict[str, ProcedureSession]:
         """Each axis's procedure session as its pages hold it (axes without one are left out)."""
-        out = {}
+        out: dict[str, ProcedureSession] = {}
         for axis, window in zip(self.project, self.axis_windows, strict=True):
             session = getattr(window.built_page(PageId.PROCEDURES), "session", None)
             if session is not None:
@@ -659,7 +660,8 @@ class MachineWindow(QMainWindow):
         return self._register_dialog
 
     def _report_clicked(self) -> None:
-        base = Path(QSettings().value("machine/report_dir", str(Path.home()))) / f"{self.project.name}.pdf"
+        folder = Path(str(QSettings().value("machine/report_dir", str(Path.home()))))
+        base = folder / f"{self.project.name}.pdf"
         path, _ = QFileDialog.getSaveFileName(self, "Machine report (PDF)", str(base), "PDF (*.pdf)")
         if not path:
             return

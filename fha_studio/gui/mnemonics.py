@@ -43,7 +43,8 @@ def resolve_mnemonics(page: QWidget, reserved: set[str]) -> list[str]:
         if isinstance(widget, QToolButton) and widget.defaultAction() is not None:
             continue
         button = isinstance(widget, QAbstractButton) and not isinstance(widget.parent(), QTabBar)
-        if button or (isinstance(widget, QLabel) and widget.buddy() is not None):
+        labelled = isinstance(widget, QLabel) and widget.buddy() is not None
+        if (isinstance(widget, QAbstractButton) and button) or (isinstance(widget, QLabel) and labelled):
             check(widget.text(), widget.setText)
         elif isinstance(widget, QGroupBox):
             check(widget.title(), widget.setTitle)

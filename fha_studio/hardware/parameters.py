@@ -34,7 +34,10 @@ class Mode(StrEnum):
 
 
 #: The modes as the HA-655 manual and its front panel name them.
-MODE_WORDS = {Mode.MONITOR: "monitor", Mode.TUNE: "tune", Mode.SYSTEM: "parameter", Mode.TEST: "test"}
+#: Keyed by the mode (a str: "system" finds it too).
+MODE_WORDS: dict[str, str] = {
+    Mode.MONITOR: "monitor", Mode.TUNE: "tune", Mode.SYSTEM: "parameter", Mode.TEST: "test"
+}
 
 
 class ParameterTableError(ValueError):

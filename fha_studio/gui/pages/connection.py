@@ -17,6 +17,7 @@ from fha_studio.gui.connect_dialog import catalogue_codes
 from fha_studio.gui.link import LinkInfo
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
+from fha_studio.logic.pairing import PairingCheck
 
 
 def _value_label() -> QLabel:
@@ -33,7 +34,7 @@ class ConnectionPage(BasePage):
         super().__init__()
         self.session = session
         self.main_window = main_window
-        self.pairing = None
+        self.pairing: PairingCheck | None = None
         layout = QVBoxLayout(self)
 
         drive_box = QGroupBox("Drive")

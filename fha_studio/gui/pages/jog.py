@@ -155,8 +155,8 @@ class JogPage(BasePage):
         self.position_label = QLabel("—")
         self.speed_label = QLabel("—")
         self.current_label = QLabel("—")
-        for w in (self.position_label, self.speed_label, self.current_label):
-            w.setMinimumWidth(120)
+        for label in (self.position_label, self.speed_label, self.current_label):
+            label.setMinimumWidth(120)
         l_layout.addRow("Output position:", self.position_label)
         l_layout.addRow("Output speed:", self.speed_label)
         l_layout.addRow("Motor current:", self.current_label)
@@ -187,10 +187,10 @@ class JogPage(BasePage):
 
     # -- settings ---------------------------------------------------------------------------------
     def restore_settings(self, settings: QSettings) -> None:
-        self.speed_spin.setValue(float(settings.value("jog/speed_rpm", self.speed_spin.value())))
-        self.angle_spin.setValue(float(settings.value("jog/angle_deg", self.angle_spin.value())))
+        self.speed_spin.setValue(float(str(settings.value("jog/speed_rpm", self.speed_spin.value()))))
+        self.angle_spin.setValue(float(str(settings.value("jog/angle_deg", self.angle_spin.value()))))
         self.move_speed_spin.setValue(
-            float(settings.value("jog/move_speed_rpm", self.move_speed_spin.value()))
+            float(str(settings.value("jog/move_speed_rpm", self.move_speed_spin.value())))
         )
 
     def save_settings(self, settings: QSettings) -> None:

@@ -34,6 +34,7 @@ from PySide6.QtWidgets import (
 from fha_studio.gui.connect_dialog import catalogue_codes
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
+from fha_studio.logic.sizing import SizingResult
 
 PASS_COLOUR = QColor("#2e7d32")
 FAIL_COLOUR = QColor("#b00020")
@@ -65,7 +66,7 @@ class SizingPage(BasePage):
         self.shapes = SHAPES
         self.materials = materials()
         self.parts: list[tuple[str, float]] = []  # (description, inertia about the output axis)
-        self.result = None
+        self.result: SizingResult | None = None
         self.suggested: list[str] = []
         outer = QHBoxLayout(self)
         splitter = QSplitter(Qt.Orientation.Horizontal)

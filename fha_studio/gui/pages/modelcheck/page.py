@@ -421,28 +421,29 @@ class ModelCheckPage(BasePage):
             )
             for col, text in enumerate((f"{e.label} ({e.id})", e.channel, params, ", ".join(e.alternatives))):
                 table.setItem(row, col, QTableWidgetItem(text))
-        text = []
+        lines: list[str] = []
         for name, ch in r.channels.items():
-            text.append(f"{name} channel: {ch.n_samples} samples, AR({ch.ar_order}) whitening, "
+            lines.append(f"{name} channel: {ch.n_samples} samples, AR({ch.ar_order}) whitening, "
                         f"practical floor {_num(ch.floor)} {ch.unit}")
             for step in ch.steps:
-                text.append(f"  {_describe_step(step)}")
+                lines.append(f"  {_describe_step(step)}")
         for a in r.ambiguities:
-            text.append(f"{a.chosen} or {a.alternative}: not separable from this data "
+            lines.append(f"{a.chosen} or {a.alternative}: not separable from this data "
                         f"(ΔBIC {a.delta_bic:.1f}); to separate them: {a.separating_test}")
         for s in r.structures:
-            text.append(f"Unexplained structure in {s.channel} by {s.variable}: {_num(s.rms)} {s.unit} rms "
+            lines.append(f"Unexplained structure in {s.channel} by {s.variable}: {_num(s.rms)} {s.unit} rms "
                         f"({100 * s.fraction:.0f} % of the residual)")
         if r.detection_limits:
-            text.append("Detection limits of this recording:")
-            text.extend(f"  {d.id}: {d.param} {_num(d.value)} {d.param_unit}" for d in r.detection_limits)
-        text.append("")
-        text.append("Updated model (Save updated model… writes it for the simulated drive):")
-        text.append(r.updated_model.to_toml())
-        self.findings.setPlainText("\n".join(text))
+            lines.append("Detection limits of this recording:")
+            lines.extend(f"  {d.id}: {d.param} {_num(d.value)} {d.param_unit}" for d in r.detection_limits)
+        lines.append("")
+        lines.append("Updated model (Save updated model… writes it for the simulated drive):")
+        lines.append(r.updated_model.to_toml())
+        self.findings.setPlainText("\n".join(lines))
 
     def _draw_gap(self, r: ModelCheckResult) -> None:
         layout = self.gap_box.layout()
+        assert isinstance(layout, QVBoxLayout)
         for plot in self.gap_plots.values():
             layout.removeWidget(plot)
             plot.deleteLater()

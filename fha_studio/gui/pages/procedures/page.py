@@ -687,7 +687,8 @@ class ProceduresPage(BasePage):
         elif step.kind == "live":
             self.inputs.setCurrentIndex(self._pages["live"])
         elif step.kind == "sensor_angle":
-            if self.dog_panel.sensor != step.sensor or self.dog_panel.wizard is None:
+            if self.context is not None and (self.dog_panel.sensor != step.sensor
+                                             or self.dog_panel.wizard is None):
                 self.dog_panel.start(step.sensor, self.context)
             self.inputs.setCurrentIndex(self._pages["sensor_angle"])
 

@@ -102,8 +102,9 @@ def _unbreakable_spans(document: QTextDocument) -> list[_Span]:
                 # a heading is never the last thing on a page: keep it with what follows
                 following = block.next()
                 after = _block_spans(following, layout)[:1] if following.isValid() else []
-                if _table_of(following) is not None:
-                    rows = _table_row_spans(_table_of(following), layout)
+                table = _table_of(following)
+                if table is not None:
+                    rows = _table_row_spans(table, layout)
                     after = rows[:2]
                 if after:
                     spans.append(_Span(lines[0].top, after[-1].bottom))

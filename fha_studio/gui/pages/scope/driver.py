@@ -328,7 +328,7 @@ class ScopeController(QObject):
             thread = QThread()
             thread.setObjectName("fha-scope")
             thread.start()
-        self.thread = thread
+        self.link_thread = thread
         self.driver = ScopeDriver(config, abort)
         self.driver.moveToThread(thread)
         self.sigRequest.connect(self.driver.handle)
@@ -359,7 +359,7 @@ class ScopeController(QObject):
         self.send(ScopeCmd.SHUTDOWN, self._own_thread)
         if not self._own_thread:
             return True
-        ended = self.thread.wait(timeout_ms)
+        ended = self.link_thread.wait(timeout_ms)
         if not ended:
             log.error("the scope thread did not end within %d ms", timeout_ms)
         return ended

@@ -107,6 +107,10 @@ class ScopeView(QWidget):
     sigFrame = Signal()  # one live redraw done (benchmarks count these)
     sigTestDone = Signal(object)  # MoveTestResult
     sigTraceDone = Signal(object)  # TraceResult
+
+    # panels made in _build (signal connections made before them refer to them)
+    tests: MoveTestPanel
+    time_plot: TimePlot
     sigLiveChanged = Signal(bool)  # live acquisition requested on / off
     sigRecordingSaved = Signal(object, str)  # Path of a finished fha-recording/1 file, what it holds
     sigLoadInertiaEdited = Signal(float)  # the user typed the declared load inertia [kg m^2]
