@@ -39,6 +39,7 @@ from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController,
 from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
+from fha_studio.gui.register_dialog import RegisterDialog
 from fha_studio.gui.session import data_dir
 from fha_studio.gui.widgets import StopButton
 from fha_studio.logic.machine import MachineAxis, MachineProject
@@ -344,7 +345,7 @@ class MachineWindow(QMainWindow):
         self.recorders: list[AxisRecorder] = []
         self._shut_down = False
         self._closing_confirmed = False
-        self._register_dialog = None
+        self._register_dialog: RegisterDialog | None = None
         self._build_toolbar()
         self._build_body(open_client)
         if register is not None:
@@ -645,7 +646,6 @@ class MachineWindow(QMainWindow):
     def show_register(self):
         """Opens the register's questions for this machine, on the axis on show (not modal: the
         pages stay usable); returns the dialog."""
-        from fha_studio.gui.register_dialog import RegisterDialog
 
         if self.register is None:
             return None
