@@ -254,6 +254,8 @@ class ModelCheckPage(BasePage):
 
     def _describe_recording(self) -> None:
         recording, label = self.recording, self._recording_label
+        if recording is None:
+            return
         m = recording.metadata
         declared = self.state.load_inertia_kgm2
         columns = ", ".join(["t", "pos", "current"] + [c for c in ("cmd_pos", "load_pos", "vel")
