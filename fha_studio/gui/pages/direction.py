@@ -229,7 +229,7 @@ class DirectionPage(BasePage):
         if no_parameters and value is None:
             self.drive_label.setText("On the drive: read it on the front panel, [parameter mode] → item 8 "
                                      "(no parameter access over CN3), and enter it below")
-        elif no_parameters:
+        elif no_parameters and value is not None:
             entry = self.session.state.front_panel.get(self._key())
             by = f" (entered from the panel by {entry.who} at {entry.time[11:16]})" if entry else ""
             self.drive_label.setText(f"On the drive's panel: <b>{value}</b> — FWD turns the flange "
