@@ -67,7 +67,19 @@ def main() -> int:
 
     window.connect_to(URL)
     wait_until(lambda: window.link.status is not None and window.link.status.absolute_counts is not None)
-    window.session.set_actuator("FHA-25C-50-S248-L", acknowledged=True)
+    window.state.set_actuator("FHA-25C-50-S248-L", acknowledged=True)
+
+    # the front-panel worksheet: values read on the drive's panel, entered with who and when
+    params = window.show_page("parameters")
+    params.who_edit.setText("J. Field")
+    model = params.model
+    for key, text in (("position_loop_gain", "60"), ("rotary_direction", "0"), ("in_position_range", "20")):
+        try:
+            model.setData(model.index(model.row_of(key), 3), text)
+        except StopIteration:
+            continue
+    params.table.selectRow(model.row_of("position_loop_gain"))
+    shot("front-panel-worksheet")
 
     page = window.show_page("absolute")
     page.who_edit.setText("J. Field")
