@@ -3,7 +3,7 @@
     xvfb-run -a -s "-screen 0 1366x768x24" python docs/screenshots/take.py [OUTDIR]
 
 A scripted commissioning session: connect, read, set the rotary direction to reversed (not
-written), servo on and jog, raise alarm 20 on the simulated drive, a sizing duty. Settings and
+written), servo on and jog, raise alarm 20 on the simulated drive, a sizing duty, a procedures session. Settings and
 data go to a temporary directory, never the user's.
 """
 
@@ -101,6 +101,17 @@ def main() -> int:
     @step(500)
     def sizing_shot():
         shot("sizing")
+
+    @step(300)
+    def procedures():
+        # the actuator is typed once, on the Connection page; the procedures take it from there
+        window.connection_page.actuator_combo.setCurrentText("FHA-25C-50-US250-B-L")
+        window.connection_page.check_pairing()
+        page = window.show_page("procedures")
+        page.operator_edit.setText("T. Trainee")
+        page.new_session(Path(TMP) / "axis1.json")
+        page.select_procedure("receiving-inspection")
+        shot("procedures")
 
     @step(100)
     def connect_dialog():
