@@ -3,8 +3,8 @@
     xvfb-run -a -s "-screen 0 1366x768x24" python docs/screenshots/take.py [OUTDIR]
 
 A scripted commissioning session: connect, read, set the rotary direction to reversed (not
-written), servo on and jog, raise alarm 20 on the simulated drive, a sizing duty, a procedures session. Settings and
-data go to a temporary directory, never the user's.
+written), servo on and jog, raise alarm 20 on the simulated drive, a sizing duty, a procedures
+session. Settings and data go to a temporary directory, never the user's.
 """
 
 from __future__ import annotations

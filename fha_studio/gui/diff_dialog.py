@@ -33,7 +33,7 @@ class ParameterDiffDialog(QDialog):
         self.session = session
         self.loaded = loaded
         layout = QVBoxLayout(self)
-        info = self.session.link.info
+        driver_model = self.session.state.driver_model
         head = (
             f"<b>{file_name}</b>: actuator {loaded.actuator or '?'}, driver {loaded.driver_model or '?'}, "
             f"saved {loaded.saved or '?'}."
@@ -44,9 +44,9 @@ class ParameterDiffDialog(QDialog):
             warnings.append(
                 f"The file was made for {loaded.actuator}, this axis is {axis_code}."
             )
-        if info and loaded.driver_model and info.driver_model and loaded.driver_model != info.driver_model:
+        if loaded.driver_model and driver_model and loaded.driver_model.upper() != driver_model:
             warnings.append(
-                f"The file was made on a {loaded.driver_model}, this drive is a {info.driver_model}."
+                f"The file was made on a {loaded.driver_model}, this drive is a {driver_model}."
             )
         if warnings:
             head += "<br><span style='color:#b00020'>⚠ " + " ".join(warnings) + " Check every row.</span>"

@@ -92,14 +92,13 @@ class Session(QObject):
 
     def parameter_file_text(self, values: dict | None = None) -> str:
         """The parameter file of the known values (those entered from the front panel marked so)."""
-        info = self.link.info
         values = self.known_values() if values is None else values
         panel = {k: e for k, e in self.state.front_panel.items() if k not in self.state.drive_values}
         return dump_parameter_file(
             self.parameter_model,
             values,
             self.state.actuator_code,
-            info.driver_model if info else "",
+            self.state.driver_model,
             front_panel=panel,
         )
 
