@@ -147,3 +147,24 @@ def test_the_sizing_page_never_shows_the_previous_actuators_result(make_window, 
     # changed while the sizing page is on show (an opened procedure session, say): sized at once
     window.state.set_actuator("FHA-17C-50-US250")
     assert sizing.result.actuator_code == "FHA-17C-50-US250"
+
+
+def test_the_adapter_signals_changes_made_on_the_model_and_lets_go_when_deleted(qtbot):
+    from PySide6.QtCore import QCoreApplication, QEvent
+
+    from fha_studio.gui.state import AxisState
+    from fha_studio.logic.commissioning import CommissioningState
+
+    model = CommissioningState()  # e.g. an axis of a machine project, outliving its window
+    state = AxisState(model)
+    inertia: list[float] = []
+    actuators: list[str] = []
+    state.sigLoadInertiaChanged.connect(inertia.append)
+    state.sigActuatorChanged.connect(actuators.append)
+    model.set_load_inertia(1.5)
+    model.set_actuator("FHA-40C-160-S248")
+    assert inertia == [1.5] and actuators == ["FHA-40C-160-S248"] and state.ratio == 160
+    state.deleteLater()
+    QCoreApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete.value)
+    model.set_load_inertia(2.0)  # the deleted adapter is no longer a listener: nothing raises
+    assert inertia == [1.5]
