@@ -27,7 +27,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import gui_startup
 import scope_throughput as scope
 import trace_readout
-from PySide6.QtWidgets import QApplication
+
+from fha_studio.gui.app import make_application
 
 STANDSTILL = ("feedback_position", "command_position", "output_speed", "motor_current")
 
@@ -51,7 +52,7 @@ class Figure:
 
 def measure(seconds: float, startup_runs: int, load: float) -> dict[str, Figure]:
     figures: dict[str, Figure] = {}
-    QApplication.instance() or QApplication([])
+    make_application()  # as the GUI makes it (GIL switch interval included)
     scope.isolate_settings()
     for name, keys, jog, before, what in (
         ("poll_1_item_pct_of_limit", ("feedback_position",), 0.0, 67.0, "polling 1 item, standstill"),

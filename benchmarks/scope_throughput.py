@@ -30,8 +30,8 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 import numpy as np
 from PySide6.QtCore import QEventLoop, QTimer
-from PySide6.QtWidgets import QApplication
 
+from fha_studio.gui.app import make_application
 from fha_studio.gui.pages.scope.driver import LiveStarted, ScopeCmd, ScopeController
 from fha_studio.gui.pages.scope.view import ScopeContext, ScopeView
 from fha_studio.hardware import protocol as p
@@ -211,14 +211,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="measuring time per case [s]")
     parser.add_argument("--switch-interval", type=float, default=None,
-                        help="sys.setswitchinterval for the run [s] (Python's default: 0.005)")
+                        help="sys.setswitchinterval for the run [s] (default: the GUI's, "
+                             "fha_studio.gui.app.GIL_SWITCH_INTERVAL_S)")
     args = parser.parse_args()
+    make_application()  # the QApplication as the GUI makes it (GIL switch interval included)
     if args.switch_interval:
         sys.setswitchinterval(args.switch_interval)
     load = os.getloadavg()[0]
     print(f"machine: {os.cpu_count()} cores, load average {load:.1f} (figures shrink with the load); "
           f"GIL switch interval {sys.getswitchinterval() * 1000:g} ms")
-    QApplication.instance() or QApplication([])
     print(f"Polling over the simulated drive paced at 19200 bit/s, {args.seconds:g} s per case")
     cases = (
         ("position", ("feedback_position",), 0.0),

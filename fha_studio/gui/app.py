@@ -13,6 +13,12 @@ from fha_studio.gui.session import DEFAULT_SIM_URL
 
 ORGANISATION = "FHA Studio"
 APPLICATION = "fha-studio"
+#: Python's GIL switch interval in the GUI process [s] (Python's default: 0.005). The link thread
+#: wakes for every few characters of a reply and must get the GIL at once; with 5 ms a GUI thread
+#: busy in Python (a frame being drawn) keeps it waiting up to 5 ms each time, line time lost for
+#: every polled sample (a 1-item sample takes 7 ms on the line). 0.5 ms bounds that wait; the
+#: extra switches cost nothing measurable (benchmarks/scope_throughput.py).
+GIL_SWITCH_INTERVAL_S = 0.0005
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -87,9 +93,11 @@ def _machine_window(args):
 
 
 def make_application(argv: Sequence[str] = ()):
-    """The QApplication (created once), with the names QSettings uses."""
+    """The QApplication (created once), with the names QSettings uses, in a process whose GIL
+    switches fast enough for the link thread (``GIL_SWITCH_INTERVAL_S``)."""
     from PySide6.QtWidgets import QApplication
 
+    sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
     existing = QApplication.instance()
     app = existing if isinstance(existing, QApplication) else QApplication(
         [sys.argv[0] if sys.argv else "fha-studio", *argv]
