@@ -39,18 +39,21 @@ imports no Qt.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import re
+import threading
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO
 
 import numpy as np
 
+from fha_studio import fileio, plausible
 from fha_studio.catalog import get_actuator
+from fha_studio.fileio import FileProblem
 
 FORMAT_ID = "fha-recording/1"
 
@@ -86,6 +89,24 @@ _KEY_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _COLUMN_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 # FHA-<frame>C-<ratio>-<encoder>[-options]: the shape of a model code (the catalogue decides if it exists).
 _MODEL_CODE_RE = re.compile(r"^FHA-(17|25|32|40)C-(50|100|160)-(US250|S248)(-[A-Z0-9]+)*$")
+# A number in a recording: a plain decimal with an optional exponent, ASCII only. What Python's
+# float() accepts beyond that ("1_0", "inf", "nan", " ١ ") is not a number in a CSV file.
+_NUMBER = r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+_NUMBER_RE = re.compile(_NUMBER)
+NUMBER_SHAPE = "a number (a plain decimal like 12, -0.5 or 1.5e-3)"
+#: What a recording file may weigh: about an hour at 1 kHz with six columns. Reading is bounded by
+#: it, and the parsed arrays take about a quarter of it in memory.
+MAX_RECORDING_BYTES = 256 * 1024 * 1024
+#: A declared sample_rate_hz and the time column must agree to this fraction (median step).
+SAMPLE_RATE_TOLERANCE = 0.1
+# plausible range of each numeric metadata key (fha_studio.plausible states why)
+_RANGES = {
+    "load_inertia_kgm2": plausible.LOAD_INERTIA_KGM2,
+    "sample_rate_hz": plausible.SAMPLE_RATE_HZ,
+    "torque_constant_nm_per_a": plausible.TORQUE_CONSTANT_NM_PER_A,
+    "actuator_inertia_kgm2": plausible.ACTUATOR_INERTIA_KGM2,
+    "motor_turns_per_output_rev": plausible.MOTOR_TURNS_PER_OUTPUT_REV,
+}
 
 
 class RecordingError(ValueError):
@@ -202,12 +223,11 @@ def read_recording(path: str | os.PathLike, *, check_actuator: bool = True) -> R
 
     ``check_actuator`` looks the model code up in the catalogue (unknown codes are refused).
     """
-    path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise RecordingError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", source=str(path)) from None
-    return parse_recording(text, source=str(path), check_actuator=check_actuator)
+        text = fileio.read_text(path, limit_bytes=MAX_RECORDING_BYTES)
+    except FileProblem as exc:
+        raise RecordingError(exc.reason, source=exc.path) from None
+    return parse_recording(text, source=os.fspath(path), check_actuator=check_actuator)
 
 
 def parse_recording(text: str, *, source: str = "", check_actuator: bool = True) -> Recording:
@@ -251,7 +271,10 @@ def parse_recording(text: str, *, source: str = "", check_actuator: bool = True)
     columns = _parse_header(lines[header_index], header_index + 1, source)
     data = _parse_rows(lines, header_index + 1, columns, source)
     channels = {name: data[:, i].copy() for i, name in enumerate(columns)}
-    _check_time(channels["t"], data_line_numbers=_data_line_numbers(lines, header_index + 1), source=source)
+    data_lines = _data_line_numbers(lines, header_index + 1)
+    _check_time(channels["t"], data_line_numbers=data_lines, source=source)
+    if "sample_rate_hz" in meta_raw:
+        _check_rate(channels["t"], metadata.sample_rate_hz, meta_raw["sample_rate_hz"][1], source)
     return Recording(metadata, channels, source)
 
 
@@ -273,26 +296,19 @@ def _parse_metadata(raw: dict[str, tuple[str, int]], source: str, check_actuator
         if key in raw:
             text, line = raw[key]
             values[key] = _parse_number(key, text, line, source)
-    if values["load_inertia_kgm2"] < 0:
-        raise RecordingError("the load inertia cannot be negative", source=source,
-                             line=raw["load_inertia_kgm2"][1], field="load_inertia_kgm2")
+    for key, value in values.items():
+        if key in _RANGES and not _RANGES[key].contains(value):
+            raise RecordingError(f"{_num(value)} is outside the plausible range {_RANGES[key].allowed()} "
+                                 f"({_RANGES[key].reason})", source=source, line=raw[key][1], field=key)
     supply = values.get("supply_voltage", 200.0)
     if supply not in (100.0, 200.0):
         raise RecordingError(f"supply_voltage is {_num(supply)}; the drivers run on 200 or 100 (V)",
                              source=source, line=raw["supply_voltage"][1], field="supply_voltage")
-    if "sample_rate_hz" in values and values["sample_rate_hz"] <= 0:
-        raise RecordingError("sample_rate_hz must be positive", source=source,
-                             line=raw["sample_rate_hz"][1], field="sample_rate_hz")
     if actuator == "custom":
         for key in _CUSTOM_REQUIRED:
             if key not in values:
                 raise RecordingError(f"'actuator: custom' requires '# {key}: <value>' ({_unit_of(key)})",
                                      source=source, line=actuator_line, field=key)
-            if values[key] <= 0:
-                raise RecordingError(f"{key} must be positive", source=source, line=raw[key][1], field=key)
-        if "motor_turns_per_output_rev" in values and values["motor_turns_per_output_rev"] <= 0:
-            key = "motor_turns_per_output_rev"
-            raise RecordingError(f"{key} must be positive", source=source, line=raw[key][1], field=key)
     else:
         _check_model_code(actuator, actuator_line, source, check_actuator)
     known = set(_NUMERIC_KEYS) | {"format", "actuator"}
@@ -338,22 +354,30 @@ def _parse_number(key: str, text: str, line: int, source: str) -> float:
         raise RecordingError(
             f"value '{text}' is not a number in {_unit_of(key)} (the unit is in the key name; "
             "write the number only)", source=source, line=line, field=key)
-    try:
-        value = float(number_text)
-    except ValueError:
-        raise RecordingError(f"value '{text}' is not a number", source=source, line=line, field=key) from None
+    if not _NUMBER_RE.fullmatch(number_text):
+        raise RecordingError(f"value '{_clip(text)}' is not {NUMBER_SHAPE}", source=source, line=line,
+                             field=key)
+    value = float(number_text)
     if not math.isfinite(value):
-        raise RecordingError(f"value '{text}' is not finite", source=source, line=line, field=key)
+        raise RecordingError(f"value '{_clip(text)}' is too large to be a number", source=source,
+                             line=line, field=key)
     return value
+
+
+def _clip(text: str, width: int = 40) -> str:
+    """A cell or value as shown in a message: one line, not too long."""
+    text = text.replace("\n", " ").replace("\r", " ")
+    return text if len(text) <= width else text[: width - 1] + "…"
 
 
 def _parse_header(line: str, line_no: int, source: str) -> list[str]:
     names = [name.strip() for name in line.split(",")]
     seen: set[str] = set()
     for name in names:
-        if not _COLUMN_RE.match(name):
-            raise RecordingError(f"column name '{name}' is not a name (letters, digits, '_')",
-                                 source=source, line=line_no, field=name or "header")
+        if not _COLUMN_RE.fullmatch(name) or len(name) > 64:
+            raise RecordingError(f"column name '{_clip(name)}' is not a name (letters, digits, '_', "
+                                 "at most 64)", source=source, line=line_no,
+                                 field=_clip(name, 20) if name else "header")
         if name in seen:
             raise RecordingError("column given twice", source=source, line=line_no, field=name)
         seen.add(name)
@@ -374,6 +398,8 @@ def _data_line_numbers(lines: Sequence[str], start: int) -> list[int]:
 def _parse_rows(lines: Sequence[str], start: int, columns: list[str], source: str) -> np.ndarray:
     rows: list[list[float]] = []
     width = len(columns)
+    cell = rf"[ \t]*{_NUMBER}[ \t]*"
+    row_re = re.compile(cell + rf"(?:,{cell}){{{width - 1}}}")
     for index in range(start, len(lines)):
         line = lines[index].strip()
         if not line or line.startswith("#"):
@@ -382,20 +408,16 @@ def _parse_rows(lines: Sequence[str], start: int, columns: list[str], source: st
         if len(cells) != width:
             raise RecordingError(f"{len(cells)} values, the header has {width} columns",
                                  source=source, line=index + 1, field=None)
-        try:
-            row = [float(c) for c in cells]
-        except ValueError:
-            for name, cell in zip(columns, cells, strict=True):
-                try:
-                    float(cell)
-                except ValueError:
-                    raise RecordingError(f"'{cell.strip()}' is not a number", source=source,
-                                         line=index + 1, field=name) from None
-            raise  # pragma: no cover - one of the cells failed above
+        if not row_re.fullmatch(line):
+            for name, text in zip(columns, cells, strict=True):
+                if not _NUMBER_RE.fullmatch(text.strip(" \t")):
+                    raise RecordingError(f"'{_clip(text.strip())}' is not {NUMBER_SHAPE}", source=source,
+                                         line=index + 1, field=name)
+        row = [float(c) for c in cells]
         for name, value in zip(columns, row, strict=True):
             if not math.isfinite(value):
-                raise RecordingError(f"'{value}' is not a finite number (NaN or infinity)",
-                                     source=source, line=index + 1, field=name)
+                raise RecordingError("the number is too large", source=source, line=index + 1,
+                                     field=name)
         rows.append(row)
     if len(rows) < 2:
         raise RecordingError(f"{len(rows)} data rows; a recording needs at least 2", source=source,
@@ -410,6 +432,24 @@ def _check_time(t: np.ndarray, *, data_line_numbers: list[int], source: str) -> 
         i = int(bad[0]) + 1
         raise RecordingError(f"time does not increase ({_num(t[i - 1])} then {_num(t[i])} s)",
                              source=source, line=data_line_numbers[i], field="t")
+    if not math.isfinite(float(t[-1] - t[0])):
+        raise RecordingError("the time span is too large to compute with", source=source,
+                             line=data_line_numbers[-1], field="t")
+
+
+def _check_rate(t: np.ndarray, rate_hz: float | None, line: int, source: str) -> None:
+    """The declared sample rate and the time column must agree (a time column in milliseconds
+    with ``sample_rate_hz: 1000`` would make every rate, inertia and delay wrong by 1000)."""
+    if rate_hz is None:
+        return
+    step_s = float(np.median(np.diff(t)))
+    expected_s = 1.0 / rate_hz
+    if abs(step_s / expected_s - 1.0) > SAMPLE_RATE_TOLERANCE:
+        raise RecordingError(
+            f"sample_rate_hz is {_num(rate_hz)} (a sample every {_num(expected_s, 6)} s), but the time "
+            f"column 't' steps by {_num(step_s, 6)} s (median): they contradict each other; 't' must "
+            "be in seconds, and sample_rate_hz must match it (or be left out)",
+            source=source, line=line, field="sample_rate_hz")
 
 
 # ----------------------------------------------------------------------------------------- writing
@@ -420,12 +460,19 @@ def _num(value: float, digits: int = 12) -> str:
 
 
 class RecordingWriter:
-    """Streaming writer: append rows as they come; the file is flushed at least once per second.
+    """Streaming writer: append rows as they come; they reach the disk within a second.
 
     ``columns`` are the column names in file order: the required ``t, pos, current`` first, then any
     of the optional contract columns and extra channels. Rows are checked as they are appended
-    (finite, time increasing) so the writer never produces a file the reader refuses.
-    Use as a context manager or call :meth:`close`.
+    (finite, time increasing) and the metadata as the writer starts, so the writer never produces
+    a file the reader refuses.
+
+    While recording the file is ``PATH.partial`` (:class:`fha_studio.fileio.PartialFile`);
+    :meth:`close` renames it to ``PATH``. A thread writes what was appended every
+    ``FLUSH_INTERVAL_S`` whether or not more rows come, in whole rows: a process killed while
+    recording leaves ``PATH.partial``, readable, missing at most the last ``FLUSH_INTERVAL_S`` of
+    rows. A failed write (disk full) is raised by the next :meth:`append` or by :meth:`close`,
+    and the file never ends in half a row. Use as a context manager or call :meth:`close`.
     """
 
     FLUSH_INTERVAL_S = 1.0
@@ -434,19 +481,34 @@ class RecordingWriter:
                  columns: Sequence[str] = REQUIRED_COLUMNS, *, digits: int = 12):
         columns = list(columns)
         _parse_header(",".join(columns), 0, "new recording")  # same rules as the reader
-        for line in metadata.lines():
+        lines = metadata.lines()
+        for line in lines:
             if "\n" in line or "\r" in line:
                 raise ValueError(f"metadata line contains a line break: {line!r}")
-        self.path = Path(path)
+        _check_metadata_lines(lines)
         self.columns = tuple(columns)
         self._digits = digits
         self._format = ",".join([f"{{:.{digits}g}}"] * len(columns)) + "\n"
         self._t_index = self.columns.index("t")
         self._last_t = -math.inf
         self._rows = 0
-        self._file: TextIO | None = self.path.open("w", encoding="utf-8", newline="\n")
-        self._file.write("\n".join(metadata.lines()) + "\n" + ",".join(columns) + "\n")
-        self._flush()
+        self._lock = threading.Lock()
+        self._pending: list[str] = []
+        self._error: FileProblem | None = None
+        self._out: fileio.PartialFile | None = fileio.PartialFile(path)
+        self.path = self._out.path
+        self.partial_path = self._out.partial_path
+        self._pending.append("\n".join(lines) + "\n" + ",".join(columns) + "\n")
+        try:
+            self._write_pending()  # a file that cannot be written is known now, not later
+        except FileProblem:
+            self._out.abandon()
+            _remove_quietly(self.partial_path)
+            raise
+        self._last_flush = time.monotonic()
+        self._stop = threading.Event()
+        self._flusher = threading.Thread(target=self._flush_on_time, name="recording-flush", daemon=True)
+        self._flusher.start()
 
     @property
     def rows_written(self) -> int:
@@ -464,8 +526,10 @@ class RecordingWriter:
 
     def append_rows(self, rows: np.ndarray | Iterable[Sequence[float]]) -> None:
         """Append a block of rows (shape ``(n, len(columns))``)."""
-        if self._file is None:
+        if self._out is None:
             raise ValueError("recording writer is closed")
+        if self._error is not None:
+            raise self._error
         block = np.asarray(rows, dtype=np.float64)
         if block.ndim != 2 or block.shape[1] != len(self.columns):
             raise ValueError(f"rows must have {len(self.columns)} values ({', '.join(self.columns)}), "
@@ -478,29 +542,60 @@ class RecordingWriter:
         t = block[:, self._t_index]
         if t[0] <= self._last_t or np.any(np.diff(t) <= 0):
             raise ValueError(f"time must increase (last written {self._last_t} s)")
-        self._file.write("".join(self._format.format(*r) for r in block.tolist()))
+        text = "".join(self._format.format(*r) for r in block.tolist())
+        with self._lock:
+            self._pending.append(text)
         self._last_t = float(t[-1])
         self._rows += len(block)
         if time.monotonic() - self._last_flush >= self.FLUSH_INTERVAL_S:
-            self._flush()
+            self.flush()
 
-    def _flush(self) -> None:
-        assert self._file is not None
-        self._file.flush()
-        self._last_flush = time.monotonic()
+    def _write_pending(self) -> None:
+        # whole rows in one unbuffered write: the file on disk always ends with a whole row
+        with self._lock:
+            if not self._pending or self._out is None:
+                return
+            data = "".join(self._pending).encode("utf-8")
+            self._pending = []
+            self._out.write(data)
+
+    def _flush_on_time(self) -> None:
+        while not self._stop.wait(self.FLUSH_INTERVAL_S):
+            try:
+                self._write_pending()
+            except FileProblem as exc:
+                self._error = exc
+                return
+            self._last_flush = time.monotonic()
 
     def flush(self) -> None:
         """Push everything appended so far to the file now."""
-        if self._file is not None:
-            self._flush()
+        if self._error is not None:
+            raise self._error
+        try:
+            self._write_pending()
+        except FileProblem as exc:
+            self._error = exc
+            raise
+        self._last_flush = time.monotonic()
 
     def close(self) -> None:
-        """Flush and close (idempotent)."""
-        if self._file is not None:
-            self._file.flush()
-            os.fsync(self._file.fileno())
-            self._file.close()
-            self._file = None
+        """Write what is left, and rename the ``.partial`` file to the final name (idempotent).
+        A write that failed is raised here; the rows written before it stay in ``PATH.partial``."""
+        if self._out is None:
+            return
+        self._stop.set()
+        if self._flusher is not threading.current_thread():
+            self._flusher.join()
+        try:
+            if self._error is not None:
+                raise self._error
+            self._write_pending()
+            self._out.commit()
+        finally:
+            if self._out is not None:
+                self._out.abandon()
+            self._out = None
 
     def __enter__(self) -> RecordingWriter:
         return self
@@ -508,10 +603,27 @@ class RecordingWriter:
     def __exit__(self, *exc) -> None:
         self.close()
 
-    def __del__(self):  # pragma: no cover - a writer dropped without close
-        file = getattr(self, "_file", None)
-        if file is not None:
-            file.close()
+    def __del__(self):  # pragma: no cover - a writer dropped without close keeps its .partial file
+        stop = getattr(self, "_stop", None)
+        if stop is not None:
+            stop.set()
+        out = getattr(self, "_out", None)
+        if out is not None:
+            out.abandon()
+
+
+def _remove_quietly(path: Path) -> None:
+    with contextlib.suppress(OSError):
+        path.unlink()
+
+
+def _check_metadata_lines(lines: Sequence[str]) -> None:
+    """The reader's metadata checks on what a writer is about to write (ValueError if refused)."""
+    raw: dict[str, tuple[str, int]] = {}
+    for number, line in enumerate(lines, 1):
+        key, _, value = line[1:].strip().partition(":")
+        raw[key.strip()] = (value.strip(), number)
+    _parse_metadata(raw, "new recording", check_actuator=False)
 
 
 def write_recording(path: str | os.PathLike, recording: Recording, *, digits: int = 12) -> None:

@@ -91,13 +91,22 @@ def _replace(old: str, new: str) -> str:
         (_replace("load_inertia_kgm2: 1.5", "load_inertia: 1.5"), 3, "load_inertia", "no unit"),
         (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: 1.5 lb ft^2"), 3, LI, "unit"),
         (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: heavy"), 3, LI, "not a number"),
-        (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: nan"), 3, "load_inertia_kgm2", "finite"),
+        (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: nan"), 3, LI, "not a number"),
         (_replace("supply_voltage: 200", "supply_voltage: 230"), 4, "supply_voltage", "200 or 100"),
         (_replace("sample_rate_hz: 1000", "sample_rate: 1000"), 5, "sample_rate", "sample_rate_hz"),
         (_replace("t,pos,current,", "t,position,current,"), 7, "pos", "required column"),
         (_replace("t,pos,current,", "t,pos,pos,"), 7, "pos", "twice"),
         (_replace("0.001,0.0002,0.35", "0.001,0.0002,abc"), 9, "current", "not a number"),
-        (_replace("0.001,0.0002,0.35", "0.001,nan,0.35"), 9, "pos", "NaN"),
+        (_replace("0.001,0.0002,0.35", "0.001,nan,0.35"), 9, "pos", "not a number"),
+        # float() accepts these, a CSV number is a plain decimal
+        (_replace("0.001,0.0002,0.35", "0.001,0.0002,3_5"), 9, "current", "not a number"),
+        (_replace("0.001,0.0002,0.35", "0.001,0.0002,inf"), 9, "current", "not a number"),
+        (_replace("0.001,0.0002,0.35", "0.001,0.0002,\u0663"), 9, "current", "not a number"),
+        (_replace("0.001,0.0002,0.35", "0.001,0.0002,1e999"), 9, "current", "too large"),
+        (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: 1_5"), 3, LI, "not a number"),
+        (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: 1e30"), 3, LI, "plausible range 0 ... 1500"),
+        (_replace("load_inertia_kgm2: 1.5", "load_inertia_kgm2: -1"), 3, LI, "plausible range"),
+        (_replace("sample_rate_hz: 1000", "sample_rate_hz: 0"), 5, "sample_rate_hz", "plausible range"),
         (_replace("0.002,0.0009", "0.001,0.0009"), 10, "t", "does not increase"),
         (_replace("0.002,0.0009,0.41,0.0011,0.0008,0.1,4", "0.002,0.0009"), 10, None, "2 values"),
     ],
@@ -171,6 +180,7 @@ def test_streaming_writer_flushes_within_a_second(tmp_path, monkeypatch):
     monkeypatch.setattr(rec.time, "monotonic", lambda: clock[0])
     path = tmp_path / "s.csv"
     with RecordingWriter(path, _meta(), ["t", "pos", "current", "torque_cmd_nm"]) as w:
+        assert w.partial_path == tmp_path / "s.csv.partial" and not path.exists()
         w.append([0.0, 0.0, 0.1, 1.0])
         w.append({"t": 0.001, "pos": 0.1, "current": 0.2, "torque_cmd_nm": 2.0})
         clock[0] += 0.5
@@ -178,11 +188,95 @@ def test_streaming_writer_flushes_within_a_second(tmp_path, monkeypatch):
         clock[0] += 0.6  # a second has passed since the last flush: this append reaches the file
         w.append([0.004, 0.4, 0.5, 5.0])
         # what a crash now would leave: everything up to the last second, readable
-        on_disk = read_recording(path)
+        on_disk = read_recording(w.partial_path)
         assert len(on_disk) == 5 and list(on_disk.extra_channels) == ["torque_cmd_nm"]
         w.append([0.005, 0.5, 0.6, 6.0])
         assert w.rows_written == 6
     assert len(read_recording(path)) == 6
+    assert not w.partial_path.exists()  # renamed to the final name on close
+
+
+def test_rows_reach_the_disk_on_time_when_appends_stop(tmp_path):
+    """Rows appended and then nothing more: they are on the disk within the flush interval,
+    not held until a next append that never comes."""
+    w = RecordingWriter(tmp_path / "quiet.csv", _meta(), ["t", "pos", "current"])
+    try:
+        w.append_rows([[i / 1000, 0.0, 0.0] for i in range(7)])
+        deadline = rec.time.monotonic() + 10 * w.FLUSH_INTERVAL_S
+        while rec.time.monotonic() < deadline:
+            if w.partial_path.read_text().count("\n") >= 6 + 1 + 7:  # metadata, header, rows
+                break
+            rec.time.sleep(0.05)
+        assert len(read_recording(w.partial_path)) == 7
+    finally:
+        w.close()
+
+
+def test_a_killed_recording_keeps_its_rows_in_the_partial_file(tmp_path):
+    """The process is killed 5 s after its last append: the 7 rows are on the disk, readable."""
+    import signal
+    import subprocess
+    import sys
+
+    path = tmp_path / "killed.csv"
+    script = (
+        "import sys, time\n"
+        "from fha_studio.recording import RecordingMetadata, RecordingWriter\n"
+        "meta = RecordingMetadata('FHA-25C-50-US250', 1.5, sample_rate_hz=1000.0)\n"
+        "w = RecordingWriter(sys.argv[1], meta)\n"
+        "w.append_rows([[i / 1000, i * 0.1, 0.5] for i in range(7)])\n"
+        "print('appended', flush=True)\n"
+        "time.sleep(60)\n"
+    )
+    proc = subprocess.Popen([sys.executable, "-c", script, str(path)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "appended"
+        rec.time.sleep(5.0)
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(timeout=30)
+        proc.stdout.close()
+    assert not path.exists()  # never renamed: it does not look complete
+    on_disk = read_recording(tmp_path / "killed.csv.partial")
+    assert len(on_disk) == 7
+
+
+def test_writer_refuses_what_cannot_be_a_file_before_any_row(tmp_path):
+    (tmp_path / "afile").write_text("x")
+    for target, words in ((tmp_path / "afile" / "r.csv", "not a directory"),
+                          ("/dev/full", "not a regular file"),
+                          (tmp_path / ("n" * 300 + ".csv"), "too long")):
+        with pytest.raises(rec.FileProblem, match=words):
+            RecordingWriter(target, _meta())
+    with pytest.raises(RecordingError, match="plausible range"):
+        RecordingWriter(tmp_path / "i.csv", _meta(load_inertia_kgm2=1e30))
+    assert not list(tmp_path.glob("i.csv*"))
+
+
+def test_a_time_column_in_milliseconds_contradicts_the_sample_rate():
+    text = GOOD.replace("0.001,", "1,").replace("0.002,", "2,")
+    with pytest.raises(RecordingError) as err:
+        parse_recording(text, source="ms.csv")
+    assert err.value.field == "sample_rate_hz" and err.value.line == 5
+    message = str(err.value)
+    assert "1000" in message and "0.001 s" in message and "steps by 1 s" in message
+
+
+def test_only_regular_files_are_read_and_reading_is_bounded(tmp_path, monkeypatch):
+    import os
+
+    fifo = tmp_path / "fifo.csv"
+    os.mkfifo(fifo)
+    (tmp_path / "afile").write_text("x")
+    for path, words in ((fifo, "FIFO"), ("/dev/zero", "character device"), (tmp_path, "directory"),
+                        (tmp_path / "afile" / "r.csv", "not a directory"),
+                        (tmp_path / ("n" * 300), "too long"), ("/proc/self/mem", "cannot be read")):
+        with pytest.raises(RecordingError, match=words):
+            read_recording(path)
+    monkeypatch.setattr(rec, "MAX_RECORDING_BYTES", 100)
+    (tmp_path / "big.csv").write_text(GOOD * 3)
+    with pytest.raises(RecordingError, match="more than the 100 bytes"):
+        read_recording(tmp_path / "big.csv")
 
 
 def test_writer_refuses_what_the_reader_would_refuse(tmp_path):

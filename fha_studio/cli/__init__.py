@@ -15,18 +15,27 @@ import pkgutil
 import sys
 from collections.abc import Sequence
 
+from fha_studio.fileio import FileProblem, os_reason
+
 
 class CliError(Exception):
     """A mistake in the user's input: printed as one line, exit status 2."""
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose refusal is one line (what, and what is allowed), exit status 2."""
+
+    def error(self, message: str):  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="fha-studio",
         description="Commissioning tool for Harmonic Drive FHA-C actuators on HA-655 / HA-675 drivers. "
         "Without a command it starts the GUI on the embedded simulated drive.",
     )
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
     modules = [
         importlib.import_module(f"{__name__}.{info.name}")
         for info in pkgutil.iter_modules(__path__)
@@ -51,7 +60,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except CliError as exc:
         print(f"fha-studio {args.command}: error: {exc}", file=sys.stderr)
         return 2
-    except (FileNotFoundError, PermissionError, IsADirectoryError) as exc:
+    except FileProblem as exc:
         print(f"fha-studio {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
@@ -61,3 +70,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         # of stdout from raising again
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
+    except OSError as exc:  # a file or device the command could not use: one line, no traceback
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"fha-studio {args.command}: error: {where}{os_reason(exc)}", file=sys.stderr)
+        return 2

@@ -9,9 +9,10 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from pathlib import Path
 
+from fha_studio import fileio
 from fha_studio.cli import CliError
+from fha_studio.cli._values import output_path
 
 ORDER = 40
 
@@ -26,9 +27,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "the RMS gap before and after on held-out data.",
     )
     p.add_argument("recording", metavar="RECORDING.csv", help="the recording (fha-recording/1)")
-    p.add_argument("--json", metavar="REPORT.json", help="write the report as JSON")
+    p.add_argument("--json", metavar="REPORT.json", type=output_path, help="write the report as JSON")
     p.add_argument(
-        "--model-out", metavar="MODEL.toml", help="write the updated axis model (fha-axis-model/1)"
+        "--model-out", metavar="MODEL.toml", type=output_path,
+        help="write the updated axis model (fha-axis-model/1)",
     )
     p.add_argument(
         "--window",
@@ -53,6 +55,14 @@ def run(args: argparse.Namespace) -> int:
         result = run_modelcheck(rec, window=args.window, resimulate=not args.no_resim)
     except ModelCheckError as exc:
         raise CliError(f"{args.recording}: {exc}") from None
+    # the files first: a write that fails is reported before anything reads as a result
+    written = []
+    if args.json:
+        fileio.write_text(args.json, json.dumps(_finite(result.to_json()), indent=2) + "\n")
+        written.append(f"report written to {args.json}")
+    if args.model_out:
+        result.write_model(args.model_out)
+        written.append(f"updated model written to {args.model_out}")
     print(
         f"{args.recording}: {result.actuator}, {len(rec)} samples over {rec.duration_s:.3g} s "
         f"(analysis bandwidth {result.bandwidth_hz:.3g} Hz: Savitzky-Golay window "
@@ -60,12 +70,8 @@ def run(args: argparse.Namespace) -> int:
     )
     for line in result.summary_lines():
         print(line)
-    if args.json:
-        Path(args.json).write_text(json.dumps(_finite(result.to_json()), indent=2) + "\n", encoding="utf-8")
-        print(f"report written to {args.json}")
-    if args.model_out:
-        result.write_model(args.model_out)
-        print(f"updated model written to {args.model_out}")
+    for line in written:
+        print(line)
     return 0
 
 

@@ -12,11 +12,14 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
+from fha_studio import fileio
 from fha_studio.catalog import ModelCodeError
 from fha_studio.cli import CliError
+from fha_studio.cli._values import output_path, text
 
 ORDER = 60
 
@@ -31,26 +34,26 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     ls = sub.add_parser("list", help="the procedures for an actuator and their status")
-    ls.add_argument("--actuator", help="model code, e.g. FHA-25C-50-US250-B-L (or from --session)")
+    ls.add_argument("--actuator", type=text, help="model code, e.g. FHA-25C-50-US250-B-L (or from --session)")
     ls.add_argument("--session", type=Path, help="a session file: show each procedure's status")
     ls.set_defaults(func=_list)
     show = sub.add_parser("show", help="print a checklist filled in for an actuator")
-    show.add_argument("procedure", metavar="ID")
-    show.add_argument("--actuator", required=True)
+    show.add_argument("procedure", metavar="ID", type=text)
+    show.add_argument("--actuator", required=True, type=text)
     show.set_defaults(func=_show)
     run = sub.add_parser("run", help="walk a procedure in the terminal, recorded in the session file")
-    run.add_argument("procedure", metavar="ID")
+    run.add_argument("procedure", metavar="ID", type=text)
     run.add_argument("--session", type=Path, required=True, help="session file (created when missing)")
-    run.add_argument("--actuator", help="model code (needed to create a session)")
-    run.add_argument("--operator", default="", help="your name: every check records it")
+    run.add_argument("--actuator", type=text, help="model code (needed to create a session)")
+    run.add_argument("--operator", default="", type=text, help="your name: every check records it")
     run.add_argument(
-        "--drive", metavar="URL", help="drive for live checks, e.g. sim://FHA-25C-50-US250?paced=0"
+        "--drive", metavar="URL", type=text, help="drive for live checks, e.g. sim://FHA-25C-50-US250?paced=0"
     )
     run.set_defaults(func=_run)
     report = sub.add_parser("report", help="write the commissioning report of a session as HTML")
     report.add_argument("session", type=Path)
-    report.add_argument("-o", "--output", type=Path, help="HTML file (default: beside the session)")
-    report.add_argument("--sign", metavar="NAME", help="sign it (refused while checks are open)")
+    report.add_argument("-o", "--output", type=output_path, help="HTML file (default: beside the session)")
+    report.add_argument("--sign", metavar="NAME", type=text, help="sign it (refused while checks are open)")
     report.set_defaults(func=_report)
 
 
@@ -136,7 +139,14 @@ def _run(args) -> int:
         load_procedure,
     )
 
-    if args.session.exists():
+    if args.drive:  # a URL that can name no drive is refused before the session file is made
+        from fha_studio.hardware.transport import check_url
+
+        try:
+            check_url(args.drive)
+        except ValueError as exc:
+            raise CliError(f"--drive: {exc}") from None
+    if os.path.lexists(args.session):
         session = _load_session(args.session)
         if args.actuator and args.actuator.strip().upper() != session.actuator_code:
             raise CliError(f"{args.session} is a session for {session.actuator_code}, not {args.actuator}")
@@ -145,6 +155,7 @@ def _run(args) -> int:
             raise CliError(f"{args.session} does not exist: give --actuator CODE to start a new session")
         _context(args.actuator)
         session = ProcedureSession(actuator_code=args.actuator.strip().upper(), operator=args.operator)
+        fileio.check_output_path(args.session)
         session.save(args.session)
     context = _context(session.actuator_code)
     try:
@@ -231,8 +242,8 @@ def _report(args) -> int:
         except SignError as exc:
             raise CliError(str(exc)) from None
     report = build_report(session)
-    output = args.output or args.session.with_suffix(".html")
-    output.write_text(render_html(report), encoding="utf-8")
+    output = Path(args.output) if args.output else args.session.with_suffix(".html")
+    fileio.write_text(output, render_html(report))
     print(f"{output}  ({len(report.warnings)} open warning(s))")
     for warning in report.warnings:
         print(f"  - {warning}", file=sys.stderr)

@@ -16,8 +16,10 @@ import sys
 import threading
 from typing import Any
 
+from fha_studio import plausible
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.cli import CliError
+from fha_studio.cli._values import in_range, output_path, tcp_port, text
 
 ORDER = 30
 
@@ -32,13 +34,15 @@ def register(subparsers: Any) -> None:
     where = p.add_mutually_exclusive_group(required=True)
     where.add_argument("--pty", action="store_true",
                        help="serve on a new pseudo-terminal; prints its path")
-    where.add_argument("--tcp", type=int, metavar="PORT",
+    where.add_argument("--tcp", type=tcp_port, metavar="PORT",
                        help="serve socket://127.0.0.1:PORT (0: any free port)")
-    p.add_argument("--actuator", default=DEFAULT_ACTUATOR, metavar="CODE",
+    p.add_argument("--actuator", default=DEFAULT_ACTUATOR, metavar="CODE", type=text,
                    help="actuator model code, options included (e.g. FHA-25C-50-S248-B-L); "
                    "default %(default)s")
-    p.add_argument("--driver", metavar="MODEL", help="driver model (default: the HA-655 of FHA-C manual 1-3)")
-    p.add_argument("--load-inertia", type=float, default=0.0, metavar="KGM2", help="load inertia [kg m^2]")
+    p.add_argument("--driver", metavar="MODEL", type=text,
+                   help="driver model (default: the HA-655 of FHA-C manual 1-3)")
+    p.add_argument("--load-inertia", type=in_range(plausible.LOAD_INERTIA_KGM2), default=0.0, metavar="KGM2",
+                   help=f"load inertia [kg m^2], {plausible.LOAD_INERTIA_KGM2.allowed()}")
     p.add_argument("--effect", action="append", default=[], metavar="ID:NAME=VALUE,...",
                    help="switch on a physical effect, e.g. coulomb_friction:torque_nm=8 (repeatable)")
     p.add_argument("--brake", choices=("yes", "no"),
@@ -48,7 +52,8 @@ def register(subparsers: Any) -> None:
     p.add_argument("--eeprom", metavar="PATH",
                    help="EEPROM file (default: the user data directory, one file per driver and actuator)")
     p.add_argument("--unpaced", action="store_true", help="reply at memory speed instead of 19200 baud")
-    p.add_argument("--oww-seconds", type=float, metavar="S", help="how long OWW takes (default 5 s)")
+    p.add_argument("--oww-seconds", type=in_range(plausible.OWW_CLEAR_S), metavar="S",
+                   help=f"how long OWW takes (default 5 s; {plausible.OWW_CLEAR_S.allowed()})")
     p.add_argument("--profile", choices=("full", "documented"), default="full",
                    help="full: every command of docs/protocol.md (default); documented: only what the "
                    "HA-655 manual documents (DGR, OWW; s to everything while the servo is on)")
@@ -56,8 +61,10 @@ def register(subparsers: Any) -> None:
                    help="read the controller's side from stdin, one per line: 'servo on', 'servo off' "
                    "(the CN2 servo-ON input), 'fwd DEG' (a command pulse train, servo on), 'turn DEG' "
                    "(turn the output by hand, servo off), 'brake release', 'brake hold'")
-    p.add_argument("--record", metavar="FILE.csv", help="write what the axis does as an fha-recording/1 CSV")
-    p.add_argument("--record-rate", type=float, default=1000.0, metavar="HZ",
+    p.add_argument("--record", metavar="FILE.csv", type=output_path,
+                   help="write what the axis does as an fha-recording/1 CSV (FILE.csv.partial until the "
+                   "sim stops)")
+    p.add_argument("--record-rate", type=in_range(plausible.SIM_RECORD_RATE_HZ), default=1000.0, metavar="HZ",
                    help="recording sample rate (default %(default)s Hz)")
     p.set_defaults(func=run)
 
@@ -108,7 +115,7 @@ def run(args: Any) -> int:
             try:
                 drive.start_recording(args.record, args.record_rate)
             except (OSError, ValueError) as exc:
-                raise CliError(f"--record {args.record}: {exc}") from None
+                raise CliError(f"--record: {exc}") from None
         drive.start()
         if args.panel:
             threading.Thread(target=_panel, args=(drive, sys.stdin, stop), name="sim-panel",

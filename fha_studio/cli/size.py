@@ -6,7 +6,9 @@ import argparse
 import json
 import math
 
+from fha_studio import plausible
 from fha_studio.cli import CliError
+from fha_studio.cli._values import NUMBER_SHAPE
 from fha_studio.logic.sizing import (
     BearingLoads,
     DutyCycle,
@@ -18,6 +20,21 @@ from fha_studio.logic.sizing import (
 )
 
 ORDER = 20
+
+# plausible range of each number (fha_studio.plausible says why)
+_RANGES = {
+    "load_inertia": plausible.LOAD_INERTIA_KGM2,
+    "speed": plausible.SPEED_RPM,
+    "angle": plausible.MOVE_ANGLE_DEG,
+    "cycle": plausible.CYCLE_TIME_S,
+    "load_torque": plausible.LOAD_TORQUE_NM,
+    "radial_load_n": plausible.BEARING_LOAD_N,
+    "axial_load_n": plausible.BEARING_LOAD_N,
+    "radial_offset_mm": plausible.LOAD_OFFSET_MM,
+    "axial_offset_mm": plausible.LOAD_OFFSET_MM,
+    "load_factor": plausible.LOAD_FACTOR,
+    "required_life_h": plausible.REQUIRED_LIFE_H,
+}
 
 # (option, attribute, unit) of the numbers; parsed here so that a bad one is one clear line
 _REQUIRED = (
@@ -95,12 +112,14 @@ def _number(args: argparse.Namespace, option: str, attr: str, unit: str) -> floa
     text = getattr(args, attr)
     if text is None:
         return None
-    try:
-        value = float(text)
-    except ValueError:
-        raise CliError(f"{option}: {text!r} is not a number" + (f" (in {unit})" if unit else "")) from None
+    if not NUMBER_SHAPE.fullmatch(text.strip()):
+        raise CliError(f"{option}: '{text[:40]}' is not a number" + (f" (in {unit})" if unit else ""))
+    value = float(text)
+    allowed = _RANGES.get(attr)
+    if allowed is not None and not allowed.contains(value):
+        raise CliError(f"{option}: {text.strip()[:40]} is outside {allowed.allowed()} ({allowed.reason})")
     if not math.isfinite(value):
-        raise CliError(f"{option}: {text!r} is not a finite number")
+        raise CliError(f"{option}: '{text[:40]}' is too large")
     return value
 
 
@@ -108,12 +127,10 @@ def _duty_factors(text: str | None) -> tuple[float, float, float] | None:
     if text is None:
         return None
     parts = [p.strip() for p in text.split(",")]
-    try:
-        values = tuple(float(p) for p in parts)
-    except ValueError:
-        values = ()
-    if len(values) != 3 or not all(math.isfinite(v) and v >= 0 for v in values):
-        raise CliError(f"--duty-factors: {text!r} must be three numbers >= 0 as KLA,KLR,KLD (e.g. 7,1,7)")
+    values = tuple(float(p) for p in parts) if all(NUMBER_SHAPE.fullmatch(p) for p in parts) else ()
+    if len(values) != 3 or not all(plausible.DUTY_FACTOR.contains(v) for v in values):
+        raise CliError(f"--duty-factors: '{text[:40]}' must be three numbers "
+                       f"{plausible.DUTY_FACTOR.allowed()} as KLA,KLR,KLD (e.g. 7,1,7)")
     return values[0], values[1], values[2]
 
 

@@ -122,6 +122,17 @@ class ParameterDiffDialog(QDialog):
             layout.addWidget(self.not_mapped_view)
         else:
             self.not_mapped_view = None
+        if loaded.missing:
+            layout.addWidget(
+                QLabel(f"<b>Not in the file ({len(loaded.missing)})</b>: the drive keeps its value "
+                       "(a file cut short, or made on another driver):")
+            )
+            self.missing_view = QPlainTextEdit("\n".join(loaded.missing))
+            self.missing_view.setReadOnly(True)
+            self.missing_view.setMaximumHeight(90)
+            layout.addWidget(self.missing_view)
+        else:
+            self.missing_view = None
         self.buttons = QDialogButtonBox(
             QDialogButtonBox.StandardButton.Apply | QDialogButtonBox.StandardButton.Cancel
         )

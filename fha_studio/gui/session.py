@@ -11,6 +11,7 @@ from pathlib import Path
 
 from PySide6.QtCore import QObject, QStandardPaths, Signal, Slot
 
+from fha_studio import fileio
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.link import Cmd, CommandResult, LinkController, LinkInfo
 from fha_studio.gui.state import AxisState
@@ -126,7 +127,7 @@ class Session(QObject):
         while path.exists():
             n += 1
             path = directory / f"{base}-{n}.toml"
-        path.write_text(self.parameter_file_text(), encoding="utf-8")
+        fileio.write_text(path, self.parameter_file_text())
         self.state.record_backup(path)
         self.sigMessage.emit(f"Backup of the drive's parameters saved before the first write: {path}")
         return path
@@ -159,7 +160,7 @@ class Session(QObject):
                 return
             try:
                 self.write_backup()
-            except OSError as exc:
+            except (OSError, ValueError) as exc:  # fileio.FileProblem is a ValueError
                 self.sigMessage.emit(f"Nothing written: the backup could not be saved ({exc}).")
                 self.sigWritesDone.emit([])
                 return

@@ -130,6 +130,32 @@ class GuardedTransport:
         return getattr(self.inner, name)
 
 
+#: The longest URL or device path taken (a sim:// URL with several effects is some 300 characters).
+MAX_URL_LENGTH = 2000
+
+
+def check_url(url: str) -> None:
+    """Refuse (ValueError, one line saying what is allowed) a URL that cannot name a drive:
+    empty, too long, with control characters, or a ``socket://`` without a host or with a port
+    outside 1 ... 65535. Whether the drive is there is for opening it to find out."""
+    if not isinstance(url, str) or not url.strip():
+        raise ValueError("no drive URL given (a device or pty path, socket://host:port or sim://ACTUATOR-CODE)")
+    if len(url) > MAX_URL_LENGTH:
+        raise ValueError(f"the drive URL is {len(url)} characters long; at most {MAX_URL_LENGTH}")
+    if any(ord(c) < 32 or ord(c) == 127 for c in url):
+        raise ValueError("the drive URL holds control characters (line breaks, tabs)")
+    if url.lower().startswith("socket://"):
+        from urllib.parse import urlsplit
+
+        parts = urlsplit(url)
+        try:
+            port = parts.port
+        except ValueError:
+            port = None
+        if not parts.hostname or port is None or not 1 <= port <= 65535:
+            raise ValueError(f"{url[:80]}: expected socket://HOST:PORT with a port 1 ... 65535")
+
+
 def open_transport(
     url: str, baudrate: int = BAUDRATE, timeout: float | None = 0.05, **kwargs: Any
 ) -> GuardedTransport:
@@ -139,6 +165,7 @@ def open_transport(
     Raises ``LinkLost`` naming the port when it cannot be opened (absent, busy, no permission),
     ``ValueError`` for a URL scheme nobody handles.
     """
+    check_url(url)
     register_url_handlers()
     try:
         port = serial.serial_for_url(

@@ -19,6 +19,7 @@ another actuator or driver loads what fits and lists what it could not map.
 from __future__ import annotations
 
 import datetime as _dt
+import os
 import re
 import tomllib
 from collections.abc import Mapping
@@ -45,6 +46,7 @@ class LoadedParameterFile:
     saved: str
     values: dict[tuple[str, int], int]  # (mode, number) -> wire value, only items that fit
     not_mapped: list[str] = field(default_factory=list)  # one line each: what and why
+    missing: list[str] = field(default_factory=list)  # items of the driver the file does not set
     source: str = ""  # FRONT_PANEL_SOURCE when the values were entered from the front panel
 
 
@@ -95,47 +97,85 @@ def dump_parameter_file(
     return "\n".join(lines) + "\n"
 
 
+#: The keys a parameter file may have outside its [tune] and [system] tables (all text).
+HEADER_KEYS = ("format", "actuator", "driver_model", "driver", "saved", "source")
+#: Bound on a parameter file's size: a full HA-655 file is about 3 kB.
+MAX_FILE_BYTES = 1024 * 1024
+
+
+def load_parameter_file(path: str | os.PathLike[str], model: ParameterModel) -> LoadedParameterFile:
+    """Reads the file at ``path`` (a regular file, at most ``MAX_FILE_BYTES``) and maps it onto
+    ``model``; ParameterFileError names the file and what is wrong with it."""
+    from fha_studio import fileio
+
+    try:
+        text = fileio.read_text(path, limit_bytes=MAX_FILE_BYTES)
+    except fileio.FileProblem as exc:
+        raise ParameterFileError(str(exc)) from None
+    return read_parameter_file(text, model, name=str(path))
+
+
 def read_parameter_file(
     text: str, model: ParameterModel, name: str = "parameter file"
 ) -> LoadedParameterFile:
     """Parses `text` and maps it onto `model`. Raises ParameterFileError (with the line) for a
-    file that is not a valid FHA Studio parameter file."""
+    file that is not a valid FHA Studio parameter file.
+
+    A value of the right shape that this driver cannot take is listed in ``not_mapped``; an item
+    of the driver that the file does not set (a file cut short, or made on another driver) is
+    listed in ``missing``.
+    """
+    if text.startswith("\ufeff"):  # a byte-order mark some editors put first
+        text = text[1:]
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         line = _line_from_message(str(exc))
         where = f"line {line}" if line else "somewhere"
         raise ParameterFileError(f"{name}: {where}: not valid TOML ({exc})") from None
+    lines = _key_lines(text)
     if data.get("format") != FORMAT:
         found = data.get("format")
-        line = _find_line(text, None, "format") or 1
-        what = f"format is {found!r}" if found is not None else "there is no format line"
+        line = lines.get(("format",), 1)
+        what = f"format is {_shown(found)}" if found is not None else "there is no format line"
         raise ParameterFileError(
             f'{name}: line {line}: not an FHA Studio parameter file ({what}; expected format = "{FORMAT}")'
         )
-    for key in ("actuator", "driver_model", "saved"):
-        if key in data and not isinstance(data[key], str | _dt.datetime):
-            raise ParameterFileError(f"{name}: line {_find_line(text, None, key)}: {key} must be text")
-    unknown_top = [k for k, v in data.items() if isinstance(v, dict) and k not in MODES]
-    if unknown_top:
-        table = unknown_top[0]
-        raise ParameterFileError(
-            f"{name}: line {_find_table_line(text, table)}: unknown table [{table}] "
-            "(expected [tune] or [system])"
-        )
+    allowed = f"allowed: {', '.join(HEADER_KEYS)} and the tables [tune] and [system]"
+    for key, value in data.items():
+        line = lines.get((key,), 1)
+        if key in MODES:
+            if not isinstance(value, dict):
+                raise ParameterFileError(
+                    f"{name}: line {line}: {key} = {_shown(value)}: {key} must be the table [{key}] "
+                    "of items, each key = integer"
+                )
+        elif isinstance(value, dict):
+            raise ParameterFileError(
+                f"{name}: line {line}: unknown table [{key}] (expected [tune] or [system])"
+            )
+        elif key not in HEADER_KEYS:
+            raise ParameterFileError(f"{name}: line {line}: unknown key {_shown(key)} ({allowed})")
+        elif not isinstance(value, str | _dt.datetime):
+            raise ParameterFileError(f"{name}: line {line}: {key} must be text, got {_shown(value)}")
     values: dict[tuple[str, int], int] = {}
     not_mapped: list[str] = []
+    mentioned: set[tuple[str, str]] = set()
     for mode in MODES:
         table = data.get(mode, {})
         for key, wire in table.items():
-            line = _find_line(text, mode, key)
+            line = lines.get((mode, key), lines.get((mode,), 1))
             if not isinstance(wire, int) or isinstance(wire, bool):
-                raise ParameterFileError(f"{name}: line {line}: {mode}.{key} = {wire!r} is not an integer")
+                raise ParameterFileError(
+                    f"{name}: line {line}: {mode}.{_shown(key, quote=False)} = {_shown(wire)} "
+                    "is not an integer"
+                )
+            mentioned.add((mode, key))
             item = _item_by_key(model, mode, key)
             if item is None:
                 not_mapped.append(
-                    f"{mode}.{key} = {wire} (line {line}): {getattr(model, 'driver', 'this driver')} "
-                    "has no such item"
+                    f"{mode}.{_shown(key, quote=False)} = {wire} (line {line}): "
+                    f"{getattr(model, 'driver', 'this driver')} has no such item"
                 )
                 continue
             try:
@@ -147,6 +187,13 @@ def read_parameter_file(
                 not_mapped.append(f"{mode}.{key} (line {line}): read-only on this driver")
                 continue
             values[(item.mode, item.number)] = wire
+    missing = [
+        f"{item.mode}.{item.key} ({item.mode} {item.number}: {item.name}): not in the file, "
+        "the drive keeps its value"
+        for item in model
+        if item.mode in MODES and getattr(item, "writable", True)
+        and (str(item.mode), item.key) not in mentioned
+    ]
     return LoadedParameterFile(
         actuator=str(data.get("actuator", "")),
         driver_model=str(data.get("driver_model", "")),
@@ -155,7 +202,24 @@ def read_parameter_file(
         values=values,
         not_mapped=not_mapped,
         source=str(data.get("source", "")),
+        missing=missing,
     )
+
+
+def _shown(value, quote: bool = True) -> str:
+    """A value from the file as a message shows it: TOML-like, one line, not too long."""
+    if isinstance(value, str):
+        text = _quote(value) if quote else value
+    elif isinstance(value, bool):
+        text = "true" if value else "false"
+    elif isinstance(value, dict):
+        text = "a table"
+    elif isinstance(value, list):
+        text = "a list [" + ", ".join(_shown(v) for v in value[:4]) + (", …" if len(value) > 4 else "") + "]"
+    else:
+        text = str(value)
+    text = text.replace("\n", " ")
+    return text if len(text) <= 60 else text[:59] + "…"
 
 
 def _item_by_key(model: ParameterModel, mode: str, key: str) -> ParameterItem | None:
@@ -174,21 +238,39 @@ def _line_from_message(message: str) -> int | None:
     return int(match.group(1)) if match else None
 
 
-def _find_table_line(text: str, table: str) -> int:
-    for number, line in enumerate(text.splitlines(), 1):
-        if re.match(rf"\s*\[\s*{re.escape(table)}\s*\]", line):
-            return number
-    return 1
+_BARE_KEY = r"[A-Za-z0-9_-]+"
+_KEY_PART = rf'(?:{_BARE_KEY}|"(?:[^"\\]|\\.)*"|\'[^\']*\')'
+_DOTTED = rf"{_KEY_PART}(?:\s*\.\s*{_KEY_PART})*"
+_TABLE_RE = re.compile(rf"\s*\[\s*({_DOTTED})\s*\]")
+_ASSIGN_RE = re.compile(rf"\s*({_DOTTED})\s*=")
 
 
-def _find_line(text: str, table: str | None, key: str) -> int | None:
-    """The line where `key` is set inside [table] (None: before any table)."""
-    current = None
+def _split_key(dotted: str) -> tuple[str, ...]:
+    parts = re.findall(_KEY_PART, dotted)
+    return tuple(p[1:-1] if p[:1] in "\"'" else p for p in parts)
+
+
+def _key_lines(text: str) -> dict[tuple[str, ...], int]:
+    """Where each key path is first set or opened: ("tune",) for [tune] or tune.x = ...,
+    ("tune", "x") for x = ... under [tune] or tune.x = ... at the top (dotted keys included).
+
+    The file has already parsed as TOML, so a line-by-line reading finds the keys; values that
+    span lines (multi-line strings or arrays) cannot hide a key here because TOML refuses them
+    in this file's shape before this runs, or they are reported at their first line."""
+    lines: dict[tuple[str, ...], int] = {}
+    table: tuple[str, ...] = ()
     for number, line in enumerate(text.splitlines(), 1):
-        header = re.match(r"\s*\[\s*([A-Za-z0-9_.-]+)\s*\]", line)
-        if header:
-            current = header.group(1)
+        if line.lstrip().startswith("#"):
             continue
-        if current == table and re.match(rf"\s*{re.escape(key)}\s*=", line):
-            return number
-    return None
+        header = _TABLE_RE.match(line)
+        if header and not line.lstrip().startswith("[["):
+            table = _split_key(header.group(1))
+            for depth in range(1, len(table) + 1):
+                lines.setdefault(table[:depth], number)
+            continue
+        assign = _ASSIGN_RE.match(line)
+        if assign:
+            path = table + _split_key(assign.group(1))
+            for depth in range(1, len(path) + 1):
+                lines.setdefault(path[:depth], number)
+    return lines

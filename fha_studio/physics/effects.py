@@ -250,11 +250,22 @@ class Effects:
 
     @classmethod
     def from_dict(cls, data: dict[str, dict[str, float]], where: str = "effects") -> Effects:
-        """From {id: params}; unknown ids or parameters raise ValueError naming them."""
+        """From {id: params} (a model file, the simulated drive's options): unknown ids or parameters,
+        and values outside their plausible range (fha_studio.plausible), raise ValueError naming them."""
+        from fha_studio.plausible import EFFECT_PARAMETER_RANGES
+
+        if not isinstance(data, dict):
+            raise ValueError(f"{where}: expected a table of effects by id, got {type(data).__name__}")
         effects = cls()
         for effect_id, params in data.items():
             if not isinstance(params, dict):
                 raise ValueError(f"{where}.{effect_id}: expected a table of parameters, got {params!r}")
+            for name, value in params.items():
+                allowed = EFFECT_PARAMETER_RANGES.get(name)
+                if allowed is not None and isinstance(value, int | float) and not isinstance(value, bool) \
+                        and not allowed.contains(float(value)):
+                    raise ValueError(f"{where}.{effect_id}.{name}: {value:g} is outside {allowed.allowed()} "
+                                     f"({allowed.reason})")
             try:
                 effects = effects.with_effect(effect_id, **params)
             except ValueError as exc:

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fha_studio import plausible
 from fha_studio.physics.effects import (
     CoulombFriction,
     Effects,
@@ -35,6 +36,13 @@ from fha_studio.physics.effects import (
 from fha_studio.physics.stiffness import GearStiffness
 
 MODEL_FORMAT = "fha-axis-model/1"
+# what a model file may say about the plant (the reasons are in fha_studio.plausible)
+_PLANT_RANGES = {
+    "load_inertia_kgm2": plausible.LOAD_INERTIA_KGM2,
+    "actuator_inertia_kgm2": plausible.ACTUATOR_INERTIA_KGM2,
+    "torque_constant_nm_per_a": plausible.TORQUE_CONSTANT_NM_PER_A,
+    "ratio": plausible.MOTOR_TURNS_PER_OUTPUT_REV,
+}
 
 # Assumption (the catalogue gives only the total J_A): share of J_A on the output flange side.
 FLANGE_INERTIA_FRACTION = 0.02
@@ -245,6 +253,8 @@ class AxisModel:
     @classmethod
     def from_dict(cls, data: dict[str, Any], where: str = "model") -> AxisModel:
         """From plain data as written by to_dict(); errors name the field."""
+        if not isinstance(data, dict):
+            raise ValueError(f"{where}: expected a table, got {type(data).__name__}")
         fmt = data.get("format")
         if fmt != MODEL_FORMAT:
             raise ValueError(f"{where}: format must be {MODEL_FORMAT!r}, got {fmt!r}")
@@ -257,8 +267,20 @@ class AxisModel:
             raise ValueError(f"{where}: unknown plant field(s) {', '.join(unknown)}")
         values = dict(plant)
         if "output_resolution_ppr" in values:
-            values["output_resolution_ppr"] = int(values["output_resolution_ppr"])
+            ppr = values["output_resolution_ppr"]
+            if isinstance(ppr, bool) or not isinstance(ppr, int | float) or not math.isfinite(ppr) \
+                    or ppr != int(ppr) or not 1 <= ppr <= 2**31:
+                raise ValueError(f"{where}: [plant] output_resolution_ppr must be a whole number "
+                                 f"1 ... {2**31}, got {ppr!r}")
+            values["output_resolution_ppr"] = int(ppr)
+        for name, allowed in _PLANT_RANGES.items():
+            value = values.get(name)
+            if isinstance(value, int | float) and not isinstance(value, bool) and not allowed.contains(value):
+                raise ValueError(f"{where}: [plant] {name} = {value:g} is outside {allowed.allowed()} "
+                                 f"({allowed.reason})")
         stiffness = data.get("stiffness")
+        if stiffness is not None and not isinstance(stiffness, dict):
+            raise ValueError(f"{where}: [stiffness] must be a table")
         if stiffness is not None:
             try:
                 values["stiffness"] = GearStiffness(**stiffness)
@@ -301,14 +323,17 @@ class AxisModel:
         return cls.from_dict(data, where=where)
 
     def save(self, path: str | Path) -> None:
-        """Write the model file."""
-        Path(path).write_text(self.to_toml(), encoding="utf-8")
+        """Write the model file whole or not at all (fha_studio.fileio.FileProblem if it cannot be)."""
+        from fha_studio import fileio
+
+        fileio.write_text(path, self.to_toml())
 
     @classmethod
     def load(cls, path: str | Path) -> AxisModel:
-        """Read a model file."""
-        p = Path(path)
-        return cls.from_toml(p.read_text(encoding="utf-8"), where=str(p))
+        """Read a model file (a regular file of at most a megabyte); ValueError names the file."""
+        from fha_studio import fileio
+
+        return cls.from_toml(fileio.read_text(path, limit_bytes=1024 * 1024), where=str(path))
 
 
 def catalogue_effects(model: AxisModel) -> Effects:

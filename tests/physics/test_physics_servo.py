@@ -200,7 +200,7 @@ def test_model_file_round_trip(make_model, tmp_path):
     ('format = "fha-axis-model/1"\n[plant]\ntorque_constant_nm_per_a = 22\nmax_current_a = 7.3\n'
      'actuator_inertia_kgm2 = 0.8\nwidth = 3\n', "unknown plant field"),
     ('format = "fha-axis-model/1"\n[plant]\ntorque_constant_nm_per_a = -22\nmax_current_a = 7.3\n'
-     'actuator_inertia_kgm2 = 0.8\n', "torque_constant_nm_per_a must be a positive"),
+     'actuator_inertia_kgm2 = 0.8\n', "torque_constant_nm_per_a = -22 is outside"),
     ('format = "fha-axis-model/1"\n[plant]\ntorque_constant_nm_per_a = 22\nmax_current_a = 7.3\n'
      'actuator_inertia_kgm2 = 0.8\n[effects.stribeck]\nspeed = 1\n', "unknown effect id"),
     ("format = \n", "not valid TOML"),

@@ -205,3 +205,59 @@ def test_session_file_errors_name_the_file(tmp_path):
         ProcedureSession.load(path)
     with pytest.raises(SessionError, match="no such session"):
         ProcedureSession.load(tmp_path / "none.json")
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        ({"runs": [1]}, 'field runs: must be a table of procedure runs by procedure id, got a list'),
+        ({"notes": "x"}, 'field notes: must be a list of tables (who, at_utc, text), got the text "x"'),
+        ({"signature": "me"}, 'field signature: must be a table of texts (who, at_utc), got the text "me"'),
+        ({"driver": [1]}, "field driver: must be a table of texts, got a list"),
+        ({"actuator_code": 5}, "field actuator_code: must be text, got the number 5"),
+        ({"actuator_code": "FHA-99C-50-US250"}, "field actuator_code: "),
+        ({"runs": {"p": {"procedure_id": "p", "records": [{"passed": "yes"}]}}}, "field runs.p.records[0]."),
+        ({"runs": {"p": {"procedure_id": "p", "status": "flying"}}}, "field runs.p.status: is the text"),
+        ({"runs": {"p": {"procedure_id": "p", "position": 7}}}, "field runs.p.position: must be a whole"),
+        ({"sensor_angles_deg": {"origin_sensor": 1e308}}, "outside -360 ... 360 deg"),
+        ({"colour": "red"}, "field colour: unknown; allowed:"),
+    ],
+)
+def test_a_session_file_of_the_wrong_shape_is_refused_naming_the_field(tmp_path, change, words):
+    import json
+
+    good = ProcedureSession(actuator_code="FHA-25C-50-US250", operator="me")
+    path = good.save(tmp_path / "s.json")
+    assert ProcedureSession.load(path).actuator_code == "FHA-25C-50-US250"
+    data = json.loads(path.read_text())
+    data.update(change)
+    path.write_text(json.dumps(data))
+    with pytest.raises(SessionError) as err:
+        ProcedureSession.load(path)
+    message = str(err.value)
+    assert message.startswith(f"{path}: ") and words in message and "\n" not in message
+
+
+def test_only_regular_files_are_read_as_sessions(tmp_path):
+    import os
+
+    os.mkfifo(tmp_path / "fifo.json")
+    for path, words in ((tmp_path / "fifo.json", "FIFO"), ("/dev/full", "character device"),
+                        ("/dev/zero", "character device"), (tmp_path / ("x" * 300), "too long")):
+        with pytest.raises(SessionError, match=words):
+            ProcedureSession.load(path)
+
+
+def test_a_session_that_cannot_be_written_leaves_the_old_file_whole(tmp_path):
+    from fha_studio.fileio import FileProblem
+
+    session = ProcedureSession(actuator_code="FHA-25C-50-US250")
+    path = session.save(tmp_path / "s.json")
+    before = path.read_text()
+    session.operator = "someone else"
+    (tmp_path / "afile").write_text("")
+    for target, words in (("/dev/full", "not a regular file"),
+                          (tmp_path / "afile" / "s.json", "not a directory")):
+        with pytest.raises(FileProblem, match=words):
+            session.save(target)
+    assert path.read_text() == before and sorted(p.name for p in tmp_path.iterdir()) == ["afile", "s.json"]

@@ -125,14 +125,14 @@ def test_suggest(capsys):
 @pytest.mark.parametrize(
     ("change", "message"),
     [
-        ({"--load-inertia": "-1"}, "--load-inertia must be a number >= 0"),
+        ({"--load-inertia": "-1"}, "--load-inertia: -1 is outside 0 ... 1500 kg m^2"),
         ({"--load-inertia": "heavy"}, "--load-inertia: 'heavy' is not a number"),
         ({"--actuator": "FHA-26C-50-US250"}, "unknown actuator 'FHA-26C-50-US250'"),
         ({"--actuator": "FHA-25C-60-US250"}, "unknown actuator"),
         ({"--speed": "91"}, "above the maximum speed of FHA-25C-50-US250 (90 r/min)"),
         ({"--duty-factors": "7,1"}, "--duty-factors"),
         ({"--duty-factors": "7;1;7"}, "--duty-factors"),
-        ({"--cycle": "0"}, "--cycle must be a number > 0"),
+        ({"--cycle": "0"}, "--cycle: 0 is outside 0.001 ... 86400 s"),
         ({"--angle": "inf"}, "--angle"),
     ],
 )

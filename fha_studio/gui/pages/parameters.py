@@ -25,6 +25,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio import fileio
 from fha_studio.gui.diff_dialog import ParameterDiffDialog
 from fha_studio.gui.link import Cmd, CommandResult, LinkInfo
 from fha_studio.gui.pages.base import BasePage
@@ -638,7 +639,12 @@ class ParametersPage(BasePage):
             if not path:
                 return None
         target = Path(path)
-        target.write_text(self.session.parameter_file_text(), encoding="utf-8")
+        try:
+            fileio.write_text(target, self.session.parameter_file_text())
+        except fileio.FileProblem as exc:
+            self.message.setText(f"Not saved: {exc}")
+            self.message.setStyleSheet("color: #b00020; font-weight: bold;")
+            return None
         QSettings().setValue("parameters/last_dir", str(target.parent))
         panel = (" (values entered from the front panel are marked so)"
                  if self.session.state.front_panel else "")
@@ -649,7 +655,7 @@ class ParametersPage(BasePage):
     def load_file(self, path: str | None = None, exec_dialog: bool = True):
         """Reads a parameter file and shows the three-way comparison; nothing is applied until the
         user confirms. Returns the dialog (tests drive it) or None when the file was refused."""
-        from fha_studio.logic.paramfile import ParameterFileError, read_parameter_file
+        from fha_studio.logic.paramfile import ParameterFileError, load_parameter_file
 
         if path is None:
             path, _ = QFileDialog.getOpenFileName(
@@ -659,9 +665,8 @@ class ParametersPage(BasePage):
                 return None
         source = Path(path)
         try:
-            text = source.read_text(encoding="utf-8")
-            loaded = read_parameter_file(text, self.session.parameter_model, name=source.name)
-        except (OSError, UnicodeDecodeError, ParameterFileError) as exc:
+            loaded = load_parameter_file(source, self.session.parameter_model)
+        except ParameterFileError as exc:
             self.message.setText(f"File refused, nothing loaded: {exc}")
             self.message.setStyleSheet("color: #b00020; font-weight: bold;")
             if exec_dialog:

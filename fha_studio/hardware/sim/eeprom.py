@@ -9,13 +9,23 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
-import tempfile
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from fha_studio import fileio
+
 FORMAT = "fha-sim-eeprom/1"
+#: An EEPROM image is about 3 kB; a larger file is not one.
+MAX_FILE_BYTES = 1024 * 1024
+#: The shaft angle an image may hold [rad]: 65536 output turns either way, more than an absolute
+#: encoder's multi-turn counter holds; beyond it the servo's encoder arithmetic would overflow.
+MAX_ENCODER_ANGLE_RAD = 2 * math.pi * 65536
+#: Seconds since power-on an alarm record may carry: ten years.
+MAX_ALARM_SECONDS = 10 * 365 * 24 * 3600.0
 
 
 class EepromError(ValueError):
@@ -41,17 +51,19 @@ class EepromFile:
 
     def load(self) -> dict[str, Any] | None:
         """The stored document, or None if there is no file. Raises EepromError naming the file."""
-        try:
-            text = self.path.read_text(encoding="utf-8")
-        except FileNotFoundError:
+        self.remove_stale_temporaries()
+        if not os.path.lexists(self.path):
             return None
-        except OSError as exc:
-            raise EepromError(f"simulated drive EEPROM {self.path}: cannot read it: {exc}") from exc
+        try:
+            text = fileio.read_text(self.path, limit_bytes=MAX_FILE_BYTES)
+        except fileio.FileProblem as exc:
+            raise EepromError(f"simulated drive EEPROM {exc}") from None
         try:
             doc = json.loads(text)
-        except json.JSONDecodeError as exc:
+        except (json.JSONDecodeError, RecursionError) as exc:
+            where = f"{exc.msg} at line {exc.lineno}" if isinstance(exc, json.JSONDecodeError) else "too deep"
             raise EepromError(
-                f"simulated drive EEPROM {self.path} is corrupt (not JSON: {exc.msg} at line {exc.lineno}); "
+                f"simulated drive EEPROM {self.path} is corrupt (not JSON: {where}); "
                 "delete it to start from the factory settings"
             ) from exc
         if not isinstance(doc, dict) or doc.get("format") != FORMAT:
@@ -60,20 +72,81 @@ class EepromFile:
                 f"simulated drive EEPROM {self.path} is not a {FORMAT} file (format: {found!r}); "
                 "delete it to start from the factory settings"
             )
+        problem = _shape_problem(doc)
+        if problem:
+            raise EepromError(f"simulated drive EEPROM {self.path}: {problem}; delete it to start from "
+                              "the factory settings")
         return doc
 
-    def save(self, doc: Mapping[str, Any]) -> None:
-        """Write ``doc`` (the ``format`` key is added) atomically."""
-        data = json.dumps({"format": FORMAT, **doc}, indent=1, sort_keys=True)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=self.path.name + ".", suffix=".tmp", dir=self.path.parent)
+    def remove_stale_temporaries(self) -> list[Path]:
+        """Delete the temporary files a process killed during :meth:`save` left beside the image
+        (``.NAME.*.tmp``, and ``NAME.*.tmp`` of earlier versions); returns them. A save in
+        progress in another process would lose its temporary file, but two processes must not
+        share one image anyway."""
+        pattern = re.compile(r"\.?" + re.escape(self.path.name) + r"\.[A-Za-z0-9_]+\.tmp")
+        removed = []
         try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(data)
-                f.flush()
-                os.fsync(f.fileno())
-            os.replace(tmp, self.path)
-        except BaseException:
-            with contextlib.suppress(FileNotFoundError):
-                os.unlink(tmp)
-            raise
+            names = os.listdir(self.path.parent)
+        except OSError:
+            return removed
+        for name in names:
+            if pattern.fullmatch(name):
+                with contextlib.suppress(OSError):
+                    os.unlink(self.path.parent / name)
+                    removed.append(self.path.parent / name)
+        return removed
+
+    def save(self, doc: Mapping[str, Any]) -> None:
+        """Write ``doc`` (the ``format`` key is added) whole or not at all (fha_studio.fileio);
+        EepromError names the file if it cannot be written."""
+        data = json.dumps({"format": FORMAT, **doc}, indent=1, sort_keys=True)
+        try:
+            if not os.path.lexists(self.path.parent):
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+            fileio.write_text(self.path, data)
+        except OSError as exc:
+            raise EepromError(
+                f"simulated drive EEPROM {self.path}: not written: {fileio.os_reason(exc)}") from None
+        except fileio.FileProblem as exc:
+            raise EepromError(f"simulated drive EEPROM {exc}") from None
+
+
+def _shape_problem(doc: dict[str, Any]) -> str:
+    """What is wrong with the shape of a loaded image ("" if nothing): every value a drive would
+    compute with is checked here, so a bad file is refused at start, not in the drive's thread."""
+    for key in ("driver", "actuator"):
+        if key in doc and not isinstance(doc[key], str):
+            return f"'{key}' must be text"
+    params = doc.get("parameters", {})
+    if not isinstance(params, dict):
+        return "'parameters' must be a table of modes"
+    for mode, values in params.items():
+        if not isinstance(values, dict):
+            return f"parameters.{mode} must be a table of items"
+        for key, value in values.items():
+            if isinstance(value, bool) or not isinstance(value, int):
+                return f"parameters.{mode}.{key} must be a whole number, got {value!r:.40}"
+    history = doc.get("alarm_history", [])
+    if not isinstance(history, list):
+        return "'alarm_history' must be a list"
+    for i, record in enumerate(history):
+        if not isinstance(record, dict):
+            return f"alarm_history[{i}] must be a table (code, seconds, time_utc)"
+        code, seconds = record.get("code"), record.get("seconds")
+        if isinstance(code, bool) or not isinstance(code, int) or not 0 <= code <= 99:
+            return f"alarm_history[{i}].code must be an alarm number 0 ... 99"
+        if isinstance(seconds, bool) or not isinstance(seconds, int | float) \
+                or not 0 <= seconds <= MAX_ALARM_SECONDS:
+            return f"alarm_history[{i}].seconds must be 0 ... {MAX_ALARM_SECONDS:g} s since power-on"
+        if not isinstance(record.get("time_utc"), str):
+            return f"alarm_history[{i}].time_utc must be text"
+    encoder = doc.get("encoder", {})
+    if not isinstance(encoder, dict):
+        return "'encoder' must be a table"
+    for key in ("mechanical_angle_rad", "absolute_zero_rad"):
+        value = encoder.get(key, 0.0)
+        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
+                or abs(value) > MAX_ENCODER_ANGLE_RAD:
+            return (f"encoder.{key} must be a number of radians within ±{MAX_ENCODER_ANGLE_RAD:.0f} "
+                    "(65536 output turns)")
+    return ""

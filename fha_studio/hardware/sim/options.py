@@ -35,10 +35,12 @@ Options (all optional):
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field, replace
 from typing import Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
+from fha_studio import plausible
 from fha_studio.catalog import DEFAULT_ACTUATOR
 
 #: The command sets a simulated drive can speak (see ``profile`` above).
@@ -76,18 +78,30 @@ class SimConfig:
             )
         if not isinstance(self.actuator, str) or not self.actuator.strip():
             raise SimConfigError("simulated drive: an actuator model code is needed, e.g. FHA-25C-50-US250")
-        _finite("load_inertia_kgm2", self.load_inertia_kgm2, minimum=0.0)
+        _ranged("load_inertia_kgm2", self.load_inertia_kgm2, plausible.LOAD_INERTIA_KGM2)
         for name in ("origin_deg", "ls1_deg", "ls2_deg"):
             if getattr(self, name) is not None:
-                _finite(name, getattr(self, name))
+                _ranged(name, getattr(self, name), plausible.SENSOR_ANGLE_DEG)
         if self.oww_clear_s is not None:
-            _finite("oww_clear_s", self.oww_clear_s, minimum=0.0)
+            _ranged("oww_clear_s", self.oww_clear_s, plausible.OWW_CLEAR_S)
+        for effect_id, params in self.effects.items():
+            for name, value in params.items():
+                allowed = plausible.EFFECT_PARAMETER_RANGES.get(name)
+                if allowed is not None:
+                    _ranged(f"{effect_id}.{name}", value, allowed)
 
     def replace(self, **changes: Any) -> SimConfig:
         return replace(self, **changes)
 
 
+_DECIMAL = re.compile(r"\s*[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\s*")
+
+
 def _finite(name: str, value: Any, minimum: float | None = None) -> float:
+    if isinstance(value, str) and not _DECIMAL.fullmatch(value):  # float() takes "1_0", "inf"
+        raise SimConfigError(f"simulated drive option {name}: '{value[:40]}' is not a number")
+    if isinstance(value, bool):
+        raise SimConfigError(f"simulated drive option {name}: {value} is not a number")
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -95,6 +109,14 @@ def _finite(name: str, value: Any, minimum: float | None = None) -> float:
     if not math.isfinite(number) or (minimum is not None and number < minimum):
         bound = f" >= {minimum:g}" if minimum is not None else ""
         raise SimConfigError(f"simulated drive option {name}: {value!r} must be a finite number{bound}")
+    return number
+
+
+def _ranged(name: str, value: Any, allowed: plausible.Range) -> float:
+    number = _finite(name, value)
+    if not allowed.contains(number):
+        raise SimConfigError(f"simulated drive option {name}: {number:g} is outside {allowed.allowed()} "
+                             f"({allowed.reason})")
     return number
 
 
@@ -115,13 +137,17 @@ def parse_effect(spec: str) -> tuple[str, dict[str, float]]:
     effect_id, _, rest = spec.strip().partition(":")
     effect_id = effect_id.strip()
     if not effect_id:
-        raise SimConfigError(f"effect {spec!r}: expected ID or ID:NAME=VALUE,NAME=VALUE")
+        raise SimConfigError(f"effect '{spec.strip()}': expected ID or ID:NAME=VALUE,NAME=VALUE, "
+                             "e.g. coulomb_friction:torque_nm=8")
     params: dict[str, float] = {}
     for part in filter(None, (p.strip() for p in rest.split(","))):
         name, eq, value = part.partition("=")
         if not eq or not name.strip():
             raise SimConfigError(f"effect {spec!r}: parameter {part!r} is not NAME=VALUE")
-        params[name.strip()] = _finite(f"{effect_id}.{name.strip()}", value)
+        name = name.strip()
+        allowed = plausible.EFFECT_PARAMETER_RANGES.get(name)
+        where = f"{effect_id}.{name}"
+        params[name] = _ranged(where, value, allowed) if allowed else _finite(where, value)
     return effect_id, params
 
 
@@ -129,7 +155,14 @@ def parse_effects(specs: list[str]) -> dict[str, dict[str, float]]:
     """Several effect specs (each may hold several, separated by ``;``) -> {id: params}."""
     effects: dict[str, dict[str, float]] = {}
     for spec in specs:
-        for one in filter(None, (s.strip() for s in spec.split(";"))):
+        if not spec.strip():
+            raise SimConfigError("effect '': empty; expected ID or ID:NAME=VALUE,NAME=VALUE, "
+                                 "e.g. coulomb_friction:torque_nm=8")
+        ones = [s.strip() for s in spec.split(";") if s.strip()]
+        if not ones:
+            raise SimConfigError(f"effect '{spec.strip()}': no effect in it; expected ID or "
+                                 "ID:NAME=VALUE,NAME=VALUE, e.g. coulomb_friction:torque_nm=8")
+        for one in ones:
             effect_id, params = parse_effect(one)
             effects[effect_id] = params
     return effects
@@ -165,7 +198,7 @@ def config_from_url(url: str) -> SimConfig:
         values["driver"] = last("driver")
     inertia = last("load_inertia_kgm2") if last("load_inertia_kgm2") is not None else last("load_inertia")
     if inertia is not None:
-        values["load_inertia_kgm2"] = _finite("load_inertia", inertia, minimum=0.0)
+        values["load_inertia_kgm2"] = _ranged("load_inertia", inertia, plausible.LOAD_INERTIA_KGM2)
     for key in ("brake", "sensors", "paced", "quantised", "packed_trace"):
         flag = last(key)
         if flag is not None:

@@ -7,14 +7,20 @@ reproduced later. Times are UTC, ISO 8601.
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 import os
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from fha_studio import fileio, plausible
+
 FORMAT = "fha-session/1"
+#: Bound on a session file's size: a fully walked session is some tens of kB.
+MAX_FILE_BYTES = 16 * 1024 * 1024
 
 # Run states of one procedure in a session.
 NOT_STARTED, RUNNING, PAUSED, STOPPED, COMPLETED = "not_started", "running", "paused", "stopped", "completed"
@@ -109,10 +115,12 @@ class ProcedureSession:
         target = Path(path) if path is not None else self.path
         if target is None:
             raise SessionError("the session has no file yet: give a path to save it to")
-        target.parent.mkdir(parents=True, exist_ok=True)
-        tmp = target.with_name(target.name + ".tmp")
-        tmp.write_text(json.dumps(self.to_json(), indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
-        os.replace(tmp, target)
+        try:
+            if not os.path.lexists(target.parent):
+                target.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise fileio.FileProblem(target, f"its folder cannot be made: {fileio.os_reason(exc)}") from None
+        fileio.write_text(target, json.dumps(self.to_json(), indent=2, ensure_ascii=False) + "\n")
         self.path = target
         return target
 
@@ -121,19 +129,24 @@ class ProcedureSession:
         """Read a session file; raises :class:`SessionError` naming the file and the problem."""
         path = Path(path)
         try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise SessionError(f"{path}: no such session file") from None
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise SessionError(f"{path}: not a readable session file: {exc}") from None
-        if not isinstance(data, dict) or data.get("format") != FORMAT:
-            raise SessionError(f"{path}: not an {FORMAT} session file")
+            text = fileio.read_text(path, limit_bytes=MAX_FILE_BYTES)
+        except fileio.FileProblem as exc:
+            if exc.reason == "no such file or directory":
+                raise SessionError(f"{path}: no such session file") from None
+            raise SessionError(str(exc)) from None
         try:
-            runs = {k: RunState.from_json(v) for k, v in data.get("runs", {}).items()}
-            fields = {k: v for k, v in data.items() if k not in ("format", "runs")}
-            session = cls(runs=runs, **fields)
-        except TypeError as exc:
-            raise SessionError(f"{path}: unexpected content: {exc}") from None
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise SessionError(
+                f"{path}: line {exc.lineno}: not a session file (not JSON: {exc.msg})") from None
+        except RecursionError:
+            raise SessionError(f"{path}: not a session file (nested too deep)") from None
+        if not isinstance(data, dict) or data.get("format") != FORMAT:
+            raise SessionError(f"{path}: not an {FORMAT} session file (no \"format\": \"{FORMAT}\")")
+        try:
+            session = _session_from_json(data)
+        except _ShapeError as exc:
+            raise SessionError(f"{path}: field {exc.where}: {exc.what}") from None
         session.path = path
         return session
 
@@ -142,3 +155,163 @@ class ProcedureSession:
 
     def add_plot(self, title: str, png_path: str | Path) -> None:
         self.plots.append({"title": title, "path": str(png_path)})
+
+
+# -- reading: every field checked against its shape -------------------------------------------------
+
+_STATUSES = (NOT_STARTED, RUNNING, PAUSED, STOPPED, COMPLETED)
+#: the longest text a session field may hold (a note, a check's text); longer is not ours
+MAX_TEXT = 100_000
+
+
+class _ShapeError(Exception):
+    def __init__(self, where: str, what: str):
+        self.where, self.what = where, what
+
+
+def _text(value: Any, where: str) -> str:
+    if not isinstance(value, str):
+        raise _ShapeError(where, f"must be text, got {_kind(value)}")
+    if len(value) > MAX_TEXT:
+        raise _ShapeError(where, f"is {len(value)} characters long; at most {MAX_TEXT}")
+    return value
+
+
+def _kind(value: Any) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return f"the number {value:g}"
+    if isinstance(value, str):
+        shown = value if len(value) <= 30 else value[:29] + "…"
+        return f'the text "{shown}"'
+    if isinstance(value, list):
+        return "a list"
+    return "a table"
+
+
+def _table(value: Any, where: str, what: str) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise _ShapeError(where, f"must be a table of {what}, got {_kind(value)}")
+    return value
+
+
+def _list(value: Any, where: str, what: str) -> list[Any]:
+    if not isinstance(value, list):
+        raise _ShapeError(where, f"must be a list of {what}, got {_kind(value)}")
+    return value
+
+
+def _texts(value: Any, where: str, keys: tuple[str, ...] | None = None) -> dict[str, str]:
+    what = "texts" if keys is None else f"texts ({', '.join(keys)})"
+    table = _table(value, where, what)
+    if keys is not None:
+        unknown = sorted(set(table) - set(keys))
+        if unknown:
+            raise _ShapeError(f"{where}.{unknown[0]}", f"unknown; allowed: {', '.join(keys)}")
+    return {k: _text(v, f"{where}.{k}") for k, v in table.items()}
+
+
+def _session_from_json(data: dict[str, Any]) -> ProcedureSession:
+    from fha_studio.catalog import ModelCodeError, parse_model_code
+
+    known = {f.name for f in dataclasses.fields(ProcedureSession)} - {"path"}
+    for key in data:
+        if key != "format" and key not in known:
+            raise _ShapeError(key, f"unknown; allowed: {', '.join(sorted(known))}")
+    if "actuator_code" not in data:
+        raise _ShapeError("actuator_code", "missing (the actuator model code, e.g. FHA-25C-50-US250)")
+    code = _text(data["actuator_code"], "actuator_code")
+    try:
+        parse_model_code(code)
+    except ModelCodeError as exc:
+        raise _ShapeError("actuator_code", str(exc)) from None
+    values: dict[str, Any] = {"actuator_code": code}
+    for key in ("axis", "operator", "site", "created_utc"):
+        if key in data:
+            values[key] = _text(data[key], key)
+    if "driver" in data:
+        values["driver"] = _texts(data["driver"], "driver")
+    if "signature" in data:
+        values["signature"] = _texts(data["signature"], "signature", ("who", "at_utc"))
+    for key, fields in (("notes", ("who", "at_utc", "text")), ("plots", ("title", "path"))):
+        if key in data:
+            values[key] = [_texts(v, f"{key}[{i}]", fields)
+                           for i, v in enumerate(_list(data[key], key, f"tables ({', '.join(fields)})"))]
+    if "sensor_angles_deg" in data:
+        angles = {}
+        for name, value in _table(data["sensor_angles_deg"], "sensor_angles_deg", "angles").items():
+            where = f"sensor_angles_deg.{name}"
+            if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+                raise _ShapeError(where, f"must be a number of degrees, got {_kind(value)}")
+            if not plausible.SENSOR_ANGLE_DEG.contains(value):
+                raise _ShapeError(where, f"{value:g} deg is outside {plausible.SENSOR_ANGLE_DEG.allowed()}")
+            angles[name] = float(value)
+        values["sensor_angles_deg"] = angles
+    if "parameters" in data:
+        values["parameters"] = _table(data["parameters"], "parameters", "parameter values")
+    if "runs" in data:
+        runs = _table(data["runs"], "runs", "procedure runs by procedure id")
+        values["runs"] = {pid: _run_from_json(run, f"runs.{pid}") for pid, run in runs.items()}
+    return ProcedureSession(**values)
+
+
+def _run_from_json(data: Any, where: str) -> RunState:
+    table = _table(data, where, "run fields")
+    known = {f.name for f in dataclasses.fields(RunState)}
+    for key in table:
+        if key not in known:
+            raise _ShapeError(f"{where}.{key}", f"unknown; allowed: {', '.join(sorted(known))}")
+    values: dict[str, Any] = {}
+    for key in ("procedure_id", "stop_step_id", "stop_warning", "started_utc", "finished_utc"):
+        if key in table:
+            values[key] = _text(table[key], f"{where}.{key}")
+    if "procedure_id" not in values:
+        raise _ShapeError(f"{where}.procedure_id", "missing")
+    if "status" in table:
+        status = table["status"]
+        if status not in _STATUSES:
+            raise _ShapeError(f"{where}.status", f"is {_kind(status)}; allowed: {', '.join(_STATUSES)}")
+        values["status"] = status
+    if "step_ids" in table:
+        step_ids = _list(table["step_ids"], f"{where}.step_ids", "step ids")
+        values["step_ids"] = [_text(v, f"{where}.step_ids[{i}]") for i, v in enumerate(step_ids)]
+    if "position" in table:
+        position = table["position"]
+        limit = len(values.get("step_ids", []))
+        if isinstance(position, bool) or not isinstance(position, int) or not 0 <= position <= limit:
+            raise _ShapeError(f"{where}.position", f"must be a whole number 0 ... {limit} (a step), "
+                              f"got {_kind(position)}")
+        values["position"] = position
+    if "answers" in table:  # any JSON value: what a step recorded (engine._plain)
+        values["answers"] = _table(table["answers"], f"{where}.answers", "answers by step id")
+    if "records" in table:
+        records = _list(table["records"], f"{where}.records", "check records")
+        values["records"] = [_record_from_json(r, f"{where}.records[{i}]") for i, r in enumerate(records)]
+    return RunState(**values)
+
+
+def _record_from_json(data: Any, where: str) -> CheckRecord:
+    fields = {f.name: f for f in dataclasses.fields(CheckRecord)}
+    table = _table(data, where, "check fields")
+    for key in table:
+        if key not in fields:
+            raise _ShapeError(f"{where}.{key}", f"unknown; allowed: {', '.join(fields)}")
+    values: dict[str, Any] = {}
+    for name, f in fields.items():
+        if name not in table:
+            if f.default is dataclasses.MISSING:
+                raise _ShapeError(f"{where}.{name}", "missing")
+            continue
+        value = table[name]
+        if name == "passed":
+            if not isinstance(value, bool):
+                raise _ShapeError(f"{where}.passed", f"must be true or false, got {_kind(value)}")
+        elif name == "value":
+            pass  # any JSON value: what the step recorded
+        else:
+            value = _text(value, f"{where}.{name}")
+        values[name] = value
+    return CheckRecord(**values)

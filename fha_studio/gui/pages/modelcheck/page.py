@@ -21,6 +21,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QHeaderView,
     QLabel,
+    QMessageBox,
     QPlainTextEdit,
     QPushButton,
     QSplitter,
@@ -31,6 +32,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio import fileio
 from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.state import AxisState
 from fha_studio.logic.modelcheck import ModelCheckError, ModelCheckResult, run_modelcheck
@@ -494,19 +496,25 @@ class ModelCheckPage(BasePage):
     def save_report(self, path: str | Path) -> Path:
         if self.result is None:
             raise ValueError("run the model check first")
-        Path(path).write_text(json.dumps(self.result.to_json(), indent=2), encoding="utf-8")
+        fileio.write_text(path, json.dumps(self.result.to_json(), indent=2))
         return Path(path)
 
     def _save_model_clicked(self) -> None:
         path, _ = QFileDialog.getSaveFileName(self, "Save the updated model", "axis-model.toml",
                                               "TOML (*.toml)")
         if path:
-            self.save_model(path)
+            try:
+                self.save_model(path)
+            except (OSError, ValueError) as exc:  # fileio.FileProblem: one line naming the file
+                QMessageBox.warning(self, "Model not saved", str(exc))
 
     def _save_report_clicked(self) -> None:
         path, _ = QFileDialog.getSaveFileName(self, "Save the report", "modelcheck.json", "JSON (*.json)")
         if path:
-            self.save_report(path)
+            try:
+                self.save_report(path)
+            except (OSError, ValueError) as exc:
+                QMessageBox.warning(self, "Report not saved", str(exc))
 
     def showEvent(self, event) -> None:
         self._update_buttons()  # the scope may have been opened since

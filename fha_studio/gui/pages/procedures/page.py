@@ -35,6 +35,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio import fileio
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
@@ -499,7 +500,7 @@ class ProceduresPage(BasePage):
             path = self.session.path.with_suffix(".params") if self.session.path else None
             if path is not None:
                 try:
-                    path.write_text(self.gui_session.parameter_file_text(), encoding="utf-8")
+                    fileio.write_text(path, self.gui_session.parameter_file_text())
                 except Exception as exc:  # the report still goes out, saying the file is missing
                     log.warning("parameter file not written: %s", exc)
                     path = None

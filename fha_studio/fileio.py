@@ -1,0 +1,288 @@
+"""Reading input files safely and writing output files whole (any layer; no Qt).
+
+- :func:`read_text` / :func:`read_bytes`: only a regular file is read as a file (a FIFO, a device
+  such as ``/dev/zero``, a directory or a socket is refused before a byte is read, so nothing
+  waits on a writer that never comes or reads without end), and reading stops at a stated size.
+- :func:`write_text` / :func:`write_bytes`: the one way FHA Studio writes an output file. The
+  content goes to a temporary file beside the target, is flushed to the disk, and only then
+  renamed over the target; a failed write (disk full, no permission, a path under a file)
+  leaves the previous file untouched and no temporary file behind, and raises before the caller
+  can print that it succeeded.
+- :func:`check_output_path`: the same checks as the writers, before any work is done, so that a
+  long computation is not lost to a target that can never be written.
+
+Every problem raises :class:`FileProblem` (a ``ValueError``) whose message is one line naming the
+file and what is wrong, in words (no errno names).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import stat
+import tempfile
+from pathlib import Path
+
+#: Default bound on what a reader reads: far above any file FHA Studio writes or reads as input
+#: (parameter, session, model and EEPROM files are kilobytes), so a larger file is not one of ours.
+DEFAULT_READ_LIMIT_BYTES = 16 * 1024 * 1024
+
+
+class FileProblem(ValueError):
+    """A file cannot be read or written as asked; ``str()`` is one line naming the file."""
+
+    def __init__(self, path: str | os.PathLike[str], reason: str):
+        self.path = str(path)
+        self.reason = reason
+        super().__init__(f"{_shown(self.path)}: {reason}")
+
+
+def _shown(path: str) -> str:
+    # a path a person typed by mistake can be long: keep the message on one readable line
+    return path if len(path) <= 120 else path[:60] + "…" + path[-40:]
+
+
+_KIND = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def _kind(mode: int) -> str:
+    for test, name in _KIND:
+        if test(mode):
+            return name
+    return "not a regular file"
+
+
+def os_reason(exc: OSError) -> str:
+    """An OSError in words, without the errno number or the path (the caller names the file)."""
+    reasons = {
+        errno.ENOENT: "no such file or directory",
+        errno.ENOTDIR: "a part of the path is not a directory",
+        errno.EISDIR: "is a directory",
+        errno.EACCES: "permission denied",
+        errno.EPERM: "permission denied",
+        errno.ENAMETOOLONG: "the name is too long for the file system",
+        errno.ENOSPC: "no space left on the device",
+        errno.EROFS: "the file system is read-only",
+        errno.ELOOP: "too many symbolic links",
+        errno.EIO: "input/output error",
+        errno.EDQUOT: "disk quota exceeded",
+        errno.EFBIG: "the file is too large for the file system",
+    }
+    if exc.errno in reasons:
+        return reasons[exc.errno]
+    return (exc.strerror or str(exc)).lower() if exc.strerror else str(exc)
+
+
+# ------------------------------------------------------------------------------------------- reading
+
+
+def read_bytes(path: str | os.PathLike[str], *, limit_bytes: int = DEFAULT_READ_LIMIT_BYTES) -> bytes:
+    """The content of a regular file of at most ``limit_bytes``; :class:`FileProblem` otherwise."""
+    name = os.fspath(path)
+    if not name:
+        raise FileProblem("''", "no file name given")
+    try:
+        # O_NONBLOCK: opening a FIFO must not wait for a writer; the kind is checked right after
+        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+    except OSError as exc:
+        raise FileProblem(name, os_reason(exc)) from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise FileProblem(name, f"is {_kind(info.st_mode)}, not a regular file: only files are read")
+        if info.st_size > limit_bytes:
+            raise FileProblem(name, f"is {_size(info.st_size)}, more than the {_size(limit_bytes)} "
+                              "such a file can be")
+        chunks: list[bytes] = []
+        total = 0
+        while True:
+            chunk = os.read(fd, min(1 << 20, limit_bytes + 1 - total))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+            if total > limit_bytes:  # a file that grows, or reports no size (/proc)
+                raise FileProblem(name, f"holds more than the {_size(limit_bytes)} such a file can be")
+        return b"".join(chunks)
+    except OSError as exc:
+        raise FileProblem(name, f"cannot be read: {os_reason(exc)}") from None
+    finally:
+        os.close(fd)
+
+
+def read_text(path: str | os.PathLike[str], *, limit_bytes: int = DEFAULT_READ_LIMIT_BYTES) -> str:
+    """A regular file as UTF-8 text (a leading byte-order mark is dropped); :class:`FileProblem`
+    for anything else, including bytes that are not UTF-8 (the message gives the line)."""
+    data = read_bytes(path, limit_bytes=limit_bytes)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise FileProblem(os.fspath(path), f"line {line}: not UTF-8 text (byte {exc.start}); "
+                          "is it the right file?") from None
+    return text[1:] if text.startswith("\ufeff") else text
+
+
+def _size(n: int) -> str:
+    if n >= 1 << 20:
+        return f"{n / (1 << 20):.0f} MB"
+    if n >= 1 << 10:
+        return f"{n / (1 << 10):.0f} kB"
+    return f"{n} bytes"
+
+
+# ------------------------------------------------------------------------------------------- writing
+
+
+def check_output_path(path: str | os.PathLike[str]) -> Path:
+    """Raises :class:`FileProblem` unless ``path`` can become a regular file: its directory
+    exists and is a directory, and the path is absent or a regular file. Returns it as a Path."""
+    name = os.fspath(path)
+    if not name:
+        raise FileProblem("''", "no file name given")
+    target = Path(name)
+    try:
+        info = os.stat(target)
+    except FileNotFoundError:
+        info = None
+    except OSError as exc:
+        raise FileProblem(name, os_reason(exc)) from None
+    if info is not None and not stat.S_ISREG(info.st_mode):
+        raise FileProblem(name, f"is {_kind(info.st_mode)}, not a regular file: only files are written")
+    parent = target.parent
+    try:
+        parent_info = os.stat(parent)
+    except OSError as exc:
+        raise FileProblem(name, f"its folder {parent}: {os_reason(exc)}") from None
+    if not stat.S_ISDIR(parent_info.st_mode):
+        raise FileProblem(name, f"{parent} is not a folder")
+    if len(target.name.encode()) > 255 - 16:  # room for the temporary file's suffix
+        raise FileProblem(name, os_reason(OSError(errno.ENAMETOOLONG, "")))
+    return target
+
+
+def write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Write ``data`` to ``path`` whole or not at all (temporary file, fsync, rename).
+
+    The new file gets the old file's permissions, or the usual ones for a new file (0666 less the
+    umask). Raises :class:`FileProblem`; the target is then as it was before.
+    """
+    target = check_output_path(path)
+    try:
+        mode = stat.S_IMODE(os.stat(target).st_mode)
+    except FileNotFoundError:
+        mode = 0o666 & ~_umask()
+    except OSError as exc:
+        raise FileProblem(target, os_reason(exc)) from None
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.chmod(tmp, mode)
+        os.replace(tmp, target)
+        tmp = None
+    except OSError as exc:
+        raise FileProblem(target, f"not written: {os_reason(exc)}") from None
+    finally:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+    return target
+
+
+def write_text(path: str | os.PathLike[str], text: str) -> Path:
+    """:func:`write_bytes` of ``text`` in UTF-8."""
+    return write_bytes(path, text.encode("utf-8"))
+
+
+def _umask() -> int:
+    # os.umask() can only read the mask by setting it, which races with other threads creating
+    # files; Linux states it in /proc, elsewhere the usual 022 is assumed
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0o022
+
+
+# ------------------------------------------------------------------------------------------- streams
+
+#: The name a streamed output has until it is complete (``run.csv`` is ``run.csv.partial``).
+PARTIAL_SUFFIX = ".partial"
+
+
+class PartialFile:
+    """A streamed output (a recording): written as ``PATH.partial``, renamed to ``PATH`` by
+    :meth:`commit`. A process killed while streaming leaves ``PATH.partial`` holding every whole
+    block written so far, and never a ``PATH`` that looks complete.
+
+    :meth:`write` writes one block with unbuffered system calls; if the disk refuses part of it the
+    file is cut back to the end of the previous block (so it ends with a whole row) and
+    :class:`FileProblem` is raised.
+    """
+
+    def __init__(self, path: str | os.PathLike[str]):
+        self.path = check_output_path(path)
+        self.partial_path = check_output_path(self.path.with_name(self.path.name + PARTIAL_SUFFIX))
+        try:
+            self._fd: int | None = os.open(
+                self.partial_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_CLOEXEC", 0), 0o666
+            )
+        except OSError as exc:
+            raise FileProblem(self.partial_path, f"cannot be created: {os_reason(exc)}") from None
+        self._size = 0
+
+    @property
+    def closed(self) -> bool:
+        return self._fd is None
+
+    def write(self, data: bytes) -> None:
+        """Append ``data`` whole, or leave the file as it was and raise :class:`FileProblem`."""
+        if self._fd is None:
+            raise FileProblem(self.partial_path, "already closed")
+        view = memoryview(data)
+        done = 0
+        try:
+            while done < len(view):
+                done += os.write(self._fd, view[done:])
+        except OSError as exc:
+            with contextlib.suppress(OSError):
+                os.ftruncate(self._fd, self._size)
+            raise FileProblem(self.partial_path, f"not written: {os_reason(exc)}") from None
+        self._size += done
+
+    def commit(self) -> Path:
+        """Flush to the disk, close, and rename to the final name; returns it."""
+        if self._fd is None:
+            raise FileProblem(self.partial_path, "already closed")
+        fd, self._fd = self._fd, None
+        try:
+            os.fsync(fd)
+            os.close(fd)
+            os.replace(self.partial_path, self.path)
+        except OSError as exc:
+            with contextlib.suppress(OSError):
+                os.close(fd)
+            raise FileProblem(self.path, f"not completed: {os_reason(exc)} (the data is in "
+                              f"{self.partial_path.name})") from None
+        return self.path
+
+    def abandon(self) -> None:
+        """Close without renaming: what was written stays in the ``.partial`` file."""
+        if self._fd is not None:
+            fd, self._fd = self._fd, None
+            with contextlib.suppress(OSError):
+                os.close(fd)
