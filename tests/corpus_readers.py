@@ -1,0 +1,46 @@
+"""How each class of the malformed-input corpus (tests/corpus/) is read: reader name -> callable
+that reads one file and raises the reader's one-line error."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def read_recording(path: Path) -> None:
+    from fha_studio.recording import read_recording
+
+    read_recording(path)
+
+
+def read_parameters(path: Path) -> None:
+    from fha_studio.hardware.parameters import load_parameter_model
+    from fha_studio.logic.paramfile import load_parameter_file
+
+    load_parameter_file(path, load_parameter_model("HA-655"))
+
+
+def read_session(path: Path) -> None:
+    from fha_studio.logic.procedures import ProcedureSession
+
+    ProcedureSession.load(path)
+
+
+def read_eeprom(path: Path) -> None:
+    from fha_studio.hardware.sim.eeprom import EepromFile
+
+    EepromFile(path).load()
+
+
+def read_model(path: Path) -> None:
+    from fha_studio.physics import AxisModel
+
+    AxisModel.load(path)
+
+
+READERS = {
+    "recording": read_recording,
+    "parameters": read_parameters,
+    "session": read_session,
+    "eeprom": read_eeprom,
+    "model": read_model,
+}

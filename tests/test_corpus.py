@@ -1,0 +1,58 @@
+"""The malformed-input corpus (tests/corpus/expected.toml): each file and command line is refused
+whole with the expected line, exit status 2 on the command line, no traceback."""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from pathlib import Path
+
+import pytest
+from corpus_readers import READERS
+
+from fha_studio.cli import main as cli_main
+
+CORPUS = Path(__file__).parent / "corpus"
+MANIFEST = tomllib.loads((CORPUS / "expected.toml").read_text(encoding="utf-8"))
+
+
+def test_every_corpus_file_has_its_expected_message():
+    listed = {case["path"] for case in MANIFEST["file"]}
+    on_disk = {str(p.relative_to(CORPUS)) for p in CORPUS.rglob("*")
+               if p.is_file() and p.name != "expected.toml"}
+    assert on_disk == listed
+
+
+@pytest.mark.parametrize("case", MANIFEST["file"], ids=[c["path"] for c in MANIFEST["file"]])
+def test_a_malformed_file_is_refused_with_one_line_naming_it(case):
+    path = CORPUS / case["path"]
+    reader = READERS[case["path"].split("/")[0]]
+    with pytest.raises(ValueError) as err:
+        reader(path)
+    message = str(err.value)
+    assert case["expect"] in message
+    assert str(path) in message
+    assert "\n" not in message and "Traceback" not in message
+
+
+@pytest.fixture
+def scratch(tmp_path):
+    (tmp_path / "afile").write_text("a regular file")
+    os.mkfifo(tmp_path / "fifo")
+    return tmp_path
+
+
+@pytest.mark.parametrize("case", MANIFEST["cli"], ids=[" ".join(c["args"])[:70] for c in MANIFEST["cli"]])
+def test_a_malformed_command_line_is_refused_with_one_line(case, scratch, capsys):
+    values = {"corpus": str(CORPUS), "tmp": str(scratch), "long": "n" * 300}
+    args = [a.format(**values) for a in case["args"]]
+    try:
+        code = cli_main(args)
+    except SystemExit as exc:  # argparse refuses an option value
+        code = exc.code
+    assert code == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert case["expect"] in err
+    assert err.count("\n") == 1 and err.startswith("fha-studio ")
+    assert sorted(p.name for p in scratch.iterdir()) == ["afile", "fifo"]  # nothing half-written
