@@ -241,10 +241,19 @@ def test_a_killed_recording_keeps_its_rows_in_the_partial_file(tmp_path):
     assert len(on_disk) == 7
 
 
+def _fifo(folder):
+    """A FIFO stands for a device such as /dev/full as a target: were a writer ever to rename
+    over it, only the test's own folder would suffer."""
+    import os
+
+    os.mkfifo(folder / "device")
+    return folder / "device"
+
+
 def test_writer_refuses_what_cannot_be_a_file_before_any_row(tmp_path):
     (tmp_path / "afile").write_text("x")
     for target, words in ((tmp_path / "afile" / "r.csv", "not a directory"),
-                          ("/dev/full", "not a regular file"),
+                          (_fifo(tmp_path), "not a regular file"),
                           (tmp_path / ("n" * 300 + ".csv"), "too long")):
         with pytest.raises(rec.FileProblem, match=words):
             RecordingWriter(target, _meta())

@@ -16,14 +16,13 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
-import os
 import sys
-import tempfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from fha_studio import fileio
 from fha_studio.cli import CliError
 
 ORDER = 35
@@ -378,16 +377,13 @@ def _params_backup(args: argparse.Namespace, link: _Link) -> int:
 
 
 def _params_restore(args: argparse.Namespace, link: _Link) -> int:
-    from fha_studio.logic.paramfile import ParameterFileError, read_parameter_file
+    from fha_studio.logic.paramfile import ParameterFileError, load_parameter_file
 
     _need_parameters(link)
     client = link.client
-    path = Path(args.file)
-    if not path.is_file():
-        raise CliError(f"{args.file}: not a file")
     try:
-        loaded = read_parameter_file(path.read_text(encoding="utf-8"), client.model, name=args.file)
-    except (ParameterFileError, UnicodeDecodeError) as exc:
+        loaded = load_parameter_file(args.file, client.model)
+    except ParameterFileError as exc:
         raise CliError(str(exc)) from None
     for line in loaded.not_mapped:
         print(f"not restored: {line}", file=sys.stderr)
@@ -402,15 +398,9 @@ def _params_restore(args: argparse.Namespace, link: _Link) -> int:
 
 
 def _write_atomically(path: Path, text: str) -> None:
+    # fileio refuses a device (renaming over /dev/full would replace the device) and a path
+    # under a file, writes a temporary file, fsyncs and renames it
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent or Path("."))
-    except OSError as exc:
-        raise CliError(f"{path}: cannot write there ({exc.strerror or exc})") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except OSError as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise CliError(f"{path}: cannot write ({exc.strerror or exc})") from None
+        fileio.write_text(path, text)
+    except fileio.FileProblem as exc:
+        raise CliError(str(exc)) from None

@@ -18,7 +18,7 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--url", help="drive to connect to at start: a serial device, a pty path, "
                    "socket://host:port or sim://ACTUATOR-CODE?...")
-    p.add_argument("--baud", type=int, help="baud rate of a serial link (default 19200)")
+    p.add_argument("--baud", type=int, help="baud rate of a serial link (default 19200; 1200 ... 115200)")
     p.add_argument("--no-connect", action="store_true", help="start without connecting")
     p.add_argument("--page", help="page to show first")
     p.set_defaults(func=run)

@@ -19,12 +19,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from contextlib import contextmanager
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from fha_studio import fileio
 from fha_studio.cli import CliError
 from fha_studio.logic.register.words import (
     KIND_WORDS,
@@ -390,10 +392,10 @@ def _export(args) -> int:
         data = reg.export(args.machine)
     text = json.dumps(data, indent=2, ensure_ascii=False) + "\n"
     if args.output:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        tmp = args.output.with_name(args.output.name + ".tmp")
-        tmp.write_text(text, encoding="utf-8")
-        tmp.replace(args.output)  # a reader never sees half an export
+        if not os.path.lexists(args.output.parent):
+            args.output.parent.mkdir(parents=True, exist_ok=True)
+        # whole or not at all; a device or a path under a file is refused (fileio)
+        fileio.write_text(args.output, text)
         print(f"{args.output}: {len(data['machines'])} machine(s)", file=sys.stderr)
     else:
         sys.stdout.write(text)

@@ -21,15 +21,45 @@ APPLICATION = "fha-studio"
 GIL_SWITCH_INTERVAL_S = 0.0005
 
 
+#: Baud rates a serial port may be opened at (CN3 runs at 19200; pyserial's standard rates).
+BAUD_RATES = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
+
+
+class _OneLineParser(argparse.ArgumentParser):
+    """A refusal is one line saying what is allowed, exit status 2 (as the CLI's)."""
+
+    def error(self, message: str):  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see fha-studio gui --help)\n")
+
+
+def _url(text: str) -> str:
+    from fha_studio.hardware.transport import check_url
+
+    try:
+        check_url(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+def _baud(text: str) -> int:
+    if not text.strip().isascii() or not text.strip().isdigit() or int(text) not in BAUD_RATES:
+        raise argparse.ArgumentTypeError(
+            f"{text[:20]} is not a baud rate; one of {', '.join(map(str, BAUD_RATES))}")
+    return int(text)
+
+
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="fha-studio [gui]", description="FHA Studio, the commissioning GUI")
+    parser = _OneLineParser(prog="fha-studio [gui]", description="FHA Studio, the commissioning GUI")
     parser.add_argument(
         "--url",
         default=None,
+        type=_url,
         help=f"drive to connect to at start (default: the embedded simulated drive, {DEFAULT_SIM_URL}, "
         "with the declared load inertia); a serial device, a pty path or socket://host:port",
     )
-    parser.add_argument("--baud", type=int, default=19200, help="baud rate of a serial link (default 19200)")
+    parser.add_argument("--baud", type=_baud, default=19200,
+                        help=f"baud rate of a serial link (default 19200; {', '.join(map(str, BAUD_RATES))})")
     parser.add_argument("--no-connect", action="store_true", help="start without connecting")
     parser.add_argument(
         "--page",

@@ -249,6 +249,8 @@ def test_only_regular_files_are_read_as_sessions(tmp_path):
 
 
 def test_a_session_that_cannot_be_written_leaves_the_old_file_whole(tmp_path):
+    import os
+
     from fha_studio.fileio import FileProblem
 
     session = ProcedureSession(actuator_code="FHA-25C-50-US250")
@@ -256,8 +258,10 @@ def test_a_session_that_cannot_be_written_leaves_the_old_file_whole(tmp_path):
     before = path.read_text()
     session.operator = "someone else"
     (tmp_path / "afile").write_text("")
-    for target, words in (("/dev/full", "not a regular file"),
+    os.mkfifo(tmp_path / "device")  # stands for /dev/full: a rename over it would harm nothing
+    for target, words in ((tmp_path / "device", "not a regular file"),
                           (tmp_path / "afile" / "s.json", "not a directory")):
         with pytest.raises(FileProblem, match=words):
             session.save(target)
-    assert path.read_text() == before and sorted(p.name for p in tmp_path.iterdir()) == ["afile", "s.json"]
+    assert path.read_text() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "device", "s.json"]
