@@ -21,7 +21,11 @@ from pathlib import Path
 from PySide6.QtCore import QObject, QSettings, Qt, Slot
 from PySide6.QtGui import QAction, QColor
 from PySide6.QtWidgets import (
+    QDialog,
+    QDialogButtonBox,
+    QDoubleSpinBox,
     QFileDialog,
+    QFormLayout,
     QHBoxLayout,
     QLabel,
     QLineEdit,
@@ -327,6 +331,64 @@ class AxisRecorder(QObject):
         )
 
 
+class AxisDialog(QDialog):
+    """A new axis: name, actuator model code, driver, port, declared load inertia, serial number,
+    notes. What is wrong is said in the dialog, which stays open."""
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.setWindowTitle("Add an axis")
+        form = QFormLayout(self)
+        self.name_edit = QLineEdit()
+        self.name_edit.setPlaceholderText("e.g. table, tilt, wrist roll")
+        self.actuator_edit = QLineEdit()
+        self.actuator_edit.setPlaceholderText("model code on the label, e.g. FHA-25C-50-US250")
+        self.driver_edit = QLineEdit()
+        self.driver_edit.setPlaceholderText(
+            "TYPE line of the driver, e.g. HA-655-2-200 (the drive says it too)"
+        )
+        self.port_edit = QLineEdit()
+        self.port_edit.setPlaceholderText("/dev/ttyUSB0, COM3, socket://host:port or sim://FHA-25C-50-US250")
+        self.inertia_spin = QDoubleSpinBox()
+        self.inertia_spin.setRange(0.0, 10000.0)
+        self.inertia_spin.setDecimals(4)
+        self.inertia_spin.setSuffix(" kg m²")
+        self.serial_edit = QLineEdit()
+        self.serial_edit.setPlaceholderText("from the actuator's label")
+        self.notes_edit = QLineEdit()
+        self.error_label = QLabel("")
+        self.error_label.setWordWrap(True)
+        self.error_label.setStyleSheet("color: #b00020; font-weight: bold;")
+        for label, widget in (
+            ("&Name:", self.name_edit),
+            ("&Actuator:", self.actuator_edit),
+            ("&Driver:", self.driver_edit),
+            ("&Port:", self.port_edit),
+            ("&Load inertia:", self.inertia_spin),
+            ("&Serial number:", self.serial_edit),
+            ("N&otes:", self.notes_edit),
+        ):
+            form.addRow(label, widget)
+        form.addRow(self.error_label)
+        buttons = QDialogButtonBox(
+            QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel
+        )
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        form.addRow(buttons)
+
+    def values(self) -> dict[str, object]:
+        return {
+            "name": self.name_edit.text().strip(),
+            "actuator_code": self.actuator_edit.text().strip(),
+            "driver_model": self.driver_edit.text().strip(),
+            "port_url": self.port_edit.text().strip(),
+            "load_inertia_kgm2": self.inertia_spin.value(),
+            "notes": self.notes_edit.text(),
+            "serial_number": self.serial_edit.text().strip(),
+        }
+
+
 class MachineWindow(QMainWindow):
     """FHA Studio for a machine: the axis list, the banner, one set of pages per axis."""
 
@@ -367,6 +429,10 @@ class MachineWindow(QMainWindow):
         self.connect_all_action.setToolTip("Connect every axis to its port (one link per port)")
         self.connect_all_action.triggered.connect(self.connect_all)
         bar.addAction(self.connect_all_action)
+        self.add_axis_action = QAction("Add a&xis…", self)
+        self.add_axis_action.setToolTip("Add an axis to the machine: its name, actuator, driver, port, load")
+        self.add_axis_action.triggered.connect(self._add_axis_clicked)
+        bar.addAction(self.add_axis_action)
         self.report_action = QAction("&Machine report…", self)
         self.report_action.setToolTip(
             "A summary of every axis, then each axis's commissioning report (PDF, HTML)"
@@ -424,39 +490,79 @@ class MachineWindow(QMainWindow):
         right.addWidget(self.stack, 1)
         row.addLayout(right, 1)
         self.setCentralWidget(body)
+        self._open_client = open_client
         for axis in self.project:
-            link = LinkController(open_client=open_client)
-            window = MainWindow(link, state=axis.state)  # the axis's own commissioning state
-            link.setParent(window)
-            window.setWindowFlags(Qt.WindowType.Widget)  # a page set inside this window
-            window.setObjectName(f"axis:{axis.name}")
-            # STOP on any axis's pages (its button, Esc) stops every connected axis
-            window.stop_button.clicked.disconnect()
-            window.stop_button.clicked.connect(self.stop_all)
-            window.stop_shortcut.activated.disconnect()
-            window.stop_shortcut.activated.connect(self.stop_all)
-            self.stack.addWidget(window)
-            self.axis_windows.append(window)
-            item = QListWidgetItem()
-            self.axis_list.addItem(item)
-            index = len(self.axis_windows) - 1
-            for signal in (link.sigDisconnected, link.sigStatus):
-                signal.connect(lambda *_args, i=index: self._refresh_axis(i))
-            link.sigConnected.connect(lambda info, i=index: self._on_axis_connected(i, info))
-            link.sigResult.connect(lambda result, i=index: self._on_axis_result(i, result))
-            window.state.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
-            if self.register is not None:
-                self.recorders.append(
-                    AxisRecorder(
-                        self.register,
-                        f"{self.project.name}/{axis.name}",
-                        window,
-                        lambda: self.operator,
-                        self.project.site,
-                    )
-                )
-            self._refresh_axis(index)
+            self._add_axis_window(axis)
         self.axis_list.currentRowChanged.connect(self._axis_chosen)
+
+    def _add_axis_window(self, axis: MachineAxis) -> MainWindow:
+        """The pages of one axis: its own link (worker and thread), its own commissioning state."""
+        link = LinkController(open_client=self._open_client)
+        window = MainWindow(link, state=axis.state)  # the axis's own commissioning state
+        link.setParent(window)
+        window.setWindowFlags(Qt.WindowType.Widget)  # a page set inside this window
+        window.setObjectName(f"axis:{axis.name}")
+        # STOP on any axis's pages (its button, Esc) stops every connected axis
+        window.stop_button.clicked.disconnect()
+        window.stop_button.clicked.connect(self.stop_all)
+        window.stop_shortcut.activated.disconnect()
+        window.stop_shortcut.activated.connect(self.stop_all)
+        self.stack.addWidget(window)
+        self.axis_windows.append(window)
+        self.axis_list.addItem(QListWidgetItem())
+        index = len(self.axis_windows) - 1
+        for signal in (link.sigConnected, link.sigDisconnected, link.sigStatus):
+            signal.connect(lambda *_args, i=index: self._refresh_axis(i))
+        link.sigResult.connect(lambda result, i=index: self._on_axis_result(i, result))
+        window.state.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
+        if self.register is not None:
+            self.recorders.append(
+                AxisRecorder(
+                    self.register,
+                    f"{self.project.name}/{axis.name}",
+                    window,
+                    lambda: self.operator,
+                    self.project.site,
+                )
+            )
+        self._refresh_axis(index)
+        return window
+
+    def add_axis(
+        self,
+        name: str,
+        actuator_code: str = "",
+        driver_model: str = "",
+        port_url: str = "",
+        load_inertia_kgm2: float = 0.0,
+        notes: str = "",
+        serial_number: str = "",
+    ) -> MainWindow:
+        """A new axis of the machine, with its pages, in the register too; shown. Raises
+        MachineError or the catalogue's ModelCodeError (ValueErrors) and adds nothing then."""
+        axis = self.project.add_axis(
+            name, actuator_code, driver_model, port_url, load_inertia_kgm2, notes, serial_number
+        )
+        if self.register is not None:
+            try:
+                self.project.save_to(self.register, who=self.operator)
+            except (RegisterError, OSError):
+                self.project.remove_axis(axis.name)
+                raise
+        window = self._add_axis_window(axis)
+        self.select_axis(axis.name)
+        return window
+
+    @Slot()
+    def _add_axis_clicked(self) -> None:
+        dialog = AxisDialog(self)
+        while dialog.exec():
+            try:
+                self.add_axis(**dialog.values())
+            except (ValueError, OSError) as exc:
+                dialog.error_label.setText(str(exc))
+                continue
+            return
 
     # -- which axis ----------------------------------------------------------------------------------
     @property
@@ -534,10 +640,6 @@ class MachineWindow(QMainWindow):
 
     def _on_actuator(self, index: int, code: str) -> None:
         axis = self.project.axes[index]
-        try:
-            axis.state.set_actuator(code)
-        except ValueError:
-            return  # the page says what is wrong with the code
         if self.register is not None:
             try:
                 self.register.update_axis(
@@ -549,14 +651,7 @@ class MachineWindow(QMainWindow):
                 )
         self._refresh_axis(index)
 
-    def _on_axis_connected(self, index: int, info: LinkInfo) -> None:
-        if info.driver_model:  # what the drive says of itself beats what was typed
-            self.project.axes[index].state.set_driver(info.driver_model, info.adjusted_for)
-        self._refresh_axis(index)
-
     def _on_axis_result(self, index: int, result: CommandResult) -> None:
-        if result.cmd is Cmd.READ_PARAMETERS and result.ok:
-            self.project.axes[index].state.record_read(result.value["values"])
         if result.cmd is Cmd.STOP:
             self._refresh_axis(index)
 

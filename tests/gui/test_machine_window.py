@@ -302,3 +302,35 @@ def test_alarms_recordings_and_model_checks_go_into_the_register(make_machine, q
     assert len(checks) == 1 and "Coulomb friction" in checks[0].text and checks[0].who == "ben"
     assert checks[0].data["recording_file"] == str(path)
     register.close()
+
+
+def test_an_axis_added_in_the_window_gets_its_pages_and_goes_into_the_register(make_machine, qtbot, tmp_path):
+    from fha_studio.catalog import ModelCodeError
+    from fha_studio.gui.machine_window import AxisDialog
+    from fha_studio.logic.machine import MachineError
+
+    register = Register(tmp_path / "register.sqlite")
+    project = MachineProject("Wrist")
+    project.add_axis("pitch", TABLE, port_url=f"sim://{TABLE}?paced=0")
+    window = make_machine(project, register)
+    dialog = AxisDialog(window)
+    dialog.name_edit.setText(" roll ")
+    dialog.actuator_edit.setText("FHA-17C-50-US250")
+    dialog.port_edit.setText("sim://FHA-17C-50-US250?paced=0")
+    dialog.inertia_spin.setValue(0.25)
+    values = dialog.values()
+    assert (values["name"], values["load_inertia_kgm2"]) == ("roll", 0.25)
+    dialog.deleteLater()
+    roll = window.add_axis(**values)
+    assert window.current_window is roll and window.axis_list.count() == 2
+    assert window.banner.text().startswith("Axis roll — FHA-17C-50-US250")
+    assert register.axis("Wrist/roll").load_inertia_kgm2 == 0.25
+    assert window.connect_all() == ["pitch", "roll"]
+    qtbot.waitUntil(lambda: roll.link.connected, timeout=15000)
+    assert roll.link is not window.axis_window("pitch").link  # a link of its own
+    with pytest.raises(ModelCodeError):
+        window.add_axis("yaw", "FHA-18C-50-US250")
+    with pytest.raises(MachineError, match="already has an axis called 'roll'"):
+        window.add_axis("roll", "FHA-17C-50-US250")
+    assert window.axis_list.count() == 2 and [a.name for a in register.axes("Wrist")] == ["pitch", "roll"]
+    register.close()
