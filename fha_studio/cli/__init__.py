@@ -14,6 +14,7 @@ import os
 import pkgutil
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 from fha_studio.fileio import FileProblem, os_reason
 
@@ -25,7 +26,7 @@ class CliError(Exception):
 class OneLineParser(argparse.ArgumentParser):
     """An argument parser whose refusal is one line (what, and what is allowed), exit status 2."""
 
-    def error(self, message: str):  # type: ignore[override]
+    def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 

@@ -127,7 +127,7 @@ class ParameterDiffDialog(QDialog):
                 QLabel(f"<b>Not in the file ({len(loaded.missing)})</b>: the drive keeps its value "
                        "(a file cut short, or made on another driver):")
             )
-            self.missing_view = QPlainTextEdit("\n".join(loaded.missing))
+            self.missing_view: QPlainTextEdit | None = QPlainTextEdit("\n".join(loaded.missing))
             self.missing_view.setReadOnly(True)
             self.missing_view.setMaximumHeight(90)
             layout.addWidget(self.missing_view)

@@ -206,7 +206,7 @@ def read_parameter_file(
     )
 
 
-def _shown(value, quote: bool = True) -> str:
+def _shown(value: object, quote: bool = True) -> str:
     """A value from the file as a message shows it: TOML-like, one line, not too long."""
     if isinstance(value, str):
         text = _quote(value) if quote else value

@@ -84,7 +84,7 @@ class EepromFile:
         progress in another process would lose its temporary file, but two processes must not
         share one image anyway."""
         pattern = re.compile(r"\.?" + re.escape(self.path.name) + r"\.[A-Za-z0-9_]+\.tmp")
-        removed = []
+        removed: list[Path] = []
         try:
             names = os.listdir(self.path.parent)
         except OSError:
