@@ -91,11 +91,14 @@ def polling(keys: tuple[str, ...], seconds: float, jog_rpm: float) -> dict:
             jog.start(40)  # the held jog button: JOG every 40 ms (it shares the line)
         view.start_live()
         run_for(1.0)  # settle: first replies, speed reached
-        status0, chars0, t0 = view._status, counter.chars, time.monotonic()
+        # samples counted where they arrive (the ring), at the same moments as the clock and the
+        # line's characters (the status the driver sends every 0.2 s would blur the interval)
+        ring = view._live.ring
+        written0, chars0, t0 = ring.written, counter.chars, time.monotonic()
         run_for(seconds)
-        status, chars, elapsed = view._status, counter.chars - chars0, time.monotonic() - t0
+        samples, chars, elapsed = ring.written - written0, counter.chars - chars0, time.monotonic() - t0
+        status = view._status
         jog.stop()
-        samples = status.samples - status0.samples
         items = len(controller.driver._poller.items)
         return {"items": items, "rate": samples / elapsed, "limit": status.limit_hz,
                 "dropped": status.dropped, "estimate": estimated_rate_hz(items),
@@ -179,10 +182,11 @@ def gui_polling(seconds: float) -> dict:
         view = window.scope_page.view
         view.start_live()
         run_for(1.5)  # settle: first replies, the window's own status poll slowed down
-        status0, chars0, frames0, t0 = view._status, counter.chars, view.frames, time.monotonic()
+        ring = view._live.ring
+        written0, chars0, frames0, t0 = ring.written, counter.chars, view.frames, time.monotonic()
         run_for(seconds)
-        status, chars, elapsed = view._status, counter.chars - chars0, time.monotonic() - t0
-        samples = status.samples - status0.samples
+        samples, chars, elapsed = ring.written - written0, counter.chars - chars0, time.monotonic() - t0
+        status = view._status
         return {"items": len(view._live.channels), "rate": samples / elapsed, "limit": status.limit_hz,
                 "dropped": status.dropped, "fps": (view.frames - frames0) / elapsed,
                 "pct": pct_of_limit(samples, elapsed, status.limit_hz, chars)}
