@@ -231,7 +231,8 @@ class AbsolutePage(BasePage):
             "FHA-C manual 4-7-2, with the servo off: loosen the dog, turn the axis by hand to where the "
             "sensor switches (watch the sensor's indicator or the controller's input: this drive does "
             "not report its inputs over CN3), then record the angle. Angles come from the absolute "
-            "position and are checked against the movable range of 4-7-3.")))
+            "position (0° = turn 0, single-turn count 0: set the absolute origin with the axis at the "
+            "actuator's origin first) and are checked against the movable range of 4-7-3.")))
         row = QHBoxLayout()
         self.dog_sensor = QComboBox()
         for sensor in SENSORS:
