@@ -9,8 +9,8 @@ over the pty:
    reply (``ALM`` -> ``0 q``) and a long one (``MMR`` of 4 monitor items), next to the limit
    ``1920 / (10 + reply characters)`` transactions/s of a half-duplex exchange at 1920 chars/s;
 2. the same through DriveClient (its locking, timeouts and reply checks included), if present;
-3. trace capture: samples per second delivered by TRB (4 channels and 1 channel), next to the
-   line's limit for the lines actually sent.
+3. trace capture: samples per second delivered by TRB (text blocks) and TRP (packed blocks), 4
+   channels and 1 channel, next to the line's limit for the characters actually sent.
 Also once unpaced (memory speed), to show what the software itself costs.
 """
 
@@ -77,8 +77,8 @@ def client_rate(path: str, seconds: float) -> float | None:
         return n / (time.perf_counter() - start)
 
 
-def trace_rate(port: serial.Serial, mask: int, samples: int) -> tuple[float, float]:
-    """(samples/s delivered by TRB, the line's limit for the characters actually sent)."""
+def trace_rate(port: serial.Serial, mask: int, samples: int, command: str = "TRB") -> tuple[float, float]:
+    """(samples/s delivered by ``command`` (TRB or TRP), the line's limit for the characters sent)."""
     for frame in (f"TCH+{mask:05d}\r", "TDV+00001\r", "TTG+00000\r", "TPR+00000\r", f"TAR+{samples:05d}\r"):
         assert transact(port, frame.encode()).endswith(b"q\r"), frame
     while not transact(port, b"TST+00000\r").startswith(b"3,"):
@@ -86,7 +86,7 @@ def trace_rate(port: serial.Serial, mask: int, samples: int) -> tuple[float, flo
     chars = 0
     start = time.perf_counter()
     for block in range((samples + 63) // 64):
-        reply = transact(port, f"TRB+{block:05d}\r".encode())
+        reply = transact(port, f"{command}+{block:05d}\r".encode())
         chars += 10 + len(reply)
     elapsed = time.perf_counter() - start
     return samples / elapsed, samples / (chars / CHARS_PER_S)
@@ -110,9 +110,10 @@ def main() -> None:
                         print(f"  raw {name:7s} {rate:8.1f} transactions/s   limit {limit:6.1f}/s "
                               f"({10 + reply_chars} chars each)   {100 * rate / limit:5.1f} % of the limit")
                     for label, mask in (("4 channels", 0b11011), ("1 channel", 0b1)):
-                        delivered, limit = trace_rate(port, mask, 1024 if paced else 4096)
-                        print(f"  trace {label:10s} {delivered:8.1f} samples/s   "
-                              f"line limit {limit:8.1f} samples/s")
+                        for command in ("TRB", "TRP"):
+                            delivered, limit = trace_rate(port, mask, 1024 if paced else 4096, command)
+                            print(f"  trace {command} {label:10s} {delivered:8.1f} samples/s   "
+                                  f"line limit {limit:8.1f} samples/s")
                 rate = client_rate(path, args.seconds)
                 if rate is None:
                     print("  DriveClient: not available")
