@@ -406,3 +406,35 @@ def test_front_panel_worksheet_parameters_direction_file_and_report(window, qtbo
     rows = {r.key: r for r in report.parameters}
     assert "entered from the front panel by J. Field" in rows["position_loop_gain"].value
     assert rows["rotary_direction"].value.startswith("1")
+
+
+def test_the_encoder_phase_check_uses_dgr_and_a_turn_by_hand(make_window, qtbot, tmp_path):
+    window = make_window(connect=SENSOR_URL)
+    page = window.show_page("procedures")
+    page.operator_edit.setText("T. Trainee")
+    page.new_session(tmp_path / "axis.json", "FHA-25C-50-S248-L")
+    page.select_procedure("wiring")
+    for _ in range(40):
+        step = page.current_step()
+        assert step is not None, "the wiring procedure ended before the encoder-phase check"
+        if step.id == "encoder-phases":
+            break
+        if step.kind == "live":
+            with qtbot.waitSignal(page.sigLiveDone, timeout=20000) as live:
+                page.live_button.click()
+            if live.args[0] is not None and live.args[0].available:
+                continue
+            page.by_hand_edit.setText("as expected")
+            assert page.answer_by_hand()
+        else:
+            _answer(page, step)
+    with qtbot.waitSignal(page.sigLiveDone, timeout=20000) as first:
+        page.live_button.click()
+    assert not first.args[0].available and "turn the output by hand by +10°" in first.args[0].detail
+    panel(window, qtbot, "turn", 10.0)
+    with qtbot.waitSignal(page.sigLiveDone, timeout=20000) as second:
+        page.live_button.click()
+    observation = second.args[0]
+    assert observation.available and observation.passed
+    record = page.run.state.records[-1]
+    assert record.step_id == "encoder-phases" and abs(record.value - 11378) <= 2

@@ -43,6 +43,8 @@ class LiveEnv:
     sensor_angles_deg: Mapping[str, float] = field(default_factory=dict)
     on_sample: Callable[[float, IoState], None] | None = None
     cancelled: Callable[[], bool] = lambda: False
+    #: what a check keeps between two presses of its button (the encoder check by hand-turning)
+    memo: dict[str, Any] = field(default_factory=dict)
 
     @property
     def output_ppr(self) -> int:
@@ -59,7 +61,7 @@ BY_HAND = {
     "driver_adjusted_for": "the ADJUSTED FOR USE WITH line of the driver's label",
     "io_bit": "what you saw (e.g. 'released: the output turns by hand')",
     "alarm_free": "the code on the drive's front panel (0 or blank display: no alarm)",
-    "encoder_counts": "the change of the absolute position for the angle turned by hand (DGR checks page)",
+    "encoder_counts": "the feedback pulses seen on the panel (monitor items 7, 8) for a turn by hand",
     "battery": "the code on the drive's front panel (alarm 56 = low battery; 0: none)",
     "rotary_direction": "parameter 8 on the drive's panel ([parameter mode] -> item 8): 0 or 1",
     "jog_forward": "which way a FWD command from the controller turned the output: CW or CCW",
@@ -163,13 +165,38 @@ def _check_encoder_counts(client: DriveApi, step: Step, env: LiveEnv) -> Observa
     try:
         start, _ = output_angle_deg(client, env.output_ppr)
     except CommandNotSupported:
-        return unavailable("it reports no feedback position over CN3 (with an absolute encoder, the DGR "
-                           "checks page's encoder check measures it by turning the output by hand)")
+        return _encoder_counts_by_hand(client, step, env)
     if not _can_move(client):
         return unavailable("it takes no move commands; turn the output by hand and watch the feedback pulses")
     end = move_and_watch(client, float(step.params.get("angle_deg", 2.0)), env)
     moved = end - start
     return Observation(round(moved, 3), abs(moved) > 0.5, f"feedback moved {moved:+.2f}° for a +2° command")
+
+
+#: The angle the technician turns the output by hand for the encoder check with DGR, deg (CW +).
+HAND_TURN_DEG = 10.0
+
+
+def _encoder_counts_by_hand(client: DriveApi, step: Step, env: LiveEnv) -> Observation:
+    """A drive without monitor items (a real HA-655): with an absolute encoder, DGR answers the
+    encoder check. First press: read the position and ask for a turn by hand; second press: read
+    again, the counts must have changed by ratio x 8192 per motor turn in the same sense."""
+    from fha_studio.logic.absolute import encoder_check
+
+    try:
+        counts = client.absolute_position()
+    except CommandRejected:
+        return unavailable("it reports no position over CN3 (DGR refused: an incremental encoder); turn the "
+                           "output by hand and watch the feedback pulses on the panel (monitor items 7, 8)")
+    ratio = int(env.context["actuator"]["ratio"])
+    start = env.memo.pop("encoder_start_counts", None)
+    if start is None:
+        env.memo["encoder_start_counts"] = counts
+        return Observation(None, False, f"position read ({counts} counts, DGR). Now, with the servo off, "
+                           f"turn the output by hand by {HAND_TURN_DEG:+g}° (CW seen from the flange) and "
+                           "press the check again", available=False)
+    passed, detail, values = encoder_check(start, counts, HAND_TURN_DEG, ratio)
+    return Observation(values["after_counts"] - values["before_counts"], passed, detail)
 
 
 def _can_move(client: DriveApi) -> bool:

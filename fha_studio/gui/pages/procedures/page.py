@@ -70,11 +70,12 @@ class _SampleRelay(QObject):
     sigSample = Signal(float, int)
 
 
-def _live_check_in_link_thread(step: Step, context, angles: dict, relay: _SampleRelay, client) -> Observation:
-    """Runs in the link thread (worker CALL)."""
+def _live_check_in_link_thread(step: Step, context, angles: dict, relay: _SampleRelay, memo: dict,
+                               client) -> Observation:
+    """Runs in the link thread (worker CALL). ``memo`` is kept by the page between two presses."""
     from fha_studio.logic.procedures.live import LiveEnv, run_live_check
 
-    env = LiveEnv(context, angles, on_sample=lambda angle, io: relay.sigSample.emit(angle, io.raw))
+    env = LiveEnv(context, angles, on_sample=lambda angle, io: relay.sigSample.emit(angle, io.raw), memo=memo)
     return run_live_check(client, step, env)
 
 
@@ -96,6 +97,7 @@ class ProceduresPage(BasePage):
         self.procedures: list[Procedure] = []
         self.run: ProcedureRun | None = None
         self._live_token: int | None = None
+        self._live_memo: dict = {}  # a live check's state between two presses (the link thread uses it)
         self._relay = _SampleRelay(self)
         self._build()
         self.link.sigResult.connect(self._on_result)
@@ -389,6 +391,7 @@ class ProceduresPage(BasePage):
         except StepInputError as exc:
             self._message(str(exc))
             return False
+        self._live_memo.clear()  # what a live check kept belongs to the step just answered
         self._message("" if record.passed else "The check failed: the procedure stops here.")
         self.value_edit.clear()
         self.live_label.setText("")
@@ -436,7 +439,8 @@ class ProceduresPage(BasePage):
         self.live_label.setText("Asking the drive …")
         self.live_button.setEnabled(False)
         function = partial(
-            _live_check_in_link_thread, step, self.context, dict(self.session.sensor_angles_deg), self._relay
+            _live_check_in_link_thread, step, self.context, dict(self.session.sensor_angles_deg), self._relay,
+            self._live_memo
         )
         self._live_token = self.link.send(Cmd.CALL, function)
 
