@@ -352,7 +352,8 @@ class MainWindow(QMainWindow):
             "This drive takes servo-ON only from the controller through CN2: switch it there"
         )
         self.stop_button.set_can_send(info.can_move)
-        self.sim_panel.set_available(info.embedded_sim)
+        # the full profile has servo, jog and inputs over CN3; the panel is for the documented one
+        self.sim_panel.set_available(info.embedded_sim and info.documented_only)
         self.setWindowTitle(f"FHA Studio — {model} — {where}")
         for page in self._pages():
             page.link_connected(info)

@@ -69,7 +69,7 @@ class SimPanelBar(QToolBar):
         self.set_available(False)
 
     def set_available(self, available: bool) -> None:
-        """Shown for an embedded simulated drive only."""
+        """Shown for an embedded simulated drive of the documented profile only (never a real drive)."""
         self.setVisible(available)
         self.setEnabled(available)
 
