@@ -104,6 +104,8 @@ class AxisRecorder(QObject):
         link.sigWrite.connect(self._on_write)
         link.sigStatus.connect(self._on_status)
         link.sigConnected.connect(self._on_connected)
+        window.state.sigFrontPanelChanged.connect(self._on_front_panel)
+        self._front_panel_seen: set[tuple[str, int, int, str]] = set()
         window.tabs.currentChanged.connect(lambda _index: self.hook_pages())
         self.hook_pages()
 
@@ -220,6 +222,32 @@ class AxisRecorder(QObject):
         alarm = load_alarm_table(self.window.session.driver).get(code)
         name = alarm.name if alarm is not None else "unknown code"
         self._record("alarm", lambda: self.register.record_alarm(self.axis_ref, code, name, who=self.who))
+
+    @Slot()
+    def _on_front_panel(self) -> None:
+        """Values read off the drive's front panel by a person: a front-panel snapshot per
+        entry time and person (an entry already recorded is not recorded again)."""
+        groups: dict[tuple[str, str], list[tuple[str, int, str, int]]] = {}
+        model = self.window.session.parameter_model
+        for entry in self.window.state.front_panel.values():
+            seen = (entry.mode, entry.number, entry.value, entry.time)
+            if seen in self._front_panel_seen:
+                continue
+            self._front_panel_seen.add(seen)
+            try:
+                key = model.item(entry.mode, entry.number).key
+            except KeyError:
+                key = f"{entry.mode}_{entry.number}"
+            groups.setdefault((entry.who, entry.time), []).append(
+                (entry.mode, entry.number, key, entry.value)
+            )
+        for (who, at), rows in groups.items():
+            self._record(
+                "front-panel value",
+                lambda who=who, at=at, rows=rows: self.register.record_snapshot(
+                    self.axis_ref, rows, "front_panel", who=who, at_utc=at
+                ),
+            )
 
     # -- from the pages -------------------------------------------------------------------------------
     def _on_procedures(self, page) -> None:

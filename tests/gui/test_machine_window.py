@@ -159,6 +159,12 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     assert ("table", f"report {tmp_path / 'table-report.pdf'} is not signed") in open_items
     assert ("tilt", "no procedure recorded yet") in open_items
 
+    # the tilt's drive has no parameter access: its values are read off the front panel
+    tilt.state.enter_front_panel("system", 8, 0, "ana")
+    panel = register.snapshots(f"{MACHINE}/tilt")
+    assert [(s["source"], s["who"], s["count"]) for s in panel] == [("front_panel", "ana", 1)]
+    assert [f.axis.name for f in register.find("rotary_direction", 0)] == ["table twin", "tilt"]
+
     # the same questions in the GUI, on the axis on show
     dialog = window.show_register()
     history = [dialog.history_table.item(r, 3).text() for r in range(dialog.history_table.rowCount())]
