@@ -58,6 +58,23 @@ def test_counts_are_scaled_with_the_actuator_typed_after_connecting(make_window,
     assert round(position_deg, 1) == -17.6
 
 
+def test_a_live_scope_rescales_at_once_when_the_actuator_changes(make_window, qtbot, documented_drive):
+    window = make_window(open_client=documented_drive, connect="documented://")
+    view = window.show_page("scope").view
+    qtbot.waitUntil(lambda: view.controller.connected, timeout=10000)
+    type_actuator(window, "FHA-25C-50-S248")
+    view.start_live()
+
+    def latest_deg() -> float | None:
+        live = view._live
+        return float(live.ring.window(1)[0, 1]) if live is not None and len(live.ring) else None
+
+    qtbot.waitUntil(lambda: latest_deg() == pytest.approx(DGR_COUNTS * 360 / (8192 * 50)), timeout=15000)
+    type_actuator(window, "FHA-32C-100-S248")  # while watching: the view goes on, at the new ratio
+    qtbot.waitUntil(lambda: latest_deg() == pytest.approx(DGR_COUNTS * 360 / (8192 * 100)), timeout=15000)
+    assert view.live_button.isChecked()
+
+
 def test_jog_page_scales_position_pulses_with_the_actuator_typed_after_connecting(make_window, qtbot):
     window = make_window(connect="sim://FHA-25C-50-US250?paced=0")
     link = window.link

@@ -49,8 +49,12 @@ class ScopePage(BasePage):
         self.view.sigLiveChanged.connect(self._on_live_changed)
 
     def _axis_changed(self, *_args) -> None:
-        self.view.set_context(self._context())
+        # the ratio goes first, so that a live view restarted here scales DGR counts with it
         self.controller.set_ratio(self.state.ratio)
+        was_live = self.view.live_button.isChecked()
+        self.view.set_context(self._context())  # another actuator stops live (and a recording)
+        if was_live and not self.view.live_button.isChecked() and self.controller.connected:
+            self.view.start_live()  # the technician watching goes on watching, at the new scale
 
     def _load_inertia_edited(self, value_kgm2: float) -> None:
         self.state.set_load_inertia(value_kgm2)
