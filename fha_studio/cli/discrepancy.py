@@ -22,8 +22,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "discrepancy",
         help="name the effect missing from the model of a recorded axis and show the gap shrink",
         description="Compare an fha-recording/1 file with the catalogue model of its declared actuator: "
-        "where they disagree, which effect is missing (Coulomb/viscous friction, gravity, offset, inertia "
-        "error, torque ripple; with load_pos: kinematic error, wind-up, lost motion), its parameters, and "
+        "where they disagree, which effect is missing (Coulomb/viscous friction, friction by direction, "
+        "breakaway friction, gravity, offset, inertia or torque-constant error, torque ripple; with "
+        "load_pos: kinematic error, wind-up, lost motion), its parameters, and "
         "the RMS gap before and after on held-out data.",
     )
     p.add_argument("recording", metavar="RECORDING.csv", help="the recording (fha-recording/1)")

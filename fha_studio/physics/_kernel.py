@@ -56,6 +56,10 @@ class KernelParams:
     ke_phase: float
     lm_half: float
     resistance: float
+    fc_pos_extra: float = 0.0  # asymmetric friction: level while turning CW (N m, on top of fc)
+    fc_neg_extra: float = 0.0  # ... and while turning CCW (a magnitude)
+    stribeck_a: float = 0.0  # Stribeck: extra breakaway torque at zero speed (N m)
+    stribeck_v: float = 1.0  # its characteristic speed (rad/s)
     pulse_rad: float = 0.0  # > 0: feedback quantised to encoder pulses of this size
     speed_filter_alpha: float = 1.0  # first-order filter of the pulse-difference speed (1 = none)
 
@@ -129,7 +133,13 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     j_motor = jm if compliant else jt
     h_jm = h / j_motor
     visc_den = 1.0 / (1.0 + h * visc / j_motor)
-    fc_dv = h * fc0 / j_motor
+    # friction impulses per substep, by direction (Coulomb + asymmetric; Stribeck added per substep)
+    fcp_dv = h * (fc0 + p.fc_pos_extra) / j_motor
+    fcn_dv = h * (fc0 + p.fc_neg_extra) / j_motor
+    has_st = p.stribeck_a > 0.0
+    st_dv = h * p.stribeck_a / j_motor
+    st_iv = 1.0 / p.stribeck_v
+    exp = math.exp
     h_jl = h / jl
     if rec is not None:
         r_t, r_c, r_xm, r_xl, r_vm, r_i, r_vr = rec
@@ -210,10 +220,16 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
                 v = vm + h_jm * tm
                 if has_visc:
                     v *= visc_den
-                if v > fc_dv:
-                    vm = v - fc_dv
-                elif v < -fc_dv:
-                    vm = v + fc_dv
+                up, dn = fcp_dv, fcn_dv
+                if has_st:
+                    q = vm * st_iv
+                    e = st_dv * exp(-q * q)
+                    up += e
+                    dn += e
+                if v > up:
+                    vm = v - up
+                elif v < -dn:
+                    vm = v + dn
                 else:
                     vm = 0.0
                 tl = tg - off
@@ -232,10 +248,16 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
                 v = vm + h_jm * tm
                 if has_visc:
                     v *= visc_den
-                if v > fc_dv:
-                    vm = v - fc_dv
-                elif v < -fc_dv:
-                    vm = v + fc_dv
+                up, dn = fcp_dv, fcn_dv
+                if has_st:
+                    q = vm * st_iv
+                    e = st_dv * exp(-q * q)
+                    up += e
+                    dn += e
+                if v > up:
+                    vm = v - up
+                elif v < -dn:
+                    vm = v + dn
                 else:
                     vm = 0.0
                 xm += h * vm

@@ -12,6 +12,11 @@ check's contract (what the model check fits and names):
     load_torque_offset    torque_nm
     inertia_error         inertia_kgm2 x acceleration
     torque_ripple         amplitude_nm x sin(cycles_per_motor_rev x motor angle + phase_deg)
+    asymmetric_friction   torque_pos_nm while turning CW (+), -torque_neg_nm while turning CCW
+    stribeck_friction     static_torque_nm x exp(-(velocity / velocity_rad_s)^2) x sign(velocity):
+                          breakaway above the Coulomb level, fading with speed
+    torque_constant_error the motor gives ratio x Kt x current (the monitor or the catalogue Kt is
+                          off by that factor); the nominal model assumes Kt x current
 position channel (load_pos - pos):
     kinematic_error       amplitude_arcsec x sin(cycles_per_motor_rev x motor angle + phase_deg)
     torsional_compliance  - wind-up under the torque carried by the gear (catalogue K1/K2/K3, T1/T2
@@ -129,6 +134,56 @@ class TorqueRipple(_Effect):
 
 
 @dataclass(frozen=True)
+class AsymmetricFriction(_Effect):
+    """Coulomb friction that differs by direction: torque_pos_nm while turning CW (positive speed),
+    torque_neg_nm (a magnitude) while turning CCW; sticks at rest below the level of the push."""
+
+    id: ClassVar[str] = "asymmetric_friction"
+    units: ClassVar[dict[str, str]] = {"torque_pos_nm": "N m", "torque_neg_nm": "N m"}
+    torque_pos_nm: float = 0.0
+    torque_neg_nm: float = 0.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _check_nonnegative(self.id, "torque_pos_nm", self.torque_pos_nm)
+        _check_nonnegative(self.id, "torque_neg_nm", self.torque_neg_nm)
+
+
+@dataclass(frozen=True)
+class StribeckFriction(_Effect):
+    """Breakaway above the Coulomb level at low speed (the Stribeck curve): the motor supplies
+    static_torque_nm x exp(-(v / velocity_rad_s)^2) x sign(v) in addition to Coulomb friction, and a
+    stuck axis needs that much more to break away."""
+
+    id: ClassVar[str] = "stribeck_friction"
+    units: ClassVar[dict[str, str]] = {"static_torque_nm": "N m", "velocity_rad_s": "rad/s"}
+    static_torque_nm: float = 0.0
+    velocity_rad_s: float = 0.01
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _check_nonnegative(self.id, "static_torque_nm", self.static_torque_nm)
+        if self.velocity_rad_s <= 0:
+            raise ValueError(
+                f"effect {self.id}: velocity_rad_s must be positive, got {self.velocity_rad_s!r}")
+
+
+@dataclass(frozen=True)
+class TorqueConstantError(_Effect):
+    """The motor gives ratio x Kt x current, where the nominal model assumes Kt x current: the
+    driver's current monitor or the catalogue torque constant is off by that factor."""
+
+    id: ClassVar[str] = "torque_constant_error"
+    units: ClassVar[dict[str, str]] = {"ratio": "1"}
+    ratio: float = 1.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not 0.1 <= self.ratio <= 10.0:
+            raise ValueError(f"effect {self.id}: ratio must be between 0.1 and 10, got {self.ratio!r}")
+
+
+@dataclass(frozen=True)
 class KinematicError(_Effect):
     """Transmission error of the gear: load_pos - pos = amplitude x sin(cycles x motor angle + phase)."""
 
@@ -189,7 +244,8 @@ EFFECT_TYPES: dict[str, type[_Effect]] = {
     cls.id: cls
     for cls in (
         CoulombFriction, ViscousFriction, GravityLoad, LoadTorqueOffset, InertiaError, TorqueRipple,
-        KinematicError, TorsionalCompliance, LostMotion,
+        KinematicError, TorsionalCompliance, LostMotion, AsymmetricFriction, StribeckFriction,
+        TorqueConstantError,
     )
 }
 EFFECT_IDS: tuple[str, ...] = tuple(EFFECT_TYPES)
@@ -208,6 +264,9 @@ class Effects:
     kinematic_error: KinematicError | None = None
     torsional_compliance: TorsionalCompliance | None = None
     lost_motion: LostMotion | None = None
+    asymmetric_friction: AsymmetricFriction | None = None
+    stribeck_friction: StribeckFriction | None = None
+    torque_constant_error: TorqueConstantError | None = None
 
     def __post_init__(self) -> None:
         for effect_id, cls in EFFECT_TYPES.items():

@@ -154,7 +154,10 @@ def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelPa
         kp=0.0 if speed_mode else settings.position_loop_gain_per_s, kv=settings.speed_loop_gain_a_s_per_rad,
         tv_inv=0.0 if math.isinf(tv) else 1.0 / tv, ff=1.0 if speed_mode else settings.feed_forward_gain,
         ilim=ilim,
-        kt=model.torque_constant_nm_per_a, jm=jm, jl=jl, j_total=jm + jl,
+        # the plant's torque per ampere: a torque-constant error scales what the motor really gives
+        kt=model.torque_constant_nm_per_a * (e.torque_constant_error.ratio if e.torque_constant_error
+                                             else 1.0),
+        jm=jm, jl=jl, j_total=jm + jl,
         compliant=compliant, k1=k1, k2=k2, k3=k3, t1=t1, t2=t2, th1=th1, th2=th2, damping=damping,
         fc=e.coulomb_friction.torque_nm if e.coulomb_friction else 0.0,
         visc=e.viscous_friction.coefficient_nm_s_per_rad if e.viscous_friction else 0.0,
@@ -169,6 +172,10 @@ def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelPa
         ke_phase=math.radians(e.kinematic_error.phase_deg) if e.kinematic_error else 0.0,
         lm_half=0.5 * e.lost_motion.width_arcsec / ARCSEC_PER_RAD if e.lost_motion else 0.0,
         resistance=model.phase_resistance_ohm,
+        fc_pos_extra=e.asymmetric_friction.torque_pos_nm if e.asymmetric_friction else 0.0,
+        fc_neg_extra=e.asymmetric_friction.torque_neg_nm if e.asymmetric_friction else 0.0,
+        stribeck_a=e.stribeck_friction.static_torque_nm if e.stribeck_friction else 0.0,
+        stribeck_v=e.stribeck_friction.velocity_rad_s if e.stribeck_friction else 1.0,
         pulse_rad=model.output_pulse_rad if settings.quantised_feedback else 0.0,
         speed_filter_alpha=(1.0 - math.exp(-2.0 * math.pi * settings.speed_filter_hz * dt)
                             if settings.speed_filter_hz > 0 else 1.0),

@@ -10,6 +10,13 @@ filter (see signals.py), so measured and modelled sides carry the same bandwidth
 Each candidate turns its fitted linear coefficients (and shape parameters) into contract
 parameters with one-sigma uncertainties (delta method) and gives its *size*: the effect's typical
 magnitude in the channel's unit, which the practical-significance floor is compared with.
+
+Everything effect-specific lives here, as attributes of the `Candidate`: how it shows (columns),
+its parameters, its size, whether it acts on the motor side of the gear (for the position
+channel's gear torque), whether it re-fits a nominal parameter first, how its detection limit
+reads in its own parameter, how it enters the updated model, which look-alikes it has and the
+one-line advice for a person. The workflow never branches on an effect id; a new effect is one
+entry in TORQUE_CANDIDATES or POSITION_CANDIDATES (see docs/physics.md, "Adding an effect").
 """
 
 from __future__ import annotations
@@ -17,6 +24,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -37,6 +45,7 @@ class ChannelContext:
     gear_torque_nm: np.ndarray | None = None
     # torque breakpoints of the wind-up curve (catalogue T1, T2) the data reaches beyond
     breakpoints_nm: tuple[float, ...] = ()
+    nominal_inertia_kgm2: float = 0.0  # J_actuator + J_load declared (the nominal model's inertia)
     cache: dict[tuple[object, ...], np.ndarray] = field(default_factory=dict)
 
     def full_sign_speed(self, memory: bool = False) -> np.ndarray:
@@ -72,9 +81,22 @@ class Param:
     unit: str
 
 
+def _clamp_nonnegative(params: dict[str, float], model: Any) -> dict[str, float] | None:
+    """Updated-model parameters of a friction-like effect: a fitted negative level becomes zero."""
+    return {k: max(v, 0.0) if k != "velocity_rad_s" else abs(v) for k, v in params.items()}
+
+
+def _as_is(params: dict[str, float], model: Any) -> dict[str, float] | None:
+    return dict(params)
+
+
+def _limit_as_size(size: float, ctx: ChannelContext) -> float:
+    return size
+
+
 @dataclass(frozen=True)
 class Candidate:
-    """A candidate effect and how to see it."""
+    """A candidate effect and how to see it (every effect-specific behaviour is an attribute)."""
 
     id: str
     channel: str
@@ -86,9 +108,30 @@ class Candidate:
     shape_grid: Sequence[tuple[float, ...]] = ((),)
     shape_refine: bool = False  # refine the (continuous) shape by least squares
     shape_names: tuple[str, ...] = ()
+    # bounds of the refinement around a grid shape (default: +-0.25 cycles per motor turn)
+    shape_bounds: Callable[[tuple[float, ...]], tuple[list[float], list[float]]] = lambda s: (
+        [s[0] - 0.25],
+        [s[0] + 0.25],
+    )
+    look_elsewhere: bool = False  # a searched frequency: the size must stand above off-frequency noise
     sign: int = 0  # +1/-1: the first coefficient must have this sign to be physical (0 = any)
+    all_positive: bool = False  # every coefficient must be >= 0 (levels by direction)
     primary: str = ""  # parameter the detection limit is stated in
+    primary_unit: str = ""  # its unit (default: the channel's)
     needs_ratio: bool = False
+    motor_side: bool = False  # acts on the motor side of the gear (not carried by the gear)
+    nominal: bool = False  # re-fits a nominal parameter: tried before any missing effect
+    # a detection limit (channel unit) in the primary parameter's unit
+    limit_in_param: Callable[[float, ChannelContext], float] = _limit_as_size
+    # the fitted parameters as the updated model takes them (None: leave the effect out)
+    model_params: Callable[[dict[str, float], Any], dict[str, float] | None] = _as_is
+    # sets of candidates that together look like this one (tested as a whole against it)
+    look_alikes: tuple[tuple[str, ...], ...] = ()
+    extends: tuple[str, ...] = ()  # candidates this one contains (nested: the BIC decides between them)
+    # the same columns as another candidate read another way: never chosen, named only as its look-alike
+    only_as_alternative: bool = False
+    # one line for a person: what to do next, from the fitted parameters
+    advice: Callable[[dict[str, float]], str] = lambda p: "add it to the model (Save updated model…)"
 
 
 def _amp_phase(beta: np.ndarray, cov: np.ndarray) -> tuple[float, float, float, float]:
@@ -175,6 +218,70 @@ def _amp_size(beta, ctx):
 
 RIPPLE_CYCLES = (1.0, 2.0, 3.0, 4.0, 6.0, 8.0)
 KINEMATIC_CYCLES = (2.0, 1.0, 4.0)
+STRIBECK_SPEEDS_RAD_S = (0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5)
+
+
+def _asymmetric_cols(ctx, shape):
+    # friction levels by direction; a stuck axis keeps the level it last slid against
+    d = ctx.full_sign_speed(memory=True)
+    return np.column_stack(
+        [ctx.sig.regressor((d > 0).astype(float)), -ctx.sig.regressor((d < 0).astype(float))]
+    )
+
+
+def _asymmetric_params(beta, cov, shape, shape_cov, ctx):
+    return [
+        Param("torque_pos_nm", float(beta[0]), _sd(cov, 0), "N m"),
+        Param("torque_neg_nm", float(beta[1]), _sd(cov, 1), "N m"),
+    ]
+
+
+def _stribeck_cols(ctx, shape):
+    # extra friction while sliding slowly, fading with speed; a stuck axis keeps the friction it
+    # last slid against, the breakaway level (the servo's integrator holds it, see Coulomb friction)
+    (v_s,) = shape
+    v = ctx.sig.full_speed_rad_s
+    return ctx.sig.regressor(ctx.full_sign_speed(memory=True) * np.exp(-((v / v_s) ** 2)))[:, None]
+
+
+def _stribeck_params(beta, cov, shape, shape_cov, ctx):
+    s_v = math.sqrt(max(float(shape_cov[0, 0]), 0.0)) if shape_cov.size else 0.0
+    return [
+        Param("static_torque_nm", float(beta[0]), _sd(cov, 0), "N m"),
+        Param("velocity_rad_s", abs(float(shape[0])), s_v, "rad/s"),
+    ]
+
+
+def _torque_constant_cols(ctx, shape):
+    # ratio x Kt x current = J a + F: read with the catalogue Kt, the residual is (1/ratio - 1) x the
+    # torque the nominal model needs (plus the other effects scaled by 1/ratio). With the torque
+    # channel alone that is exactly an inertia error: only a known torque tells them apart.
+    return (ctx.nominal_inertia_kgm2 * ctx.sig.accel_rad_s2)[:, None]
+
+
+def _torque_constant_params(beta, cov, shape, shape_cov, ctx):
+    b = float(beta[0])
+    ratio = 1.0 / (1.0 + b) if b > -1.0 else math.inf
+    return [Param("ratio", ratio, _sd(cov, 0) * ratio**2 if math.isfinite(ratio) else math.inf, "1")]
+
+
+def _per_rms(signal: Callable[[ChannelContext], np.ndarray]) -> Callable[[float, ChannelContext], float]:
+    """A detection limit (N m) in a coefficient per unit of a signal's RMS (N m s/rad, kg m^2)."""
+    return lambda size, ctx: size / max(_rms(signal(ctx)), 1e-12)
+
+
+def _inertia_model_params(params: dict[str, float], model: Any) -> dict[str, float] | None:
+    # an inertia error that leaves no positive load-side inertia cannot enter the model
+    return None if model.load_side_inertia_kgm2 + params["inertia_kgm2"] <= 0 else dict(params)
+
+
+def _ratio_model_params(params: dict[str, float], model: Any) -> dict[str, float] | None:
+    return dict(params) if 0.1 <= params["ratio"] <= 10.0 else None
+
+
+def _nm(x: float) -> str:
+    return f"{x:.3g} N m"
+
 
 TORQUE_CANDIDATES: tuple[Candidate, ...] = (
     Candidate(
@@ -186,6 +293,15 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         _one("inertia_kgm2", "kg m^2"),
         lambda b, c: abs(float(b[0])) * _rms(c.sig.accel_rad_s2),
         primary="inertia_kgm2",
+        primary_unit="kg m^2",
+        nominal=True,
+        limit_in_param=_per_rms(lambda c: c.sig.accel_rad_s2),
+        model_params=_inertia_model_params,
+        advice=lambda p: (
+            f"{'add' if p['inertia_kgm2'] > 0 else 'take off'} {abs(p['inertia_kgm2']):.3g} kg m² "
+            f"{'to' if p['inertia_kgm2'] > 0 else 'from'} the declared load inertia; check what is mounted "
+            "on the output (a part missed in the sizing)"
+        ),
     ),
     Candidate(
         "coulomb_friction",
@@ -197,6 +313,12 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         lambda b, c: abs(float(b[0])),
         sign=1,
         primary="torque_nm",
+        motor_side=True,
+        model_params=_clamp_nonnegative,
+        advice=lambda p: (
+            f"add {_nm(p['torque_nm'])} Coulomb friction to the model; if the axis is new, check the brake "
+            "releases fully and the seals or the load's bearings do not drag"
+        ),
     ),
     Candidate(
         "viscous_friction",
@@ -208,6 +330,14 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         lambda b, c: abs(float(b[0])) * _rms(c.sig.speed_rad_s),
         sign=1,
         primary="coefficient_nm_s_per_rad",
+        primary_unit="N m s/rad",
+        motor_side=True,
+        limit_in_param=_per_rms(lambda c: c.sig.speed_rad_s),
+        model_params=_clamp_nonnegative,
+        advice=lambda p: (
+            f"add {p['coefficient_nm_s_per_rad']:.3g} N m s/rad viscous friction to the model; a cold gear "
+            "is stiffer: compare after a warm-up run"
+        ),
     ),
     Candidate(
         "gravity_load",
@@ -218,6 +348,10 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         _gravity_params,
         _amp_size,
         primary="amplitude_nm",
+        advice=lambda p: (
+            f"add a {_nm(p['amplitude_nm'])} unbalance to the model; balance the load or size the "
+            "actuator for the holding torque, and mind it when the servo is off (the brake holds it)"
+        ),
     ),
     Candidate(
         "load_torque_offset",
@@ -228,6 +362,10 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         _one("torque_nm", "N m"),
         lambda b, c: abs(float(b[0])),
         primary="torque_nm",
+        advice=lambda p: (
+            f"add a constant {_nm(p['torque_nm'])} load torque to the model; look for a spring, a cable "
+            "chain or a process force pushing the load"
+        ),
     ),
     Candidate(
         "torque_ripple",
@@ -240,8 +378,74 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         shape_grid=tuple((c,) for c in RIPPLE_CYCLES),
         shape_refine=True,
         shape_names=("cycles_per_motor_rev",),
+        look_elsewhere=True,
         primary="amplitude_nm",
         needs_ratio=True,
+        motor_side=True,
+        advice=lambda p: (
+            f"add {_nm(p['amplitude_nm'])} ripple at {p['cycles_per_motor_rev']:.3g} cycles per motor turn "
+            "to the model; if it is large, have the motor and its encoder alignment checked"
+        ),
+    ),
+    Candidate(
+        "asymmetric_friction",
+        TORQUE,
+        "Friction that differs by direction",
+        2,
+        _asymmetric_cols,
+        _asymmetric_params,
+        lambda b, c: 0.5 * abs(float(b[0]) - float(b[1])),  # the asymmetry: what Coulomb friction lacks
+        all_positive=True,
+        primary="torque_pos_nm",
+        motor_side=True,
+        model_params=_clamp_nonnegative,
+        look_alikes=(("coulomb_friction", "load_torque_offset"),),
+        extends=("coulomb_friction",),
+        advice=lambda p: (
+            f"add friction of {_nm(p['torque_pos_nm'])} turning CW and {_nm(p['torque_neg_nm'])} turning CCW "
+            "to the model; a direction-dependent drag often comes from a seal or a preloaded bearing"
+        ),
+    ),
+    Candidate(
+        "stribeck_friction",
+        TORQUE,
+        "Breakaway friction at low speed (Stribeck)",
+        1,
+        _stribeck_cols,
+        _stribeck_params,
+        lambda b, c: abs(float(b[0])),
+        shape_grid=tuple((v,) for v in STRIBECK_SPEEDS_RAD_S),
+        shape_refine=True,
+        shape_names=("velocity_rad_s",),
+        shape_bounds=lambda s: ([0.5 * s[0]], [2.0 * s[0]]),
+        sign=1,
+        primary="static_torque_nm",
+        motor_side=True,
+        model_params=_clamp_nonnegative,
+        advice=lambda p: (
+            f"add {_nm(p['static_torque_nm'])} breakaway friction below about "
+            f"{p['velocity_rad_s'] * 30.0 / math.pi:.2g} r/min to the model; avoid crawling at such speeds "
+            "(stick-slip), or lubricate"
+        ),
+    ),
+    Candidate(
+        "torque_constant_error",
+        TORQUE,
+        "Torque constant (or current monitor) error",
+        1,
+        _torque_constant_cols,
+        _torque_constant_params,
+        lambda b, c: abs(float(b[0])) * _rms(c.nominal_inertia_kgm2 * c.sig.accel_rad_s2),
+        primary="ratio",
+        primary_unit="1",
+        # a relative error of the torque per ampere the record would show (as a ratio's distance from 1)
+        limit_in_param=lambda size, c: size / max(_rms(c.nominal_inertia_kgm2 * c.sig.accel_rad_s2), 1e-12),
+        model_params=_ratio_model_params,
+        only_as_alternative=True,
+        advice=lambda p: (
+            f"the motor gives {p['ratio']:.3g} x the catalogue torque per ampere: check the current "
+            "monitor's scaling (monitor item and its full scale) and the actuator's model code"
+        ),
     ),
 )
 
@@ -307,8 +511,14 @@ POSITION_CANDIDATES: tuple[Candidate, ...] = (
         shape_grid=tuple((c,) for c in KINEMATIC_CYCLES),
         shape_refine=True,
         shape_names=("cycles_per_motor_rev",),
+        look_elsewhere=True,
         primary="amplitude_arcsec",
         needs_ratio=True,
+        advice=lambda p: (
+            f"add {p['amplitude_arcsec']:.3g} arcsec kinematic error at "
+            f"{p['cycles_per_motor_rev']:.3g} cycles per motor turn to the model; compare with the gear's "
+            "accuracy in the catalogue (1-9-1)"
+        ),
     ),
     Candidate(
         "torsional_compliance",
@@ -321,6 +531,18 @@ POSITION_CANDIDATES: tuple[Candidate, ...] = (
         sign=-1,
         shape_grid=((0.0,), (1.0,), (2.0,)),
         primary="stiffness_nm_per_rad",
+        primary_unit="N m/rad",
+        # wind-up smaller than the limit (arcsec) would not show: the stiffest spring still visible
+        limit_in_param=lambda size, c: _rms(c.gear_torque_nm) * ARCSEC_PER_RAD / max(size, 1e-12),
+        model_params=lambda p, m: (
+            {k: v for k, v in p.items() if math.isfinite(v) and v > 0}
+            if math.isfinite(p.get("stiffness_nm_per_rad", math.nan)) and p["stiffness_nm_per_rad"] > 0
+            else None
+        ),
+        advice=lambda p: (
+            f"add the gear's wind-up (K1 {p['stiffness_nm_per_rad']:.3g} N m/rad) to the model; if it is "
+            "softer than the catalogue's, check the load's mounting and its screws' torque"
+        ),
     ),
     Candidate(
         "lost_motion",
@@ -333,10 +555,24 @@ POSITION_CANDIDATES: tuple[Candidate, ...] = (
         sign=1,
         shape_grid=((0.0,), (1.0,)),
         primary="width_arcsec",
+        limit_in_param=lambda size, c: 2.0 * size,
+        model_params=_clamp_nonnegative,
+        advice=lambda p: (
+            f"add {p['width_arcsec']:.3g} arcsec lost motion to the model; a harmonic gear has almost none: "
+            "check the load's coupling and keys for play"
+        ),
     ),
 )
 
+CANDIDATES: dict[str, Candidate] = {c.id: c for c in TORQUE_CANDIDATES + POSITION_CANDIDATES}
+
 LABELS = {c.id: c.label for c in TORQUE_CANDIDATES + POSITION_CANDIDATES}
+
+
+def label_of(effect_ids: str) -> str:
+    """The human name of an effect id, or of look-alike ids joined by " + "."""
+    return " + ".join(LABELS.get(i, i) for i in effect_ids.split(" + "))
+
 
 # Which recording would tell two look-alikes apart.
 SEPARATING_TESTS: dict[frozenset[str], str] = {
@@ -379,6 +615,23 @@ SEPARATING_TESTS: dict[frozenset[str], str] = {
     frozenset(
         {"kinematic_error", "lost_motion"}
     ): "record slow moves over several motor turns in both directions",
+    frozenset({"asymmetric_friction", "coulomb_friction + load_torque_offset"}): (
+        "record a standstill with the servo on before the first move: a load offset needs current "
+        "there, friction does not"
+    ),
+    frozenset({"coulomb_friction", "stribeck_friction"}): (
+        "record constant-speed runs at several low speeds: breakaway (Stribeck) friction fades with "
+        "speed, Coulomb friction does not"
+    ),
+    frozenset({"viscous_friction", "stribeck_friction"}): (
+        "record constant-speed runs from very low to high speeds: Stribeck friction is largest at the "
+        "lowest speeds, viscous friction at the highest"
+    ),
+    frozenset({"inertia_error", "torque_constant_error"}): (
+        "apply a known load torque (a known mass on a known arm, or a torque wrench against the held "
+        "axis) and compare it with Kt x current: a torque-constant error scales it, an inertia error "
+        "does not"
+    ),
 }
 DEFAULT_SEPARATING_TEST = (
     "record a longer motion covering more speeds, positions and accelerations, in both directions"

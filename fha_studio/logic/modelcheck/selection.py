@@ -57,6 +57,7 @@ MIN_SIGMAS = 3.0  # a named effect's size must stand this many jackknife sigmas 
 # size must stand this many times above the median size the same fit finds at frequencies nobody
 # claims. Pure noise reaches ~3-4x (the largest of a few hundred peaks); real ripple 150x and more.
 MIN_OFF_SHAPE_RATIO = 6.0
+MASKED_CV_FACTOR = 3.0  # a look-alike the record cannot rule out fits within this factor of the chosen
 OFF_SHAPE_GAP = 0.45  # off-shape frequencies keep this far (cycles per turn) from the chosen one
 
 
@@ -284,19 +285,25 @@ class ChannelSelector:
             beta, _ = ols(self.y, x1)
             return self.y - x1 @ beta
 
-        c0 = shape[0]
         try:
-            sol = least_squares(resid, [c0], bounds=([c0 - 0.25], [c0 + 0.25]), diff_step=1e-4, max_nfev=30)
+            sol = least_squares(
+                resid, [shape[0]], bounds=cand.shape_bounds(shape), diff_step=1e-4, max_nfev=30
+            )
             return (float(sol.x[0]),)
         except (ValueError, np.linalg.LinAlgError):  # pragma: no cover - degenerate data
             return shape
 
-    def try_add(self, cand: Candidate, terms: list[Term]) -> tuple[Trial, Term]:
-        """Score cand added to terms: whitened BIC gain (AR from the larger model), block CV, size."""
-        shape = self.best_shape(cand, terms)
+    def try_add(self, cand: Candidate, terms: list[Term], replace: Term | None = None) -> tuple[Trial, Term]:
+        """Score cand added to terms: whitened BIC gain (AR from the larger model), block CV, size.
+
+        replace: a chosen term cand extends (a refinement, e.g. friction by direction for Coulomb
+        friction): cand takes its place and must beat the model that holds it.
+        """
+        kept = [t for t in terms if t is not replace]
+        shape = self.best_shape(cand, kept)
         term = Term(cand, shape, self.cols(cand, shape))
         x0 = self.design(terms)
-        x1 = self.design([*terms, term])
+        x1 = self.design([*kept, term])
         phi = self._ar_for(x1)
         _, rss1, nw = self._wrss(x1, phi)
         _, rss0, _ = self._wrss(x0, phi)
@@ -318,7 +325,7 @@ class ChannelSelector:
         if size < MIN_SIGMAS * sigma:
             reasons.append(f"size {size:.3g} {self.unit} within {MIN_SIGMAS:g} sigma ({sigma:.3g}) of zero")
         noise_peak = False
-        if cand.shape_refine and size >= self.floor:
+        if cand.look_elsewhere and size >= self.floor:
             off = self.off_shape_size(cand, x1, shape)
             noise_peak = size < MIN_OFF_SHAPE_RATIO * off
             if noise_peak:
@@ -373,6 +380,8 @@ class ChannelSelector:
 
     @staticmethod
     def _physical(cand: Candidate, beta: np.ndarray) -> bool:
+        if cand.all_positive:
+            return bool(np.all(beta >= 0.0) and np.any(beta > 0.0))
         if cand.sign == 0:
             return True
         # cumulative: every region of a piecewise term (wind-up slopes) must keep the sign
@@ -401,14 +410,22 @@ class ChannelSelector:
         while len(terms) < MAX_EFFECTS:
             phi = fit_ar(self.residual(terms))
             in_model = [t.id for t in terms]
-            tried = [self.try_add(cand, terms) for cand in self.candidates if cand.id not in in_model]
-            good = [(tr, tm) for tr, tm in tried if tr.accepted]
+            trials = []
+            for cand in self.candidates:
+                if cand.id in in_model:
+                    continue
+                # a refinement of a chosen term is tried in its place, never beside it
+                replaced = next((t for t in terms if t.id in cand.extends), None)
+                if (cand.extends and replaced is None) or cand.only_as_alternative:
+                    continue
+                trials.append((*self.try_add(cand, terms, replaced), replaced))
+            good = [trial for trial in trials if trial[0].accepted]
             best = min(good, key=lambda p: p[0].delta_bic) if good else None
             chosen = best[0].id if best else None
-            steps.append(SelectionStep("forward", len(phi), [tr for tr, _ in tried], chosen))
+            steps.append(SelectionStep("forward", len(phi), [tr for tr, _, _ in trials], chosen))
             if best is None:
                 break
-            terms.append(best[1])
+            terms = [t for t in terms if t is not best[2]] + [best[1]]
         # backward: drop a term the others have made redundant
         changed = True
         while changed and len(terms) > 1:
@@ -535,6 +552,43 @@ class ChannelSelector:
             col += k
         return out
 
+    def _look_alike_sets(
+        self, terms: list[Term], phi: np.ndarray, full: float, fit_full: np.ndarray
+    ) -> list[tuple[str, str, float, dict[str, float]]]:
+        """A chosen effect against the set of effects that together look like it (a candidate's
+        look_alikes), both ways: (chosen ids, alternative ids, BIC difference), ids joined by " + "."""
+        by_id = {c.id: c for c in self.candidates}
+        chosen = {t.id for t in terms}
+        out = []
+        for cand in self.candidates:
+            for combo in cand.look_alikes:
+                if not all(i in by_id for i in combo):
+                    continue
+                if cand.id in chosen and not set(combo) <= chosen:
+                    rest = [t for t in terms if t.id != cand.id and t.id not in combo]
+                    alt_terms = list(rest)
+                    for i in combo:
+                        member = by_id[i]
+                        shape = self.best_shape(member, alt_terms)
+                        alt_terms.append(Term(member, shape, self.cols(member, shape)))
+                    pair = (cand.id, " + ".join(combo))
+                elif set(combo) <= chosen and cand.id not in chosen:
+                    rest = [t for t in terms if t.id not in combo]
+                    trial, alt = self.try_add(cand, rest)
+                    if not (trial.physical and trial.size >= self.floor):
+                        continue
+                    alt_terms = [*rest, alt]
+                    pair = (" + ".join(combo), cand.id)
+                else:
+                    continue
+                x_alt = self.design(alt_terms)
+                b_alt, _ = ols(self.y, x_alt)
+                differ = float(np.sqrt(np.mean((x_alt @ b_alt - fit_full) ** 2)))
+                alt_bic = self.score(alt_terms, phi)
+                if abs(alt_bic - full) < BIC_MIN or differ < 0.5 * self.floor:
+                    out.append((*pair, alt_bic - full, {}))
+        return out
+
     def _term_sizes(self, terms: list[Term], beta: np.ndarray) -> list[float]:
         """Each term's size (channel unit) from the coefficients of the whole design (base first)."""
         out = []
@@ -550,9 +604,14 @@ class ChannelSelector:
         """Smallest size of cand this record would have revealed next to terms (channel unit).
 
         The jackknife spread of cand's coefficient(s) when fitted next to the chosen terms, times
-        the whitened-BIC gate's own threshold sqrt(BIC_MIN + k ln n), never below the floor.
+        the whitened-BIC gate's own threshold sqrt(BIC_MIN + k ln n), never below the floor. A shape
+        that is not a searched frequency (a Stribeck speed) is the one that fits best next to terms.
         """
-        shape = cand.shape_grid[0]
+        shape = (
+            self.best_shape(cand, terms)
+            if cand.shape_refine and not cand.look_elsewhere
+            else cand.shape_grid[0]
+        )
         x = np.column_stack([self.design(terms), self.cols(cand, shape)])
         k = x.shape[1] - self.design(terms).shape[1]
         reps = []
@@ -568,12 +627,13 @@ class ChannelSelector:
         unit_size = cand.size(np.full(k, 1.0 / math.sqrt(k)) if k > 1 else np.ones(1), self.ctx)
         z = math.sqrt(BIC_MIN + k * math.log(self.n))
         limit = max(self.floor, z * sigma * unit_size, MIN_SIGMAS * sigma * unit_size)
-        if cand.shape_refine:  # the look-elsewhere gate of try_add
+        if cand.look_elsewhere:  # the look-elsewhere gate of try_add
             limit = max(limit, MIN_OFF_SHAPE_RATIO * self.off_shape_size(cand, x, shape))
         return limit, shape
 
-    def substitutes(self, terms: list[Term]) -> list[tuple[str, str, float]]:
-        """(chosen, alternative, BIC difference) for alternatives that explain the data as well.
+    def substitutes(self, terms: list[Term]) -> list[tuple[str, str, float, dict[str, float]]]:
+        """(chosen, alternative, BIC difference, the alternative's parameters) for alternatives that
+        explain the data as well.
 
         An alternative (swapped in for one chosen term, physical, above the floor and lowering the
         held-out RMS; its own precision gates do not matter: a look-alike is as uncertain as the
@@ -592,12 +652,18 @@ class ChannelSelector:
         out = []
         chosen = {t.id for t in terms}
         sizes = self._term_sizes(terms, beta)
+        cv_full, _ = block_cv(self.y, x_full)
         hidden = {c.id: self.detection_limit(terms, c)[0] for c in self.candidates if c.id not in chosen}
         for term, size in zip(terms, sizes, strict=True):
             rest = [t for t in terms if t is not term]
             for cand in self.candidates:
-                if cand.id in chosen:
-                    continue
+                if (
+                    cand.id in chosen
+                    or cand.extends
+                    or term.id in cand.extends
+                    or cand.id in term.cand.extends
+                ):
+                    continue  # a refinement replaces only its base, and the whitened BIC chose between them
                 trial, alt = self.try_add(cand, rest)
                 if not (
                     trial.physical
@@ -612,7 +678,12 @@ class ChannelSelector:
                 differ = float(np.sqrt(np.mean((x_alt @ b_alt - fit_full) ** 2)))
                 # below what the record can show: next to the chosen terms, an effect of this kind as
                 # large as the chosen one would not have been seen, so the data cannot tell them apart
-                masked = hidden[cand.id] > size
+                # (and it must explain the data nearly as well: within MASKED_CV_FACTOR of the held-out RMS)
+                masked = hidden[cand.id] > size and trial.cv_rms_after <= MASKED_CV_FACTOR * cv_full
                 if alt_bic - full < BIC_MIN or differ < 0.5 * self.floor or masked:
-                    out.append((term.id, cand.id, alt_bic - full))
+                    k = alt.cols.shape[1]
+                    none = np.zeros((0, 0))
+                    alt_params = cand.to_params(b_alt[-k:], np.zeros((k, k)), alt.shape, none, self.ctx)
+                    out.append((term.id, cand.id, alt_bic - full, {q.name: q.value for q in alt_params}))
+        out.extend(self._look_alike_sets(terms, phi, full, fit_full))
         return out

@@ -19,14 +19,17 @@ from fha_studio.logic.modelcheck.axis import (
 )
 from fha_studio.logic.modelcheck.bandwidth import BandwidthPoint, choose_bandwidth
 from fha_studio.logic.modelcheck.candidates import (
+    CANDIDATES,
     CHANNEL_UNITS,
     LABELS,
     POSITION,
     POSITION_CANDIDATES,
     TORQUE,
     TORQUE_CANDIDATES,
+    Candidate,
     ChannelContext,
     Param,
+    label_of,
     separating_test,
 )
 from fha_studio.logic.modelcheck.selection import (
@@ -54,6 +57,8 @@ TORQUE_FLOOR_MIN_NM = 0.02
 POSITION_FLOOR_ARCSEC = 2.0
 STRUCTURE_MIN_FRACTION = 0.15  # a structured residual explains >= 15 % of the residual's variance
 BURST_FACTOR = 6.0  # a burst in time: local RMS this many times the residual's median local RMS
+BURST_FLOOR_FACTOR = 3.0  # ... and above this many practical floors
+BREAKAWAY_SETTLE_S = 0.1  # a burst peaking this soon after a breakaway from standstill is stick-slip
 BURST_EDGE_FACTOR = 3.0  # ... and it lasts while the local RMS stays above this many times the median
 RESIM_BANDWIDTH_HZ = 60.0  # speed-loop bandwidth of the stiff servo that follows the measured motion
 # A channel is checked when what it shows (smoothed) stands this many noise sigmas above its noise.
@@ -103,6 +108,7 @@ class Effect:
     units: dict[str, str]
     size: float  # typical magnitude in the channel unit
     alternatives: list[str] = field(default_factory=list)  # not separable from these
+    advice: str = ""  # one line for a person: what to do next
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -114,6 +120,7 @@ class Effect:
             "label": self.label,
             "size": self.size,
             "not_separable_from": list(self.alternatives),
+            "what_to_do_next": self.advice,
         }
 
 
@@ -126,6 +133,7 @@ class Ambiguity:
     alternative: str
     delta_bic: float
     separating_test: str
+    alternative_params: dict[str, float] = field(default_factory=dict)  # the alternative, fitted in its place
 
 
 @dataclass
@@ -265,7 +273,7 @@ class ModelCheckResult:
             )
             text = f"{e.label} missing: {main}" + (f" ({others})" if others else "")
             if e.alternatives:
-                alts = " or ".join(LABELS[a] for a in e.alternatives)
+                alts = " or ".join(label_of(a) for a in e.alternatives)
                 text = f"{e.label} or {alts} — not separable from this data; as {e.id}: {main}"
             gap = self.gap.get(e.channel)
             if gap is not None and by_channel.get(e.channel) is e:
@@ -275,8 +283,11 @@ class ModelCheckResult:
                 )
             lines.append(text)
         for a in self.ambiguities:
+            as_alt = ", ".join(f"{k} {_fmt(v)}" for k, v in a.alternative_params.items())
             lines.append(
-                f"  {LABELS[a.chosen]} or {LABELS[a.alternative]} — not separable from this data; "
+                f"  {label_of(a.chosen)} or {label_of(a.alternative)}"
+                + (f" ({as_alt})" if as_alt else "")
+                + " — not separable from this data; "
                 f"to separate them: {a.separating_test}"
             )
         for s in self.structures:
@@ -347,7 +358,12 @@ class ModelCheckResult:
                 for ch, g in self.gap.items()
             },
             "not_separable": [
-                {"channel": a.channel, "ids": [a.chosen, a.alternative], "separating_test": a.separating_test}
+                {
+                    "channel": a.channel,
+                    "ids": [a.chosen, a.alternative],
+                    "separating_test": a.separating_test,
+                    "alternative_params": dict(a.alternative_params),
+                }
                 for a in self.ambiguities
             ],
             "structured_residual": [
@@ -490,7 +506,7 @@ def run_modelcheck(
     status: dict[str, ChannelStatus] = {TORQUE: _torque_status(sig, axis, torque_nominal, floor_t)}
     channels: dict[str, ChannelReport] = {}
     selectors: dict[str, tuple[ChannelSelector, list[Term], list[FittedTerm], np.ndarray]] = {}
-    ctx_t = ChannelContext(sig, TORQUE)
+    ctx_t = ChannelContext(sig, TORQUE, nominal_inertia_kgm2=axis.nominal_inertia_kgm2)
     fitted_t: list[FittedTerm] = []
     delay_ms = 0.0
     if status[TORQUE].checked:
@@ -500,7 +516,7 @@ def run_modelcheck(
         sel_t = ChannelSelector(
             ctx_t, y_torque[index], TORQUE_CANDIDATES, index, floor_t, CHANNEL_UNITS[TORQUE], base=jerk_col
         )
-        terms_t, steps_t = sel_t.select(nominal_first=("inertia_error",))
+        terms_t, steps_t = sel_t.select(nominal_first=tuple(c.id for c in TORQUE_CANDIDATES if c.nominal))
         fitted_t, fit_t, base_t, ar_t = sel_t.final_fit(terms_t)
         delay_ms = -1000.0 * float(base_t[0])
         if abs(delay_ms) > 0.05:
@@ -521,8 +537,8 @@ def run_modelcheck(
     else:
         motor_side = np.zeros(n)
         for ft in fitted_t:
-            if ft.id in ("coulomb_friction", "viscous_friction", "torque_ripple"):
-                cand = next(c for c in TORQUE_CANDIDATES if c.id == ft.id)
+            cand = CANDIDATES[ft.id]
+            if cand.motor_side:  # friction and ripple act before the gear: it does not carry them
                 motor_side += cand.build(ctx_t, ft.shape) @ ft.beta
         gear_torque = sig.torque_f_nm - model.motor_side_inertia_kgm2 * sig.accel_rad_s2 - motor_side
         residual["gear_torque_nm"] = gear_torque
@@ -563,10 +579,11 @@ def run_modelcheck(
     where: dict[str, ChannelWhere] = {}
     for ch, (sel, terms, fitted, fit) in selectors.items():
         unit = CHANNEL_UNITS[ch]
-        for a, b, dbic in sel.substitutes(terms):
-            ambiguities.append(Ambiguity(ch, a, b, dbic, separating_test(a, b)))
+        for a, b, dbic, alt_params in sel.substitutes(terms):
+            ambiguities.append(Ambiguity(ch, a, b, dbic, separating_test(a, b), alt_params))
         for ft in fitted:
-            effects.append(_effect(ft, [amb.alternative for amb in ambiguities if amb.chosen == ft.id]))
+            alternatives = [amb.alternative for amb in ambiguities if ft.id in amb.chosen.split(" + ")]
+            effects.append(_effect(ft, alternatives, ambiguities))
         chosen = {t.id for t in terms}
         for cand in sel.candidates:
             if cand.id in chosen or any(a.alternative == cand.id for a in ambiguities):
@@ -584,7 +601,9 @@ def run_modelcheck(
         # an unmeasured load acts on the torque; the position channel's model errors (a dead band's
         # transitions) sit at reversals and would read as bursts there
         bursts = (
-            _bursts_in_time(after, sig.t_s[index], sel.floor, max(5, 4 * sig.filt.window // step))
+            _bursts_in_time(
+                after, sig.t_s[index], sel.floor, max(5, 4 * sig.filt.window // step), _breakaways(ctx_t)
+            )
             if ch == TORQUE
             else None
         )
@@ -701,29 +720,21 @@ def _position_status(sig: Signals, y_arcsec: np.ndarray) -> ChannelStatus:
     )
 
 
-def _effect(ft: FittedTerm, alternatives: list[str]) -> Effect:
+def _effect(ft: FittedTerm, alternatives: list[str], ambiguities: list[Ambiguity]) -> Effect:
     params = {p.name: p.value for p in ft.params}
     sig = {p.name: p.std for p in ft.params}
     units = {p.name: p.unit for p in ft.params}
-    return Effect(ft.id, ft.channel, ft.label, params, sig, units, ft.size, alternatives)
-
-
-def _limit(cand, ch: str, size: float, unit: str, sel: ChannelSelector) -> DetectionLimit:
-    ctx = sel.ctx
-    sig = ctx.sig
-    primary = cand.primary
-    if cand.id == "viscous_friction":
-        value, punit = size / max(rms(sig.speed_rad_s), 1e-12), "N m s/rad"
-    elif cand.id == "inertia_error":
-        value, punit = size / max(rms(sig.accel_rad_s2), 1e-12), "kg m^2"
-    elif cand.id == "torsional_compliance":
-        # wind-up smaller than this (in arcsec) would not show: the stiffest spring still visible
-        value, punit = rms(ctx.gear_torque_nm) * ARCSEC_PER_RAD / max(size, 1e-12), "N m/rad"
-    elif cand.id == "lost_motion":
-        value, punit = 2.0 * size, "arcsec"
+    if alternatives:
+        test = next(a.separating_test for a in ambiguities if ft.id in a.chosen.split(" + "))
+        advice = f"the data cannot tell it from {' or '.join(label_of(a) for a in alternatives)}: {test}"
     else:
-        value, punit = size, unit
-    return DetectionLimit(cand.id, ch, size, unit, primary, value, punit)
+        advice = CANDIDATES[ft.id].advice(params)
+    return Effect(ft.id, ft.channel, ft.label, params, sig, units, ft.size, alternatives, advice)
+
+
+def _limit(cand: Candidate, ch: str, size: float, unit: str, sel: ChannelSelector) -> DetectionLimit:
+    value = cand.limit_in_param(size, sel.ctx)
+    return DetectionLimit(cand.id, ch, size, unit, cand.primary, value, cand.primary_unit or unit)
 
 
 def _where_variables(sig: Signals, index: np.ndarray, ch: str, residual: dict[str, np.ndarray]):
@@ -806,24 +817,34 @@ def _structure(
     return best
 
 
+def _breakaways(ctx: ChannelContext) -> np.ndarray:
+    """Times (s) the axis starts to move from standstill: where a stuck axis breaks away."""
+    d = ctx.full_sign_speed(memory=False)
+    starts = np.flatnonzero((d[1:] != 0) & (d[:-1] == 0)) + 1
+    return ctx.sig.raw_t_s[starts]
+
+
 def _bursts_in_time(
-    e: np.ndarray, t: np.ndarray, floor: float, length: int
+    e: np.ndarray, t: np.ndarray, floor: float, length: int, breakaways: np.ndarray | None = None
 ) -> tuple[float, float, list[tuple[float, float, float]]] | None:
     """Bursts of residual at times no state variable explains (an unmeasured disturbance).
 
     The residual's local RMS over `length` samples (a few analysis windows) is compared with its
-    median: a burst peaks above BURST_FACTOR x the median and above twice the practical floor; it
+    median: a burst peaks above BURST_FACTOR x the median and BURST_FLOOR_FACTOR practical floors; it
     extends while the local RMS stays above BURST_EDGE_FACTOR x the median. A model's own errors sit
     at every acceleration change and stay within a few times the median; a disturbance at
-    irregular times stands out by an order of magnitude. Returns (rms within the bursts, their share
-    of the residual variance, [(start s, end s, peak local RMS)]) or None.
+    irregular times stands out by an order of magnitude. A burst peaking just after the axis breaks
+    away from standstill is the rigid model's own limit (stick-slip), not a disturbance. Returns
+    (rms within the bursts, their share of the residual variance, [(start s, end s, peak local RMS)])
+    or None.
     """
     total = float(np.sum(e**2))
     if total <= 0 or len(e) < 4 * length:
         return None
     local = np.sqrt(np.convolve(e**2, np.ones(length) / length, mode="same"))
     median = float(np.median(local))
-    threshold = max(BURST_FACTOR * median, 2.0 * floor)
+    threshold = max(BURST_FACTOR * median, BURST_FLOOR_FACTOR * floor)
+    settle_s = BREAKAWAY_SETTLE_S + length * float(t[1] - t[0])
     if not np.any(local > threshold):
         return None
     inside = local > BURST_EDGE_FACTOR * median
@@ -832,11 +853,13 @@ def _bursts_in_time(
     mask = np.zeros(len(e), bool)
     for a, b in zip(edges[::2], edges[1::2], strict=True):
         peak = float(local[a:b].max())
-        if peak > threshold:
+        at = float(t[a + int(np.argmax(local[a:b]))])
+        after_breakaway = breakaways is not None and np.any((breakaways <= at) & (at - breakaways < settle_s))
+        if peak > threshold and not after_breakaway:
             spans.append((float(t[a]), float(t[b - 1]), peak))
             mask[a:b] = True
     fraction = float(np.sum(e[mask] ** 2)) / total
-    if fraction < STRUCTURE_MIN_FRACTION:
+    if not spans or fraction < STRUCTURE_MIN_FRACTION:
         return None
     return float(np.sqrt(np.mean(e[mask] ** 2))), fraction, spans
 
@@ -856,17 +879,9 @@ def _gap(sel: ChannelSelector, terms, ch: str, unit: str, t: np.ndarray) -> Gap:
 def _updated_model(model: AxisModel, effects: list[Effect]) -> AxisModel:
     e = Effects()
     for eff in effects:
-        params = dict(eff.params)
-        if eff.id in ("coulomb_friction", "viscous_friction", "lost_motion"):
-            key = next(iter(params))
-            params[key] = max(params[key], 0.0)
-        if eff.id == "torsional_compliance":
-            params = {k: v for k, v in params.items() if math.isfinite(v) and v > 0}
-            if "stiffness_nm_per_rad" not in params:
-                continue
-        if eff.id == "inertia_error" and model.load_side_inertia_kgm2 + params["inertia_kgm2"] <= 0:
-            continue
-        e = e.with_effect(eff.id, **params)
+        params = CANDIDATES[eff.id].model_params(dict(eff.params), model)
+        if params is not None:
+            e = e.with_effect(eff.id, **params)
     return model.with_effects(e)
 
 
