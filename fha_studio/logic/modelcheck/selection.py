@@ -410,7 +410,7 @@ class ChannelSelector:
         while len(terms) < MAX_EFFECTS:
             phi = fit_ar(self.residual(terms))
             in_model = [t.id for t in terms]
-            trials = []
+            tried: list[tuple[Trial, Term, Term | None]] = []
             for cand in self.candidates:
                 if cand.id in in_model:
                     continue
@@ -418,11 +418,11 @@ class ChannelSelector:
                 replaced = next((t for t in terms if t.id in cand.extends), None)
                 if (cand.extends and replaced is None) or cand.only_as_alternative:
                     continue
-                trials.append((*self.try_add(cand, terms, replaced), replaced))
-            good = [trial for trial in trials if trial[0].accepted]
+                tried.append((*self.try_add(cand, terms, replaced), replaced))
+            good = [trial for trial in tried if trial[0].accepted]
             best = min(good, key=lambda p: p[0].delta_bic) if good else None
             chosen = best[0].id if best else None
-            steps.append(SelectionStep("forward", len(phi), [tr for tr, _, _ in trials], chosen))
+            steps.append(SelectionStep("forward", len(phi), [tr for tr, _, _ in tried], chosen))
             if best is None:
                 break
             terms = [t for t in terms if t is not best[2]] + [best[1]]
@@ -559,7 +559,7 @@ class ChannelSelector:
         look_alikes), both ways: (chosen ids, alternative ids, BIC difference), ids joined by " + "."""
         by_id = {c.id: c for c in self.candidates}
         chosen = {t.id for t in terms}
-        out = []
+        out: list[tuple[str, str, float, dict[str, float]]] = []
         for cand in self.candidates:
             for combo in cand.look_alikes:
                 if not all(i in by_id for i in combo):
