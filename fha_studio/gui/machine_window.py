@@ -16,6 +16,7 @@ import logging
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -244,8 +245,8 @@ class AxisRecorder(QObject):
         for (who, at), rows in groups.items():
             self._record(
                 "front-panel value",
-                lambda who=who, at=at, rows=rows: self.register.record_snapshot(
-                    self.axis_ref, rows, "front_panel", who=who, at_utc=at
+                partial(
+                    self.register.record_snapshot, self.axis_ref, rows, "front_panel", who=who, at_utc=at
                 ),
             )
 
