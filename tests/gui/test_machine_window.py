@@ -6,6 +6,8 @@ axes are commissioned (history, a diff against the twin, a find)."""
 from __future__ import annotations
 
 import gc
+import shutil
+import subprocess
 
 import pytest
 from PySide6.QtCore import QCoreApplication
@@ -232,6 +234,11 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     assert TILT in summary and "not signed" in summary
     assert "absolute origin set: multi-turn data cleared" in summary
     assert pdf.is_file() and pdf.stat().st_size > 1000
+    if shutil.which("pdftotext") is not None:  # each axis's report starts a page of its own
+        text = subprocess.run(["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
+        firsts = [page.strip().splitlines()[0] for page in text.split("\f") if page.strip()]
+        assert firsts[0] == f"Machine report — {MACHINE}"
+        assert [f for f in firsts if f.startswith("Axis ")] == ["Axis table", "Axis table twin", "Axis tilt"]
     assert register.export(MACHINE)["machines"][0]["machine_reports"][0]["file"] == str(pdf.resolve())
     register.close()
 

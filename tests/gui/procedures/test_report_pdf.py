@@ -90,3 +90,14 @@ def test_page_breaks_never_cut_a_row_and_every_page_is_numbered(qapp, tmp_path):
     for number, page in enumerate(pages, start=1):
         assert f"page {number} of {len(pages)}" in page
     assert "True" not in "".join(pages)  # yes/no, never a Python bool
+
+
+def test_a_page_starts_where_the_document_asks_for_one():
+    from fha_studio.gui.pages.procedures.report_pdf import _Span, page_breaks
+
+    # a break asked for at 100 px and 2000 px; the pages between end when full
+    assert page_breaks([], 3000.0, 1500.0, forced=[100.0, 2000.0]) == [0.0, 100.0, 1600.0, 2000.0]
+    # a break asked for at the very top or beyond the end makes no empty page
+    assert page_breaks([], 1000.0, 1500.0, forced=[0.0, 1200.0]) == [0.0]
+    # a full page still never cuts a span
+    assert page_breaks([_Span(1400.0, 1600.0)], 3000.0, 1500.0) == [0.0, 1400.0, 2900.0]

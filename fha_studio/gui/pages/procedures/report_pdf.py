@@ -8,6 +8,7 @@ drawn with a footer that says which report and which page it is.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,6 +23,7 @@ from PySide6.QtGui import (
     QPdfWriter,
     QTextBlock,
     QTextDocument,
+    QTextFormat,
     QTextFrame,
     QTextTable,
 )
@@ -121,18 +123,40 @@ def _table_of(block: QTextBlock) -> QTextTable | None:
     return None
 
 
-def page_breaks(spans: list[_Span], total_height: float, page_height: float) -> list[float]:
+def forced_breaks(document: QTextDocument) -> list[float]:
+    """Where the document asks for a new page (``page-break-before: always``) [px from the top]."""
+    layout = document.documentLayout()
+    tops = []
+    block = document.begin()
+    while block.isValid():
+        if block.blockFormat().pageBreakPolicy() & QTextFormat.PageBreakFlag.PageBreak_AlwaysBefore:
+            tops.append(layout.blockBoundingRect(block).top())
+        block = block.next()
+    return tops
+
+
+def page_breaks(
+    spans: list[_Span], total_height: float, page_height: float, forced: Sequence[float] = ()
+) -> list[float]:
     """Top of each page [px]: a page ends where it is full, or earlier, at the top of the first
-    span that the full page would cut. A span taller than a page is cut (nothing else can be done)."""
+    span that the full page would cut, or where the document asks for a new page (``forced``).
+    A span taller than a page is cut (nothing else can be done)."""
     tops = [0.0]
     top = 0.0
-    while top + page_height < total_height:
+    wanted = sorted(forced)
+    while True:
         end = top + page_height
-        while True:  # moving the break up can land it inside another span (a heading's): again
-            cut = [s.top for s in spans if s.top < end < s.bottom and s.top > top + 1.0]
-            if not cut:
-                break
-            end = min(cut)
+        asked = [f for f in wanted if top + 1.0 < f < min(end, total_height)]
+        if asked:
+            end = asked[0]
+        elif end >= total_height:
+            break
+        else:
+            while True:  # moving the break up can land it inside another span (a heading's): again
+                cut = [s.top for s in spans if s.top < end < s.bottom and s.top > top + 1.0]
+                if not cut:
+                    break
+                end = min(cut)
         tops.append(end)
         top = end
     return tops
@@ -168,7 +192,7 @@ def write_pdf(
     footer_px = _mm_to_px(FOOTER_MM)
     body_height = paint.height() - footer_px
     total = document.size().height()
-    tops = page_breaks(_unbreakable_spans(document), total, body_height)
+    tops = page_breaks(_unbreakable_spans(document), total, body_height, forced_breaks(document))
     ends = [*tops[1:], total]
     painter = QPainter(writer)
     try:
