@@ -24,6 +24,7 @@ os.environ["XDG_DATA_HOME"] = str(TMP / "data")
 os.environ.pop("FHA_STUDIO_REGISTER", None)
 
 from PySide6.QtCore import QCoreApplication, QEventLoop, QTimer  # noqa: E402
+from PySide6.QtGui import QColor, QImage, QPainter  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
 
 OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
@@ -61,7 +62,7 @@ def main() -> int:
     project.add_axis(
         "table twin", "FHA-25C-50-US250", port_url="sim://FHA-25C-50-US250?paced=0", load_inertia_kgm2=1.5
     )
-    tilt = "sim://FHA-32C-100-S248-B?paced=0&profile=documented"
+    tilt = "sim://FHA-32C-100-S248-B?paced=0&profile=documented&oww_clear_s=1"
     project.add_axis("tilt", "FHA-32C-100-S248-B", port_url=tilt, load_inertia_kgm2=4.0)
     register = Register(TMP / "register.sqlite")
     window = MachineWindow(project, register)
@@ -82,6 +83,16 @@ def main() -> int:
         page.answer(good_answer(step))
     page.write_report(TMP / "table.html", TMP / "table.pdf")
 
+    # the tilt's drive speaks only DGR and OWW: its direction read off the front panel, its
+    # absolute origin set with OWW on the DGR checks page
+    tilt_window = window.axis_windows[2]
+    tilt_window.state.enter_front_panel("system", 8, 0, "A. Technician")
+    dgr = tilt_window.show_page("absolute")
+    dgr.who_edit.setText("A. Technician")
+    wait_until(lambda: dgr.origin_button.isEnabled())
+    dgr.origin_button.click()
+    wait_until(lambda: bool(dgr.records))
+
     window.select_axis("table twin")
     twin.show_page("parameters")
     settle(800)
@@ -100,13 +111,25 @@ def main() -> int:
     dialog.close()
 
     _html, pdf = window.write_machine_report(TMP / "machine.html", TMP / "machine.pdf")
-    # the PDF's first page, as the person receiving it sees it
-    subprocess.run(
-        ["pdftoppm", "-png", "-r", "100", "-f", "1", "-l", "1", str(pdf), str(TMP / "page")], check=True
+    # the PDF's first two pages (the summary, the first axis's report) side by side, as the
+    # person receiving it sees them
+    first_pages = ["pdftoppm", "-png", "-r", "90", "-f", "1", "-l", "2", str(pdf), str(TMP / "page")]
+    subprocess.run(first_pages, check=True)
+    pages = [QImage(str(p)) for p in sorted(TMP.glob("page*.png"))]
+    sheet = QImage(
+        sum(p.width() for p in pages) + 30 * (len(pages) + 1),
+        pages[0].height() + 60,
+        QImage.Format.Format_RGB32,
     )
-    page_png = next(TMP.glob("page*.png"))
+    sheet.fill(QColor("#808080"))
+    painter = QPainter(sheet)
+    x = 30
+    for p in pages:
+        painter.drawImage(x, 30, p)
+        x += p.width() + 30
+    painter.end()
     target = OUT / "machine-report.png"
-    page_png.replace(target)
+    sheet.save(str(target))
     print("saved", target)
     window.shutdown()
     window.close()

@@ -321,11 +321,12 @@ class AxisRecorder(QObject):
             )
             self._record("check", lambda: self.register.record_checks(self.axis_ref, [check]))
         if record.check == "absolute_origin" and record.passed:
+            where = record.values.get("position_deg")
+            read_back = f", read back at {where:+.2f}°" if isinstance(where, float) else ""
+            text = f"absolute origin set (OWW){read_back}"
             self._record(
                 "origin",
-                lambda: self.register.record_origin(
-                    self.axis_ref, f"absolute origin set: {record.detail}", who=record.who, at_utc=record.at
-                ),
+                lambda: self.register.record_origin(self.axis_ref, text, who=record.who, at_utc=record.at),
             )
         if record.check == "sensor_dog" and record.passed and record.values.get("sensor") == "origin_sensor":
             angle = float(record.values["angle_deg"])

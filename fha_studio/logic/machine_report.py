@@ -8,6 +8,7 @@ says nothing an axis report does not. Plain HTML (QTextDocument prints it to PDF
 
 from __future__ import annotations
 
+import contextlib
 import html
 import re
 from collections.abc import Mapping
@@ -130,6 +131,10 @@ def build_machine_report(
         ref = f"{project.name}/{axis.name}"
         report = build_report(session) if session is not None else None
         passed, failed = _checks(session)
+        if register is not None:
+            # the register also holds the checks done outside the procedures (DGR checks)
+            with contextlib.suppress(ValueError):  # an axis the register does not have
+                passed, failed = max((passed, failed), register.check_counts(ref), key=sum)
         signature = session.signature if session is not None else {}
         if signature:
             signed = f"signed by {signature['who']} ({signature['at_utc'][:16].replace('T', ' ')} UTC)"
@@ -194,6 +199,7 @@ def render_machine_html(report: MachineReport) -> str:
         "Checks failed",
         "Report",
     ]
+    widths = [10, 17, 12, 19, 18, 7, 7, 10]  # per cent of the page
     rows = []
     for s in report.summaries:
         failed = f"<span class='fail'>{s.checks_failed}</span>" if s.checks_failed else "0"
@@ -214,7 +220,7 @@ def render_machine_html(report: MachineReport) -> str:
                 signed,
             ]
         )
-    header = "".join(f"<th>{h}</th>" for h in head)
+    header = "".join(f"<th width='{w}%'>{h}</th>" for h, w in zip(head, widths, strict=True))
     body = "".join("<tr>" + "".join(f"<td>{c}</td>" for c in row) + "</tr>" for row in rows)
     out.append(f"<table width='100%'><tr>{header}</tr>{body}</table>")
     if report.problems:

@@ -219,7 +219,7 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     qtbot.waitUntil(lambda: len(dgr.records) > before, timeout=15000)
     origin = register.latest_origin(f"{MACHINE}/tilt")
     assert (
-        origin["text"].startswith("absolute origin set: multi-turn data cleared") and origin["who"] == "ana"
+        origin["text"].startswith("absolute origin set (OWW), read back at") and origin["who"] == "ana"
     )
     assert [e.text.split(":")[0] for e in register.history(f"{MACHINE}/tilt") if e.kind == "check"] == [
         "dgr-checks / absolute_origin"
@@ -232,7 +232,7 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     assert "1: FWD command → REV rotation" in summary  # the table, reversed
     assert "0: FWD command → FWD rotation (default)" in summary  # the twin
     assert TILT in summary and "not signed" in summary
-    assert "absolute origin set: multi-turn data cleared" in summary
+    assert "absolute origin set (OWW), read back at" in summary
     assert pdf.is_file() and pdf.stat().st_size > 1000
     if shutil.which("pdftotext") is not None:  # each axis's report starts a page of its own
         text = subprocess.run(["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
