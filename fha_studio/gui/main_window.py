@@ -492,5 +492,26 @@ class LazyPage(QWidget):
         super().showEvent(event)
 
 
+#: What the person asked for, as the message names it ("Move failed: ...").
+_CMD_WORDS = {
+    Cmd.OPEN: "Connecting",
+    Cmd.CLOSE: "Disconnecting",
+    Cmd.IDENTIFY: "Identifying the drive",
+    Cmd.READ_PARAMETERS: "Reading the parameters",
+    Cmd.WRITE_PARAMETERS: "Writing the parameters",
+    Cmd.SERVO: "Servo on/off",
+    Cmd.JOG: "Jog",
+    Cmd.SET_MOVE_SPEED: "Setting the move speed",
+    Cmd.MOVE_BY: "Move",
+    Cmd.STOP: "STOP",
+    Cmd.CLEAR_ALARM: "Clearing the alarm",
+    Cmd.ALARM_HISTORY: "Reading the alarm history",
+    Cmd.POWER_CYCLE: "Power cycle",
+    Cmd.SET_INPUTS: "Setting the simulated inputs",
+    Cmd.CALL: "The drive request",
+    Cmd.SIM_PANEL: "The simulated drive's panel",
+}
+
+
 def _command_words(cmd: Cmd) -> str:
-    return cmd.name.replace("_", " ").lower().capitalize()
+    return _CMD_WORDS.get(cmd, cmd.name.replace("_", " ").lower().capitalize())

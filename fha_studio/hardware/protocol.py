@@ -92,6 +92,63 @@ class Command(StrEnum):
     SNQ = "SNQ"  # read the sensor angles (sim only)
 
 
+#: What each command asks the drive to do, in words for a person ("the drive refused to ...").
+COMMAND_WORDS: dict[Command, str] = {
+    Command.DGR: "report the absolute position",
+    Command.OWW: "clear the multi-turn data",
+    Command.IDN: "say what it is",
+    Command.CAP: "list the commands it has",
+    Command.PSL: "select parameter-mode item",
+    Command.TSL: "select tune-mode item",
+    Command.JSL: "select test-mode item",
+    Command.PRD: "read the selected item",
+    Command.PWR: "write the selected item",
+    Command.MON: "read monitor item",
+    Command.MMR: "read the monitor items",
+    Command.SVO: "switch the servo",
+    Command.JOG: "jog",
+    Command.SPD: "set the move speed",
+    Command.MOV: "move by an angle",
+    Command.STP: "stop",
+    Command.ALM: "report the alarm",
+    Command.AHS: "report the alarm history",
+    Command.ACL: "clear the alarm",
+    Command.IOS: "report its inputs and outputs",
+    Command.INP: "set the simulated inputs",
+    Command.PWC: "power-cycle",
+    Command.TCH: "set the trace channels",
+    Command.TDV: "set the trace sample rate",
+    Command.TTG: "set the trace trigger",
+    Command.TTC: "set the trace trigger channel",
+    Command.TTL: "set the trace trigger level",
+    Command.TPR: "set the trace pre-trigger",
+    Command.TAR: "arm the trace",
+    Command.TST: "report the trace state",
+    Command.TRB: "send a trace block",
+    Command.TRP: "send a trace block",
+    Command.FLT: "raise alarm",
+    Command.SNO: "move the origin slit",
+    Command.SNA: "move the dog of limit switch 1",
+    Command.SNB: "move the dog of limit switch 2",
+    Command.SNQ: "report the sensor angles",
+}
+
+
+#: Commands whose value names what they act on (an item or alarm number): said with the words.
+NUMBERED_COMMANDS = frozenset({Command.PSL, Command.TSL, Command.JSL, Command.MON, Command.FLT})
+
+
+def command_words(command: Command | str, value: int | None = None) -> str:
+    """What ``command`` asks the drive to do, in words ("move by an angle", "select
+    parameter-mode item 8" with its ``value`` where the value names the item)."""
+    try:
+        command = Command(command)
+        words = COMMAND_WORDS[command]
+    except (KeyError, ValueError):
+        return f"answer {command}"
+    return f"{words} {value}" if value is not None and command in NUMBERED_COMMANDS else words
+
+
 #: The commands a real HA-655 is known to answer (its public manual, p.21).
 DOCUMENTED_COMMANDS = frozenset({Command.DGR, Command.OWW})
 #: Commands that only the simulated drive has (a real drive answers x).

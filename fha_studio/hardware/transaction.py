@@ -28,7 +28,7 @@ from typing import TypeVar
 
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.errors import CommandRejected, LinkLost, LinkTimeout, ServoOnRefused
-from fha_studio.hardware.protocol import Command, Garbage, Reply, Request, Status
+from fha_studio.hardware.protocol import Command, Garbage, Reply, Request, Status, command_words
 from fha_studio.hardware.transport import GuardedTransport, Transport
 
 __all__ = [
@@ -212,10 +212,12 @@ class Transaction:
                         continue
                     if reply.status is Status.SERVO_ON:
                         self._succeeded()
-                        raise ServoOnRefused(f"{command}: refused, the servo is on (not processed)")
+                        raise ServoOnRefused(
+                            f"the drive does not {command_words(command)} while the servo is on"
+                        )
                     if reply.status is Status.REJECTED:
                         self._succeeded()
-                        raise CommandRejected(f"{command}{value:+06d}: rejected by the drive (x)")
+                        raise CommandRejected(f"the drive refused to {command_words(command, value)}")
                     try:
                         result = parse(reply)
                     except ValueError as exc:

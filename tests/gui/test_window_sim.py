@@ -196,7 +196,8 @@ def test_stop_and_failures_are_seen_in_the_message_area_and_kept_in_its_log(wind
     )
     assert not text_rect.intersects(caps_rect)
     window.link.send(Cmd.MOVE_BY, 10.0)  # servo off: the drive refuses to move
-    qtbot.waitUntil(lambda: "Move by failed" in area.text_label.text(), timeout=10000)
+    refused = "Move failed: the drive refused to move by an angle"
+    qtbot.waitUntil(lambda: refused in area.text_label.text(), timeout=10000)
     assert "#b00020" in area.text_label.styleSheet()
     texts = [m.text for m in area.messages]
     assert any(t.startswith("STOP sent") for t in texts) and any(t.startswith("STOP done") for t in texts)

@@ -325,3 +325,11 @@ def test_the_dgr_count_per_motor_turn_is_the_catalogues_absolute_encoder():
     from fha_studio.catalog import tables
 
     assert tables.encoder_resolution_table("absolute").counts_per_motor_rev == p.ABSOLUTE_COUNTS_PER_TURN
+
+
+def test_every_command_has_words_for_a_person():
+    from fha_studio.hardware.protocol import COMMAND_WORDS, command_words
+
+    assert set(COMMAND_WORDS) == set(p.Command)
+    assert command_words(p.Command.PSL, 8) == "select parameter-mode item 8"
+    assert command_words(p.Command.MOV, 1000) == "move by an angle"  # a value that names nothing

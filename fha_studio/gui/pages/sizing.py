@@ -35,6 +35,7 @@ from fha_studio.gui.connect_dialog import catalogue_codes
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
 from fha_studio.logic.sizing import SizingResult
+from fha_studio.logic.wording import with_unit
 
 PASS_COLOUR = QColor("#2e7d32")
 FAIL_COLOUR = QColor("#b00020")
@@ -430,11 +431,11 @@ class SizingPage(BasePage):
         checks = list(result.checks)
         self.checks_table.setRowCount(len(checks))
         for row, check in enumerate(checks):
-            unit = f" {check.unit}" if check.unit else ""
+            comparison = {"<=": "≤", ">=": "≥"}.get(check.comparison, check.comparison)
             cells = [
                 check.name,
-                f"{check.value:.4g}{unit}",
-                f"{check.comparison} {check.limit:.4g}{unit}",
+                with_unit(f"{check.value:.4g}", check.unit),
+                with_unit(f"{comparison} {check.limit:.4g}", check.unit),
                 "pass" if check.ok else "FAIL",
                 check.section,
             ]
