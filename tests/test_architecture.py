@@ -78,6 +78,10 @@ heavy = sorted({m.split('.')[0] if not m.startswith('fha_studio') else m for m i
 print('heavy:', heavy)
 window._closing_confirmed = True
 window.shutdown()
+window.deleteLater()  # before the QApplication, as the app does: not in the exit's arbitrary order
+from PySide6.QtCore import QEvent
+QCoreApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete.value)
+del window
 """
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "XDG_CONFIG_HOME": str(tmp_path / "config"),
            "XDG_DATA_HOME": str(tmp_path / "data"), "PYTHONPATH": str(ROOT)}

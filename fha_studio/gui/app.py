@@ -146,7 +146,7 @@ def run(argv: Sequence[str] = ()) -> int:
     args = _parser().parse_args(list(argv))
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     app = make_application()
-    from PySide6.QtCore import QTimer
+    from PySide6.QtCore import QCoreApplication, QEvent, QTimer
     from PySide6.QtGui import QIcon
 
     from fha_studio.gui.main_window import MainWindow
@@ -183,4 +183,9 @@ def run(argv: Sequence[str] = ()) -> int:
     window.shutdown()
     if machine is not None and machine.register is not None:
         machine.register.close()
+    # the window goes while the QApplication is still there: left to the interpreter's exit the
+    # order is arbitrary, and Qt can crash there after a clean close
+    window.deleteLater()
+    QCoreApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete.value)
+    del window
     return int(code)

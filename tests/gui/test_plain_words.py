@@ -90,7 +90,7 @@ def leaks(window) -> list[str]:
 def test_every_page_speaks_the_manuals_words(make_window, qtbot):
     window = make_window(connect=SIM_URL)
     window.resize(1366, 740)
-    qtbot.waitUntil(lambda: len(window.session.drive_values) >= 14, timeout=15000)
+    qtbot.waitUntil(lambda: len(window.state.drive_values) >= 14, timeout=15000)
     # a short session: an edit written, a refused move, an alarm
     parameters = window.show_page("parameters")
     model = parameters.model
