@@ -21,6 +21,7 @@ import hashlib
 import json
 import os
 import sqlite3
+import time
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -201,8 +202,7 @@ class Register:
             self._db.row_factory = sqlite3.Row
             self._db.execute("PRAGMA foreign_keys = ON")
             self._db.execute("PRAGMA synchronous = FULL")
-            mode = self._db.execute("PRAGMA journal_mode = WAL").fetchone()[0]
-            self.journal_mode = str(mode).lower()
+            self.journal_mode = self._set_wal(busy_timeout_s)
             self._migrate()
         except sqlite3.DatabaseError as exc:
             self._db.close()
@@ -215,6 +215,19 @@ class Register:
     @property
     def version(self) -> int:
         return int(self._db.execute("PRAGMA user_version").fetchone()[0])
+
+    def _set_wal(self, busy_timeout_s: float) -> str:
+        """Switch the file to WAL. SQLite does not wait on its busy timeout for this switch: while
+        another process creates or writes the same new file, it says "database is locked" at
+        once, so try again until the busy timeout has passed."""
+        deadline = time.monotonic() + busy_timeout_s
+        while True:
+            try:
+                return str(self._db.execute("PRAGMA journal_mode = WAL").fetchone()[0]).lower()
+            except sqlite3.OperationalError as exc:
+                if "locked" not in str(exc) or time.monotonic() > deadline:
+                    raise
+                time.sleep(0.05)
 
     def _migrate(self, target: int = SCHEMA_VERSION) -> None:
         if self.version > SCHEMA_VERSION:
