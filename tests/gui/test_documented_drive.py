@@ -139,7 +139,7 @@ def click_and_record(page, qtbot, button):
     return page.records[-1]
 
 
-def test_dgr_checks_encoder_direction_dogs_and_origin(make_window, qtbot):
+def test_dgr_checks_encoder_direction_dogs_and_origin(make_window, qtbot, tmp_path):
     window = make_window(connect=SENSOR_URL)
     window.state.set_actuator("FHA-25C-50-S248-L", acknowledged=True)
     page = window.show_page("absolute")
@@ -191,6 +191,17 @@ def test_dgr_checks_encoder_direction_dogs_and_origin(make_window, qtbot):
     assert record.check == "absolute_origin" and record.passed
     assert record.values["position_counts"] == record.values["before_counts"] % 8192
     assert page.history.rowCount() == 5
+
+    # the records go into the commissioning report (as notes with who), each once
+    from fha_studio.logic.procedures.report import build_report
+
+    procedures = window.show_page("procedures")
+    procedures.new_session(tmp_path / "axis.json", "FHA-25C-50-S248-L")
+    procedures._collect_for_report()
+    procedures._collect_for_report()
+    notes = build_report(procedures.session).notes
+    assert len(notes) == 5 and all(n["who"] == "A. Tester" for n in notes)
+    assert any(n["text"].startswith("Absolute origin (OWW)") and ": pass:" in n["text"] for n in notes)
 
 
 def test_dgr_checks_on_an_incremental_encoder_ask_and_record_by_hand(make_window, qtbot):

@@ -517,8 +517,28 @@ class ProceduresPage(BasePage):
                 except (KeyError, ValueError):
                     continue
             self.session.parameters = {"file": str(path or ""), "values": by_key, "front_panel": panel}
+        self._collect_dgr_checks()
         if self.session.path:
             self.session.save()
+
+    def _collect_dgr_checks(self) -> None:
+        """The DGR checks page's records (encoder, rotary direction, sensor dogs, absolute origin)
+        go into the report as notes with who and the verdict, each once."""
+        from fha_studio.gui.pages.base import PageId
+        from fha_studio.logic.absolute import CHECK_TITLES
+
+        window = self.main_window
+        built = getattr(window, "built_page", None)
+        checks = built(PageId.ABSOLUTE) if built is not None else None
+        if checks is None or self.session is None:
+            return
+        noted = {n.get("text", "") for n in self.session.notes}
+        for record in getattr(checks, "records", []):
+            verdict = {True: "pass", False: "FAIL", None: "recorded"}[record.passed]
+            how = ", entered by hand" if record.by_hand else ", with DGR"
+            text = f"{CHECK_TITLES[record.check]} ({record.at}{how}): {verdict}: {record.detail}"
+            if text not in noted:
+                self.session.add_note(text, who=record.who)
 
     def add_plot(self, title: str, png_path: str | Path) -> None:
         if self.session is not None:
