@@ -79,3 +79,26 @@ def test_pairing_warning_must_be_acknowledged(make_window, qtbot):
     assert not window.state.actuator_acknowledged
     page.acknowledge()
     assert not page.warning_pending and window.state.actuator_acknowledged
+
+
+def test_sizing_says_which_assumption_decides_and_takes_an_acceleration_time(make_window, qtbot):
+    """FHA-25C-50 fails the effective torque at its own maximum torque (the manual's method) where
+    a smaller frame passes; the page says so, and with the machine's acceleration time it passes.
+    Calculate stays in sight at 1366x768."""
+    window = make_window()
+    window.resize(1366, 740)
+    window.state.set_actuator("FHA-25C-50-US250")
+    window.state.set_load_inertia(1.2)
+    page = window.show_page("sizing")
+    page.speed_spin.setValue(40.0)
+    page.angle_spin.setValue(120.0)
+    page.cycle_spin.setValue(1.5)
+    page.calculate()
+    qtbot.waitUntil(lambda: page.result is not None, timeout=10000)
+    assert any(c.name == "effective torque" and not c.ok for c in page.result.checks)
+    assert "at the maximum torque TM = 150 N·m" in page.assumption.text()
+    assert page.accel_spin.text() == "at the maximum torque (2-4-4)"
+    page.accel_spin.setValue(0.15)
+    page.calculate()
+    assert page.result.ok and "in the given 0.15 s" in page.assumption.text()
+    assert not page.calculate_button.visibleRegion().isEmpty()

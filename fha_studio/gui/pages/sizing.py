@@ -141,17 +141,30 @@ class SizingPage(BasePage):
         self.torque_spin.setToolTip(
             "Load torque TL, positive when it opposes the rotation (friction, a load to lift)"
         )
+        self.accel_spin = _spin(0.0, 0.0, 1000.0, 3, " s")
+        self.accel_spin.setSpecialValueText("at the maximum torque (2-4-4)")
+        self.accel_spin.setToolTip(
+            "Acceleration (and braking) time the machine needs. Left at the minimum, each actuator "
+            "accelerates at its own maximum torque as the manual does: a larger one accelerates harder, "
+            "so its effective torque is higher and it can fail where a smaller one passes."
+        )
         d_form.addRow("Ac&tuator:", self.actuator_combo)
         d_form.addRow("Load &inertia JL:", self.inertia_spin)
         d_form.addRow("Spee&d N:", self.speed_spin)
         d_form.addRow("Move an&gle θ:", self.angle_spin)
         d_form.addRow("C&ycle time t:", self.cycle_spin)
         d_form.addRow("Load tor&que TL:", self.torque_spin)
-        self.calculate_button = QPushButton("&Calculate")
-        d_form.addRow(self.calculate_button)
+        d_form.addRow("Acceleration time ta:", self.accel_spin)
         l_layout.addWidget(duty_box)
         l_layout.addStretch(1)
-        splitter.addWidget(scroll)
+        # Calculate stays in sight below the inputs, however far they scroll
+        left_pane = QWidget()
+        lp_layout = QVBoxLayout(left_pane)
+        lp_layout.setContentsMargins(0, 0, 0, 0)
+        lp_layout.addWidget(scroll, 1)
+        self.calculate_button = QPushButton("&Calculate")
+        lp_layout.addWidget(self.calculate_button)
+        splitter.addWidget(left_pane)
 
         # -- right: results ----------------------------------------------------------------------
         right = QWidget()
@@ -161,6 +174,11 @@ class SizingPage(BasePage):
         self.verdict.setWordWrap(True)
         self.verdict.setObjectName("sizingVerdict")
         r_layout.addWidget(self.verdict)
+        self.assumption = QLabel("")
+        self.assumption.setWordWrap(True)
+        self.assumption.setObjectName("sizingAssumption")
+        self.assumption.setStyleSheet("color: #444;")
+        r_layout.addWidget(self.assumption)
         self.plot = pg.PlotWidget(background="w")
         self.plot.setObjectName("torqueSpeedPlot")
         self.plot.setLabel("bottom", "Output speed", units="r/min")
@@ -195,7 +213,7 @@ class SizingPage(BasePage):
         self.add_part_button.clicked.connect(self.add_part)
         self.remove_part_button.clicked.connect(self.remove_part)
         self.calculate_button.clicked.connect(self.calculate)
-        for spin in (self.speed_spin, self.angle_spin, self.cycle_spin, self.torque_spin):
+        for spin in (self.speed_spin, self.angle_spin, self.cycle_spin, self.torque_spin, self.accel_spin):
             spin.editingFinished.connect(self.calculate)
         # the actuator and the load inertia are the axis's: edited here, they change for every page,
         # and a change from anywhere sizes again (never the previous actuator's result on show)
@@ -237,6 +255,7 @@ class SizingPage(BasePage):
             "angle_deg": self.angle_spin,
             "cycle_time_s": self.cycle_spin,
             "load_torque_nm": self.torque_spin,
+            "accel_time_s": self.accel_spin,
         }
 
     # -- load inertia ----------------------------------------------------------------------------------
@@ -358,6 +377,7 @@ class SizingPage(BasePage):
 
     def _clear_result(self, why: str) -> None:
         self.result = None
+        self.assumption.setText("")
         self.verdict.setText(f"<span style='color:#b00020'>{why}</span>" if why else "")
         self.checks_table.setRowCount(0)
         self.plot.clear()
@@ -371,6 +391,8 @@ class SizingPage(BasePage):
             angle_deg=self.angle_spin.value(),
             cycle_time_s=self.cycle_spin.value(),
             load_torque_nm=self.torque_spin.value(),
+            # the minimum of the field means "not given": at the maximum torque, as the manual does
+            accel_time_s=self.accel_spin.value() or None,
         )
 
     @Slot()
@@ -414,6 +436,7 @@ class SizingPage(BasePage):
 
     def _show_result(self, code: str, result) -> None:
         self.result = result
+        self.assumption.setText(f"<b>Assumption:</b> {code} {result.assumption}.")
         failed = result.failed
         if result.ok:
             self.verdict.setText(
