@@ -12,6 +12,7 @@ reads and verified writes, alarms, procedure checks, reports, recordings and mod
 
 from __future__ import annotations
 
+import getpass
 import logging
 import os
 from collections.abc import Callable
@@ -56,6 +57,13 @@ log = logging.getLogger(__name__)
 
 #: Width of the axis list [px].
 AXIS_LIST_WIDTH_PX = 230
+
+
+def _login_name() -> str:
+    try:
+        return getpass.getuser()
+    except (KeyError, OSError):  # no login name in the environment or the password database
+        return ""
 
 
 def register_path() -> Path:
@@ -481,7 +489,7 @@ class MachineWindow(QMainWindow):
         bar.addWidget(QLabel("Operator: "))
         self.operator_edit = QLineEdit(str(QSettings().value("machine/operator", "")))
         self.operator_edit.setObjectName("operator")
-        self.operator_edit.setPlaceholderText("your name (the register records it)")
+        self.operator_edit.setPlaceholderText(f"your name (the register records it; else {_login_name()!r})")
         self.operator_edit.setMaximumWidth(200)
         self.operator_edit.editingFinished.connect(
             lambda: QSettings().setValue("machine/operator", self.operator_edit.text().strip())
@@ -598,7 +606,8 @@ class MachineWindow(QMainWindow):
     # -- which axis ----------------------------------------------------------------------------------
     @property
     def operator(self) -> str:
-        return self.operator_edit.text().strip()
+        """Who the register records: the name typed, else the computer's login name."""
+        return self.operator_edit.text().strip() or _login_name()
 
     @property
     def current_index(self) -> int:
