@@ -28,6 +28,10 @@ SIMULATION_UNITS: dict[str, str] = {
 }
 
 
+# Servo periods simulated per chunk: the per-period records are kept for one chunk only.
+SIMULATION_CHUNK = 50_000
+
+
 @dataclass(frozen=True)
 class MonitorOptions:
     """What a real drive's monitors do to the signals (applied to simulate()'s output).
@@ -108,28 +112,40 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
     p = kernel_params(model, settings)
     dt = p.dt
     n = math.ceil((t[-1] - t[0]) / dt - 1e-9) + 1
-    t_servo = t[0] + dt * np.arange(1, n + 1)
     d = p.direction
-    cmd_servo = (d * np.interp(t_servo, t, cmd)).tolist()
 
     state = _kernel.KernelState(step_index=0)
     _initialise_at_rest(state, p, float(cmd[0]), start_at_rest)
-    # the initial state at t0, then the servo samples at t0 + (k+1) dt
-    rec: tuple[list, ...] = ([0.0], [d * state.cprev], [state.xm], [state.xl], [state.vm], [state.current],
-                             [state.vref])
-    _kernel.run(p, state, cmd_servo, n, True, rec, 1)
-    ts = t[0] + np.asarray(rec[0])
-    series = {"cmd_pos": rec[1], "pos": rec[2], "load_pos": rec[3], "vel": rec[4], "current": rec[5],
-              "speed_cmd": rec[6]}
+    keys = ("cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd")
     out: dict[str, np.ndarray] = {"t": t.copy()}
-    for key, values in series.items():
-        out[key] = np.interp(t, ts, np.asarray(values))
+    for key in keys:
+        out[key] = np.empty(len(t))
+    charge_at = np.empty(len(t))  # integral of the current over time at each sample (current_average)
+    # the servo periods run in chunks: memory stays bounded by the chunk, whatever the duration
+    last_t, last = 0.0, [d * state.cprev, state.xm, state.xl, state.vm, state.current, state.vref]
+    last_charge = 0.0
+    done = 0  # samples filled
+    for k0 in range(0, n, SIMULATION_CHUNK):
+        m = min(SIMULATION_CHUNK, n - k0)
+        t_servo = dt * np.arange(k0 + 1, k0 + m + 1)  # relative to t[0]
+        cmd_servo = (d * np.interp(t[0] + t_servo, t, cmd)).tolist()
+        rec: tuple[list, ...] = ([], [], [], [], [], [], [])
+        _kernel.run(p, state, cmd_servo, m, True, rec, 1)
+        ts = np.concatenate(([last_t], t_servo))
+        cur = np.asarray(rec[5])
+        charge = last_charge + np.concatenate(([0.0], np.cumsum(cur) * dt))
+        stop = int(np.searchsorted(t, t[0] + ts[-1], side="right")) if k0 + m < n else len(t)
+        rel = t[done:stop] - t[0]
+        for j, key in enumerate(keys):
+            out[key][done:stop] = np.interp(rel, ts, np.concatenate(([last[j]], rec[j + 1])))
+        charge_at[done:stop] = np.interp(rel, ts, charge)
+        done = stop
+        last_t = float(ts[-1])
+        last = [float(rec[j + 1][-1]) for j in range(len(keys))]
+        last_charge = float(charge[-1])
     if current_average:
         # the current recorded at the end of a servo period was applied during all of it
-        cur = np.asarray(rec[5])
-        charge = np.concatenate(([0.0], np.cumsum(cur[1:]) * dt))  # integral of i dt at ts
-        q = np.interp(t, ts, charge)
-        out["current"][1:] = np.diff(q) / np.diff(t)
+        out["current"][1:] = np.diff(charge_at) / np.diff(t)
     out["torque"] = out["current"] * model.torque_constant_nm_per_a
     if monitor is not None:
         out = apply_monitor(out, model, monitor)

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import fftconvolve
 
+from fha_studio.logic.modelcheck.selection import gram
 from fha_studio.logic.modelcheck.signals import make_filter
 
 GROWTH_LIMIT = 1.5  # unexplained torque may grow this much over the best of the longer windows
@@ -167,12 +168,12 @@ def _heldout_rms(y: np.ndarray, x: np.ndarray, gap: int) -> float:
     xs = x / scale
     cuts = np.linspace(0, n, CV_BLOCKS + 1).round().astype(int)
     # normal equations: the training Gram matrix is the whole one minus the left-out rows'
-    gram, xty = xs.T @ xs, xs.T @ y
+    g_all, xty = gram(xs, y)
     sse = 0.0
     for a, b in itertools.pairwise(cuts):
         lo, hi = max(0, a - gap), min(n, b + gap)
-        out = xs[lo:hi]
-        beta = np.linalg.pinv(gram - out.T @ out, rcond=1e-10, hermitian=True) @ (xty - out.T @ y[lo:hi])
+        g_out, xty_out = gram(xs[lo:hi], y[lo:hi])
+        beta = np.linalg.pinv(g_all - g_out, rcond=1e-10, hermitian=True) @ (xty - xty_out)
         r = y[a:b] - xs[a:b] @ beta
         sse += float(r @ r)
     return math.sqrt(sse / max(n, 1))

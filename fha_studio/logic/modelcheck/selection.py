@@ -96,6 +96,12 @@ def whiten(x: np.ndarray, phi: np.ndarray) -> np.ndarray:
     return out
 
 
+def gram(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """x'x and x'y of a tall, narrow design without BLAS: a multi-threaded BLAS spends more CPU
+    starting and spinning its threads than these few thousand x a dozen products take."""
+    return np.einsum("ij,ik->jk", x, x), np.einsum("ij,i->j", x, y)
+
+
 def ols(y: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, float]:
     """Least squares (normal equations on scaled columns, pseudo-inverse): coefficients and RSS."""
     if x.shape[1] == 0:
@@ -103,8 +109,8 @@ def ols(y: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, float]:
     scale = np.sqrt(np.sum(x * x, axis=0))
     scale[scale == 0] = 1.0
     xs = x / scale
-    gram = xs.T @ xs
-    beta = (np.linalg.pinv(gram, rcond=1e-10, hermitian=True) @ (xs.T @ y)) / scale
+    g, xty = gram(xs, y)
+    beta = (np.linalg.pinv(g, rcond=1e-10, hermitian=True) @ xty) / scale
     r = y - x @ beta
     return beta, float(r @ r)
 
@@ -120,15 +126,31 @@ def block_edges(n: int, blocks: int = CV_BLOCKS) -> list[tuple[int, int]]:
     return [(int(a), int(b)) for a, b in itertools.pairwise(cuts)]
 
 
+def fold_betas(y: np.ndarray, x: np.ndarray, edges: list[tuple[int, int]]) -> list[np.ndarray]:
+    """Least-squares coefficients with each block [a, b) left out, in turn.
+
+    The normal equations of a fold are the whole record's minus the left-out block's, so the
+    record is multiplied out once, not once per fold (the cost stays linear in its length).
+    """
+    scale = np.sqrt(np.sum(x * x, axis=0))
+    scale[scale == 0] = 1.0
+    xs = x / scale
+    g_all, xty = gram(xs, y)
+    out = []
+    for a, b in edges:
+        g_block, xty_block = gram(xs[a:b], y[a:b])
+        beta = np.linalg.pinv(g_all - g_block, rcond=1e-10, hermitian=True) @ (xty - xty_block)
+        out.append(beta / scale)
+    return out
+
+
 def block_cv(y: np.ndarray, x: np.ndarray, blocks: int = CV_BLOCKS) -> tuple[float, np.ndarray]:
     """Held-out RMS and the held-out prediction: each block predicted from a fit on the others."""
     n = len(y)
     pred = np.zeros(n)
     if x.shape[1]:
-        for a, b in block_edges(n, blocks):
-            train = np.ones(n, bool)
-            train[a:b] = False
-            beta, _ = ols(y[train], x[train])
+        edges = block_edges(n, blocks)
+        for (a, b), beta in zip(edges, fold_betas(y, x, edges), strict=True):
             pred[a:b] = x[a:b] @ beta
     r = y - pred
     return float(np.sqrt(np.mean(r**2))), pred
@@ -351,12 +373,8 @@ class ChannelSelector:
 
     def size_sigma(self, cand: Candidate, x: np.ndarray, k: int) -> float:
         """Delete-one-block jackknife sigma of cand's size (its last k columns of x, shape held)."""
-        sizes = []
-        for a, b in block_edges(self.n, JACKKNIFE_BLOCKS):
-            rows = np.ones(self.n, bool)
-            rows[a:b] = False
-            bj, _ = ols(self.y[rows], x[rows])
-            sizes.append(float(cand.size(bj[-k:], self.ctx)))
+        edges = block_edges(self.n, JACKKNIFE_BLOCKS)
+        sizes = [float(cand.size(bj[-k:], self.ctx)) for bj in fold_betas(self.y, x, edges)]
         vals = np.array(sizes)
         g = len(vals)
         return math.sqrt((g - 1) / g * float(np.sum((vals - vals.mean()) ** 2)))
@@ -614,12 +632,7 @@ class ChannelSelector:
         )
         x = np.column_stack([self.design(terms), self.cols(cand, shape)])
         k = x.shape[1] - self.design(terms).shape[1]
-        reps = []
-        for a, b in block_edges(self.n, JACKKNIFE_BLOCKS):
-            rows = np.ones(self.n, bool)
-            rows[a:b] = False
-            bj, _ = ols(self.y[rows], x[rows])
-            reps.append(bj[-k:])
+        reps = [bj[-k:] for bj in fold_betas(self.y, x, block_edges(self.n, JACKKNIFE_BLOCKS))]
         reps_arr = np.array(reps)
         g = len(reps)
         var = (g - 1) / g * np.sum((reps_arr - reps_arr.mean(axis=0)) ** 2, axis=0)

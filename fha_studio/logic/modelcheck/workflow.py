@@ -60,6 +60,7 @@ BURST_FACTOR = 6.0  # a burst in time: local RMS this many times the residual's 
 BURST_FLOOR_FACTOR = 3.0  # ... and above this many practical floors
 BREAKAWAY_SETTLE_S = 0.1  # a burst peaking this soon after a breakaway from standstill is stick-slip
 BURST_EDGE_FACTOR = 3.0  # ... and it lasts while the local RMS stays above this many times the median
+RESIM_MAX_S = 60.0  # the re-simulation covers at most this much of a recording (bounded cost)
 RESIM_BANDWIDTH_HZ = 60.0  # speed-loop bandwidth of the stiff servo that follows the measured motion
 # A channel is checked when what it shows (smoothed) stands this many noise sigmas above its noise.
 SIGNAL_NOISE_FACTOR = 4.0
@@ -888,15 +889,22 @@ def _updated_model(model: AxisModel, effects: list[Effect]) -> AxisModel:
 def _resimulate(
     sig: Signals, axis: DeclaredAxis, nominal: AxisModel, updated: AxisModel, servo: ServoSettings | None
 ) -> Resimulation:
-    t = sig.raw_t_s
     f = sig.filt
+    h = f.half
+    # the closed loop runs at the servo rate: its cost grows with the duration, not the samples, so
+    # only the first RESIM_MAX_S seconds are re-simulated (the analysis itself uses all of them)
+    n_raw = int(np.searchsorted(sig.raw_t_s, sig.raw_t_s[0] + RESIM_MAX_S, side="right"))
+    n_raw = max(n_raw, min(len(sig.raw_t_s), 2 * h + 3))
+    t = sig.raw_t_s[:n_raw]
+    n_valid = n_raw - 2 * h
     if servo is not None and sig.cmd_pos_rad is not None:
-        command, cmd = "cmd_pos", sig.cmd_pos_rad
+        command, cmd = "cmd_pos", sig.cmd_pos_rad[:n_raw]
     else:
         command = "motion (measured pos, smoothed, stiff servo)"
-        cmd = savgol_filter(sig.raw_pos_rad, f.window, POLYORDER)
+        cmd = savgol_filter(sig.raw_pos_rad, f.window, POLYORDER)[:n_raw]
         servo = ServoSettings.tuned_for(nominal, speed_bandwidth_hz=RESIM_BANDWIDTH_HZ, feed_forward_gain=1.0)
-    h = f.half
+    if n_raw < len(sig.raw_t_s):
+        command += f", its first {RESIM_MAX_S:g} s"
     kt = axis.kt_nm_per_a
     out = {}
     for name, m in (("nominal", nominal), ("updated", updated)):
@@ -905,15 +913,15 @@ def _resimulate(
         except ValueError as exc:
             raise ModelCheckError(f"re-simulation with the {name} model failed: {exc}") from None
         out[name] = r
-    meas = sig.torque_f_nm
+    meas = sig.torque_f_nm[:n_valid]
     tn = kt * f.apply(out["nominal"]["current"])
     tu = kt * f.apply(out["updated"]["current"])
     res = Resimulation(
-        t_s=sig.t_s,
+        t_s=sig.t_s[:n_valid],
         torque_measured_nm=meas,
         torque_nominal_nm=tn,
         torque_updated_nm=tu,
-        pos_measured_deg=np.degrees(sig.pos_rad),
+        pos_measured_deg=np.degrees(sig.pos_rad[:n_valid]),
         pos_nominal_deg=np.degrees(out["nominal"]["pos"][h:-h]),
         pos_updated_deg=np.degrees(out["updated"]["pos"][h:-h]),
         rms_nominal_nm=rms(meas - tn),
@@ -921,7 +929,7 @@ def _resimulate(
         command=command,
     )
     if sig.load_diff_f_rad is not None:
-        res.load_diff_measured_arcsec = sig.load_diff_f_rad * ARCSEC_PER_RAD
+        res.load_diff_measured_arcsec = sig.load_diff_f_rad[:n_valid] * ARCSEC_PER_RAD
         for name in ("nominal", "updated"):
             d = f.apply(out[name]["load_pos"] - out[name]["pos"]) * ARCSEC_PER_RAD
             setattr(res, f"load_diff_{name}_arcsec", d)
