@@ -57,6 +57,8 @@ def register(subparsers: Any) -> None:
     p.add_argument("--profile", choices=("full", "documented"), default="full",
                    help="full: every command of docs/protocol.md (default); documented: only what the "
                    "HA-655 manual documents (DGR, OWW; s to everything while the servo is on)")
+    p.add_argument("--text-trace", action="store_true",
+                   help="trace blocks in text only (TRB), as a drive from before the packed encoding (TRP)")
     p.add_argument("--panel", action="store_true",
                    help="read the controller's side from stdin, one per line: 'servo on', 'servo off' "
                    "(the CN2 servo-ON input), 'fwd DEG' (a command pulse train, servo on), 'turn DEG' "
@@ -90,6 +92,7 @@ def run(args: Any) -> int:
             paced=not args.unpaced,
             oww_clear_s=args.oww_seconds,
             profile=args.profile,
+            packed_trace=not args.text_trace,
         )
         drive = SimDrive(config=config)
     except (SimConfigError, EepromError) as exc:

@@ -6,6 +6,7 @@ import os
 import select
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -65,3 +66,43 @@ def test_serves_tcp_and_records(tmp_path):
     recording = read_recording(record)
     assert recording.metadata.actuator == "FHA-17C-50-US250"
     assert len(recording) > 10 and recording.metadata.sample_rate_hz == 1000
+
+
+@pytest.mark.e2e
+@pytest.mark.parametrize(("flags", "encoding"), [((), "packed"), (("--text-trace",), "text")])
+def test_a_sim_in_another_process_offers_packed_trace_blocks_unless_told_not_to(tmp_path, flags, encoding):
+    """The client reads a trace from a drive with packed blocks (TRP in CAP) and from one
+    without (an older drive: TRB only), over TCP from another process, with the same values."""
+    from fha_studio.hardware import protocol as p
+    from fha_studio.hardware.client import DriveClient
+
+    cmd = [sys.executable, "-m", "fha_studio", "sim", "--tcp", "0", "--unpaced", "--eeprom",
+           str(tmp_path / "e.json"), *flags]
+    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            env={**os.environ, "PYTHONPATH": str(ROOT)})
+    try:
+        ready, _, _ = select.select([proc.stdout], [], [], 30.0)
+        assert ready, "no address printed"
+        address = proc.stdout.readline().decode().strip()
+        with DriveClient.open(address) as client:
+            assert client.trace_encoding == encoding
+            assert ("TRP" in {c.value for c in client.capabilities.commands}) == (encoding == "packed")
+            client.servo(True)
+            client.jog(20.0)
+            client.configure_trace([100, 103], divider=5)
+            client.arm_trace(200)
+            deadline = time.monotonic() + 20
+            while client.trace_status().state is not p.TraceState.DONE:
+                assert time.monotonic() < deadline, "the capture did not finish"
+                client.jog(20.0)
+                time.sleep(0.02)
+            seen = []
+            capture = client.read_trace(progress=lambda done, total: seen.append((done, total)))
+        assert len(capture.samples) == 200 and seen[0] == (0, 200) and seen[-1] == (200, 200)
+        positions = capture.column(100)
+        assert positions[-1] > positions[0] and positions == sorted(positions)
+    finally:
+        proc.terminate()
+        proc.wait(10)
+        proc.stdout.close()
+        proc.stderr.close()
