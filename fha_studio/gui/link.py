@@ -33,8 +33,10 @@ from fha_studio.hardware.api import (
     LinkTimeout,
     ServoOnRefused,
 )
+from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import Mode, MonitorItem
 from fha_studio.hardware.protocol import INPUT_MASK, Command, IoBit
+from fha_studio.hardware.transaction import LinkSettings
 
 log = logging.getLogger(__name__)
 
@@ -205,12 +207,10 @@ class DriveStatus:
 OpenClient = Callable[[str, int], DriveApi]
 
 
-def _default_open(url: str, baud_rate: int) -> DriveApi:
-    from fha_studio.hardware.client import DriveClient, LinkSettings
-
-    # short timeouts: a dead link must show within a second (one retry of 0.25 s each)
-    settings = LinkSettings(baudrate=baud_rate, response_timeout_s=0.25, retries=1)
-    return DriveClient.open(url, settings)
+def link_settings(baud_rate: int = 19200) -> LinkSettings:
+    """The link worker's settings: short timeouts, so a dead link shows within a second or two
+    (one retry of 0.25 s); every call ends within ``transaction_limit_s`` whatever the line does."""
+    return LinkSettings(baudrate=baud_rate, response_timeout_s=0.25, retries=1)
 
 
 _PLAIN_FAILURES: tuple[tuple[type[Exception], str], ...] = (
@@ -244,11 +244,20 @@ class LinkWorker(QObject):
     sigResult = Signal(object)  # CommandResult
     sigWrite = Signal(object)  # WriteEntry: one write, for the session log
 
-    def __init__(self, abort: threading.Event, open_client: OpenClient | None = None):
+    def __init__(
+        self,
+        abort: threading.Event,
+        open_client: OpenClient | None = None,
+        closing: threading.Event | None = None,
+    ):
         super().__init__()
         self._abort = abort
+        # Set (in the GUI thread) when the window closes: every exchange but the final STOP gives
+        # up at its next read, so the thread ends at once even while connecting to a babbling line.
+        self._closing = closing or threading.Event()
+        self._final = False
         self._poll_interval_ms = POLL_INTERVAL_MS
-        self._open_client: OpenClient = open_client or _default_open
+        self._open_client: OpenClient = open_client or self._open_drive
         self._client: DriveApi | None = None
         self._url = ""
         self._poll_timer: QTimer | None = None
@@ -357,6 +366,7 @@ class LinkWorker(QObject):
 
     def _shutdown(self) -> None:
         """The last command: runs in the link thread, so the timers die in their own thread."""
+        self._final = True  # the STOP below must reach the drive although the window is closing
         self._shut(stop_axis=True)
         for timer in (self._poll_timer, self._jog_timer):
             if timer is not None:
@@ -365,6 +375,12 @@ class LinkWorker(QObject):
         self._poll_timer = self._jog_timer = None
         _forget_dummy_thread()
         QThread.currentThread().quit()
+
+    def _abandon(self) -> bool:
+        return self._closing.is_set() and not self._final
+
+    def _open_drive(self, url: str, baud_rate: int) -> DriveApi:
+        return DriveClient.open(url, link_settings(baud_rate), should_abort=self._abandon)
 
     # -- commands -----------------------------------------------------------------------------
     def _do_open(self, url: str, baud_rate: int = 19200) -> LinkInfo:
@@ -692,9 +708,10 @@ class LinkController(QObject):
         super().__init__(parent)
         self._tokens = itertools.count(1)
         self._abort = threading.Event()
+        self._closing = threading.Event()
         self._thread = QThread()
         self._thread.setObjectName("fha-link")
-        self._worker = LinkWorker(self._abort, open_client)
+        self._worker = LinkWorker(self._abort, open_client, self._closing)
         self._worker.moveToThread(self._thread)
         self._thread.started.connect(self._worker.start)
         self.sigCommand.connect(self._worker.handle)  # queued: the worker lives in the thread
@@ -767,11 +784,16 @@ class LinkController(QObject):
         self._jog_lease_timer.stop()
         return self.send(Cmd.JOG, 0.0)
 
-    def shutdown(self, timeout_ms: int = 3000) -> bool:
-        """Stops the axis, closes the port, ends the thread. True when the thread ended in time."""
+    def shutdown(self, timeout_ms: int = 10000) -> bool:
+        """Stops the axis, closes the port, ends the thread. True when the thread ended in time.
+
+        Whatever the worker is doing (connecting to a silent or babbling line, a long read-out)
+        gives up at its next read; only the port's own opening (a TCP connect: at most 5 s) and
+        the final STOP (``transaction_limit_s``) can hold it, both well inside ``timeout_ms``."""
         self._jog_lease_timer.stop()
         if not self._thread.isRunning():
             return True
+        self._closing.set()
         self._abort.set()
         self.sigCommand.emit(LinkCommand(Cmd.SHUTDOWN, (), 0))  # the worker quits its thread when done
         ended = self._thread.wait(timeout_ms)

@@ -39,7 +39,9 @@ from fha_studio.hardware.errors import (
     DriveRefused,
     LinkError,
     LinkFailure,
+    LinkGarbled,
     LinkLost,
+    LinkSilent,
     LinkTimeout,
     ReadAborted,
     ServoOnRefused,
@@ -78,8 +80,10 @@ __all__ = [
     "IoState",
     "LinkError",
     "LinkFailure",
+    "LinkGarbled",
     "LinkLost",
     "LinkSettings",
+    "LinkSilent",
     "LinkTimeout",
     "ReadAborted",
     "ServoOnRefused",
@@ -101,9 +105,17 @@ class DriveClient:
     in the caller's thread, under the lock; it must be quick and must not call the client.
     """
 
-    def __init__(self, transport: Transport, settings: LinkSettings | None = None, *, driver: str = "HA-655"):
-        """Wrap an open transport without talking to it (``attach`` also detects capabilities)."""
-        self.transaction = Transaction(transport, settings)
+    def __init__(
+        self,
+        transport: Transport,
+        settings: LinkSettings | None = None,
+        *,
+        driver: str = "HA-655",
+        should_abort: Callable[[], bool] | None = None,
+    ):
+        """Wrap an open transport without talking to it (``attach`` also detects capabilities).
+        ``should_abort``: asked at every read; True abandons the exchange (``ReadAborted``)."""
+        self.transaction = Transaction(transport, settings, should_abort)
         self.settings = self.transaction.settings
         self._lock = self.transaction.lock
         self._transact = self.transaction.transact
@@ -116,22 +128,42 @@ class DriveClient:
     # --- opening and closing ------------------------------------------------------------------
 
     @classmethod
-    def open(cls, url: str, settings: LinkSettings | None = None, *, driver: str = "HA-655") -> DriveClient:
+    def open(
+        cls,
+        url: str,
+        settings: LinkSettings | None = None,
+        *,
+        driver: str = "HA-655",
+        should_abort: Callable[[], bool] | None = None,
+    ) -> DriveClient:
         """Open ``url`` (see ``transport.open_transport``), detect what the drive supports.
 
-        Raises ``LinkLost`` when the port cannot be opened and ``LinkTimeout`` when no drive
-        answers; the port is closed again in both cases.
+        Raises ``LinkLost`` when the port cannot be opened, ``LinkSilent`` when nothing arrives,
+        ``LinkGarbled`` when bytes arrive but no reply; the port is closed again in each case.
+        Whatever the line does, it returns or raises within ``open_limit_s(settings)`` (plus the
+        time the port itself takes to open), or at the next read after ``should_abort()``.
         """
         settings = settings or LinkSettings()
         transport = open_transport(url, baudrate=settings.baudrate, timeout=settings.poll_s)
-        return cls.attach(transport, settings, driver=driver)
+        return cls.attach(transport, settings, driver=driver, should_abort=should_abort)
+
+    @staticmethod
+    def open_limit_s(settings: LinkSettings | None = None) -> float:
+        """The longest wall time of capability detection (``open`` after the port opened)."""
+        settings = settings or LinkSettings()
+        return settings.transaction_limit_s(Command.CAP) + settings.transaction_limit_s(Command.DGR)
 
     @classmethod
     def attach(
-        cls, transport: Transport, settings: LinkSettings | None = None, *, driver: str = "HA-655"
+        cls,
+        transport: Transport,
+        settings: LinkSettings | None = None,
+        *,
+        driver: str = "HA-655",
+        should_abort: Callable[[], bool] | None = None,
     ) -> DriveClient:
         """Use an already open transport (a pipe end, a port) and detect capabilities."""
-        client = cls(transport, settings, driver=driver)
+        client = cls(transport, settings, driver=driver, should_abort=should_abort)
         try:
             client.detect_capabilities()
         except BaseException:
@@ -187,8 +219,9 @@ class DriveClient:
         return self._capabilities
 
     def detect_capabilities(self) -> Capabilities:
-        """Ask CAP, probe DGR; set and return ``capabilities``. Never hangs on a silent drive:
-        raises ``LinkTimeout`` when neither CAP nor DGR gets any answer."""
+        """Ask CAP, probe DGR; set and return ``capabilities``. Never hangs, whatever the line
+        does: raises ``LinkGarbled`` at once when CAP got bytes but no reply (a wrong baud rate or
+        device: DGR would fare no better), ``LinkSilent`` when neither CAP nor DGR got a byte."""
         notes: list[str] = []
         answered_cap = False
         commands: set[Command] = set(p.DOCUMENTED_COMMANDS)
@@ -203,6 +236,8 @@ class DriveClient:
                     notes.append(f"It also lists commands FHA Studio does not know: {' '.join(unknown)}.")
             except DriveRefused:
                 answered_cap = True  # x or s: a drive of the manual's command set
+            except LinkGarbled as exc:
+                raise LinkGarbled(f"no drive answers on {self.port}: {exc}") from None
             except LinkTimeout:
                 notes.append("It did not answer CAP at all.")
             try:
@@ -212,11 +247,11 @@ class DriveClient:
                 absolute = None
             except CommandRejected:
                 absolute = False
-            except LinkTimeout:
+            except LinkTimeout as exc:
                 if not answered_cap:
-                    raise LinkTimeout(
-                        f"no drive answers on {self.port} (neither CAP nor DGR got a reply): check the "
-                        "cable, the port and the drive's power"
+                    kind = type(exc) if isinstance(exc, LinkSilent | LinkGarbled) else LinkTimeout
+                    raise kind(
+                        f"no drive answers on {self.port} (neither CAP nor DGR got a reply): {exc}"
                     ) from None
                 absolute = None
                 notes.append("DGR got no answer.")

@@ -3,8 +3,9 @@
 Every error the client raises is a ``LinkError`` (one ``except`` for a caller that only reports).
 Two families below it say very different things:
 
-- ``LinkFailure``: the link did not work: ``LinkTimeout`` (no usable reply after the retries),
-  ``LinkLost`` (the port is gone, or too many failures in a row).
+- ``LinkFailure``: the link did not work: ``LinkTimeout`` (no usable reply after the retries;
+  ``LinkSilent`` when nothing at all arrived, ``LinkGarbled`` when bytes arrived but never a
+  complete reply), ``LinkLost`` (the port is gone, or too many failures in a row).
 - ``ReadAborted``: the caller asked a long read-out to give up (between exchanges); neither the
   link nor the drive failed.
 - ``DriveRefused``: the link worked and the drive said no: ``ServoOnRefused`` (``s``: the servo
@@ -25,6 +26,14 @@ class LinkFailure(LinkError):
 
 class LinkTimeout(LinkFailure):
     """No complete, well-formed reply within the timeout, after all retries."""
+
+
+class LinkSilent(LinkTimeout):
+    """Not a byte arrived during the whole exchange: the cable, the port or the drive's power."""
+
+
+class LinkGarbled(LinkTimeout):
+    """Bytes arrived, but never a complete reply: a wrong baud rate, or another device on the port."""
 
 
 class LinkLost(LinkFailure):

@@ -15,6 +15,14 @@ Commands whose repetition could act twice (MOV, OWW, PWC) are never retried. ``s
 answers, not failures: raised at once as ``ServoOnRefused`` / ``CommandRejected``, never retried.
 After ``settings.max_consecutive_failures`` failed transactions in a row the link is marked lost
 (``LinkLost``); one success resets the count.
+
+Wall time: an attempt ends at the latest ``reply_time_limit_s`` after its first-byte timeout,
+however the line behaves (silent, trickling, flooding, garbage, NUL), and so does each wait for a
+quiet line; so a transaction is bounded (``LinkSettings.transaction_limit_s``). A transaction that
+failed says what the line did: ``LinkSilent`` (not a byte arrived), ``LinkGarbled`` (bytes, but
+never a complete reply) or ``LinkTimeout`` (replies came, but corrupt or of the wrong form).
+``should_abort`` (e.g. a closing window's event) is asked at every read: when it says True the
+exchange gives up at once with ``ReadAborted``.
 """
 
 from __future__ import annotations
@@ -27,7 +35,15 @@ from dataclasses import dataclass
 from typing import TypeVar
 
 from fha_studio.hardware import protocol as p
-from fha_studio.hardware.errors import CommandRejected, LinkLost, LinkTimeout, ServoOnRefused
+from fha_studio.hardware.errors import (
+    CommandRejected,
+    LinkGarbled,
+    LinkLost,
+    LinkSilent,
+    LinkTimeout,
+    ReadAborted,
+    ServoOnRefused,
+)
 from fha_studio.hardware.protocol import Command, Garbage, Reply, Request, Status, command_words
 from fha_studio.hardware.transport import GuardedTransport, Transport
 
@@ -46,6 +62,17 @@ T = TypeVar("T")
 
 #: A bus monitor: called with every block written (True) and read (False).
 PacketMonitor = Callable[[bool, bytes], None]
+
+#: Longest reply of a trace block: 64 lines of 4 values of up to 11 characters and their commas,
+#: each line with its CR, then the terminal line.
+_TRACE_BLOCK_CHARS = p.TRACE_BLOCK_SAMPLES * (p.TRACE_MAX_CHANNELS * 12 + 1) + 2
+#: Longest reply of each command, in characters; others have one short line (DEFAULT_REPLY_CHARS).
+LONGEST_REPLY_CHARS = {
+    Command.TRB: _TRACE_BLOCK_CHARS,
+    Command.TRP: _TRACE_BLOCK_CHARS,
+    Command.AHS: 1024,  # the history, one code,seconds line per alarm
+}
+DEFAULT_REPLY_CHARS = 256  # CAP, IDN, MMR of 16 items and every one-line reply fit
 
 
 @dataclass(frozen=True)
@@ -95,6 +122,21 @@ class LinkSettings:
         wait = max(self.response_timeout_s, slow.get(command, 0.0))
         return self.transfer_time_s(p.FRAME_LENGTH) + wait
 
+    def reply_time_limit_s(self, command: Command) -> float:
+        """How long an attempt of ``command`` may go on after its first-byte timeout: twice the
+        line time of the command's longest reply plus one response timeout, at most
+        ``max_reply_s``. A line still sending then is babbling, not replying."""
+        chars = LONGEST_REPLY_CHARS.get(command, DEFAULT_REPLY_CHARS)
+        return min(self.max_reply_s, 2 * self.transfer_time_s(chars) + self.response_timeout_s)
+
+    def transaction_limit_s(self, command: Command) -> float:
+        """The longest wall time of one transaction of ``command``, whatever the line does: every
+        attempt, the quiet-line waits between and after them (each at most one attempt long)."""
+        attempts = 1 if command in NOT_RETRIED else 1 + self.retries
+        attempt = self.first_byte_timeout_s(command) + self.reply_time_limit_s(command)
+        quiet = self.response_timeout_s + self.reply_time_limit_s(command)
+        return attempts * (attempt + quiet)
+
 
 #: Commands whose repetition could act twice; sent once, never retried.
 NOT_RETRIED = frozenset({Command.MOV, Command.OWW, Command.PWC})
@@ -134,7 +176,12 @@ class Transaction:
     lock; it must be quick and must not call the link.
     """
 
-    def __init__(self, transport: Transport, settings: LinkSettings | None = None):
+    def __init__(
+        self,
+        transport: Transport,
+        settings: LinkSettings | None = None,
+        should_abort: Callable[[], bool] | None = None,
+    ):
         self.settings = settings or LinkSettings()
         self.transport = (
             transport if isinstance(transport, GuardedTransport) else GuardedTransport(transport)
@@ -145,6 +192,9 @@ class Transaction:
         self._health = _LinkHealth()
         self._closed = False
         self.packet_monitor: PacketMonitor | None = None
+        self.should_abort = should_abort
+        self._received = 0  # bytes read during the current transaction
+        self._framed = False  # a reply (well-formed or not) was decoded in it
 
     # --- state ----------------------------------------------------------------------------------
 
@@ -201,12 +251,20 @@ class Transaction:
                 raise LinkLost(str(self._health.lost), port=self.port)
             attempts = 1 if (retry is False or command in NOT_RETRIED) else 1 + self.settings.retries
             why = ""
+            started = time.monotonic()
+            self._received, self._framed = 0, False
+            made = 0
+            quiet = True
             try:
                 for attempt in range(attempts):
                     if attempt:
                         self._health.failed_attempts += 1
                         log.info("%s: %s failed (%s), retry %d", self.port, command, why, attempt)
-                        self._drain_until_quiet()
+                        quiet = self._drain_until_quiet(command)
+                        if not quiet:  # a line that never pauses carries no reply: do not retry
+                            why += "; the line never went quiet"
+                            break
+                    made += 1
                     reply, why = self._attempt(request)
                     if reply is None:
                         continue
@@ -230,18 +288,36 @@ class Transaction:
                 raise
             self._health.failed_attempts += 1
             self._health.consecutive_failures += 1
-            self._drain_quietly()
-            unknown = " (not repeated: unknown whether the drive acted on it)" if attempts == 1 else ""
-            text = f"{command} on {self.port}: {why} after {attempts} attempt(s){unknown}"
+            if quiet:
+                self._drain_quietly(command)
+            failure = self._failure(command, why, made, attempts == 1, time.monotonic() - started)
             if self._health.consecutive_failures >= self.settings.max_consecutive_failures:
                 lost = LinkLost(
-                    f"{text}; {self._health.consecutive_failures} failed transactions in a row: "
+                    f"{failure}; {self._health.consecutive_failures} failed transactions in a row: "
                     "link marked lost (check the cable and the drive's power, then reconnect)",
                     port=self.port,
                 )
                 self._health.lost = lost
                 raise lost
-            raise LinkTimeout(text)
+            raise failure
+
+    def _failure(
+        self, command: Command, why: str, attempts: int, once: bool, elapsed_s: float
+    ) -> LinkTimeout:
+        """The error of a failed transaction, saying what the line did."""
+        unknown = " (not repeated: unknown whether the drive acted on it)" if once else ""
+        tried = f"to {command_words(command)}: {attempts} attempt(s) in {elapsed_s:.1f} s{unknown}"
+        if not self._received:
+            return LinkSilent(
+                f"nothing arrives on {self.port} ({tried}): check the cable, the port and the "
+                "drive's power"
+            )
+        if not self._framed:
+            return LinkGarbled(
+                f"bytes arrive on {self.port} but no complete reply ({self._received} bytes; {tried}): "
+                "a wrong baud rate, or not an HA-655/HA-675 on this port"
+            )
+        return LinkTimeout(f"{command} on {self.port}: {why} after {attempts} attempt(s){unknown}")
 
     # --- the line ---------------------------------------------------------------------------------
 
@@ -253,25 +329,31 @@ class Transaction:
                 log.exception("packet monitor failed")
 
     def _read_some(self) -> bytes:
+        if self.should_abort is not None and self.should_abort():
+            raise ReadAborted(f"{self.port}: the exchange was abandoned (the link is closing)")
         waiting = self.transport.in_waiting
         data = self.transport.read(max(1, waiting))
+        self._received += len(data)
         self._monitor(False, data)
         return data
 
-    def _drain_until_quiet(self) -> None:
+    def _drain_until_quiet(self, command: Command) -> bool:
         """Drop input until the line has been quiet for response_timeout_s: a reply that comes
-        late (after its attempt timed out) is dropped here, not taken for the next request's."""
+        late (after its attempt timed out) is dropped here, not taken for the next request's.
+        Gives up after the longest reply of ``command`` could have come (a flooding line).
+        True when the line went quiet."""
         quiet_until = time.monotonic() + self.settings.response_timeout_s
-        give_up = time.monotonic() + self.settings.max_reply_s
+        give_up = quiet_until + self.settings.reply_time_limit_s(command)
         while time.monotonic() < min(quiet_until, give_up):
             if self._read_some():
                 quiet_until = time.monotonic() + self.settings.response_timeout_s
         self.transport.reset_input_buffer()
         self._decoder.clear()
+        return quiet_until <= give_up
 
-    def _drain_quietly(self) -> None:
+    def _drain_quietly(self, command: Command) -> None:
         try:
-            self._drain_until_quiet()
+            self._drain_until_quiet(command)
         except LinkLost as exc:
             self._health.lost = exc
             raise
@@ -287,7 +369,7 @@ class Transaction:
         self._monitor(True, data)
         start = time.monotonic()
         deadline = start + self.settings.first_byte_timeout_s(request.command)
-        cap = deadline + self.settings.max_reply_s
+        cap = deadline + self.settings.reply_time_limit_s(request.command)
         tainted = False
         while True:
             now = time.monotonic()
@@ -306,6 +388,7 @@ class Transaction:
                     log.debug("%s: skipped %r (%s)", self.port, message.data, message.reason)
                     tainted = tainted or message.printable
                     continue
+                self._framed = True
                 if message.corrupt or tainted:
                     return None, "corrupt reply (noise inside it)"
                 return message, ""
