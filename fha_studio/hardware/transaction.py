@@ -340,16 +340,25 @@ class Transaction:
     def _drain_until_quiet(self, command: Command) -> bool:
         """Drop input until the line has been quiet for response_timeout_s: a reply that comes
         late (after its attempt timed out) is dropped here, not taken for the next request's.
-        Gives up after the longest reply of ``command`` could have come (a flooding line).
-        True when the line went quiet."""
+        Gives up after the longest reply of ``command`` could have come. False for a flood: it
+        gave up having read more than that reply's length (another attempt would fare no better)."""
         quiet_until = time.monotonic() + self.settings.response_timeout_s
         give_up = quiet_until + self.settings.reply_time_limit_s(command)
+        drained = 0
         while time.monotonic() < min(quiet_until, give_up):
-            if self._read_some():
+            data = self._read_some()
+            if data:
+                drained += len(data)
                 quiet_until = time.monotonic() + self.settings.response_timeout_s
+                # a late reply is a reply: the line carries frames (only not in time)
+                if drained <= LONGEST_REPLY_CHARS.get(command, DEFAULT_REPLY_CHARS) and any(
+                    not isinstance(m, Garbage) for m in self._decoder.feed(data)
+                ):
+                    self._framed = True
         self.transport.reset_input_buffer()
         self._decoder.clear()
-        return quiet_until <= give_up
+        flooding = quiet_until > give_up and drained > LONGEST_REPLY_CHARS.get(command, DEFAULT_REPLY_CHARS)
+        return not flooding
 
     def _drain_quietly(self, command: Command) -> None:
         try:

@@ -166,3 +166,21 @@ def test_the_stated_bound_covers_the_slow_commands_and_the_longest_replies():
     assert s.reply_time_limit_s(Command.IOS) < 1.0
     assert s.transaction_limit_s(Command.OWW) > s.oww_timeout_s  # OWW's q comes about 5 s later
     assert DriveClient.open_limit_s(GUI) < 10.0
+
+
+def test_replies_that_come_late_are_a_timeout_not_garbage(pipes):
+    slow = LinkSettings(response_timeout_s=0.3, retries=1)
+
+    def late(request):
+        if isinstance(request, p.Request) and request.command is Command.IOS:
+            # after the attempt gave up (0.3 s), inside the quiet-line wait before the retry
+            return [0.45, p.Reply(("0",))]
+        return documented_only()(request)
+
+    drive = ScriptedDrive(pipes[1], late)
+    try:
+        client = DriveClient.attach(pipes[0], slow)
+        error, _ = _timed(lambda: client.transaction.transact(Command.IOS, parse=lambda r: r))
+    finally:
+        drive.close()
+    assert type(error) is LinkTimeout and "IOS on hostile" in str(error)
