@@ -5,7 +5,9 @@ It never opens a port. It is moved to the thread of the link worker that owns th
 in the link thread, interleaved with the worker's own commands (a STOP waits at most one
 polling pass, ``PASS_BUDGET_S``). Requests come in through one queued signal carrying a
 ``ScopeRequest``; results go out through signals. Samples go into the acquisition's
-``RingBuffer``, which the GUI timer drains (friture's pattern).
+``RingBuffer``, which the GUI timer drains (friture's pattern). The link thread never waits for
+the GUI: no signal per sample (the state goes out five times a second, a read-out's progress once
+a block), and the ring's lock is held only to copy rows in or out, never while the GUI draws.
 """
 
 from __future__ import annotations
