@@ -93,17 +93,22 @@ def test_a_trace_read_out_shows_its_progress_and_time_left(qtbot, scope, packed)
     view.trigger_kind.setCurrentIndex(view.trigger_kind.findData(p.TriggerKind.IMMEDIATE))
     view.trace_samples.setValue(512 if packed else 256)
     view.trace_pre.setValue(0)
-    seen = []
-    view.controller.sigReadoutProgress.connect(lambda done, total, left: seen.append((done, total, left)))
+    bar = view.readout_progress
+    seen = []  # (done, total, seconds left, the bar's text, shown) after the view took each report
+
+    def after_view(done, total, left):  # connected after the view's slot: sees what it made of it
+        seen.append((done, total, left, bar.text(), not bar.isHidden()))
+
+    view.controller.sigReadoutProgress.connect(after_view)
     with qtbot.waitSignal(view.sigTraceDone, timeout=30000) as done:
         view.arm_trace()
-        bar = view.readout_progress
-        qtbot.waitUntil(lambda: not bar.isHidden() and "s left" in bar.text(), timeout=20000)
-        text = bar.text()
     total = 512 if packed else 256
-    assert text.startswith("Reading out the capture: ") and f" of {total} samples, about " in text
     assert len(done.args[0].t_s) == total
-    assert [d for d, _t, _l in seen] == list(range(0, total + 1, 64)) and seen[-1][2] == 0.0
+    assert [d for d, *_ in seen] == list(range(0, total + 1, 64)) and seen[-1][2] == 0.0
+    during = [(text, shown) for d, _t, _l, text, shown in seen if 0 < d < total]
+    assert during and all(shown for _text, shown in during)
+    assert all(text.startswith("Reading out the capture: ") and f" of {total} samples, about " in text
+               and text.endswith(" s left") for text, _shown in during)
     assert view.readout_progress.isHidden()
 
 
