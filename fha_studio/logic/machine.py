@@ -109,6 +109,14 @@ class MachineProject:
             raise MachineError(f"an axis of '{self.name}' needs a name")
         if any(a.name == name for a in self._axes):
             raise MachineError(f"'{self.name}' already has an axis called '{name}'")
+        port = port_url.strip()
+        # one port, one drive: two axes on one serial line would fight over it (an embedded
+        # simulated drive is made anew for every connection, so sim:// URLs may repeat)
+        taken = next(
+            (a for a in self._axes if port and a.port_url == port and not port.startswith("sim://")), None
+        )
+        if taken is not None:
+            raise MachineError(f"axis '{name}': port {port} is already axis '{taken.name}''s")
         state = CommissioningState(
             actuator_code, driver_model=driver_model, load_inertia_kgm2=load_inertia_kgm2
         )

@@ -37,9 +37,12 @@ def test_each_axis_has_its_own_commissioning_state():
         project.add_axis("tilt")
     with pytest.raises(ModelCodeError):
         project.add_axis("roll", "FHA-26C-50-US250")
+    with pytest.raises(MachineError, match="axis 'roll': port /dev/ttyUSB2 is already axis 'tilt''s"):
+        project.add_axis("roll", "FHA-17C-50-US250", port_url="/dev/ttyUSB2")
     assert [a.name for a in project] == ["table", "table twin", "tilt"]  # nothing half-added
     with pytest.raises(MachineError, match=r"has no axis 'roll' \(axes: table, table twin, tilt\)"):
         project.axis("roll")
+    project.add_axis("roll", "FHA-17C-50-US250", port_url="sim://FHA-25C-50-US250-L")  # a sim each time
 
 
 def test_the_project_file_round_trips_and_a_wrong_one_is_refused(tmp_path):

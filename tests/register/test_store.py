@@ -62,6 +62,12 @@ def test_machines_and_axes_are_found_by_name(line3):
         line3.add_machine("A/B")
     with pytest.raises(RegisterError, match="load inertia -1"):
         line3.add_axis(M, "roll", load_inertia_kgm2=-1)
+    with pytest.raises(RegisterError, match="axis 'roll': port /dev/ttyUSB2 is already axis 'tilt''s"):
+        line3.add_axis(M, "roll", port_url="/dev/ttyUSB2")
+    with pytest.raises(RegisterError, match="axis 'table': port /dev/ttyUSB2 is already axis 'tilt''s"):
+        line3.update_axis(f"{M}/table", port_url="/dev/ttyUSB2")
+    # another machine (on another computer, maybe) has ports of its own
+    assert line3.add_axis("Robot wrist", "yaw", port_url="/dev/ttyUSB2").port_url == "/dev/ttyUSB2"
 
 
 def test_history_of_an_axis_in_time_order(line3):

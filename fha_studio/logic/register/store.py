@@ -348,6 +348,7 @@ class Register:
                 "SELECT 1 FROM axis WHERE machine_id = ? AND name = ?", (machine_row.id, name)
             ).fetchone():
                 raise RegisterError(f"machine '{machine_row.name}' already has an axis called '{name}'")
+            self._check_port_free(machine_row.id, port_url.strip(), name)
             now = utc_stamp()
             cursor = db.execute(
                 "INSERT INTO axis (machine_id, name, actuator_code, driver_model, port_url,"
@@ -420,6 +421,9 @@ class Register:
             return current
         if "name" in changes and not str(changes["name"]).strip():
             raise RegisterError("an axis needs a name")
+        if "port_url" in changes:
+            machine_id = self.machine(current.machine).id
+            self._check_port_free(machine_id, str(changes["port_url"]).strip(), current.name, current.id)
         with self._transaction() as db:
             now = utc_stamp()
             for key, value in changes.items():
@@ -435,6 +439,18 @@ class Register:
                     ),
                 )
         return self.axis(current.id)
+
+    def _check_port_free(self, machine_id: int, port: str, name: str, axis_id: int | None = None) -> None:
+        # one port, one drive: two axes on one serial line would fight over it (an embedded
+        # simulated drive is made anew for every connection, so sim:// URLs may repeat)
+        if not port or port.startswith("sim://"):
+            return
+        row = self._db.execute(
+            "SELECT name FROM axis WHERE machine_id = ? AND port_url = ? AND id IS NOT ?",
+            (machine_id, port, axis_id),
+        ).fetchone()
+        if row is not None:
+            raise RegisterError(f"axis '{name}': port {port} is already axis '{row['name']}''s")
 
     def add_axis_note(
         self, axis: Axis | str | int, text: str, who: str = "", at_utc: str | None = None
