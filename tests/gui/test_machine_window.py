@@ -218,9 +218,7 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     dgr.origin_button.click()
     qtbot.waitUntil(lambda: len(dgr.records) > before, timeout=15000)
     origin = register.latest_origin(f"{MACHINE}/tilt")
-    assert (
-        origin["text"].startswith("absolute origin set (OWW), read back at") and origin["who"] == "ana"
-    )
+    assert origin["text"].startswith("absolute origin set (OWW), read back at") and origin["who"] == "ana"
     assert [e.text.split(":")[0] for e in register.history(f"{MACHINE}/tilt") if e.kind == "check"] == [
         "dgr-checks / absolute_origin"
     ]
@@ -347,3 +345,30 @@ def test_an_axis_added_in_the_window_gets_its_pages_and_goes_into_the_register(m
         window.add_axis("roll", "FHA-17C-50-US250")
     assert window.axis_list.count() == 2 and [a.name for a in register.axes("Wrist")] == ["pitch", "roll"]
     register.close()
+
+
+def test_closing_with_a_servo_on_asks_and_cancel_keeps_every_link(make_machine, qtbot, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QMessageBox
+
+    project = MachineProject("Cell 4")
+    project.add_axis("x", TABLE, port_url=f"sim://{TABLE}?paced=0")
+    project.add_axis("y", TABLE, port_url=f"sim://{TABLE}?paced=0")
+    window = make_machine(project, None)
+    window.connect_all()
+    x, y = window.axis_windows
+    qtbot.waitUntil(lambda: x.link.connected and y.link.connected, timeout=15000)
+    y.link.send(Cmd.SERVO, True)
+    qtbot.waitUntil(lambda: y.link.servo_on, timeout=10000)
+    asked = []
+
+    def answer(parent, title, text, buttons, default):
+        asked.append(text)
+        return QMessageBox.StandardButton.Cancel
+
+    monkeypatch.setattr(QMessageBox, "warning", answer)
+    assert not window.close()
+    assert asked and "The servo is on at y." in asked[0]
+    assert window.isVisible() and x.link.connected and y.link.connected
+    monkeypatch.setattr(QMessageBox, "warning", lambda *args: QMessageBox.StandardButton.Ok)
+    assert window.close()
+    assert not x.link._thread.isRunning() and not y.link._thread.isRunning()
