@@ -43,7 +43,7 @@ class TimePlot(QWidget):
         self._grid_pen = pg.mkPen(255, 255, 255, 50)
         self._grid_on = False
         self.plot.plotItem.vb.sigYRangeChanged.connect(self._update_grid_lines)
-        self.show_x_grid(False)
+        self.show_grid_for_still_data(False)
         self.cursor1 = pg.InfiniteLine(angle=90, movable=True, pen=pg.mkPen("#ffffff", width=1))
         self.cursor2 = pg.InfiniteLine(angle=90, movable=True, pen=pg.mkPen("#ffffff", width=1,
                                                                              style=Qt.PenStyle.DashLine))
@@ -66,12 +66,12 @@ class TimePlot(QWidget):
     def view_box(self) -> pg.ViewBox:
         return self.plot.plotItem.vb
 
-    def show_x_grid(self, on: bool) -> None:
+    def show_grid_for_still_data(self, still: bool) -> None:
         """Still data: the axes' grid. Live: no x grid (it would scroll every frame) and the y grid
         as plain lines: an axis that draws a grid covers the plot and repaints its text with
         every frame of the curves."""
-        self.plot.showGrid(x=on, y=on, alpha=0.25)
-        self._grid_on = not on
+        self.plot.showGrid(x=still, y=still, alpha=0.25)
+        self._grid_on = not still
         self._update_grid_lines()
 
     def _update_grid_lines(self, *_args) -> None:

@@ -307,7 +307,7 @@ class ScopeView(QWidget):
         self._levels.append(started.ring.drain())  # what came before this view learnt of it
         self._static = None
         self._status = None
-        self.time_plot.show_x_grid(False)
+        self.time_plot.show_grid_for_still_data(False)
         self._fill_channel_table()
         self._update_indicator()
 
@@ -392,7 +392,7 @@ class ScopeView(QWidget):
                     uniform: bool = True) -> None:
         """Show data that is not live (a capture, a file); live acquisition goes on unseen."""
         self._static = _Static(tuple(channels), np.asarray(rows, dtype=float), label, sample_rate_hz, uniform)
-        self.time_plot.show_x_grid(True)
+        self.time_plot.show_grid_for_still_data(True)
         for c in self._static.channels:
             self._visible[c.key] = True  # a capture shows all it has; hide by hand
         self._fill_channel_table()
@@ -409,7 +409,7 @@ class ScopeView(QWidget):
 
     def back_to_live(self) -> None:
         self._static = None
-        self.time_plot.show_x_grid(False)
+        self.time_plot.show_grid_for_still_data(False)
         self._fill_channel_table()
         self._update_indicator()
 
