@@ -15,23 +15,15 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 from datetime import datetime
-from typing import Any, Protocol
+from typing import Any
 
 from fha_studio.catalog import ModelCodeError, parse_model_code
 from fha_studio.hardware import protocol as p
+from fha_studio.hardware.api import Capabilities, DriveApi
 from fha_studio.hardware.errors import CommandRejected, DriveRefused, ServoOnRefused
 
 #: What the technician is told when the drive answers ``s``.
 SERVO_ON_TEXT = "servo on (controller): the drive does not answer over CN3 until servo off"
-
-
-class _Client(Protocol):
-    capabilities: Any
-
-    def absolute_position(self) -> int: ...
-    def clear_multiturn(self) -> None: ...
-    def identify(self) -> Any: ...
-    def io_state(self) -> Any: ...
 
 
 def output_deg(counts: int, ratio: int) -> float:
@@ -54,7 +46,7 @@ def ratio_of(code: str | None) -> int | None:
         return None
 
 
-def documented_only(capabilities: Any) -> bool:
+def documented_only(capabilities: Capabilities) -> bool:
     """True when the drive listed no extension command (it speaks only the manual's DGR and OWW)."""
     return not (set(capabilities.commands) - p.DOCUMENTED_COMMANDS)
 
@@ -122,7 +114,7 @@ def position_text(counts: int, angle_deg: float | None) -> str:
     return text
 
 
-def probe(client: _Client, ratio: int | None = None) -> Probe:
+def probe(client: DriveApi, ratio: int | None = None) -> Probe:
     """Ask the drive what it is and where it stands. ``ratio`` scales the position; without it the
     ratio of the actuator the drive says it is adjusted for (IDN) is used, if it says so."""
     caps = client.capabilities
@@ -177,7 +169,7 @@ class OriginResult:
         }
 
 
-def set_absolute_origin(client: _Client, ratio: int | None = None) -> OriginResult:
+def set_absolute_origin(client: DriveApi, ratio: int | None = None) -> OriginResult:
     """The absolute-origin steps of the manual: DGR (proves servo off and an absolute encoder),
     OWW (clears the multi-turn data, ``q`` about 5 s later), DGR again (the new position).
 
