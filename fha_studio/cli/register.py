@@ -149,10 +149,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def _open_register(args):
     from fha_studio.logic.register import Register, RegisterError
 
+    # a question asked of a register that is not there is a mistake (a typed path), not an empty
+    # answer; adding or importing creates it
+    create = args.action in ("add-machine", "add-axis", "import")
     try:
-        reg = Register(args.db) if args.db else Register()
+        reg = Register(args.db, create=create)
     except RegisterError as exc:
-        raise CliError(str(exc)) from None
+        hint = "" if create else " (start one: fha-studio register add-machine NAME)"
+        raise CliError(f"{exc}{hint}") from None
     try:
         yield reg
     except RegisterError as exc:

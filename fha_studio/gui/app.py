@@ -46,7 +46,8 @@ def _url(text: str) -> str:
 def _baud(text: str) -> int:
     if not text.strip().isascii() or not text.strip().isdigit() or int(text) not in BAUD_RATES:
         raise argparse.ArgumentTypeError(
-            f"{text[:20]} is not a baud rate; one of {', '.join(map(str, BAUD_RATES))}")
+            f"{text[:20]} is not a baud rate; one of {', '.join(map(str, BAUD_RATES))}"
+        )
     return int(text)
 
 
@@ -59,8 +60,12 @@ def _parser() -> argparse.ArgumentParser:
         help=f"drive to connect to at start (default: the embedded simulated drive, {DEFAULT_SIM_URL}, "
         "with the declared load inertia); a serial device, a pty path or socket://host:port",
     )
-    parser.add_argument("--baud", type=_baud, default=19200,
-                        help=f"baud rate of a serial link (default 19200; {', '.join(map(str, BAUD_RATES))})")
+    parser.add_argument(
+        "--baud",
+        type=_baud,
+        default=19200,
+        help=f"baud rate of a serial link (default 19200; {', '.join(map(str, BAUD_RATES))})",
+    )
     parser.add_argument("--no-connect", action="store_true", help="start without connecting")
     parser.add_argument(
         "--page",
@@ -101,7 +106,10 @@ def _machine_window(args):
     from fha_studio.logic.register import Register, RegisterError
 
     try:
-        register = Register(Path(args.register) if args.register else register_path())
+        # a machine file is put into the register (made when missing); a machine by name must be there
+        register = Register(
+            Path(args.register) if args.register else register_path(), create=bool(args.machine_file)
+        )
         try:
             if args.machine_file:
                 project = MachineProject.load(args.machine_file)
@@ -130,8 +138,10 @@ def make_application(argv: Sequence[str] = ()):
 
     sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
     existing = QApplication.instance()
-    app = existing if isinstance(existing, QApplication) else QApplication(
-        [sys.argv[0] if sys.argv else "fha-studio", *argv]
+    app = (
+        existing
+        if isinstance(existing, QApplication)
+        else QApplication([sys.argv[0] if sys.argv else "fha-studio", *argv])
     )
     if not app.organizationName() or app.organizationName() == "":
         app.setOrganizationName(ORGANISATION)

@@ -245,6 +245,9 @@ def test_the_gui_opens_a_machine_of_the_register_or_says_why_not(qtbot, tmp_path
     from fha_studio.gui.app import run
 
     path = tmp_path / "plant.sqlite"
+    with pytest.raises(SystemExit):
+        run(["--machine", "Press 7", "--register", str(path), "--no-connect"])
+    assert capsys.readouterr().err == f"fha-studio: there is no register at {path}\n"
     with Register(path) as register:
         register.add_machine("Press 7")
     for args, message in (

@@ -173,3 +173,16 @@ def test_machine_report_from_the_register(capsys, db, tmp_path):
         and err.strip()
         == "fha-studio register: error: no machine called 'Line 9' in the register (machines: Line 3)"
     )
+
+
+def test_a_question_to_a_register_that_is_not_there_is_refused(capsys, tmp_path):
+    missing = tmp_path / "tpyo.sqlite"
+    assert main(["register", "--db", str(missing), "machines"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"fha-studio register: error: there is no register at {missing} "
+        "(start one: fha-studio register add-machine NAME)\n"
+    )
+    assert not missing.exists()
+    assert main(["register", "--db", str(missing), "add-machine", "Press 7"]) == 0
+    assert missing.exists()

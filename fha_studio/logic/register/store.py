@@ -189,10 +189,14 @@ class Found:
 class Register:
     """One register file, open. Use as a context manager or call :meth:`close`."""
 
-    def __init__(self, path: str | Path | None = None, busy_timeout_s: float = 30.0):
+    def __init__(self, path: str | Path | None = None, busy_timeout_s: float = 30.0, create: bool = True):
+        """Opens the register at ``path`` (default: :func:`default_register_path`), created when
+        missing unless ``create`` is False (then RegisterError says there is none)."""
         self.path = Path(path) if path is not None else default_register_path()
         if self.path.is_dir():
             raise RegisterError(f"register {self.path}: is a directory, not a register file")
+        if not create and not self.path.exists():
+            raise RegisterError(f"there is no register at {self.path}")
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._db = sqlite3.connect(self.path, timeout=busy_timeout_s, isolation_level=None)
