@@ -239,3 +239,19 @@ def test_after_the_power_cycle_nothing_is_pending(window, qtbot):
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=cycled, timeout=10000):
         page.power_cycle_button.click()
     qtbot.waitUntil(lambda: "power cycle" not in state() and "restart" not in state(), timeout=10000)
+
+
+def test_a_direction_confirmed_on_its_page_is_done_in_the_report(window, qtbot, tmp_path):
+    from fha_studio.logic.procedures.report import build_report
+
+    direction = window.show_page("direction")
+    assert direction.answer("cw") is True  # parameter 8 = 0: FWD turns CW, and CW was seen
+    procedures = window.show_page("procedures")
+    procedures.new_session(tmp_path / "axis.json", "FHA-25C-50-US250")
+    procedures._collect_for_report()
+    report = build_report(procedures.session)
+    done = next(r for r in report.procedures if r.id == "rotary-direction")
+    assert done.status == "completed" and done.records[-1].value == "CW"
+    assert "Rotary direction (1-10) — done" in procedures.procedure_list.item(
+        [p.id for p in procedures.procedures].index("rotary-direction")
+    ).text()

@@ -351,6 +351,14 @@ class DirectionPage(BasePage):
             )
             return None
         ok = seen == expected
+        from fha_studio.logic.procedures.direction_check import DirectionCheck
+        from fha_studio.logic.procedures.session import utc_now
+
+        # kept for the commissioning report: a check confirmed here is the 1-10 procedure done
+        self.last_check = DirectionCheck(
+            parameter_value=setting.value, expected=expected.upper(), seen=seen.upper(), who="",
+            at_utc=utc_now(),
+        )
         if ok:
             self.check_result.setText(
                 f"<span style='color:#2e7d32'><b>Confirmed</b>: FWD turns the flange {seen.upper()}, "

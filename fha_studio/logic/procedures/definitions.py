@@ -230,6 +230,8 @@ class Procedure:
     context: Mapping[str, Any]
     applies: bool
     source: str
+    #: Why it does not apply to this actuator, in words ("" when it applies).
+    not_applicable_reason: str = ""
 
     def step_ids(self) -> list[str]:
         return [s.id for s in self.steps]
@@ -332,6 +334,7 @@ def load_procedure(source: str | Path, context: Mapping[str, Any]) -> Procedure:
         context=context,
         applies=applies,
         source=name,
+        not_applicable_reason="" if applies else _why_not(head.get("when", []), context),
     )
     if applies:
         # Fill every step in now with placeholder answers, so that a wrong path in the data shows
@@ -340,6 +343,26 @@ def load_procedure(source: str | Path, context: Mapping[str, Any]) -> Procedure:
         for step in steps:
             step.resolve(context, placeholder)
     return procedure
+
+
+#: What a procedure-level condition asks of the actuator, in words (the manual's option letters).
+_NEEDS = {
+    "sensor_set": "an actuator with the rotary position sensor set (option L, 4-7)",
+    "brake": "an actuator with a brake (option B)",
+    "absolute": "an actuator with an absolute encoder (S248)",
+    "incremental": "an actuator with an incremental encoder (US250)",
+}
+
+
+def _why_not(conditions: list[str], context: Mapping[str, Any]) -> str:
+    """Why a procedure whose ``when`` fails does not apply: "needs an actuator with ..."."""
+    needs = [
+        _NEEDS.get(c, f"the condition '{c}'") for c in conditions if not condition_holds(c, context, {})
+    ]
+    if not needs:
+        return ""
+    code = context.get("actuator", {}).get("model_code", "this actuator")
+    return f"needs {' and '.join(needs)}; this one is {code}"
 
 
 class _Placeholders(dict[str, Any]):

@@ -32,6 +32,7 @@ class ProcedureResult:
     status: str
     records: tuple[CheckRecord, ...]
     applies: bool
+    not_applicable_reason: str = ""
 
     @property
     def passed(self) -> int:
@@ -163,6 +164,7 @@ def build_report(session: ProcedureSession, context: Mapping[str, Any] | None = 
                 status=(state.status if state else "not_started") if procedure.applies else "not applicable",
                 records=tuple(state.records) if state else (),
                 applies=procedure.applies,
+                not_applicable_reason=procedure.not_applicable_reason,
             )
         )
     warnings = open_warnings(session, procedures)
@@ -288,7 +290,8 @@ def render_html(report: CommissioningReport) -> str:
         status = _e(result.status.replace("_", " "))
         out.append(f"<h3>{_e(result.title)} ({_e(result.section)}) — {status}</h3>")
         if not result.applies:
-            out.append("<p>Does not apply to this actuator.</p>")
+            why = f": {_e(result.not_applicable_reason)}" if result.not_applicable_reason else ""
+            out.append(f"<p>Does not apply to this actuator{why}.</p>")
             continue
         if not result.records:
             out.append("<p>Not done.</p>")

@@ -489,6 +489,7 @@ class ProceduresPage(BasePage):
         """Bring the drive's identity and parameter values into the session before a report."""
         if self.session is None:
             return
+        self._collect_direction_check()
         identity = self._identity()
         if identity:
             self.session.driver = identity
@@ -520,6 +521,24 @@ class ProceduresPage(BasePage):
         self._collect_dgr_checks()
         if self.session.path:
             self.session.save()
+
+    def _collect_direction_check(self) -> None:
+        """A rotary-direction check confirmed on the Rotary direction page is the 1-10 procedure
+        done (unless it was walked here): the report shows it with its records, not "not started"."""
+        import dataclasses
+
+        from fha_studio.gui.pages.base import PageId
+        from fha_studio.logic.procedures.direction_check import record_direction_check
+
+        built = getattr(self.main_window, "built_page", None)
+        page = built(PageId.DIRECTION) if built is not None else None
+        check = getattr(page, "last_check", None)
+        if check is None or self.session is None:
+            return
+        if record_direction_check(self.session, dataclasses.replace(check, who=check.who or self.who)):
+            if self.session.path:
+                self.session.save()
+            self._refresh()
 
     def _collect_dgr_checks(self) -> None:
         """The DGR checks page's records (encoder, rotary direction, sensor dogs, absolute origin)
@@ -648,6 +667,7 @@ class ProceduresPage(BasePage):
             item = self.procedure_list.item(row)
             if not procedure.applies:
                 status = "does not apply"
+                item.setToolTip(f"Does not apply: {procedure.not_applicable_reason}.")
             else:
                 state = self.session.runs.get(procedure.id)
                 status = _STATUS_WORDS.get(state.status if state else "not_started", "")
