@@ -574,6 +574,9 @@ class ProceduresPage(BasePage):
         number = len(self.session.plots) + 1
         path = self.session.path.with_name(f"{self.session.path.stem}-plot{number}.png")
         scope.view.export_png(path)
+        from fha_studio.gui.paper import save_for_paper
+
+        save_for_paper(path)  # printed in the report: a light background, the legend readable
         self.add_plot(title or f"Scope plot {number}", path)
         self._message(f"Plot saved for the report: {path}")
         return path
