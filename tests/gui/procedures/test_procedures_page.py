@@ -133,9 +133,14 @@ def test_sensor_dogs_set_on_the_simulated_drive_and_the_report_prints(window, qt
         panel.record_button.click()
         assert page.session.sensor_angles_deg[sensor] == pytest.approx(angle, abs=0.6)
     page.yes_button.click()  # screws tightened
+    progress = []
     with qtbot.waitSignal(page.sigLiveDone, timeout=60000) as done:
         page.live_button.click()
+        # the test run takes a while: the page says where the output is while it runs
+        qtbot.waitUntil(lambda: page.live_label.text().startswith("Running on the drive"), timeout=30000)
+        progress.append(page.live_label.text())
     assert done.args[0].passed, done.args[0].detail
+    assert "the output is at" in progress[0] and "°" in progress[0]
     assert page.session.runs["sensor-adjustment"].status == "completed"
 
     html, pdf = page.write_report(tmp_path / "report.html", tmp_path / "report.pdf")

@@ -10,6 +10,7 @@ with the manual's warning until someone says it was put right.
 from __future__ import annotations
 
 import logging
+import time
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -79,6 +80,14 @@ def _live_check_in_link_thread(step: Step, context, angles: dict, relay: _Sample
     return run_live_check(client, step, env)
 
 
+#: The sensors a live check's samples report, by I/O bit (docs/protocol.md, IOS).
+_SENSOR_BITS = (
+    (IoBit.LIMIT_SWITCH_1, "limit switch 1"),
+    (IoBit.LIMIT_SWITCH_2, "limit switch 2"),
+    (IoBit.ORIGIN_SENSOR, "origin sensor"),
+)
+
+
 class ProceduresPage(BasePage):
     """Receiving inspection, installation, wiring, sensor set, rotary direction; the report."""
 
@@ -106,6 +115,9 @@ class ProceduresPage(BasePage):
         self._relay.sigSample.connect(
             lambda angle, bits: self.dog_panel.observe(angle, bits) if self.dog_panel.wizard else None
         )
+        self._relay.sigSample.connect(self._live_progress)
+        self._live_started_s = 0.0
+        self._live_shown_s = 0.0
         self._refresh()
 
     # -- layout -------------------------------------------------------------------------------
@@ -437,12 +449,28 @@ class ProceduresPage(BasePage):
             self._ask_by_hand(step, "no drive is connected")
             return
         self.live_label.setText("Asking the drive …")
+        self._live_started_s = time.monotonic()
         self.live_button.setEnabled(False)
         function = partial(
             _live_check_in_link_thread, step, self.context, dict(self.session.sensor_angles_deg), self._relay,
             self._live_memo
         )
         self._live_token = self.link.send(Cmd.CALL, function)
+
+    @Slot(float, int)
+    def _live_progress(self, angle_deg: float, io_bits: int) -> None:
+        """While a live check moves the axis (the sensor test run takes tens of seconds), say
+        where the output is and which sensors are on, a few times a second."""
+        now = time.monotonic()
+        if self._live_token is None or now - self._live_shown_s < 0.2:
+            return
+        self._live_shown_s = now
+        on = [name for bit, name in _SENSOR_BITS if io_bits >> bit & 1]
+        sensors = f"; on: {', '.join(on)}" if on else "; no sensor on"
+        self.live_label.setText(
+            f"Running on the drive ({now - self._live_started_s:.0f} s): the output is at "
+            f"{angle_deg:+.1f}°{sensors} …"
+        )
 
     @Slot(object)
     def _on_result(self, result: CommandResult) -> None:
