@@ -33,7 +33,7 @@ def save_for_paper(png_path: str | Path) -> Path:
     if image.isNull():
         raise ValueError(f"{path}: not an image FHA Studio can read")
     partial = path.with_name(f".{path.name}.partial.png")
-    if not for_paper(image).save(str(partial), "PNG"):
+    if not for_paper(image).save(str(partial)):  # PNG, from the .png suffix
         raise OSError(f"{path}: could not be written")
     partial.replace(path)
     return path

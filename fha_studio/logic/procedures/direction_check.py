@@ -43,7 +43,9 @@ def record_direction_check(session: ProcedureSession, check: DirectionCheck) -> 
     at = check.at_utc or utc_now()
     where = "on the Rotary direction page"
 
-    def record(step_id: str, kind: str, text: str, value, expected: str, passed: bool, detail: str):
+    def record(
+        step_id: str, kind: str, text: str, value: object, expected: str, passed: bool, detail: str
+    ) -> CheckRecord:
         return CheckRecord(PROCEDURE_ID, step_id, kind, SECTION, text, value, expected, "", passed,
                            check.who, at, detail)
 
