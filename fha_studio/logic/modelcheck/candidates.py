@@ -569,6 +569,37 @@ CANDIDATES: dict[str, Candidate] = {c.id: c for c in TORQUE_CANDIDATES + POSITIO
 LABELS = {c.id: c.label for c in TORQUE_CANDIDATES + POSITION_CANDIDATES}
 
 
+# Parameters in words, for a person (the ids and names above are the machine contract).
+PARAM_WORDS = {
+    "torque_nm": "torque",
+    "coefficient_nm_s_per_rad": "coefficient",
+    "amplitude_nm": "amplitude",
+    "amplitude_arcsec": "amplitude",
+    "phase_deg": "phase",
+    "cycles_per_motor_rev": "cycles per motor turn",
+    "inertia_kgm2": "inertia",
+    "stiffness_nm_per_rad": "stiffness K1",
+    "k2_nm_per_rad": "stiffness K2",
+    "k3_nm_per_rad": "stiffness K3",
+    "width_arcsec": "width",
+    "torque_pos_nm": "turning CW",
+    "torque_neg_nm": "turning CCW",
+    "static_torque_nm": "breakaway above Coulomb",
+    "velocity_rad_s": "fading by",
+    "ratio": "torque per ampere / catalogue",
+}
+UNIT_WORDS = {"kg m^2": "kg m²", "1/rev": "", "1": ""}
+
+
+def param_words(name: str, value: float, unit: str, sigma: float | None = None) -> str:
+    """'torque 11.9 ± 0.1 N m': a fitted parameter as a person reads it."""
+    unit = UNIT_WORDS.get(unit, unit)
+    text = f"{PARAM_WORDS.get(name, name.replace('_', ' '))} {value:.3g}"
+    if sigma is not None and math.isfinite(sigma) and sigma > 0:
+        text += f" ± {sigma:.2g}"
+    return f"{text} {unit}".rstrip()
+
+
 def label_of(effect_ids: str) -> str:
     """The human name of an effect id, or of look-alike ids joined by " + "."""
     return " + ".join(LABELS.get(i, i) for i in effect_ids.split(" + "))

@@ -186,6 +186,8 @@ class Trial:
     accepted: bool
     reason: str
     noise_peak: bool = False  # a searched shape that does not stand above its neighbours (look-elsewhere)
+    # gates failed: "evidence", "held_out", "floor", "precision", "noise_peak", "sign"
+    failed: tuple[str, ...] = ()
 
 
 @dataclass
@@ -337,15 +339,20 @@ class ChannelSelector:
         size = float(cand.size(beta_c, self.ctx))
         physical = self._physical(cand, beta_c)
         reasons = []
+        failed: list[str] = []  # the gates it failed, by name (for plain words in the GUI)
         if bic1 - bic0 > -BIC_MIN:
             reasons.append(f"whitened BIC gain {bic0 - bic1:.1f} < {BIC_MIN:g}")
+            failed.append("evidence")
         if cv1 > cv0 * (1.0 - CV_MIN_GAIN):
             reasons.append("held-out RMS does not fall")
+            failed.append("held_out")
         if size < self.floor:
             reasons.append(f"size {size:.3g} {self.unit} below the floor {self.floor:.3g}")
+            failed.append("floor")
         sigma = self.size_sigma(cand, x1, term.cols.shape[1])
         if size < MIN_SIGMAS * sigma:
             reasons.append(f"size {size:.3g} {self.unit} within {MIN_SIGMAS:g} sigma ({sigma:.3g}) of zero")
+            failed.append("precision")
         noise_peak = False
         if cand.look_elsewhere and size >= self.floor:
             off = self.off_shape_size(cand, x1, shape)
@@ -357,6 +364,7 @@ class ChannelSelector:
                 )
         if not physical:
             reasons.append("unphysical sign")
+            failed.append("sign")
         trial = Trial(
             cand.id,
             shape,
@@ -368,6 +376,7 @@ class ChannelSelector:
             not reasons,
             "; ".join(reasons) or "named",
             noise_peak,
+            tuple(failed + (["noise_peak"] if noise_peak else [])),
         )
         return trial, term
 

@@ -53,7 +53,7 @@ class AnalysisFilter:
     @property
     def bandwidth_hz(self) -> float:
         """Rough -3 dB frequency of the smoothing (informative)."""
-        return 1.0 / (1.7 * (self.window - 2) * self.dt_s)
+        return bandwidth_of_window(self.window, self.dt_s)
 
     @property
     def noise_gain(self) -> float:
@@ -108,6 +108,24 @@ def check_window(window: int, n_samples: int) -> int:
             f"(at least {MIN_WINDOWS_PER_RECORD} windows must fit in it)"
         )
     return int(window) | 1
+
+
+def bandwidth_of_window(window: int, dt_s: float) -> float:
+    """The analysis bandwidth (Hz, rough -3 dB) of a window of that many samples."""
+    return 1.0 / (1.7 * (window - 2) * dt_s)
+
+
+def window_for_bandwidth(bandwidth_hz: float, n_samples: int, dt_s: float) -> int:
+    """The odd window (samples) nearest an analysis bandwidth, within what the recording supports."""
+    lo, hi = window_bounds(n_samples)
+    window = round(1.0 / (1.7 * bandwidth_hz * dt_s)) + 2
+    return min(max(window, lo), hi) | 1  # hi is odd: the result stays within the bounds
+
+
+def bandwidth_bounds_hz(n_samples: int, dt_s: float) -> tuple[float, float]:
+    """The lowest and highest analysis bandwidth (Hz) a recording of n_samples at dt_s supports."""
+    lo, hi = window_bounds(n_samples)
+    return bandwidth_of_window(hi, dt_s), bandwidth_of_window(lo, dt_s)
 
 
 def noise_sigma(x: np.ndarray) -> float:

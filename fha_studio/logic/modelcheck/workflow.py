@@ -22,6 +22,7 @@ from fha_studio.logic.modelcheck.candidates import (
     CANDIDATES,
     CHANNEL_UNITS,
     LABELS,
+    PARAM_WORDS,
     POSITION,
     POSITION_CANDIDATES,
     TORQUE,
@@ -270,12 +271,14 @@ class ModelCheckResult:
             p = next(iter(e.params))
             main = _fmt_pm(e.params[p], e.uncertainty[p], e.units[p])
             others = ", ".join(
-                f"{k} {_fmt_pm(v, e.uncertainty[k], e.units[k])}" for k, v in e.params.items() if k != p
+                f"{PARAM_WORDS.get(k, k)} {_fmt_pm(v, e.uncertainty[k], e.units[k])}"
+                for k, v in e.params.items()
+                if k != p
             )
             text = f"{e.label} missing: {main}" + (f" ({others})" if others else "")
             if e.alternatives:
                 alts = " or ".join(label_of(a) for a in e.alternatives)
-                text = f"{e.label} or {alts} — not separable from this data; as {e.id}: {main}"
+                text = f"{e.label} or {alts} — not separable from this data; as {e.label.lower()}: {main}"
             gap = self.gap.get(e.channel)
             if gap is not None and by_channel.get(e.channel) is e:
                 text += (
@@ -284,7 +287,7 @@ class ModelCheckResult:
                 )
             lines.append(text)
         for a in self.ambiguities:
-            as_alt = ", ".join(f"{k} {_fmt(v)}" for k, v in a.alternative_params.items())
+            as_alt = ", ".join(f"{PARAM_WORDS.get(k, k)} {_fmt(v)}" for k, v in a.alternative_params.items())
             lines.append(
                 f"  {label_of(a.chosen)} or {label_of(a.alternative)}"
                 + (f" ({as_alt})" if as_alt else "")
@@ -430,12 +433,13 @@ def _fmt(x: float) -> str:
 
 
 def _fmt_pm(value: float, sigma: float, unit: str) -> str:
+    unit = "" if unit in ("1", "1/rev") else unit  # a ratio, or cycles per motor turn (said in words)
     if not math.isfinite(sigma) or sigma <= 0:
-        return f"{_fmt(value)} {unit}"
+        return f"{_fmt(value)} {unit}".rstrip()
     digits = max(0, -math.floor(math.log10(sigma)))
     if abs(value) >= 1e5:
-        return f"{value:.4g} {unit} ± {sigma:.2g}"
-    return f"{value:.{min(digits, 8)}f} {unit} ± {sigma:.{min(digits, 8)}f}"
+        return f"{value:.4g} {unit} ± {sigma:.2g}".replace("  ", " ")
+    return f"{value:.{min(digits, 8)}f} {unit} ± {sigma:.{min(digits, 8)}f}".replace("  ", " ")
 
 
 # ------------------------------------------------------------------------------------------ workflow
@@ -533,7 +537,7 @@ def run_modelcheck(
         status[POSITION] = ChannelStatus(
             POSITION,
             ABSENT,
-            "is absent: the recording has no load_pos column (an external encoder on the load)",
+            "is absent: the recording has no load-side encoder position (an external encoder on the load)",
         )
     else:
         motor_side = np.zeros(n)
@@ -715,7 +719,8 @@ def _position_status(sig: Signals, y_arcsec: np.ndarray) -> ChannelStatus:
     return ChannelStatus(
         POSITION,
         TOO_LITTLE_SIGNAL,
-        f"shows nothing above {_fmt(level)} arcsec between load_pos and pos ({_fmt(shown)} arcsec at most)",
+        f"shows nothing above {_fmt(level)} arcsec between the load and motor encoders "
+        f"({_fmt(shown)} arcsec at most)",
         level,
         "arcsec",
     )
@@ -900,7 +905,7 @@ def _resimulate(
     if servo is not None and sig.cmd_pos_rad is not None:
         command, cmd = "cmd_pos", sig.cmd_pos_rad[:n_raw]
     else:
-        command = "motion (measured pos, smoothed, stiff servo)"
+        command = "motion (the measured position, smoothed, through a stiff servo)"
         cmd = savgol_filter(sig.raw_pos_rad, f.window, POLYORDER)[:n_raw]
         servo = ServoSettings.tuned_for(nominal, speed_bandwidth_hz=RESIM_BANDWIDTH_HZ, feed_forward_gain=1.0)
     if n_raw < len(sig.raw_t_s):

@@ -36,6 +36,8 @@ from fha_studio import fileio
 from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.state import AxisState
 from fha_studio.logic.modelcheck import ModelCheckError, ModelCheckResult, run_modelcheck
+from fha_studio.logic.modelcheck.candidates import LABELS, label_of, param_words
+from fha_studio.logic.modelcheck.signals import bandwidth_bounds_hz, window_for_bandwidth
 from fha_studio.recording import Recording, RecordingError, read_recording
 
 COLORS = {"measured": "#1f77b4", "nominal": "#d62728", "updated": "#2ca02c", "residual": "#555555"}
@@ -56,10 +58,11 @@ class _Worker(QObject):
     sigFailed = Signal(str)
 
     @Slot(object)
-    def run(self, recording: Recording) -> None:
+    def run(self, request: tuple[Recording, int | None]) -> None:
+        recording, window = request
         started = time.perf_counter()
         try:
-            result = run_modelcheck(recording)
+            result = run_modelcheck(recording, window=window)
         except (ModelCheckError, RecordingError, ValueError) as exc:
             self.sigFailed.emit(str(exc))
             return
@@ -85,7 +88,7 @@ def _plot(title: str, left: str, bottom: str = "time (s)") -> pg.PlotWidget:
 class ModelCheckPage(BasePage):
     """Loads a recording, runs the model check, shows the story step by step."""
 
-    sigRequestRun = Signal(object)  # Recording, to the worker
+    sigRequestRun = Signal(object)  # (Recording, analysis window in samples or None), to the worker
     sigFinished = Signal(object)  # ModelCheckResult, after the views were filled
     sigFailed = Signal(str)
 
@@ -129,6 +132,15 @@ class ModelCheckPage(BasePage):
                                      "pages); the model check uses it, whatever the recording declares")
         self.inertia_spin.valueChanged.connect(self.state.set_load_inertia)
         self.state.sigLoadInertiaChanged.connect(self._declared_inertia_changed)
+        self.bandwidth_spin = QDoubleSpinBox()
+        self.bandwidth_spin.setDecimals(2)
+        self.bandwidth_spin.setSuffix(" Hz")
+        self.bandwidth_spin.setRange(0.0, 0.0)
+        self.bandwidth_spin.setSpecialValueText("from the data")
+        self.bandwidth_spin.setKeyboardTracking(False)
+        self.bandwidth_spin.setToolTip(
+            "The analysis bandwidth: by default the highest at which the rigid model still explains "
+            "the recording; set one yourself within what the recording supports")
         self.run_button = QPushButton("Run model check")
         self.run_button.setDefault(True)
         self.run_button.clicked.connect(self.run)
@@ -138,7 +150,8 @@ class ModelCheckPage(BasePage):
         self.save_report_button.clicked.connect(self._save_report_clicked)
         bar = QHBoxLayout()
         for w in (self.open_button, self.scope_button, QLabel("Declared load inertia:"), self.inertia_spin,
-                  self.run_button, self.save_model_button, self.save_report_button):
+                  QLabel("Bandwidth:"), self.bandwidth_spin, self.run_button, self.save_model_button,
+                  self.save_report_button):
             bar.addWidget(w)
         bar.addStretch(1)
         self.source_label = QLabel("No recording loaded. Open an fha-recording/1 file, or capture a move "
@@ -153,9 +166,9 @@ class ModelCheckPage(BasePage):
         self.steps = QTabWidget()
         self.steps.setDocumentMode(True)
         self.steps.addTab(self._build_residual_tab(), "1 Residual")
-        self.steps.addTab(self._build_where_tab(), "2 Where")
-        self.steps.addTab(self._build_effects_tab(), "3-4 Effects && model")
-        self.steps.addTab(self._build_gap_tab(), "5 Gap (held-out)")
+        self.steps.addTab(self._build_where_tab(), "2 Where it sits")
+        self.steps.addTab(self._build_effects_tab(), "3 Effects and what to do")
+        self.steps.addTab(self._build_gap_tab(), "4 Gap on held-out data")
         self.steps.addTab(self._build_resim_tab(), "5 Re-simulation")
 
         split = QSplitter()
@@ -198,15 +211,17 @@ class ModelCheckPage(BasePage):
 
     def _build_effects_tab(self) -> QWidget:
         self.effects_table = QTableWidget(0, 4)
-        self.effects_table.setHorizontalHeaderLabels(["Effect", "Channel", "Parameters (± 1 sigma)",
-                                                      "Not separable from"])
+        self.effects_table.setHorizontalHeaderLabels(["Effect", "Size (± one standard deviation)",
+                                                      "Could also be", "What to do next"])
+        self.effects_table.setWordWrap(True)
         self.effects_table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         self.effects_table.horizontalHeader().setStretchLastSection(True)
         self.effects_table.verticalHeader().setVisible(False)
         self.findings = QPlainTextEdit()
         self.findings.setReadOnly(True)
-        self.findings.setPlaceholderText("Selection steps, ambiguities, unexplained structure, detection "
-                                         "limits and the updated model file appear here.")
+        self.findings.setPlaceholderText("How each effect was tried, what the data cannot tell apart, "
+                                         "what no effect explains and how small an effect the recording "
+                                         "could have shown appear here.")
         return _stack(self.effects_table, self.findings)
 
     def _build_gap_tab(self) -> QWidget:
@@ -224,6 +239,7 @@ class ModelCheckPage(BasePage):
     def _update_buttons(self) -> None:
         self.run_button.setEnabled(self.recording is not None and not self._running)
         self.inertia_spin.setEnabled(not self._running)
+        self.bandwidth_spin.setEnabled(self.recording is not None and not self._running)
         self.save_model_button.setEnabled(self.result is not None and not self._running)
         self.save_report_button.setEnabled(self.result is not None and not self._running)
         self.open_button.setEnabled(not self._running)
@@ -250,6 +266,12 @@ class ModelCheckPage(BasePage):
         self.recording = recording
         self._recording_label = label
         self.result = None
+        low, high = bandwidth_bounds_hz(len(recording), self._sample_interval_s(recording))
+        self.bandwidth_spin.setRange(0.0, round(high, 2))
+        self.bandwidth_spin.setValue(0.0)
+        self.bandwidth_spin.setToolTip(
+            f"The analysis bandwidth: by default the highest at which the rigid model still explains "
+            f"the recording; this recording supports {low:.2g} to {high:.3g} Hz")
         self._describe_recording()
         self.summary.setPlainText("Not run yet: press Run model check.")
         self._update_buttons()
@@ -306,6 +328,19 @@ class ModelCheckPage(BasePage):
             self._show_error(str(exc))
 
     # ---------------------------------------------------------------- run
+    @staticmethod
+    def _sample_interval_s(recording: Recording) -> float:
+        return float(np.median(np.diff(recording.t_s))) if len(recording) > 1 else 1e-3
+
+    def analysis_window(self) -> int | None:
+        """The analysis window (samples) the user set as a bandwidth, or None: chosen from the data.
+
+        A bandwidth outside what the recording supports is brought to the nearest bound."""
+        hz = self.bandwidth_spin.value()
+        if self.recording is None or hz <= 0.0:
+            return None
+        return window_for_bandwidth(hz, len(self.recording), self._sample_interval_s(self.recording))
+
     def declared_recording(self) -> Recording | None:
         """The loaded recording with the axis's declared load inertia (what the check runs on)."""
         recording = self.recording
@@ -326,12 +361,13 @@ class ModelCheckPage(BasePage):
         self._running = True
         self._update_buttons()
         self.summary.setPlainText("Running the model check…")
-        self.sigRequestRun.emit(recording)
+        self.sigRequestRun.emit((recording, self.analysis_window()))
 
     def _on_done(self, result: ModelCheckResult, seconds: float) -> None:
         self._running = False
         self.result = result
         lines = result.summary_lines()
+        lines.append(f"Analysis bandwidth {result.bandwidth_hz:.3g} Hz: {result.window_reason}.")
         self.summary.setPlainText("\n".join(lines) + f"\n\n(analysis took {seconds:.1f} s)")
         self._draw_residual(result)
         self._fill_where(result)
@@ -364,13 +400,21 @@ class ModelCheckPage(BasePage):
                                 name="torque residual [N m]")
         if "load_diff_arcsec" in res:
             self.residual_plot.plot(t, res["load_diff_arcsec"], pen=pg.mkPen(COLORS["updated"], width=1),
-                                    name="load_pos - pos [arcsec]")
+                                    name="load encoder - motor encoder [arcsec]")
+        # where a residual no effect explains sits in time (an unmeasured disturbance)
+        self.burst_regions = []
+        for structure in r.structures:
+            for start, stop, _peak in structure.spans:
+                region = pg.LinearRegionItem((start, stop), movable=False, brush=pg.mkBrush(214, 39, 40, 50),
+                                             pen=pg.mkPen(None))
+                self.residual_plot.addItem(region)
+                self.burst_regions.append(region)
 
     def _fill_where(self, r: ModelCheckResult) -> None:
         self.where_channel.blockSignals(True)
         self.where_channel.clear()
         for name in r.where:
-            self.where_channel.addItem(name, name)
+            self.where_channel.addItem(CHANNEL_WORDS.get(name, name), name)
         self.where_channel.blockSignals(False)
         self._fill_where_variables()
 
@@ -419,31 +463,16 @@ class ModelCheckPage(BasePage):
         for e in r.effects:
             row = table.rowCount()
             table.insertRow(row)
-            params = "; ".join(
-                f"{k} = {_num(v)} ± {_num(e.uncertainty.get(k, float('nan')))} {e.units.get(k, '')}".rstrip()
-                for k, v in e.params.items()
+            size = "; ".join(
+                param_words(k, v, e.units.get(k, ""), e.uncertainty.get(k)) for k, v in e.params.items()
             )
-            for col, text in enumerate((f"{e.label} ({e.id})", e.channel, params, ", ".join(e.alternatives))):
-                table.setItem(row, col, QTableWidgetItem(text))
-        lines: list[str] = []
-        for name, ch in r.channels.items():
-            lines.append(f"{name} channel: {ch.n_samples} samples, AR({ch.ar_order}) whitening, "
-                        f"practical floor {_num(ch.floor)} {ch.unit}")
-            for step in ch.steps:
-                lines.append(f"  {_describe_step(step)}")
-        for a in r.ambiguities:
-            lines.append(f"{a.chosen} or {a.alternative}: not separable from this data "
-                        f"(ΔBIC {a.delta_bic:.1f}); to separate them: {a.separating_test}")
-        for s in r.structures:
-            lines.append(f"Unexplained structure in {s.channel} by {s.variable}: {_num(s.rms)} {s.unit} rms "
-                        f"({100 * s.fraction:.0f} % of the residual)")
-        if r.detection_limits:
-            lines.append("Detection limits of this recording:")
-            lines.extend(f"  {d.id}: {d.param} {_num(d.value)} {d.param_unit}" for d in r.detection_limits)
-        lines.append("")
-        lines.append("Updated model (Save updated model… writes it for the simulated drive):")
-        lines.append(r.updated_model.to_toml())
-        self.findings.setPlainText("\n".join(lines))
+            also = " or ".join(label_of(a) for a in e.alternatives) or "—"
+            for col, text in enumerate((e.label, size, also, e.advice)):
+                item = QTableWidgetItem(text)
+                item.setToolTip(text)
+                table.setItem(row, col, item)
+        table.resizeRowsToContents()
+        self.findings.setPlainText("\n".join(_findings_in_words(r)))
 
     def _draw_gap(self, r: ModelCheckResult) -> None:
         layout = self.gap_box.layout()
@@ -453,8 +482,9 @@ class ModelCheckPage(BasePage):
             plot.deleteLater()
         self.gap_plots.clear()
         for name, gap in r.gap.items():
-            plot = _plot(f"{name}: gap {_num(gap.rms_before)} -> {_num(gap.rms_after)} {gap.unit} rms "
-                         "on held-out blocks (shaded)", gap.unit)
+            plot = _plot(f"{CHANNEL_WORDS.get(name, name)}: {_num(gap.rms_before)} -> {_num(gap.rms_after)} "
+                         f"{gap.unit} rms on held-out stretches (shaded): how much better the updated model "
+                         "explains data it was not fitted on", gap.unit)
             for start, stop in gap.blocks:
                 region = pg.LinearRegionItem((start, stop), movable=False,
                                              brush=pg.mkBrush(255, 200, 0, 40), pen=pg.mkPen(None))
@@ -545,12 +575,73 @@ def _num(x: float) -> str:
     return f"{x:.3g}"
 
 
-def _describe_step(step) -> str:
-    """One selection step: which candidates were tried, how they scored, which was taken."""
-    chosen = step.chosen or "none"
-    tried = ", ".join(
-        f"{t.id} ΔBIC {t.delta_bic:.0f} cv {_num(t.cv_rms_before)}->{_num(t.cv_rms_after)}"
-        + ("" if t.accepted else f" ({t.reason})")
-        for t in sorted(step.trials, key=lambda t: -t.delta_bic)[:4]
-    )
-    return f"{step.kind} step (AR {step.ar_order}): chose {chosen}" + (f"; tried {tried}" if tried else "")
+CHANNEL_WORDS = {
+    "torque": "Torque (motor current)",
+    "position": "Position (load encoder against motor encoder)",
+}
+GATE_WORDS = {
+    "evidence": "the data do not show it clearly enough",
+    "held_out": "it does not explain held-out data better",
+    "floor": "too small to matter",
+    "precision": "the recording does not pin its size down",
+    "noise_peak": "no larger than what noise gives at other frequencies",
+    "sign": "its sign is not physical (friction cannot push)",
+}
+
+
+def _better(before: float, after: float) -> str:
+    """How much better a model explains held-out data, in words."""
+    if before <= 0 or not np.isfinite(before) or not np.isfinite(after):
+        return "does not change how well held-out data are explained"
+    change = 100.0 * (before - after) / before
+    return f"explains held-out data {change:.0f} % better ({before:.3g} -> {after:.3g}"
+
+
+def _findings_in_words(r: ModelCheckResult) -> list[str]:
+    """The Effects tab's text: how each effect was tried, in the words a person uses."""
+    out = [f"Analysis bandwidth {r.bandwidth_hz:.3g} Hz: {r.window_reason}.", ""]
+    for ch, status in r.channel_status.items():
+        name = CHANNEL_WORDS.get(ch, ch)
+        if not status.checked:
+            out.append(f"{name}: not checked, it {status.reason}.")
+            continue
+        report = r.channels.get(ch)
+        out.append(f"{name}: checked.")
+        if report is None:
+            continue
+        for number, step in enumerate(report.steps, 1):
+            if step.kind == "backward":
+                dropped = label_of(step.chosen) if step.chosen else "nothing"
+                out.append(f"  Step {number}: the named effects checked together; {dropped} dropped: "
+                           "the others explain the data without it.")
+                continue
+            chosen = next((t for t in step.trials if t.id == step.chosen), None)
+            if chosen is not None:
+                out.append(f"  Step {number}: {label_of(chosen.id)} named: it "
+                           f"{_better(chosen.cv_rms_before, chosen.cv_rms_after)} {report.unit} rms).")
+            else:
+                out.append(f"  Step {number}: no further effect passes every test.")
+            for t in step.trials:
+                if t.accepted or t.id == step.chosen:
+                    continue
+                why = "; ".join(GATE_WORDS.get(g, g) for g in t.failed) or "another explains it better"
+                out.append(f"      {label_of(t.id)}: not named: {why}.")
+    for a in r.ambiguities:
+        out.append(f"{label_of(a.chosen)} or {label_of(a.alternative)}: the data cannot tell them apart. "
+                   f"To tell them apart: {a.separating_test}.")
+    for st in r.structures:
+        if st.spans:
+            where = "at " + ", ".join(f"{x:.2f}-{y:.2f} s" for x, y, _ in st.spans[:8])
+        else:
+            where = f"against {VARIABLE_LABELS.get(st.variable, st.variable)}"
+        out.append(f"A residual no effect explains in the {st.channel} channel, {where} "
+                   f"({100 * st.fraction:.0f} % of what is left); shaded on the Residual tab.")
+    if r.detection_limits:
+        out.append("")
+        out.append("The smallest effect of each kind this recording could have shown:")
+        for d in r.detection_limits:
+            out.append(f"  {LABELS.get(d.id, d.id)}: {param_words(d.param, d.value, d.param_unit)}")
+    out.append("")
+    changes = ", ".join(e.label.lower() for e in r.effects) or "no change"
+    out.append(f"Updated model (Save updated model… writes it for the simulated drive): {changes}.")
+    return out
