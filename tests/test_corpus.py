@@ -39,6 +39,9 @@ def test_a_malformed_file_is_refused_with_one_line_naming_it(case):
 def scratch(tmp_path):
     (tmp_path / "afile").write_text("a regular file")
     os.mkfifo(tmp_path / "fifo")
+    from fha_studio.logic.register import Register
+
+    Register(tmp_path / "r.sqlite").close()  # the register the register cases ask (it must exist)
     return tmp_path
 
 

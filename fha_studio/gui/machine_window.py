@@ -767,11 +767,10 @@ class MachineWindow(QMainWindow):
         partial.replace(html_path)
         pdf = write_pdf(html, pdf_path, report.title, html_path.parent) if pdf_path is not None else None
         if self.register is not None:
-            signed = all(s.is_signed for s in report.summaries)
+            # a machine report is not signed itself: each axis's report is
             self.register.record_report(
                 pdf or html_path,
                 machine=self.project.name,
-                signed_by="every axis signed" if signed else "",
                 open_warnings=sum(s.open_warnings for s in report.summaries),
                 who=self.operator,
             )
