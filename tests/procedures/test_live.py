@@ -185,21 +185,19 @@ def test_a_drive_that_cannot_tell_is_confirmed_by_hand(drive):
 
 
 def test_a_servo_on_refusal_is_not_a_failed_check():
-    from fha_studio.hardware.errors import CommandNotSupported, ServoOnRefused
+    from fha_studio.hardware.api import IoState, ServoOnRefused
+    from fha_studio.hardware.protocol import Command
+    from tests.gui.fake_drive import FakeDriveClient
 
-    class RealDriveServoOn:  # a real HA-655 answers "s" to everything while the servo is on
-        def io_state(self):
-            raise ServoOnRefused("s: the servo is on")
+    class DriveServoOn(FakeDriveClient):  # a drive that answers "s" while the servo is on
+        def io_state(self) -> IoState:
+            raise ServoOnRefused("the drive does not read the I/O state while the servo is on")
 
-        def alarm(self):
-            raise CommandNotSupported("ALM: not an HA-655 command")
-
+    drive = DriveServoOn().without(Command.ALM)  # and has no alarm command (CommandNotSupported)
     context = build_context(CODE)
     wiring = load_procedure("wiring", context)
     step = wiring.step("brake-releases").resolve(context, {})
-    seen = run_live_check(RealDriveServoOn(), step, LiveEnv(context))
+    seen = run_live_check(drive, step, LiveEnv(context))
     assert not seen.available and "switch it off" in seen.detail
-    seen = run_live_check(
-        RealDriveServoOn(), wiring.step("encoder-signals").resolve(context, {}), LiveEnv(context)
-    )
+    seen = run_live_check(drive, wiring.step("encoder-signals").resolve(context, {}), LiveEnv(context))
     assert not seen.available and "enter what you saw" in seen.detail
