@@ -34,6 +34,7 @@ from PySide6.QtWidgets import (
 from fha_studio.gui.connect_dialog import catalogue_codes
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
+from fha_studio.gui.shape_figure import LETTERS, ShapeFigure
 from fha_studio.logic.sizing import SizingResult
 from fha_studio.logic.wording import with_unit
 
@@ -96,6 +97,8 @@ class SizingPage(BasePage):
             max(0, self.material_combo.findText("Aluminum", Qt.MatchFlag.MatchStartsWith))
         )
         form.addRow("&Shape:", self.shape_combo)
+        self.shape_figure = ShapeFigure()
+        form.addRow(self.shape_figure)
         form.addRow("&Material:", self.material_combo)
         self.dims_widget = QWidget()
         self.dims_form = QFormLayout(self.dims_widget)
@@ -264,7 +267,10 @@ class SizingPage(BasePage):
         while self.dims_form.rowCount():
             self.dims_form.removeRow(0)
         self.dim_spins.clear()
-        function = self.shapes[self.shape_combo.currentData()]
+        shape = self.shape_combo.currentData()
+        function = self.shapes[shape]
+        self.shape_figure.set_shape(shape)
+        letters = LETTERS.get(shape, {})
         for name in inspect.signature(function).parameters:
             if name == "density_kg_m3":
                 continue
@@ -274,6 +280,8 @@ class SizingPage(BasePage):
             else:
                 spin = _spin(100.0, 0.1, 100000.0, 1, " mm")
                 label = _words(name[:-2] if name.endswith("_m") else name)
+            if name in letters:  # the letter of the figure first: "B — base"
+                label = f"{letters[name]} — {label.lower()}"
             if "inner" in name or "wall" in name:
                 spin.setValue(20.0)
             spin.valueChanged.connect(self._update_part)
