@@ -234,7 +234,8 @@ def encoder_check(before: int, after: int, turned_deg: float, ratio: int
     passed = expected != 0 and change * expected > 0 and close
     seen = output_deg(change, ratio)
     detail = (f"turned {turned_deg:+g}° by hand: the counts changed by {change:+d} ({seen:+.2f}° at the "
-              f"output), expected {expected:+.0f} (ratio {ratio} x 8192 counts per motor turn)")
+              f"output), expected {expected:+.0f} (ratio {ratio} x {p.ABSOLUTE_COUNTS_PER_TURN} counts "
+              "per motor turn)")
     if not passed:
         detail += ("; wrong sense: check the encoder wiring (phases) and the model code"
                    if change * expected < 0

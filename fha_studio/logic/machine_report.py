@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures.report import CommissioningReport, build_report, render_html
 from fha_studio.logic.procedures.session import ProcedureSession, SessionError, utc_now
@@ -238,6 +239,6 @@ def render_machine_html(report: MachineReport) -> str:
 
 def _fallback_style() -> str:
     # no axis has a report: the axis report's style, taken from an empty session's report
-    sample = render_html(build_report(ProcedureSession(actuator_code="FHA-25C-50-US250")))
+    sample = render_html(build_report(ProcedureSession(actuator_code=DEFAULT_ACTUATOR)))
     match = _STYLE.search(sample)
     return match.group(1) if match else ""

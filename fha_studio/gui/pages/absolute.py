@@ -47,7 +47,7 @@ from fha_studio.gui.link import SERVO_ON_NOTE, Cmd, CommandResult, DriveStatus, 
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import data_dir
 from fha_studio.hardware.api import CommandNotSupported, CommandRejected, ServoOnRefused
-from fha_studio.hardware.protocol import Command
+from fha_studio.hardware.protocol import ABSOLUTE_COUNTS_PER_TURN, Command
 from fha_studio.logic import absolute as ab
 from fha_studio.logic.procedures.sensor_dogs import SENSOR_NAMES, SENSORS, angle_problem
 
@@ -148,7 +148,7 @@ class AbsolutePage(BasePage):
         v.addWidget(_wrap(QLabel(
             "With the servo off (and the brake released), turn the output flange by hand by the angle "
             "below, CW seen from the flange for a positive angle. The absolute position must change by "
-            "ratio x 8192 counts per motor turn, in the same sense.")))
+            f"ratio x {ABSOLUTE_COUNTS_PER_TURN} counts per motor turn, in the same sense.")))
         form = QFormLayout()
         self.encoder_angle = QDoubleSpinBox()
         self.encoder_angle.setRange(-360.0, 360.0)
