@@ -74,3 +74,29 @@ def test_the_window_closes_while_connecting_to_a_hostile_line(make_window, qtbot
     assert not window.link._thread.isRunning()
     assert elapsed < CLOSE_LIMIT_S
     assert not window.link.connected
+
+
+@pytest.mark.e2e
+def test_the_program_exits_cleanly_when_closed_while_connecting_to_a_flood(tmp_path):
+    """The report's repro: a TCP server that sends A without end, the GUI pointed at it, the
+    window closed while it connects. It used to abort (exit 134, "QThread: Destroyed while
+    thread 'fha-link' is still running")."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    server = LineServer(b"A" * 512)
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", "PYTHONPATH": str(root),
+           "XDG_CONFIG_HOME": str(tmp_path / "config"), "XDG_DATA_HOME": str(tmp_path / "data")}
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "fha_studio", "gui", "--url", server.url, "--quit-after-ms", "700"],
+            cwd=root, env=env, capture_output=True, timeout=60,
+        )
+    finally:
+        server.close()
+    assert server.accepted.is_set()
+    assert "QThread: Destroyed" not in done.stderr.decode()
+    assert done.returncode == 0, done.stderr.decode()[-2000:]
