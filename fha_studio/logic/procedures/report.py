@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fha_studio.hardware.parameters import MODE_WORDS, Mode
 from fha_studio.logic.procedures.definitions import Procedure, load_all
 from fha_studio.logic.procedures.sensor_dogs import SENSOR_NAMES
 from fha_studio.logic.procedures.session import COMPLETED, STOPPED, CheckRecord, ProcedureSession, utc_now
@@ -240,6 +241,14 @@ def _value(record: CheckRecord) -> str:
     return f"{record.value} {record.unit}".strip() if record.value is not None else ""
 
 
+def _item(mode: str, number: int) -> str:
+    """"parameter 8", "tune 2": an item as the driver's front panel names its mode and number."""
+    try:
+        return f"{MODE_WORDS[Mode(mode)]} {number}"
+    except ValueError:
+        return f"{mode} {number}"
+
+
 def _when(at_utc: str) -> str:
     """An ISO time as a person reads it on paper: '2026-11-30 03:56' (the column says UTC)."""
     text = str(at_utc or "")
@@ -313,7 +322,7 @@ def render_html(report: CommissioningReport) -> str:
             _table(
                 ["§", "Check", "Value", "Expected", "Result", "Who", "When (UTC)", "Detail"],
                 rows,
-                [7, 37, 10, 10, 6, 10, 12, 8],
+                [6, 33, 9, 9, 6, 10, 11, 16],
             )
         )
 
@@ -336,13 +345,13 @@ def render_html(report: CommissioningReport) -> str:
         changed = report.changed_parameters
         out.append(f"<p>{len(changed)} of {len(report.parameters)} items differ from the defaults.</p>")
         if changed:
-            rows = [[_e(f"{p.mode} {p.number}"), _e(p.name), _e(p.default), _e(p.value)] for p in changed]
+            rows = [[_e(_item(p.mode, p.number)), _e(p.name), _e(p.default), _e(p.value)] for p in changed]
             out.append(
                 "<h3>Changed from the defaults</h3>" + _table(["Item", "Name", "Default", "Value"], rows)
             )
         rows = [
             [
-                _e(f"{p.mode} {p.number}"),
+                _e(_item(p.mode, p.number)),
                 _e(p.name),
                 _e(p.value),
                 _e(p.default),
@@ -364,7 +373,7 @@ def render_html(report: CommissioningReport) -> str:
     out.append("<h2>Plots</h2>")
     if report.plots:
         for plot in report.plots:
-            out.append(f"<p><b>{_e(plot['title'])}</b><br/><img src='{_e(plot['path'])}' width='600'/></p>")
+            out.append(f"<p><b>{_e(plot['title'])}</b><br/><img src='{_e(plot['path'])}' width='900'/></p>")
     else:
         out.append("<p>No plots captured.</p>")
 
