@@ -320,7 +320,10 @@ class ModelCheckResult:
                 )
         if self.detection_limits:
             limits = ", ".join(
-                f"{LABELS[d.id]} {_fmt(d.value)} {d.param_unit}" for d in self.detection_limits
+                f"{LABELS[d.id]} ±{100 * d.value:.2g} %"
+                if d.param_unit == "1"  # a ratio's distance from 1
+                else f"{LABELS[d.id]} {_fmt(d.value)} {d.param_unit}"
+                for d in self.detection_limits
             )
             lines.append(f"Detection limit (smallest effect this recording could have revealed): {limits}")
         if self.resimulation is not None:

@@ -610,6 +610,10 @@ def _findings_in_words(r: ModelCheckResult) -> list[str]:
         if report is None:
             continue
         for number, step in enumerate(report.steps, 1):
+            if step.kind == "nominal":
+                verdict = "re-fitted" if step.chosen else "kept as declared (the data show no clear change)"
+                out.append(f"  Step {number}: the declared inertia checked first: {verdict}.")
+                continue
             if step.kind == "backward":
                 dropped = label_of(step.chosen) if step.chosen else "nothing"
                 out.append(f"  Step {number}: the named effects checked together; {dropped} dropped: "
@@ -640,7 +644,10 @@ def _findings_in_words(r: ModelCheckResult) -> list[str]:
         out.append("")
         out.append("The smallest effect of each kind this recording could have shown:")
         for d in r.detection_limits:
-            out.append(f"  {LABELS.get(d.id, d.id)}: {param_words(d.param, d.value, d.param_unit)}")
+            if d.param_unit == "1":  # a ratio: how far from 1 it could have been seen
+                out.append(f"  {LABELS.get(d.id, d.id)}: ±{100 * d.value:.2g} %")
+            else:
+                out.append(f"  {LABELS.get(d.id, d.id)}: {param_words(d.param, d.value, d.param_unit)}")
     out.append("")
     changes = ", ".join(e.label.lower() for e in r.effects) or "no change"
     out.append(f"Updated model (Save updated model… writes it for the simulated drive): {changes}.")
