@@ -10,7 +10,9 @@ import contextlib
 import os
 import select
 import socket
+import struct
 import threading
+import time
 import tty
 from collections.abc import Callable
 
@@ -81,7 +83,13 @@ def serve_pty(server: SimProtocolServer, stop: threading.Event,
 
 def serve_tcp(server: SimProtocolServer, port: int, stop: threading.Event,
               announce: Callable[[str], None], host: str = "127.0.0.1") -> None:
-    """Serve ``socket://host:port``, one host connection at a time (as one serial cable)."""
+    """Serve ``socket://host:port``, one host connection at a time (as one serial cable).
+
+    Each connection starts on a clean line (:meth:`SimProtocolServer.reset`): nothing a previous
+    host wrote or did not read reaches it. A host that connects while another is served is
+    closed at once, so it learns that the line is taken instead of waiting for answers that
+    would come from someone else's conversation.
+    """
     listener = socket.create_server((host, port))
     listener.settimeout(0.1)
     try:
@@ -94,29 +102,62 @@ def serve_tcp(server: SimProtocolServer, port: int, stop: threading.Event,
             with conn:
                 conn.setblocking(False)
                 conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-                _serve_socket(server, conn, stop)
+                server.reset()
+                try:
+                    _serve_socket(server, conn, stop, listener)
+                finally:
+                    server.reset()
     finally:
         listener.close()
 
 
-def _serve_socket(server: SimProtocolServer, conn: socket.socket, stop: threading.Event) -> None:
-    server.reset_output()
+def _serve_socket(server: SimProtocolServer, conn: socket.socket, stop: threading.Event,
+                  listener: socket.socket | None = None) -> None:
+    watched = [conn] if listener is None else [conn, listener]
     while not stop.is_set():
-        readable, _, _ = select.select([conn], [], [], _wait_s(server))
-        if readable:
-            try:
-                data = conn.recv(4096)
-            except (BlockingIOError, InterruptedError):
-                data = None
-            except OSError:
+        readable, _, _ = select.select(watched, [], [], _wait_s(server))
+        if listener is not None and listener in readable:
+            # a host that hung up and connects again at once: finish the old connection first
+            if not _take_input(server, conn, wait_s=0.2):
                 return
-            if data == b"":
-                return  # the host hung up
-            if data:
-                server.feed(data)
+            _refuse(listener)
+        if conn in readable and not _take_input(server, conn):
+            return  # the host hung up
         out = server.read_ready()
         if out:
             try:
                 conn.sendall(out)
             except OSError:
                 return
+
+
+def _take_input(server: SimProtocolServer, conn: socket.socket, wait_s: float = 0.0) -> bool:
+    """Feed what the host has sent (waiting up to ``wait_s`` for more); False once it hung up."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            data = conn.recv(65536)
+        except (BlockingIOError, InterruptedError):
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                return True
+            select.select([conn], [], [], remaining)
+            continue
+        except OSError:
+            return False
+        if not data:
+            return False
+        server.feed(data)
+        if wait_s == 0.0:
+            return True
+
+
+def _refuse(listener: socket.socket) -> None:
+    """Accept and close a second host at once (the line is taken)."""
+    try:
+        extra, _ = listener.accept()
+    except (TimeoutError, BlockingIOError, OSError):
+        return
+    with contextlib.suppress(OSError):
+        extra.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))  # RST, not FIN
+    extra.close()

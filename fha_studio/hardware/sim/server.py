@@ -8,6 +8,14 @@ one character time after the previous one. Unpaced (``paced=False``) everything 
 The server owns no thread: whoever carries the bytes (the ``sim://`` handler, the pty or TCP
 loop of ``fha-studio sim``) calls :meth:`feed` with what the host wrote, and :meth:`read_ready`
 for what the host may read now; :meth:`next_event_s` says when to look again.
+
+Both directions are bounded, as a serial adapter's buffers are: bytes the host writes faster than
+the line carries wait at most ``INPUT_BACKLOG_BYTES`` (about half a second of line time at 19200
+baud); what comes beyond is dropped and counted in ``overrun_bytes``, so a flood can neither grow
+the process's memory nor keep the drive busy for long after the sender has gone. Replies the host
+does not read wait up to ``OUTPUT_BACKLOG_BYTES``; later ones are dropped (``dropped_reply_bytes``).
+:meth:`reset` starts a new connection on a clean line: nothing of the previous host's bytes or
+replies reaches the next host.
 """
 
 from __future__ import annotations
@@ -30,6 +38,10 @@ from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.reply import SimReply
 
 _STATUS = {"q": Status.DONE, "s": Status.SERVO_ON, "x": Status.REJECTED}
+#: Bytes written by the host that may wait for the line (1024 characters: 0.53 s at 19200 baud).
+INPUT_BACKLOG_BYTES = 1024
+#: Reply bytes that may wait for the host to read them.
+OUTPUT_BACKLOG_BYTES = 64 * 1024
 
 
 class SimProtocolServer:
@@ -53,12 +65,17 @@ class SimProtocolServer:
         self._clock = clock
         self._lock = threading.Lock()
         self._on_transaction = on_transaction
-        self._incoming: deque[tuple[float, bytes]] = deque()  # (arrival time of the last byte, bytes)
-        self._in_free_at = 0.0  # when the host -> drive line is free again
-        self._rx = bytearray()  # arrived, not yet decoded
+        # written by the host, not yet arrived: _incoming[i] is byte number _in_done + i since the
+        # line started at _in_start, and byte k arrives at _in_start + (k + 1) * char_s
+        self._incoming = bytearray()
+        self._in_start = 0.0
+        self._in_done = 0
+        self._rx = bytearray()  # arrived, not yet decoded (at most an unfinished frame)
         self._out: deque[tuple[float, int]] = deque()  # (time the byte is readable, byte)
         self._out_free_at = 0.0
         self.garbage_bytes = 0
+        self.overrun_bytes = 0
+        self.dropped_reply_bytes = 0
         self.transactions = 0
 
     # ---- host -> drive --------------------------------------------------------------------
@@ -68,15 +85,20 @@ class SimProtocolServer:
             return
         with self._lock:
             now = self._clock()
-            if self.paced:
-                start = max(now, self._in_free_at)
-                # each byte is its own arrival, so a frame is handled when its CR has arrived
-                for i, byte in enumerate(data):
-                    self._incoming.append((start + (i + 1) * self.char_s, bytes((byte,))))
-                self._in_free_at = start + len(data) * self.char_s
-            else:
-                self._incoming.append((now, bytes(data)))
             self._pump(now)
+            view = memoryview(data)
+            while view:
+                room = INPUT_BACKLOG_BYTES - len(self._incoming)
+                if room <= 0:
+                    break
+                if not self._incoming:
+                    line_free_at = self._in_start + self._in_done * self.char_s
+                    self._in_start, self._in_done = max(now, line_free_at), 0
+                self._incoming += view[:room]
+                view = view[room:]
+                self._pump(now)  # unpaced, everything is handled at once: room again
+            if view:
+                self.overrun_bytes += len(view)
 
     # ---- drive -> host --------------------------------------------------------------------
     def read_ready(self, size: int | None = None) -> bytes:
@@ -106,7 +128,8 @@ class SimProtocolServer:
             if self._out:
                 return max(0.0, self._out[0][0] - self._clock())
             if self._incoming:
-                return max(0.0, self._incoming[-1][0] + self.char_s - self._clock())
+                last = self._in_start + (self._in_done + len(self._incoming)) * self.char_s
+                return max(0.0, last + self.char_s - self._clock())
             return None
 
     def reset_output(self) -> None:
@@ -114,12 +137,31 @@ class SimProtocolServer:
         with self._lock:
             self._out.clear()
 
+    def reset(self) -> None:
+        """A new connection on a clean line: the previous host's unsent bytes, its unfinished
+        frame and the replies it did not read are dropped. The drive itself keeps its state
+        (like a drive whose cable is unplugged and plugged again)."""
+        with self._lock:
+            self._incoming.clear()
+            self._in_start, self._in_done = 0.0, 0
+            self._rx.clear()
+            self._out.clear()
+            self._out_free_at = 0.0
+
     # ---- the work ---------------------------------------------------------------------------
     def _pump(self, now: float) -> None:
-        while self._incoming and self._incoming[0][0] <= now:
-            arrived, data = self._incoming.popleft()
-            self._rx += data
-            self._decode(arrived)
+        # move what has arrived, a frame at a time (up to each CR), so each command is acted on
+        # when its CR arrives
+        while self._incoming and self._in_start + (self._in_done + 1) * self.char_s <= now:
+            arrived = len(self._incoming) if self.char_s == 0 else min(
+                len(self._incoming), max(1, int((now - self._in_start) / self.char_s + 1e-9) - self._in_done))
+            cr = self._incoming.find(b"\r", 0, arrived)
+            count = arrived if cr < 0 else cr + 1
+            self._in_done += count
+            at = self._in_start + self._in_done * self.char_s
+            self._rx += self._incoming[:count]
+            del self._incoming[:count]
+            self._decode(at)
         for reply in self.drive.take_deferred_replies():
             self._send(reply, now)
 
@@ -148,6 +190,9 @@ class SimProtocolServer:
 
     def _send(self, reply: SimReply, at: float) -> None:
         data = encode_reply(protocol.Reply(tuple(reply.lines), _STATUS[reply.terminal]))
+        if len(self._out) + len(data) > OUTPUT_BACKLOG_BYTES:  # the host does not read: drop
+            self.dropped_reply_bytes += len(data)
+            return
         start = max(at, self._out_free_at)
         for i, byte in enumerate(data):
             self._out.append((start + (i + 1) * self.char_s, byte))
