@@ -16,6 +16,9 @@ class SimConstants:
 
     jog_watchdog_s: float
     jog_watchdog_stop_s: float
+    jog_watchdog_torque_share: float
+    standstill_speed_rpm: float
+    standstill_s: float
     oww_clear_s: float
     regeneration_resistor_w: float
     regeneration_energy_capacity_j: float

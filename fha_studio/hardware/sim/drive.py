@@ -196,6 +196,7 @@ class SimDrive:
         self.time_s = 0.0
         self.servo_on = False
         self._motion = "idle"  # idle | jog | move | stop
+        self._still_since = 0.0  # since when the output turns slower than standstill_speed_rpm
         self._motion_sign = 0.0  # direction of the commanded motion, command frame
         self._jog_speed_rad_s = 0.0
         self._jog_deadline = 0.0
@@ -359,8 +360,21 @@ class SimDrive:
 
     @property
     def moving(self) -> bool:
-        """The command is moving (a jog, a move, or a stop ramp in progress)."""
+        """The axis is moving: a jog, a move or a stop ramp is in progress, or the command has
+        arrived but the output still turns faster than ``standstill_speed_rpm`` (the servo lags
+        the command; the bit clears when the output stands still, not when the command does)."""
         return self._motion != "idle"
+
+    def watchdog_decel_rad_s2(self, speed_rad_s: float) -> float:
+        """The deceleration the JOG watchdog stops the command with [rad/s^2]: the command
+        reaches standstill within ``jog_watchdog_stop_s``, unless that asks for more than
+        ``jog_watchdog_torque_share`` of the axis's torque-limited acceleration (TM / (JA + JL),
+        manual 2-4-4): a heavy load is then braked at that share, slower but without the current
+        limit making the axis overshoot (docs/sim.md states the resulting standstill time)."""
+        c = self.constants
+        wanted = abs(speed_rad_s) / c.jog_watchdog_stop_s
+        followable = c.jog_watchdog_torque_share * self.model.max_acceleration_rad_s2()
+        return max(min(wanted, followable), 1e-6)
 
     def io_bits(self) -> int:
         """The I/O bit mask of IOS / monitor 106 (docs/protocol.md, I/O table)."""
@@ -461,6 +475,7 @@ class SimDrive:
                 return
             self.axis.move_by(math.radians(angle_deg), self._move_speed_rad_s, self._accel_rad_s2())
             self._motion = "move"
+            self._still_since = self.time_s
             self._motion_sign = 1.0 if angle_deg > 0 else -1.0
 
     def stop(self) -> None:
@@ -469,11 +484,14 @@ class SimDrive:
             if self.moving and self.servo_on:
                 self.axis.stop(self._accel_rad_s2())
                 self._motion = "stop"
+                self._still_since = self.time_s
 
     def _halt(self) -> None:
-        """Stop the command at once (an inhibit input or a limit switch)."""
+        """Stop the command at once (an inhibit input or a limit switch); "moving" until the
+        output stands still."""
         self.axis.stop(math.inf)
-        self._motion = "idle"
+        self._motion = "stop"
+        self._still_since = self.time_s
 
     # ------------------------------------------------------------------ alarms
     @property
@@ -583,13 +601,17 @@ class SimDrive:
         if self._oww_done_at is not None and t >= self._oww_done_at:
             self._finish_oww()
         if self._motion == "jog" and t >= self._jog_deadline:
-            # the watchdog: no JOG for 100 ms -> the command ramps down fast enough for the axis to
-            # stand still within the next 100 ms
-            decel = max(self._accel_rad_s2(), abs(self._jog_speed_rad_s) / self.constants.jog_watchdog_stop_s)
-            axis.stop(decel)
+            # the watchdog: no JOG for 100 ms -> the command ramps to standstill (docs/sim.md)
+            axis.stop(self.watchdog_decel_rad_s2(self._jog_speed_rad_s))
             self._motion = "stop"
+            self._still_since = t
         elif self._motion in ("move", "stop") and axis.motion_done:
-            self._motion = "idle"
+            # idle when the output stands still, not only the command: below standstill_speed_rpm
+            # for standstill_s (a swing through zero speed is not standstill)
+            if abs(axis.output_speed_rad_s) >= self.constants.standstill_speed_rpm * RPM:
+                self._still_since = t
+            elif t - self._still_since >= self.constants.standstill_s:
+                self._motion = "idle"
         if self.servo_on and self._motion != "idle" and self.io.blocks(
             self._angle_deg,
             forward=self._motion_sign > 0,
