@@ -37,10 +37,17 @@ def read_model(path: Path) -> None:
     AxisModel.load(path)
 
 
+def read_machine(path: Path) -> None:
+    from fha_studio.logic.machine import MachineProject
+
+    MachineProject.load(path)
+
+
 READERS = {
     "recording": read_recording,
     "parameters": read_parameters,
     "session": read_session,
     "eeprom": read_eeprom,
     "model": read_model,
+    "machine": read_machine,
 }

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fha_studio import fileio
 from fha_studio.logic.commissioning import CommissioningState
 
 FORMAT = "fha-machine/1"
@@ -154,10 +155,10 @@ class MachineProject:
     def save(self, path: str | Path) -> Path:
         """Writes the project file atomically (a crash leaves the old file whole)."""
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.partial")
-        tmp.write_text(json.dumps(self.to_json(), indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
-        os.replace(tmp, path)
+        if not os.path.lexists(path.parent):
+            path.parent.mkdir(parents=True, exist_ok=True)
+        # fileio: temporary file, fsync, rename; a device or a path under a file is refused
+        fileio.write_text(path, json.dumps(self.to_json(), indent=2, ensure_ascii=False) + "\n")
         return path
 
     @classmethod
@@ -189,10 +190,14 @@ class MachineProject:
         """Reads a project file; MachineError names the file and what is wrong."""
         path = Path(path)
         try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise MachineError(f"{path}: no such machine file") from None
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            text = fileio.read_text(path)  # a regular file, bounded
+        except fileio.FileProblem as exc:
+            if exc.reason == "no such file or directory":
+                raise MachineError(f"{path}: no such machine file") from None
+            raise MachineError(str(exc)) from None
+        try:
+            data = json.loads(text)
+        except (json.JSONDecodeError, RecursionError) as exc:
             raise MachineError(f"{path}: not a readable machine file: {exc}") from None
         return cls.from_json(data, str(path))
 
