@@ -142,3 +142,20 @@ class _closed:
             self.data = b""
             return True
         return False
+
+
+def test_the_next_client_after_a_flood_finds_every_capability(tcp_drive):
+    """A host floods the line and leaves; the next DriveClient.open probes CAP and finds MON,
+    instead of reading the flood's late answers as the probe's."""
+    from fha_studio.hardware.client import DriveClient
+    from fha_studio.hardware.protocol import Command
+
+    _server, (host, port) = tcp_drive
+    with socket.create_connection((host, port), timeout=10) as flooder:
+        flooder.sendall(b"IDN+00000\rCAP+00000\r" * 1000)  # 20 kB of commands it never reads
+    client = DriveClient.open(f"socket://{host}:{port}")
+    try:
+        assert client.capabilities.supports(Command.MON)
+        assert client.capabilities.supports(Command.CAP)
+    finally:
+        client.close()
