@@ -489,6 +489,8 @@ class SimDrive:
     def _halt(self) -> None:
         """Stop the command at once (an inhibit input or a limit switch); "moving" until the
         output stands still."""
+        if self._motion == "stop" and self.axis.motion_done:
+            return  # halted already: the output is coming to rest (checked every 1 ms)
         self.axis.stop(math.inf)
         self._motion = "stop"
         self._still_since = self.time_s

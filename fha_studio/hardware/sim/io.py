@@ -26,6 +26,8 @@ INPUT_MASK = sum(1 << b for b in (4, 5, 6, 7, 8, 9, 10))
 SENSOR_MASK = sum(1 << b for b in (BIT_ORIGIN, BIT_LIMIT_1, BIT_LIMIT_2))
 
 SENSORS = ("origin", "ls1", "ls2")
+#: More than one output encoder pulse of any FHA-C (the coarsest, 409600 pulses per turn, is 0.00088 deg)
+DOG_EDGE_TOLERANCE_DEG = 0.001
 
 
 def _wrap_deg(angle: float) -> float:
@@ -93,10 +95,12 @@ class SimIo:
         c = self.constants
         if abs(_wrap_deg(angle_deg - self.origin_deg)) <= c.origin_slit_width_deg / 2:
             bits |= 1 << BIT_ORIGIN
-        # a dog holds its switch from its edge on, over its arc, towards its stroke end
-        if 0.0 <= _wrap_deg(self.ls1_deg - angle_deg) <= c.limit_dog_arc_deg:
+        # a dog holds its switch from its edge on, over its arc, towards its stroke end; the edge
+        # takes DOG_EDGE_TOLERANCE_DEG, so a dog set "here" from the angle the drive reports
+        # (whole encoder pulses) switches with the output resting a fraction of a pulse before it
+        if -DOG_EDGE_TOLERANCE_DEG <= _wrap_deg(self.ls1_deg - angle_deg) <= c.limit_dog_arc_deg:
             bits |= 1 << BIT_LIMIT_1
-        if 0.0 <= _wrap_deg(angle_deg - self.ls2_deg) <= c.limit_dog_arc_deg:
+        if -DOG_EDGE_TOLERANCE_DEG <= _wrap_deg(angle_deg - self.ls2_deg) <= c.limit_dog_arc_deg:
             bits |= 1 << BIT_LIMIT_2
         return bits
 
