@@ -263,7 +263,10 @@ class MainWindow(QMainWindow):
     @Slot()
     def stop_axis(self) -> None:
         """STOP: decelerate and hold. Sent even when the link looks idle."""
-        self.jog_page.release_jog()
+        for page in self._pages():  # a jog held anywhere (the Jog page, the scope's panel) lets go
+            release = getattr(page, "release_jog", None)
+            if release is not None:
+                release()
         if not self.link.connected:
             self.show_message("STOP: no drive is connected, nothing was sent.", Level.WARNING)
             return

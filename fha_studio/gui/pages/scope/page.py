@@ -14,6 +14,8 @@ from PySide6.QtWidgets import QVBoxLayout
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.link import POLL_INTERVAL_MS, Cmd, LinkInfo
 from fha_studio.gui.pages.base import BasePage
+from fha_studio.gui.pages.jog_panel import JogPanel
+from fha_studio.gui.widgets import space_jogs_only
 
 from .driver import ScopeCmd, ScopeController, ScopeRequest
 from .view import ScopeContext, ScopeView
@@ -41,6 +43,11 @@ class ScopePage(BasePage):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.view)
+        # move and watch at once: the jog panel beside the plot, STOP as the window's
+        stop = main_window.stop_axis if main_window is not None else link.stop_now
+        self.jog_panel = JogPanel(link, stop)
+        self.view.dock_under_channels(self.jog_panel)
+        space_jogs_only(self, (self.jog_panel.fwd_button, self.jog_panel.rev_button))
         # the axis's actuator, driver and load decide the scaling and what is recorded, at every moment
         state = self.state
         for signal in (state.sigActuatorChanged, state.sigDriverChanged, state.sigLoadInertiaChanged):
@@ -70,15 +77,22 @@ class ScopePage(BasePage):
                             load_inertia_kgm2=state.load_inertia_kgm2, supply_voltage=state.supply_voltage_v,
                             driver=state.driver, actuator_declared=bool(state.actuator_code))
 
+    def release_jog(self) -> None:
+        """Let go of a jog held on the page's panel (STOP does it on every page)."""
+        self.jog_panel.release_jog()
+
     def link_connected(self, info: LinkInfo) -> None:
+        self.jog_panel.link_connected(info)
         self.view.set_context(self._context())
         self.controller.connected = True
         self.session.link.send(Cmd.CALL, partial(_attach_in_link_thread, self.controller, self.state.ratio))
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
+        self.jog_panel.link_disconnected()
         self.view.stop_live()
         self.controller.attach(None)
 
     def shutdown(self) -> None:
+        self.jog_panel.release_jog()
         self.view.shutdown()
         self.controller.shutdown()

@@ -116,6 +116,10 @@ class TimePlot(QWidget):
                 curve.setClipToView(True)
             self._curves[c.key] = curve
 
+    def curve(self, key: str) -> pg.PlotDataItem | None:
+        """The curve of channel ``key`` (None when it is not shown)."""
+        return self._curves.get(key)
+
     def draw_levels(self, levels: MinMaxLevels, channels: Sequence[ScopeChannel], t0_s: float, t1_s: float,
                     scale: Mapping[str, float]) -> None:
         """Draw [t0_s, t1_s] of the live levels: about one min/max bin per pixel."""

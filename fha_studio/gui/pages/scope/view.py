@@ -171,10 +171,14 @@ class ScopeView(QWidget):
         outer.addWidget(bar)
 
         split = QSplitter(Qt.Orientation.Horizontal)
+        left = QWidget()
+        self._left_column = QVBoxLayout(left)
+        self._left_column.setContentsMargins(0, 0, 0, 0)
         self.channel_table = ChannelTable()
         self.channel_table.sigVisibleChanged.connect(self.set_channel_visible)
         self.channel_table.sigScaleChanged.connect(self.set_channel_scale)
-        split.addWidget(self.channel_table)
+        self._left_column.addWidget(self.channel_table, 1)
+        split.addWidget(left)
 
         self.plots = QTabWidget()
         self.time_plot = TimePlot()
@@ -225,6 +229,10 @@ class ScopeView(QWidget):
         self.plot = self.time_plot.plot
         self.spectrum_channel = self.spectrum_panel.spectrum_channel
         self.spectrum_label = self.spectrum_panel.spectrum_label
+
+    def dock_under_channels(self, widget: QWidget) -> None:
+        """Put ``widget`` (the jog panel) under the channel table, beside the plot."""
+        self._left_column.addWidget(widget)
 
     # --------------------------------------------------------------------------------- channels
     def _shown_channels(self) -> tuple[ScopeChannel, ...]:

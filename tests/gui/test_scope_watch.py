@@ -1,0 +1,87 @@
+"""Move and watch on the Scope page: the jog panel beside the plot, one plot per unit with a
+shared time axis, and the cursor table (the main window on the embedded simulated drive)."""
+
+from __future__ import annotations
+
+import pytest
+from PySide6.QtCore import Qt
+
+from fha_studio.gui.link import Cmd
+
+SIM_URL = "sim://FHA-25C-50-US250?paced=0"
+
+
+def latest(view, key):
+    live = view._live
+    j = [c.key for c in live.channels].index(key) + 1
+    return live.ring.window()[:, j]
+
+
+@pytest.fixture
+def scope_window(make_window, qtbot):
+    window = make_window(connect=SIM_URL)
+    page = window.show_page("scope")
+    qtbot.waitUntil(lambda: page.view.controller.connected, timeout=10000)
+    return window, page
+
+
+def test_jog_from_the_scope_panel_moves_the_axis_the_plot_shows_it_and_release_stops(scope_window, qtbot):
+    window, page = scope_window
+    panel, view = page.jog_panel, page.view
+    assert not panel.fwd_button.isEnabled()  # servo off: nothing moves, and the panel says why
+    assert "Servo OFF" in panel.message.text()
+    view.start_live()
+    qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=10000)
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO, timeout=10000):
+        panel.servo_on_button.click()
+    qtbot.waitUntil(lambda: panel.fwd_button.isEnabled(), timeout=10000)
+    start = float(latest(view, "feedback_position")[-1])
+    panel.speed_spin.setValue(20.0)
+    qtbot.mousePress(panel.fwd_button, Qt.MouseButton.LeftButton)
+    try:
+        qtbot.waitUntil(lambda: abs(latest(view, "output_speed")[-1] - 20.0) < 0.5, timeout=10000)
+    finally:
+        qtbot.mouseRelease(panel.fwd_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: abs(latest(view, "output_speed")[-1]) < 0.01, timeout=10000)
+    assert latest(view, "feedback_position")[-1] > start + 1.0  # the plot's data moved FWD
+    assert window.link.servo_on  # release stops and holds
+    # the curve on show has the motion in it
+    curve = view.time_plot.curve("output_speed")
+    assert curve is not None and max(curve.getData()[1]) > 19.0
+
+
+def test_hiding_the_scope_lets_go_of_a_held_jog(scope_window, qtbot):
+    window, page = scope_window
+    panel = page.jog_panel
+    window.link.send(Cmd.SERVO, True)
+    qtbot.waitUntil(lambda: panel.fwd_button.isEnabled(), timeout=10000)
+    panel.speed_spin.setValue(10.0)
+    qtbot.mousePress(panel.fwd_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: (window.link.status.speed_rpm or 0) > 5.0, timeout=10000)
+    window.show_page("jog")  # the scope hidden with the button still down
+    assert not panel.fwd_button.held
+    qtbot.waitUntil(lambda: abs(window.link.status.speed_rpm or 0) < 0.01, timeout=10000)
+
+
+def test_stop_on_the_scope_panel_stops_a_move(scope_window, qtbot):
+    window, page = scope_window
+    panel = page.jog_panel
+    window.link.send(Cmd.SERVO, True)
+    qtbot.waitUntil(lambda: panel.move_button.isEnabled(), timeout=10000)
+    panel.angle_spin.setValue(900.0)
+    panel.speed_spin.setValue(20.0)
+    panel.move_button.click()
+    qtbot.waitUntil(lambda: (window.link.status.speed_rpm or 0) > 1.0, timeout=10000)
+    panel.stop_button.click()
+    qtbot.waitUntil(lambda: abs(window.link.status.speed_rpm or 0) < 0.01, timeout=10000)
+    assert any(m.text.startswith("STOP") for m in window.message_area.messages)
+
+
+def test_on_a_documented_only_drive_the_panel_is_disabled_and_says_why(make_window, qtbot):
+    window = make_window(connect="sim://FHA-25C-50-S248?paced=0&profile=documented")
+    page = window.show_page("scope")
+    panel = page.jog_panel
+    qtbot.waitUntil(lambda: "documented CN3 commands" in panel.message.text(), timeout=10000)
+    buttons = (panel.servo_on_button, panel.servo_off_button, panel.fwd_button, panel.rev_button,
+               panel.move_button)
+    assert not any(b.isEnabled() for b in buttons)
