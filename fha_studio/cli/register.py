@@ -418,12 +418,12 @@ def _report(args) -> int:
         for axis in project:
             recorded = reg.session_file(f"{project.name}/{axis.name}")
             axis.session_file = Path(recorded) if recorded else None
-        report = build_machine_report(project, register=reg)
         output = args.output or Path(f"{project.name}.html")
-        output.parent.mkdir(parents=True, exist_ok=True)
-        tmp = output.with_name(f".{output.name}.partial")
-        tmp.write_text(render_machine_html(report), encoding="utf-8")
-        tmp.replace(output)  # a reader never sees half a report
+        if not os.path.lexists(output.parent):
+            output.parent.mkdir(parents=True, exist_ok=True)
+        fileio.check_output_path(output)  # before the work: a target that cannot be written
+        report = build_machine_report(project, register=reg)
+        fileio.write_text(output, render_machine_html(report))  # whole or not at all
         reg.record_report(
             output, machine=project.name, open_warnings=sum(s.open_warnings for s in report.summaries)
         )

@@ -42,6 +42,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio import fileio
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo, OpenClient
 from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
@@ -758,13 +759,14 @@ class MachineWindow(QMainWindow):
         from fha_studio.gui.pages.procedures.report_pdf import write_pdf
         from fha_studio.logic.machine_report import build_machine_report, render_machine_html
 
-        report = build_machine_report(self.project, self.sessions(), self.register)
-        html = render_machine_html(report)
         html_path = Path(html_path)
         html_path.parent.mkdir(parents=True, exist_ok=True)
-        partial = html_path.with_name(f".{html_path.name}.partial")
-        partial.write_text(html, encoding="utf-8")
-        partial.replace(html_path)
+        for target in (html_path, pdf_path):
+            if target is not None:
+                fileio.check_output_path(target)  # before the work: a target that cannot be written
+        report = build_machine_report(self.project, self.sessions(), self.register)
+        html = render_machine_html(report)
+        fileio.write_text(html_path, html)  # whole or not at all
         pdf = write_pdf(html, pdf_path, report.title, html_path.parent) if pdf_path is not None else None
         if self.register is not None:
             # a machine report is not signed itself: each axis's report is

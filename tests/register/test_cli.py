@@ -186,3 +186,12 @@ def test_a_question_to_a_register_that_is_not_there_is_refused(capsys, tmp_path)
     assert not missing.exists()
     assert main(["register", "--db", str(missing), "add-machine", "Press 7"]) == 0
     assert missing.exists()
+
+
+def test_a_report_to_a_place_that_cannot_take_it_is_refused_before_the_work(capsys, db, tmp_path):
+    (tmp_path / "afile").write_text("a regular file")
+    code, out, err = run(capsys, db, "report", "Line 3", "-o", str(tmp_path / "afile" / "r.html"))
+    assert (code, out) == (2, "") and err.count("\n") == 1
+    assert "a part of the path is not a directory" in err
+    with Register(db) as reg:
+        assert reg.export("Line 3")["machines"][0]["machine_reports"] == []  # nothing recorded

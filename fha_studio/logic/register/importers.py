@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fha_studio import fileio
 from fha_studio.logic.register.store import Axis, Register, RegisterError, utc_stamp
 
 
@@ -144,9 +145,9 @@ def import_parameter_file(
 
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RegisterError(f"{path}: cannot read it: {exc}") from None
+        text = fileio.read_text(path)  # a regular file, bounded
+    except fileio.FileProblem as exc:
+        raise RegisterError(str(exc)) from None
     # the file's driver decides the model; a file without one is read as HA-655
     first = _peek_driver(text)
     model = load_parameter_model(driver_family(first))
