@@ -97,3 +97,27 @@ def test_a_parameter_file_becomes_a_snapshot_at_its_saved_time(register, tmp_pat
     with pytest.raises(RegisterError, match=r"broken\.toml: line 3: system\.rotary_direction"):
         import_parameter_file(register, broken, "Line 3", "tilt")
     assert len(register.snapshots("Line 3/tilt")) == 1
+
+
+def test_a_refused_import_leaves_no_machine_or_axis_behind(register, tmp_path):
+    path = tmp_path / "empty.toml"
+    path.write_text(
+        'format = "fha-parameters/1"\nactuator = "FHA-25C-50-US250"\n[system]\nno_such_item = 1\n'
+    )
+    with pytest.raises(RegisterError, match="no value in it fits HA-655"):
+        import_parameter_file(register, path, "Line 9", "roll")
+    assert register.machines() == []
+
+
+def test_a_batch_is_committed_whole_or_not_at_all(register):
+    register.add_machine("m")
+    register.add_axis("m", "a")
+    with pytest.raises(RuntimeError), register.batch():
+        register.record_alarm("m/a", 20, "Deviation counter overflow")
+        register.record_snapshot("m/a", [("system", 8, "rotary_direction", 1)], "link")
+        raise RuntimeError("the power went")
+    assert [e.kind for e in register.history("m/a")] == ["axis"]
+    with register.batch():
+        register.record_alarm("m/a", 20)
+        register.record_alarm("m/a", 60)
+    assert [e.kind for e in register.history("m/a")] == ["axis", "alarm", "alarm"]

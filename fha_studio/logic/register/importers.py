@@ -47,7 +47,11 @@ def _procedures_for(actuator_code: str) -> list[Any]:
 def record_session(register: Register, axis: Axis | str | int, session: Any) -> ImportResult:
     """Records a procedure session of ``axis``: its check answers (new ones only), the status of
     every procedure that applies to the actuator, and its parameter values as a snapshot (once)."""
-    axis = register.axis(axis)
+    with register.batch():  # a session is recorded whole or not at all
+        return _record_session(register, register.axis(axis), session)
+
+
+def _record_session(register: Register, axis: Axis, session: Any) -> ImportResult:
     source = str(session.path or "")
     records = [r for state in session.runs.values() for r in state.records]
     added = register.record_checks(axis, records, session_file=source)
@@ -124,14 +128,16 @@ def import_session_file(
         raise RegisterError(str(exc)) from None
     name = (axis or session.axis or "axis 1").strip()
     driver = (session.driver or {}).get("model", "")
-    target = register.ensure_axis(
-        machine, name, actuator_code=session.actuator_code, driver_model=driver, who=session.operator
-    )
-    if target.actuator_code and target.actuator_code != session.actuator_code.strip().upper():
-        raise RegisterError(
-            f"{path}: a session for {session.actuator_code}, but axis {target.ref} has {target.actuator_code}"
+    with register.batch():  # all of it or nothing: no machine or axis left behind by a refusal
+        target = register.ensure_axis(
+            machine, name, actuator_code=session.actuator_code, driver_model=driver, who=session.operator
         )
-    return record_session(register, target, session)
+        if target.actuator_code and target.actuator_code != session.actuator_code.strip().upper():
+            raise RegisterError(
+                f"{path}: a session for {session.actuator_code}, but axis {target.ref} has "
+                f"{target.actuator_code}"
+            )
+        return record_session(register, target, session)
 
 
 def import_parameter_file(
@@ -155,29 +161,31 @@ def import_parameter_file(
         loaded = read_parameter_file(text, model, name=str(path))
     except ParameterFileError as exc:
         raise RegisterError(str(exc)) from None
-    target = register.ensure_axis(
-        machine, axis, actuator_code=loaded.actuator, driver_model=loaded.driver_model, who=who
-    )
-    rows = [
-        (mode, number, model.item(mode, number).key, wire) for (mode, number), wire in loaded.values.items()
-    ]
-    if not rows:
-        raise RegisterError(f"{path}: no value in it fits {model.driver}")
-    at = loaded.saved or None
-    file = str(path.resolve())
-    if register.has_snapshot(target, utc_stamp(at), file):
-        return ImportResult(target, not_taken=tuple(loaded.not_mapped))
-    number = register.record_snapshot(
-        target,
-        rows,
-        "file",
-        who=who,
-        at_utc=at,
-        driver_model=loaded.driver_model,
-        file=file,
-        note="imported parameter file",
-    )
-    return ImportResult(target, snapshot=number, not_taken=tuple(loaded.not_mapped))
+    with register.batch():  # all of it or nothing: no machine or axis left behind by a refusal
+        target = register.ensure_axis(
+            machine, axis, actuator_code=loaded.actuator, driver_model=loaded.driver_model, who=who
+        )
+        rows = [
+            (mode, number, model.item(mode, number).key, wire)
+            for (mode, number), wire in loaded.values.items()
+        ]
+        if not rows:
+            raise RegisterError(f"{path}: no value in it fits {model.driver}")
+        at = loaded.saved or None
+        file = str(path.resolve())
+        if register.has_snapshot(target, utc_stamp(at), file):
+            return ImportResult(target, not_taken=tuple(loaded.not_mapped))
+        number = register.record_snapshot(
+            target,
+            rows,
+            "file",
+            who=who,
+            at_utc=at,
+            driver_model=loaded.driver_model,
+            file=file,
+            note="imported parameter file",
+        )
+        return ImportResult(target, snapshot=number, not_taken=tuple(loaded.not_mapped))
 
 
 def _peek_driver(text: str) -> str:

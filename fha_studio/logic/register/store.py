@@ -249,8 +249,19 @@ class Register:
                 self._db.execute(f"PRAGMA user_version = {current + 1}")
 
     @contextlib.contextmanager
+    def batch(self) -> Iterator[None]:
+        """Several facts as one transaction: all of them are committed, or none (an import, a
+        session recorded after an answer); the writes inside do not commit on their own."""
+        with self._transaction():
+            yield
+
+    @contextlib.contextmanager
     def _transaction(self) -> Iterator[sqlite3.Connection]:
-        """One write transaction: all of it is committed, or none of it."""
+        """One write transaction: all of it is committed, or none of it. Inside :meth:`batch`
+        it is part of the batch's transaction."""
+        if self._db.in_transaction:
+            yield self._db
+            return
         self._db.execute("BEGIN IMMEDIATE")
         try:
             yield self._db
