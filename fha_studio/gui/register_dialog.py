@@ -270,19 +270,26 @@ class RegisterDialog(QDialog):
             if not text:
                 value = None
             else:
+                why = ""
                 try:
                     value = int(text)
-                    if item is not None:
-                        item.check(value)
-                except ValueError as exc:
-                    why = str(exc) if "outside" in str(exc) else f"'{text}' is not a whole number"
+                except ValueError:
+                    why = f"'{text}' is not a whole number"
+                else:
+                    try:
+                        if item is not None:
+                            item.check(value)
+                    except ValueError as exc:  # outside the item's range: the item says which
+                        why = str(exc)
+                if why:
                     self.find_label.setText(f"Nothing searched: {why}.")
                     _fill(self.find_table, [])
                     return
         found = self.register.find(key, value, machine=self.machine)
         name = item.name if item is not None else key
         wanted = f" = {value_text(key, value)}" if value is not None else ""
-        self.find_label.setText(f"{len(found)} axis/axes with {name}{wanted} (their latest known value).")
+        axes = "axis has" if len(found) == 1 else "axes have"
+        self.find_label.setText(f"{len(found)} {axes} {name}{wanted} (the latest known value of each).")
         rows = [
             [
                 f.axis.name,
