@@ -3,6 +3,7 @@ shared time axis, and the cursor table (the main window on the embedded simulate
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from PySide6.QtCore import Qt
 
@@ -85,3 +86,44 @@ def test_on_a_documented_only_drive_the_panel_is_disabled_and_says_why(make_wind
     buttons = (panel.servo_on_button, panel.servo_off_button, panel.fwd_button, panel.rev_button,
                panel.move_button)
     assert not any(b.isEnabled() for b in buttons)
+
+
+def test_channels_of_different_units_are_in_different_plots_on_one_linked_time_axis(scope_window, qtbot):
+    _window, page = scope_window
+    view = page.view
+    view.start_live()
+    qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=10000)
+    plot = view.time_plot
+    position = plot.plot_of("feedback_position")
+    assert position is not None and plot.plot_of("command_position") is position  # both in degrees
+    speed, current = plot.plot_of("output_speed"), plot.plot_of("motor_current")
+    assert len({id(position), id(speed), id(current)}) == 3 and len(plot.plot_items()) == 3
+    position.vb.setXRange(-4.0, -1.0, padding=0)
+    for item in (speed, current):
+        x0, x1 = item.vb.viewRange()[0]
+        assert abs(x0 + 4.0) < 1e-6 and abs(x1 + 1.0) < 1e-6
+    # an unticked channel stays in the table, to be ticked again, and the legend says what is polled
+    table = view.channel_table
+    names = [table.item(r, 0).text() for r in range(table.rowCount())]
+    assert "Error pulses" in names and "Overload rate" in names
+    assert "4 ticked channels" in plot.legend.text()
+
+
+def test_the_cursor_table_has_a_row_per_channel_with_the_values_at_a_and_b(scope_window, qtbot):
+    _window, page = scope_window
+    view = page.view
+    by_key = {c.key: c for c in view.all_channels}
+    channels = [by_key["feedback_position"], by_key["output_speed"], by_key["motor_current"]]
+    t = np.linspace(0.0, 4.0, 401)
+    rows = np.column_stack([t, 100.0 * t, 10.0 + 0 * t, 0.5 * t])
+    view.show_static(channels, rows, "a test capture", 100.0)
+    view.set_cursors(1.0, 3.0)
+    table = view.time_plot.cursor_table
+    assert table.isVisible() and table.rowCount() == 1 + len(channels)
+    assert table.cell_text(0, 3).startswith("2000 ms")
+    got = {table.cell_text(r, 0): [table.cell_text(r, c) for c in range(1, 5)] for r in range(1, 4)}
+    assert got["Feedback position (output)"] == ["100 deg", "300 deg", "200 deg", "100 deg/s"]
+    assert got["Output speed"] == ["10 r/min", "10 r/min", "0 r/min", "0 r/min/s"]
+    assert got["Motor current"] == ["0.5 A", "1.5 A", "1 A", "0.5 A/s"]
+    # each unit its own plot, time axes linked for still data too
+    assert len(view.time_plot.plot_items()) == 3

@@ -170,9 +170,14 @@ def spectrum(t_s: ArrayLike, values: ArrayLike, *, detrend: str = "linear") -> S
 
 @dataclass(frozen=True)
 class CursorDelta:
+    """A channel between two cursors: the time between them [s], the change of the value (its
+    unit), the slope [unit/s], and the values at the first (A) and second (B) cursor."""
+
     dt_s: float
     dvalue: float
     slope_per_s: float | None  # dvalue / dt, None when dt == 0
+    value_a: float = float("nan")
+    value_b: float = float("nan")
 
 
 def cursor_delta(t_s: ArrayLike, values: ArrayLike, t1_s: float, t2_s: float) -> CursorDelta:
@@ -181,4 +186,4 @@ def cursor_delta(t_s: ArrayLike, values: ArrayLike, t1_s: float, t2_s: float) ->
     y = np.asarray(values, dtype=float)
     y1, y2 = np.interp([t1_s, t2_s], t, y)
     dt = t2_s - t1_s
-    return CursorDelta(dt, float(y2 - y1), None if dt == 0 else float((y2 - y1) / dt))
+    return CursorDelta(dt, float(y2 - y1), None if dt == 0 else float((y2 - y1) / dt), float(y1), float(y2))

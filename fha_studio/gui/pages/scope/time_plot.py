@@ -1,16 +1,22 @@
-"""The scope's time plot: one curve per shown channel, two cursors and their read-out line.
+"""The scope's time plot: one plot per unit, stacked on one linked time axis, with the legend
+above the plots, two cursors and the cursor table under them.
+
+Channels of different units never share a y-axis (position in hundreds of degrees would flatten
+speed and current): each unit has its own plot, the time axes are linked (zooming or panning one
+moves all) and only the bottom one carries the time labels.
 
 Live, the curves are drawn from pre-decimated min/max levels (``MinMaxLevels``): at most about
 two points per pixel, already finite, so pyqtgraph's own downsampling, clipping and finiteness
 check are switched off for them (they would cost more than the drawing). The time axis then
-counts back from now (the newest sample at 0) and the y range moves only when the data leaves
-it or uses less than half of it: the axes, whose text is the costliest part of a frame, are
+counts back from now (the newest sample at 0) and each plot's y range moves only when its data
+leaves it or uses less than half of it: the axes, whose text is the costliest part of a frame, are
 repainted only when they change, not 30 times a second. A capture, a test or a file is drawn
 whole once, with pyqtgraph's peak downsampling and clip to view for zooming, on absolute time.
 """
 
 from __future__ import annotations
 
+import html
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
@@ -22,9 +28,32 @@ from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 from fha_studio.logic.scope.channels import ScopeChannel
 from fha_studio.logic.scope.levels import MinMaxLevels
 
+from .cursor_table import CursorTable
+
+#: The plots' background and the colour of their axes and text (a light plot: the channel
+#: colours are the same on the plot, in the legend and in the channel table, all readable).
+BACKGROUND = "#ffffff"
+FOREGROUND = "#303030"
+
+
+class _UnitPlot:
+    """One plot of the stack: the channels of one unit, its y range and its live grid lines."""
+
+    def __init__(self, item: pg.PlotItem, unit: str):
+        self.item = item
+        self.unit = unit
+        self.keys: list[str] = []
+        self.y_range: tuple[float, float] | None = None
+        self.grid_lines: list[pg.InfiniteLine] = []
+        self.cursors: tuple[pg.InfiniteLine, pg.InfiniteLine] | None = None
+
+    @property
+    def view_box(self) -> pg.ViewBox:
+        return self.item.vb
+
 
 class TimePlot(QWidget):
-    """Curves against time, the cursors, and the cursor read-out line under the plot."""
+    """Curves against time in one plot per unit, the legend, the cursors and their table."""
 
     sigCursorsMoved = Signal()
 
@@ -33,80 +62,140 @@ class TimePlot(QWidget):
         pg.setConfigOptions(antialias=False)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        self.plot = pg.PlotWidget()
+        layout.setSpacing(2)
+        self.legend = QLabel("")
+        self.legend.setObjectName("scopeLegend")
+        self.legend.setWordWrap(True)
+        self.legend.setTextFormat(Qt.TextFormat.RichText)
+        layout.addWidget(self.legend)
+        self.plot = pg.GraphicsLayoutWidget()
         self.plot.setObjectName("scopePlot")
-        self.plot.setBackground("#111")
-        self.plot.setLabel("bottom", "time", units="s")
-        self.plot.addLegend(offset=(-8, 8), brush=pg.mkBrush(17, 17, 17, 200), labelTextColor="#ddd")
-        self.plot.plotItem.vb.enableAutoRange(axis="y", enable=True)
-        self._grid_lines: list[pg.InfiniteLine] = []
-        self._grid_pen = pg.mkPen(255, 255, 255, 50)
-        self._grid_on = False
-        self.plot.plotItem.vb.sigYRangeChanged.connect(self._update_grid_lines)
-        self.show_grid_for_still_data(False)
-        self.cursor1 = pg.InfiniteLine(angle=90, movable=True, pen=pg.mkPen("#ffffff", width=1))
-        self.cursor2 = pg.InfiniteLine(angle=90, movable=True, pen=pg.mkPen("#ffffff", width=1,
-                                                                             style=Qt.PenStyle.DashLine))
-        for c in (self.cursor1, self.cursor2):
-            c.sigPositionChanged.connect(self.sigCursorsMoved)
+        self.plot.setBackground(BACKGROUND)
+        self.plot.ci.setSpacing(0)
         layout.addWidget(self.plot, 1)
-        self.cursor_label = QLabel("")
-        self.cursor_label.setObjectName("scopeCursorReadout")
-        self.cursor_label.setWordWrap(True)
-        layout.addWidget(self.cursor_label)
+        self.cursor_table = CursorTable()
+        self.cursor_table.setVisible(False)
+        layout.addWidget(self.cursor_table)
+        self._plots: list[_UnitPlot] = []
         self._curves: dict[str, pg.PlotDataItem] = {}
+        self._grid_pen = pg.mkPen(0, 0, 0, 40)
+        self._grid_on = False
         self._cursors_on = False
+        self._cursor_t = (0.0, 0.0)  # the cursors' positions on the plots' x axis
         self._live = False
         self._x_offset = 0.0  # live: the time shown as 0 (now) [s]; still data: 0
         self._live_span: float | None = None
-        self._y_range: tuple[float, float] | None = None
         self.autoscale = True
+        self._set_units([""])
 
+    # -- the stack of plots ------------------------------------------------------------------------
     @property
     def view_box(self) -> pg.ViewBox:
-        return self.plot.plotItem.vb
+        """The top plot's view box (the time axis is the same in every plot)."""
+        return self._plots[0].view_box
+
+    def plot_items(self) -> list[pg.PlotItem]:
+        """The plots, top to bottom (one per unit of the shown channels)."""
+        return [p.item for p in self._plots]
+
+    def plot_of(self, key: str) -> pg.PlotItem | None:
+        """The plot that shows channel ``key`` (None when it is not shown)."""
+        return next((p.item for p in self._plots if key in p.keys), None)
+
+    def _set_units(self, units: Sequence[str]) -> None:
+        """One plot per unit, in this order, with a linked time axis (rebuilt only on change)."""
+        if [p.unit for p in self._plots] == list(units):
+            return
+        (x0, x1), _ = self.view_box.viewRange() if self._plots else ((0.0, 1.0), None)
+        self.plot.ci.clear()
+        self._plots = []
+        for row, unit in enumerate(units):
+            item = pg.PlotItem()
+            item.setMenuEnabled(False)
+            for name in ("left", "bottom"):
+                axis = item.getAxis(name)
+                axis.setPen(FOREGROUND)
+                axis.setTextPen(FOREGROUND)
+            item.getAxis("left").setWidth(64)  # the same for all: the time axes line up
+            item.getAxis("left").enableAutoSIPrefix(False)  # degrees stay degrees, not "kdeg"
+            item.setLabel("left", unit or "value")
+            self.plot.addItem(item, row=row, col=0)
+            plot = _UnitPlot(item, unit)
+            item.vb.sigYRangeChanged.connect(lambda *_a, p=plot: self._update_grid_lines(p))
+            if self._plots:
+                item.setXLink(self._plots[0].item)
+            self._plots.append(plot)
+        for plot in self._plots[:-1]:
+            plot.item.getAxis("bottom").setStyle(showValues=False)
+        self._plots[-1].item.setLabel("bottom", "time before now" if self._live else "time", units="s")
+        self.view_box.setXRange(x0, x1, padding=0)
+        self._apply_grid()
+        self._apply_autoscale()
+        cursors_on, self._cursors_on = self._cursors_on, False
+        if cursors_on:
+            self._add_cursors()
+            self._cursors_on = True
 
     def show_grid_for_still_data(self, still: bool) -> None:
         """Still data: the axes' grid. Live: no x grid (it would scroll every frame) and the y grid
         as plain lines: an axis that draws a grid covers the plot and repaints its text with
         every frame of the curves."""
-        self.plot.showGrid(x=still, y=still, alpha=0.25)
-        self._grid_on = not still
-        self._update_grid_lines()
+        self._still_grid = still
+        self._apply_grid()
 
-    def _update_grid_lines(self, *_args) -> None:
+    def _apply_grid(self) -> None:
+        still = getattr(self, "_still_grid", False)
+        self._grid_on = not still
+        for plot in self._plots:
+            plot.item.showGrid(x=still, y=still, alpha=0.3)
+            self._update_grid_lines(plot)
+
+    def _update_grid_lines(self, plot: _UnitPlot) -> None:
         """Horizontal lines at the left axis' major ticks (live only)."""
-        for line in self._grid_lines:
-            self.plot.removeItem(line)
-        self._grid_lines = []
+        for line in plot.grid_lines:
+            plot.item.removeItem(line)
+        plot.grid_lines = []
         if not self._grid_on:
             return
-        _, (y0, y1) = self.view_box.viewRange()
-        levels = self.plot.getAxis("left").tickValues(y0, y1, max(50, self.view_box.height()))
+        _, (y0, y1) = plot.view_box.viewRange()
+        levels = plot.item.getAxis("left").tickValues(y0, y1, max(50, plot.view_box.height()))
         for value in (levels[0][1] if levels else []):
             line = pg.InfiniteLine(pos=value, angle=0, movable=False, pen=self._grid_pen)
-            self.plot.addItem(line, ignoreBounds=True)
-            self._grid_lines.append(line)
+            plot.item.addItem(line, ignoreBounds=True)
+            plot.grid_lines.append(line)
 
     # -- curves ------------------------------------------------------------------------------------
     def set_curves(self, channels: Sequence[ScopeChannel], visible: Mapping[str, bool],
-                   scale: Mapping[str, float], color: Callable[[str], str], live: bool) -> None:
-        """One curve per visible channel, named with its unit and scale; ``live`` switches the
-        time axis to "before now" and the y range to ``autoscale`` with hysteresis."""
-        if live != self._live:
+                   scale: Mapping[str, float], color: Callable[[str], str], live: bool,
+                   note: str = "") -> None:
+        """One curve per visible channel, in the plot of its unit, named in the legend with its
+        unit and scale; ``live`` switches the time axis to "before now" and the y range to
+        ``autoscale`` with hysteresis. ``note`` goes after the legend (what is shown, and why)."""
+        live_changed = live != self._live
+        if live_changed:
             self._live = live
-            self._x_offset, self._live_span, self._y_range = 0.0, None, None
-            self.plot.setLabel("bottom", "time before now" if live else "time", units="s")
-            self.view_box.enableAutoRange(axis="y", enable=self.autoscale and not live)
-        for curve in self._curves.values():
-            self.plot.removeItem(curve)
+            self._x_offset, self._live_span = 0.0, None
+        shown = [c for c in channels if visible.get(c.key, True)]
+        units = list(dict.fromkeys(c.unit for c in shown)) or [""]
+        for plot in self._plots:
+            for key in plot.keys:
+                curve = self._curves.get(key)
+                if curve is not None:
+                    plot.item.removeItem(curve)
+            plot.keys = []
         self._curves.clear()
-        for c in channels:
-            if not visible.get(c.key, True):
-                continue
+        self._set_units(units)
+        if live_changed:
+            self._plots[-1].item.setLabel("bottom", "time before now" if live else "time", units="s")
+            for plot in self._plots:
+                plot.y_range = None
+            self._apply_autoscale()
+        entries = []
+        for c in shown:
+            plot = self._plots[units.index(c.unit)]
             factor = scale.get(c.key, 1.0)
             label = f"{c.name} [{c.unit}]" + (f" ×{factor:g}" if factor != 1 else "")
-            curve = self.plot.plot(pen=pg.mkPen(color(c.key), width=1), name=label)
+            curve = plot.item.plot(pen=pg.mkPen(color(c.key), width=1.5 if not live else 1))
             if live:  # already decimated and finite (MinMaxLevels)
                 curve.setDownsampling(ds=1, auto=False)
                 curve.setClipToView(False)
@@ -114,7 +203,14 @@ class TimePlot(QWidget):
             else:
                 curve.setDownsampling(auto=True, method="peak")
                 curve.setClipToView(True)
+            plot.keys.append(c.key)
             self._curves[c.key] = curve
+            entries.append(f"<span style='color:{color(c.key)}; font-weight:bold'>━━</span>&nbsp;"
+                           f"{html.escape(label)}")
+        text = " &nbsp; ".join(entries) if entries else "No channel ticked: tick one in the table."
+        if note:
+            text += f"<br><span style='color:#555'>{html.escape(note)}</span>"
+        self.legend.setText(text)
 
     def curve(self, key: str) -> pg.PlotDataItem | None:
         """The curve of channel ``key`` (None when it is not shown)."""
@@ -127,7 +223,7 @@ class TimePlot(QWidget):
         t, y = levels.window(t0_s, t1_s, bins)
         t -= t1_s
         self._x_offset = t1_s
-        lo, hi = np.inf, -np.inf
+        ranges: dict[str, tuple[float, float]] = {}
         for j, c in enumerate(channels):
             curve = self._curves.get(c.key)
             if curve is not None:
@@ -135,24 +231,31 @@ class TimePlot(QWidget):
                 column = y[:, j] * factor if factor != 1 else y[:, j]
                 curve.setData(t, column)
                 if len(column):
-                    lo, hi = min(lo, float(column.min())), max(hi, float(column.max()))
+                    lo, hi = ranges.get(c.unit, (np.inf, -np.inf))
+                    ranges[c.unit] = min(lo, float(column.min())), max(hi, float(column.max()))
         span = t1_s - t0_s
         if span != self._live_span:
             self._live_span = span
             self.view_box.setXRange(-span, 0.0, padding=0)
-        if self.autoscale and lo <= hi:
-            self._follow_y(lo, hi)
+        if self.autoscale:
+            for plot in self._plots:
+                lo, hi = ranges.get(plot.unit, (np.inf, -np.inf))
+                if lo <= hi:
+                    self._follow_y(plot, lo, hi)
+        if self._cursors_on:
+            self._place_cursors()
 
-    def _follow_y(self, lo: float, hi: float) -> None:
+    @staticmethod
+    def _follow_y(plot: _UnitPlot, lo: float, hi: float) -> None:
         """Move the y range only when the data leaves it or fills less than half of it."""
-        current = self._y_range
+        current = plot.y_range
         if current is not None:
             c_lo, c_hi = current
             if c_lo <= lo and hi <= c_hi and (hi - lo) >= 0.5 * (c_hi - c_lo):
                 return
         pad = 0.1 * (hi - lo) if hi > lo else max(1.0, abs(hi) * 0.1)
-        self._y_range = (lo - pad, hi + pad)
-        self.view_box.setYRange(*self._y_range, padding=0)
+        plot.y_range = (lo - pad, hi + pad)
+        plot.view_box.setYRange(*plot.y_range, padding=0)
 
     def draw_rows(self, channels: Sequence[ScopeChannel], rows: np.ndarray,
                   scale: Mapping[str, float]) -> None:
@@ -162,28 +265,40 @@ class TimePlot(QWidget):
             if curve is not None:
                 curve.setData(rows[:, 0], rows[:, j + 1] * scale.get(c.key, 1.0))
 
-    def fit(self, rows: np.ndarray | None, columns: Sequence[int], factors: Sequence[float],
-            autoscale: bool) -> None:
-        """Show all of ``rows`` (x from the data, y over ``columns`` x ``factors``), or the
-        curves' own range when there are no rows."""
-        vb = self.view_box
+    def fit(self, rows: np.ndarray | None, columns: Mapping[str, Sequence[int]] | Sequence[int],
+            factors: Mapping[str, Sequence[float]] | Sequence[float], autoscale: bool) -> None:
+        """Show all of ``rows`` (x from the data; y of each plot over its ``columns[unit]`` x
+        ``factors[unit]``), or the curves' own range when there are no rows."""
         if rows is not None and len(rows):
             t = rows[:, 0]
-            vb.setXRange(float(t[0]), float(t[-1]), padding=0.02)  # from the data, not from clipped curves
-            if columns:
-                y = rows[:, list(columns)] * list(factors)
-                lo, hi = float(np.nanmin(y)), float(np.nanmax(y))
-                vb.setYRange(lo, hi if hi > lo else lo + 1.0, padding=0.05)
+            self.view_box.setXRange(float(t[0]), float(t[-1]), padding=0.02)  # from the data
+            by_unit_columns = columns if isinstance(columns, Mapping) else {"": columns}
+            by_unit_factors = factors if isinstance(factors, Mapping) else {"": factors}
+            for plot in self._plots:
+                cols = list(by_unit_columns.get(plot.unit, ()))
+                if cols:
+                    y = rows[:, cols] * list(by_unit_factors.get(plot.unit, [1.0] * len(cols)))
+                    lo, hi = float(np.nanmin(y)), float(np.nanmax(y))
+                    plot.view_box.setYRange(lo, hi if hi > lo else lo + 1.0, padding=0.05)
         else:
-            vb.autoRange(padding=0.02)
+            for plot in self._plots:
+                plot.view_box.autoRange(padding=0.02)
         if autoscale and not self._live:
-            vb.enableAutoRange(axis="y", enable=True)
-        self._y_range = self._live_span = None  # live: the next frame shows the time base again
+            for plot in self._plots:
+                plot.view_box.enableAutoRange(axis="y", enable=True)
+        self._live_span = None  # live: the next frame shows the time base again
+        for plot in self._plots:
+            plot.y_range = None
 
     def set_autoscale(self, on: bool) -> None:
         self.autoscale = bool(on)
-        self._y_range = None
-        self.view_box.enableAutoRange(axis="y", enable=self.autoscale and not self._live)
+        for plot in self._plots:
+            plot.y_range = None
+        self._apply_autoscale()
+
+    def _apply_autoscale(self) -> None:
+        for plot in self._plots:
+            plot.view_box.enableAutoRange(axis="y", enable=self.autoscale and not self._live)
 
     def x_range(self) -> tuple[float, float]:
         """The time range on show [s], in the data's own time (live: not "before now")."""
@@ -199,25 +314,68 @@ class TimePlot(QWidget):
         if on == self._cursors_on:
             return
         self._cursors_on = on
-        for c in (self.cursor1, self.cursor2):
-            if on:
-                self.plot.addItem(c, ignoreBounds=True)
-            else:
-                self.plot.removeItem(c)
+        self.cursor_table.setVisible(on)
         if on:
+            self._add_cursors()
             x0, x1 = self.x_range()
             self.set_cursors(x0 + 0.3 * (x1 - x0), x0 + 0.7 * (x1 - x0))
+        else:
+            for plot in self._plots:
+                for line in plot.cursors or ():
+                    plot.item.removeItem(line)
+                plot.cursors = None
+
+    def _add_cursors(self) -> None:
+        """Cursor A (solid) and B (dashed) in every plot, moving together."""
+        for plot in self._plots:
+            a = pg.InfiniteLine(angle=90, movable=True, pen=pg.mkPen(FOREGROUND, width=1),
+                                label="A" if plot is self._plots[0] else None,
+                                labelOpts={"position": 0.95, "color": FOREGROUND})
+            b = pg.InfiniteLine(angle=90, movable=True, pen=pg.mkPen(FOREGROUND, width=1,
+                                                                     style=Qt.PenStyle.DashLine),
+                                label="B" if plot is self._plots[0] else None,
+                                labelOpts={"position": 0.95, "color": FOREGROUND})
+            plot.cursors = (a, b)
+            for index, line in enumerate((a, b)):
+                line.setValue(self._cursor_t[index])
+                plot.item.addItem(line, ignoreBounds=True)
+                line.sigPositionChanged.connect(lambda ln, i=index: self._cursor_dragged(i, ln))
+
+    def _cursor_dragged(self, index: int, line: pg.InfiniteLine) -> None:
+        value = float(line.value())
+        if value == self._cursor_t[index]:
+            return
+        t = list(self._cursor_t)
+        t[index] = value
+        self._cursor_t = (t[0], t[1])
+        self._place_cursors()
+        self.sigCursorsMoved.emit()
+
+    def _place_cursors(self) -> None:
+        for plot in self._plots:
+            for index, line in enumerate(plot.cursors or ()):
+                if float(line.value()) != self._cursor_t[index]:
+                    line.setValue(self._cursor_t[index])
 
     def set_cursors(self, t1_s: float, t2_s: float) -> None:
         """Put the cursors at these times of the data (live: they then stay that long before now)."""
-        self.cursor1.setValue(t1_s - self._x_offset)
-        self.cursor2.setValue(t2_s - self._x_offset)
+        self._cursor_t = (t1_s - self._x_offset, t2_s - self._x_offset)
+        self._place_cursors()
+        self.sigCursorsMoved.emit()
+
+    def cursor_axis_times(self) -> tuple[float, float]:
+        """The cursors' times as the time axis reads them [s] (live: before now, negative)."""
+        return self._cursor_t
+
+    @property
+    def live(self) -> bool:
+        return self._live
 
     def cursor_times(self) -> tuple[float, float]:
         """The cursors' times in the data's own time [s]."""
-        return float(self.cursor1.value()) + self._x_offset, float(self.cursor2.value()) + self._x_offset
+        return self._cursor_t[0] + self._x_offset, self._cursor_t[1] + self._x_offset
 
     def export_png(self, path) -> None:
-        exporter = exporters.ImageExporter(self.plot.plotItem)
+        exporter = exporters.ImageExporter(self.plot.ci)
         exporter.parameters()["width"] = max(800, self.plot.width())
         exporter.export(str(path))

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from PySide6.QtCore import Signal
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtGui import QFont, QFontMetrics
 from PySide6.QtWidgets import QCheckBox, QComboBox, QLabel, QPushButton, QToolBar
 
 TIME_BASES_S = (0.5, 1.0, 2.0, 5.0, 10.0, 30.0, 60.0)
@@ -13,6 +14,12 @@ INDICATOR_STYLE = {
     "not": "background:#b71c1c; color:white; font-weight:bold; padding:3px 8px; border-radius:3px;",
     "paused": "background:#e65100; color:white; font-weight:bold; padding:3px 8px; border-radius:3px;",
 }
+
+
+#: The indicator's width [px]: room for "NOT LIVE: waiting for the first sample".
+INDICATOR_WIDTH_PX = 270
+#: The indicator's padding and border, left and right together [px] (INDICATOR_STYLE).
+_INDICATOR_PADDING_PX = 20
 
 
 class ScopeToolbar(QToolBar):
@@ -31,7 +38,9 @@ class ScopeToolbar(QToolBar):
         super().__init__("Scope", parent)
         self.indicator = QLabel()
         self.indicator.setObjectName("scopeIndicator")
-        self.indicator.setMinimumWidth(90)
+        # a fixed width: the buttons do not shift when LIVE becomes NOT LIVE: ... (long texts are
+        # elided, the whole text is in the tooltip)
+        self.indicator.setFixedWidth(INDICATOR_WIDTH_PX)
         self.addWidget(self.indicator)
         self.addSeparator()
         self.live_button = QPushButton("Start live")
@@ -96,7 +105,10 @@ class ScopeToolbar(QToolBar):
         if text == self._indicator_text:
             return False
         self._indicator_text = text
-        self.indicator.setText(text if len(text) < 48 else text[:46] + "…")
+        font = QFont(self.indicator.font())
+        font.setBold(True)
+        self.indicator.setText(QFontMetrics(font).elidedText(text, Qt.TextElideMode.ElideRight,
+                                                             INDICATOR_WIDTH_PX - _INDICATOR_PADDING_PX))
         self.indicator.setToolTip(text)
         self.indicator.setStyleSheet(INDICATOR_STYLE[kind])
         return True

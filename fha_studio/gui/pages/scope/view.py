@@ -37,13 +37,14 @@ from PySide6.QtWidgets import (
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.hardware.parameters import load_parameter_model
 from fha_studio.logic.scope.acquisition import LiveMode, MoveTestResult, TraceResult, TraceSettings
-from fha_studio.logic.scope.analysis import cursor_delta, spectrum
+from fha_studio.logic.scope.analysis import CursorDelta, cursor_delta, spectrum
 from fha_studio.logic.scope.channels import ScopeChannel, scope_channels
 from fha_studio.logic.scope.levels import MinMaxLevels
 from fha_studio.logic.scope.recorder import CONTRACT_SOURCES, ScopeRecorder
 from fha_studio.recording import RecordingMetadata, read_recording
 
 from .channel_table import ChannelTable
+from .cursor_table import CursorRow
 from .driver import LiveStarted, ScopeCmd, ScopeController
 from .move_test_panel import MoveTestPanel
 from .spectrum_panel import SpectrumPanel
@@ -58,8 +59,10 @@ REFRESH_MS = 25
 #: How often the text under the plot and the cursor read-out follow the live data [s].
 TEXT_INTERVAL_S = 0.25
 DEFAULT_VISIBLE = ("feedback_position", "command_position", "output_speed", "motor_current")
-COLORS = ("#f0c419", "#4fc3f7", "#81c784", "#ff8a65", "#ba68c8", "#e57373", "#90a4ae", "#aed581",
-          "#ffd54f", "#4dd0e1", "#f06292", "#a1887f", "#7986cb", "#dce775", "#ffb74d", "#9575cd")
+#: Channel colours, strong enough on the white plot and on the window's background (the legend and
+#: the channel table): no pale yellow or light pastel.
+COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#e07000", "#9467bd", "#8c564b", "#e377c2", "#008b8b",
+          "#555555", "#1a237e", "#b8860b", "#006400", "#c2185b", "#4e342e", "#0097a7", "#6a1b9a")
 # Recording columns back to scope channels (opening a file).
 _COLUMN_KEYS = {column: key for column, key in CONTRACT_SOURCES.items()}
 
@@ -244,7 +247,10 @@ class ScopeView(QWidget):
 
     def _fill_channel_table(self) -> None:
         channels = self._shown_channels()
-        self.channel_table.fill(channels, self._visible, self._scale, self._color)
+        # live (or not started) the table lists every channel, ticked or not: an unticked one is not
+        # polled, but stays there to be ticked again
+        listed = channels if self._static is not None else tuple(self.all_channels)
+        self.channel_table.fill(listed, self._visible, self._scale, self._color)
         self._rebuild_curves()
         self.spectrum_panel.set_channels(channels)
 
@@ -274,7 +280,18 @@ class ScopeView(QWidget):
 
     def _rebuild_curves(self) -> None:
         self.time_plot.set_curves(self._shown_channels(), self._visible, self._scale, self._color,
-                                  live=self._static is None)
+                                  live=self._static is None, note=self._shown_note())
+
+    def _shown_note(self) -> str:
+        """What the plots show, in a line under the legend."""
+        ticked = sum(1 for c in self.all_channels if self._visible.get(c.key))
+        if self._static is not None:
+            return (f"Showing {self._static.label} (not live): untick a channel in the table to hide it; "
+                    "each unit has its own plot, on one time axis.")
+        if self._live is not None:
+            return (f"Live: the {ticked} ticked channels of {len(self.all_channels)} are polled; tick "
+                    "another in the table to add it (the live view restarts with it).")
+        return "Not live: Start live polls the ticked channels; each unit has its own plot."
 
     # ------------------------------------------------------------------------------------- live
     def _live_toggled(self, on: bool) -> None:
@@ -425,9 +442,13 @@ class ScopeView(QWidget):
         """Show the whole capture (or the live time base) and scale Y to the visible channels."""
         s = self._static
         if s is not None and len(s.rows):
-            shown = [j + 1 for j, c in enumerate(s.channels) if self._visible.get(c.key, True)]
-            factors = [self._scale.get(s.channels[j - 1].key, 1.0) for j in shown]
-            self.time_plot.fit(s.rows, shown, factors, self.toolbar.autoscale.isChecked())
+            columns: dict[str, list[int]] = {}
+            factors: dict[str, list[float]] = {}
+            for j, c in enumerate(s.channels):
+                if self._visible.get(c.key, True):
+                    columns.setdefault(c.unit, []).append(j + 1)
+                    factors.setdefault(c.unit, []).append(self._scale.get(c.key, 1.0))
+            self.time_plot.fit(s.rows, columns, factors, self.toolbar.autoscale.isChecked())
         else:
             self.time_plot.fit(None, (), (), self.toolbar.autoscale.isChecked())
 
@@ -444,7 +465,10 @@ class ScopeView(QWidget):
 
     def cursor_readout(self) -> dict[str, tuple[float, float, float | None]]:
         """{channel key: (dt s, dvalue, slope per s)} for the visible channels between the cursors."""
-        out: dict[str, tuple[float, float, float | None]] = {}
+        return {key: (d.dt_s, d.dvalue, d.slope_per_s) for key, d in self._cursor_deltas().items()}
+
+    def _cursor_deltas(self) -> dict[str, CursorDelta]:
+        out: dict[str, CursorDelta] = {}
         data = self.shown_rows()
         if data is None or len(data[1]) < 2:
             return out
@@ -452,27 +476,22 @@ class ScopeView(QWidget):
         t1, t2 = self.time_plot.cursor_times()
         for j, c in enumerate(channels):
             if self._visible.get(c.key, True):
-                d = cursor_delta(rows[:, 0], rows[:, j + 1], t1, t2)
-                out[c.key] = (d.dt_s, d.dvalue, d.slope_per_s)
+                out[c.key] = cursor_delta(rows[:, 0], rows[:, j + 1], t1, t2)
         return out
 
     def _update_cursor_readout(self, *_args) -> None:
-        label = self.time_plot.cursor_label
+        table = self.time_plot.cursor_table
         if not self.time_plot.cursors_on:
-            label.setText("")
             return
-        readout = self.cursor_readout()
-        if not readout:
-            label.setText("Cursors: no data")
+        deltas = self._cursor_deltas()
+        if not deltas:
+            table.show_message("No data between the cursors yet.")
             return
-        units = {c.key: c for c in self._shown_channels()}
-        dt = next(iter(readout.values()))[0]
-        parts = [f"Δt = {dt * 1000:.2f} ms" + (f" ({1 / abs(dt):.2f} Hz)" if dt else "")]
-        for key, (_dt, dv, slope) in readout.items():
-            c = units[key]
-            slope_text = "—" if slope is None else f"{slope:.4g} {c.unit}/s"
-            parts.append(f"{c.name}: Δ {dv:.4g} {c.unit}, {slope_text}")
-        label.setText(" | ".join(parts))
+        channels = {c.key: c for c in self._shown_channels()}
+        rows = [CursorRow(channels[key].name, channels[key].unit, self._color(key), d.value_a, d.value_b,
+                          d.slope_per_s) for key, d in deltas.items()]
+        t_a, t_b = self.time_plot.cursor_axis_times()
+        table.show_rows(t_a, t_b, rows, "Time before now" if self.time_plot.live else "Time")
 
     # ------------------------------------------------------------------------------ data on show
     def shown_rows(self) -> tuple[tuple[ScopeChannel, ...], np.ndarray] | None:
