@@ -21,6 +21,8 @@ def _wants_gui(args: list[str]) -> bool:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
+    if args[:2] == ["training", "start"] and len(args) == 3 and args[2] not in _HELP:
+        args = ["gui", "--training", args[2]]  # a trainee's session is the GUI's
     if _wants_gui(args):
         try:
             from fha_studio.gui.app import run

@@ -30,6 +30,9 @@ class SimConstants:
     limit_switch_1_angle_deg: float
     limit_switch_2_angle_deg: float
     limit_dog_arc_deg: float
+    wiring_fault_trip_s: float
+    wiring_fault_lurch_deg: float
+    lost_multi_turn_turns: int
 
 
 @cache

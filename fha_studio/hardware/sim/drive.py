@@ -52,8 +52,9 @@ from fha_studio.hardware.sim.commands import COMMANDS, DEFERRED, DOCUMENTED_ONLY
 from fha_studio.hardware.sim.constants import SimConstants, load_sim_constants
 from fha_studio.hardware.sim.eeprom import EepromFile, default_eeprom_dir
 from fha_studio.hardware.sim.io import SimIo
+from fha_studio.hardware.sim.journal import Journal, JournalEntry
 from fha_studio.hardware.sim.memory import ItemId, ParameterMemory, PersistentState
-from fha_studio.hardware.sim.options import SimConfig, SimConfigError
+from fha_studio.hardware.sim.options import SimConfig, SimConfigError, training_registration
 from fha_studio.hardware.sim.recorder import SimRecorder
 from fha_studio.hardware.sim.reply import SimRefused, SimReply, rejected
 from fha_studio.hardware.sim.supervision import SUPERVISION_PERIOD_S, AlarmSupervisor, SimAlarmRecord
@@ -61,6 +62,8 @@ from fha_studio.hardware.sim.trace import SimTrace, TraceError
 from fha_studio.physics import ServoAxis, ServoSettings
 
 TWO_PI = 2.0 * math.pi
+#: wiring faults that leave the motor without useful torque (see _supervise_wiring_fault)
+MOTION_WIRING_FAULTS = ("motor_swapped", "motor_open", "encoder_swapped")
 RPM = TWO_PI / 60.0  # rad/s per r/min
 
 
@@ -125,7 +128,17 @@ class SimDrive:
             origin_deg=config.origin_deg if config.origin_deg is not None else c.origin_angle_deg,
             ls1_deg=config.ls1_deg if config.ls1_deg is not None else c.limit_switch_1_angle_deg,
             ls2_deg=config.ls2_deg if config.ls2_deg is not None else c.limit_switch_2_angle_deg,
+            brake_supply=config.brake_supply,
         )
+        if config.battery != "ok" and not self.absolute_encoder:
+            raise SimConfigError(f"simulated drive option battery={config.battery}: {self.actuator_code} "
+                                 "has an incremental encoder (no backup battery)")
+        # a training drive writes what is done to it in its registration's journal
+        registration = training_registration(config.training) if config.training else None
+        self.journal: Journal | None = registration.journal if registration is not None else None
+        # the encoder's A/B leads swapped: it counts the other way (docs/sim.md, wiring faults)
+        self._encoder_sign = -1.0 if config.wiring == "encoder_swapped" else 1.0
+        self._faulty_motion_s = 0.0  # how long a motion has been commanded into a wiring fault
         self.oww_clear_s = config.oww_clear_s if config.oww_clear_s is not None else c.oww_clear_s
         self.supervisor = AlarmSupervisor(
             self.alarm_table,
@@ -147,6 +160,12 @@ class SimDrive:
         persistent = self.memory.load()
         if persistent is None:
             persistent = PersistentState()
+            try:
+                self._store_as_delivered(persistent)
+            except SimConfigError:
+                if self._tempdir is not None:  # no drive: nothing will close it
+                    self._tempdir.cleanup()
+                raise
             self.memory.save(persistent)
         self.supervisor.history = persistent.alarm_history
         self._absolute_zero_rad = persistent.absolute_zero_rad  # physical angle where the absolute count is 0
@@ -169,6 +188,20 @@ class SimDrive:
 
         return cls(config=config_from_url(url), **kwargs)
 
+    def _store_as_delivered(self, persistent: PersistentState) -> None:
+        """A new EEPROM: the ``preset`` items, and with ``battery=lost`` multi-turn data that no
+        longer matches the shaft (the backup failed while the drive was stored)."""
+        for mode, number, value in self.config.preset:
+            try:
+                self.memory.write(mode, number, value, servo_on=False)
+            except SimRefused as exc:
+                raise SimConfigError(
+                    f"simulated drive option preset {mode}.{number}={value}: {exc.reason}"
+                ) from None
+        if self.config.battery == "lost":
+            turns = self.constants.lost_multi_turn_turns
+            persistent.absolute_zero_rad -= turns * TWO_PI / self.ratio
+
     def _eeprom_path(self, option: str | None) -> Path:
         if option is None or option == "":
             self._tempdir = tempfile.TemporaryDirectory(prefix="fha-sim-")
@@ -187,7 +220,11 @@ class SimDrive:
     # ------------------------------------------------------------------ power
     def _settings(self, values: dict[ItemId, int]) -> ServoSettings:
         by_key = self.memory.by_key(values)
-        return servo_settings(self.model, by_key, self.servo_rate_hz, self.config.quantised)
+        settings = servo_settings(self.model, by_key, self.servo_rate_hz, self.config.quantised)
+        if self.config.wiring in MOTION_WIRING_FAULTS:
+            # a lead open or swapped: the motor makes no useful torque
+            settings = settings.replace(current_limit_a=0.0)
+        return settings
 
     def _power_on(self) -> None:
         """Control power on: active items from the EEPROM, counters from zero, no alarm."""
@@ -216,6 +253,11 @@ class SimDrive:
         self.supervisor.power_on(axis)
         axis.reset_peaks()
         self._update_brake()
+        self._faulty_motion_s = 0.0
+        if self.config.wiring == "encoder_open":
+            self.raise_alarm(50)  # no valid signal from the encoder
+        elif self.config.battery != "ok":
+            self.raise_alarm(56)  # the backup battery's voltage is low
 
     @property
     def _axis(self) -> ServoAxis:
@@ -289,7 +331,8 @@ class SimDrive:
     def feedback_pulses(self) -> int:
         """Monitor 100: feedback position in output pulses, command sense, 0 at power-on with an
         incremental encoder."""
-        return self._pulses(self._direction * (self.axis.output_pos_rad - self._feedback_zero_rad))
+        sense = self._encoder_sign * self._direction
+        return self._pulses(sense * (self.axis.output_pos_rad - self._feedback_zero_rad))
 
     @property
     def speed_mode(self) -> bool:
@@ -301,7 +344,8 @@ class SimDrive:
         """Monitor 101: command position in output pulses, command sense."""
         if self.speed_mode:
             return self.feedback_pulses
-        return self._pulses(self._direction * (self.axis.command_pos_rad - self._feedback_zero_rad))
+        sense = self._encoder_sign * self._direction
+        return self._pulses(sense * (self.axis.command_pos_rad - self._feedback_zero_rad))
 
     @property
     def error_pulses(self) -> int:
@@ -311,7 +355,8 @@ class SimDrive:
     @property
     def absolute_counts(self) -> int:
         """Multi-turn x 8192 + single-turn of the absolute motor encoder (DGR), physical sense."""
-        turns = (self.axis.output_pos_rad - self._absolute_zero_rad) / TWO_PI * self.ratio
+        angle = self._encoder_sign * (self.axis.output_pos_rad - self._absolute_zero_rad)
+        turns = angle / TWO_PI * self.ratio
         return math.floor(turns * ABSOLUTE_COUNTS_PER_TURN + 0.5)
 
     @property
@@ -421,12 +466,14 @@ class SimDrive:
             if self.brake_holding:
                 raise rejected("the brake holds: release it (24 V on the brake) to turn the axis by hand")
             self.axis.turn_by_hand(math.radians(angle_deg))
+            self._journal_entry("HAND_TURN", round(angle_deg), "q", self.alarm)
 
     def controller_command(self, angle_deg: float) -> None:
         """The controller's pulse train on CN2: turn the output by ``angle_deg`` in the command
         sense (FWD positive; the rotary direction, system 8, decides CW or CCW). Needs the servo
         on (``x`` otherwise), as on a real drive."""
-        self.move_by(angle_deg)
+        with self._lock:
+            self._journal_call("CN2_MOVE", round(angle_deg), lambda: self.move_by(angle_deg))
 
     def _servo_off(self) -> None:
         self.servo_on = False
@@ -614,6 +661,8 @@ class SimDrive:
                 self._still_since = t
             elif t - self._still_since >= self.constants.standstill_s:
                 self._motion = "idle"
+        if self.config.wiring in MOTION_WIRING_FAULTS:
+            self._supervise_wiring_fault()
         if self.servo_on and self._motion != "idle" and self.io.blocks(
             self._angle_deg,
             forward=self._motion_sign > 0,
@@ -623,6 +672,21 @@ class SimDrive:
         self._supervise_alarms()
         if self._recorder is not None:
             self._recorder.tick(self.clock_s, axis)
+
+    def _supervise_wiring_fault(self) -> None:
+        """A motor lead open or swapped, or the encoder's A/B swapped: a commanded motion finds no
+        useful torque (open) or runs away from the command (swapped) and the error counter
+        overflows (alarm 60) within ``wiring_fault_trip_s``."""
+        if not (self.servo_on and self._motion in ("jog", "move")):
+            self._faulty_motion_s = 0.0
+            return
+        self._faulty_motion_s += SUPERVISION_PERIOD_S
+        if self._faulty_motion_s < self.constants.wiring_fault_trip_s:
+            return
+        sign = self._motion_sign * self._direction
+        self.raise_alarm(60)
+        if self.config.wiring != "motor_open":  # the axis lurched the wrong way before the trip
+            self.axis.turn_by_hand(-sign * math.radians(self.constants.wiring_fault_lurch_deg))
 
     def _supervise_alarms(self) -> None:
         allowance: float | None = None
@@ -759,6 +823,50 @@ class SimDrive:
     def execute(self, command: Command | str, value: int) -> SimReply | None:
         """Do one CN3 command (a :class:`Command` or its name). Returns its reply, or None when
         the reply comes later (OWW: see :meth:`take_deferred_replies`)."""
+        with self._lock:
+            if self.journal is None:
+                return self._execute(command, value)
+            name = command.value if isinstance(command, Command) else str(command)
+            before = self._journal_state()
+            reply = self._execute(command, value)
+            self._journal_entry(name, value, reply.terminal if reply is not None else "", self.alarm, before)
+            return reply
+
+    def _journal_call(self, name: str, value: int, call: Any) -> None:
+        """Run ``call`` and write it in the training journal with the state before it."""
+        if self.journal is None:
+            call()
+            return
+        before = self._journal_state()
+        terminal = "q"
+        try:
+            call()
+        except SimRefused as exc:
+            terminal = exc.terminal
+            raise
+        finally:
+            self._journal_entry(name, value, terminal, self.alarm, before)
+
+    def _journal_state(self) -> dict[str, Any]:
+        fwd, rev = self.io.blocked(self._angle_deg, self._direction)
+        return {"item": self.selected_item, "servo_on": self.servo_on, "brake_holding": self.brake_holding,
+                "blocked_fwd": fwd, "blocked_rev": rev, "alarm_before": self.alarm}
+
+    def _journal_entry(self, name: str, value: int, terminal: str, alarm_after: int,
+                       before: dict[str, Any] | None = None) -> None:
+        if self.journal is None:
+            return
+        state = before if before is not None else self._journal_state()
+        item = state["item"]
+        self.journal.append(JournalEntry(
+            at_s=time.time(), command=name, value=int(value), terminal=terminal,
+            item=(str(item[0]), int(item[1])) if item is not None else None,
+            servo_on=state["servo_on"], brake_holding=state["brake_holding"],
+            blocked_fwd=state["blocked_fwd"], blocked_rev=state["blocked_rev"],
+            alarm_before=state["alarm_before"], alarm_after=alarm_after,
+        ))
+
+    def _execute(self, command: Command | str, value: int) -> SimReply | None:
         with self._lock:
             if self.documented_only and self.servo_on:
                 # HA-655 manual p.21: with the servo on the drive processes nothing over CN3

@@ -47,10 +47,14 @@ class SimIo:
         origin_deg: float,
         ls1_deg: float,
         ls2_deg: float,
+        brake_supply: bool = True,
     ):
         self.constants = constants
         self.has_sensors = has_sensors
         self.has_brake = has_brake
+        # False: the brake's 24 V supply is missing (a wiring fault): the coil never gets its
+        # voltage, whatever the controller switches
+        self.brake_supply = brake_supply
         self.inputs = 0  # the INP bits
         self.origin_deg = origin_deg
         self.ls1_deg = ls1_deg
@@ -70,7 +74,12 @@ class SimIo:
     @property
     def brake_holding(self) -> bool:
         """True while the brake holds: fitted and its 24 V coil unpowered (non-excitation brake)."""
-        return self.has_brake and not self.inputs >> BIT_BRAKE_RELEASED & 1
+        return self.has_brake and not self.coil_powered
+
+    @property
+    def coil_powered(self) -> bool:
+        """24 V is on the brake coil: the controller switched it on and the supply is there."""
+        return bool(self.inputs >> BIT_BRAKE_RELEASED & 1) and self.brake_supply
 
     def set_sensor_angle(self, which: str, angle_deg: float) -> None:
         """Move the origin slit (``"origin"``) or a limit-switch dog (``"ls1"``, ``"ls2"``)."""
@@ -104,6 +113,14 @@ class SimIo:
             bits |= 1 << BIT_LIMIT_2
         return bits
 
+    def blocked(self, angle_deg: float, direction: float) -> tuple[bool, bool]:
+        """(FWD blocked, REV blocked) by an inhibit input or a limit switch, with ``direction``
+        the rotary-direction sign (+1: FWD = CW)."""
+        return (
+            self.blocks(angle_deg, forward=True, physical_cw=direction > 0),
+            self.blocks(angle_deg, forward=False, physical_cw=direction < 0),
+        )
+
     def blocks(self, angle_deg: float, *, forward: bool, physical_cw: bool) -> bool:
         """An inhibit input (command sense) or a limit switch (physical sense) stops a motion
         going ``forward`` (FWD) and ``physical_cw`` (CW seen from the flange)."""
@@ -127,6 +144,8 @@ class SimIo:
     ) -> int:
         """The I/O bit mask of IOS / monitor 106; ``alm_bits`` is the active alarm's ALM code."""
         bits = self.inputs | self.sensor_bits(angle_deg)
+        if not self.coil_powered:
+            bits &= ~(1 << BIT_BRAKE_RELEASED)
         if servo_on:
             bits |= 1 << BIT_SERVO_ON
         if not alarm:

@@ -29,6 +29,16 @@ Options (all optional):
                    what the public HA-655 manual documents (DGR, OWW; ``x`` to the rest, ``s`` to
                    everything while the servo is on). Servo-ON then comes from the simulated CN2
                    input (``SimDrive.set_servo``), as on a real drive from the controller
+``wiring``         a wiring fault (training): ``ok`` (default), ``motor_swapped``,
+                   ``motor_open``, ``encoder_swapped``, ``encoder_open`` (docs/sim.md says what each
+                   does)
+``brake_supply``   1 (default) / 0: the brake's 24 V supply is missing, the brake never releases
+``battery``        the absolute encoder's backup battery: ``ok`` (default), ``low`` (alarm 56 at
+                   power-on), ``lost`` (alarm 56 and the multi-turn data lost)
+``preset``         items as the drive is delivered, ``MODE.NUMBER=VALUE,...`` (e.g.
+                   ``system.8=1,system.6=1``); stored into a new EEPROM only
+``training``       a token from :func:`register_training`: hidden options of a training drive,
+                   merged in (they never appear in the address a person sees)
 =================  ==========================================================================
 """
 
@@ -36,15 +46,22 @@ from __future__ import annotations
 
 import math
 import re
+import secrets
+import threading
 from dataclasses import dataclass, field, replace
 from typing import Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
 from fha_studio import plausible
 from fha_studio.catalog import DEFAULT_ACTUATOR
+from fha_studio.hardware.sim.journal import Journal
 
 #: The command sets a simulated drive can speak (see ``profile`` above).
 PROFILES = ("full", "documented")
+#: Wiring faults a simulated drive can carry (see ``wiring`` above and docs/sim.md).
+WIRING_FAULTS = ("ok", "motor_swapped", "motor_open", "encoder_swapped", "encoder_open")
+#: States of the absolute encoder's backup battery (see ``battery`` above).
+BATTERY_STATES = ("ok", "low", "lost")
 
 
 class SimConfigError(ValueError):
@@ -70,11 +87,26 @@ class SimConfig:
     oww_clear_s: float | None = None
     packed_trace: bool = True
     profile: str = "full"
+    wiring: str = "ok"
+    brake_supply: bool = True
+    battery: str = "ok"
+    #: items stored into a new EEPROM, as delivered: ((mode, number, value), ...)
+    preset: tuple[tuple[str, int, int], ...] = ()
+    #: the training registration this drive belongs to (its journal), or None
+    training: str | None = None
 
     def __post_init__(self) -> None:
         if self.profile not in PROFILES:
             raise SimConfigError(
                 f"simulated drive option profile: {self.profile!r} is not one of {', '.join(PROFILES)}"
+            )
+        if self.wiring not in WIRING_FAULTS:
+            raise SimConfigError(
+                f"simulated drive option wiring: {self.wiring!r} is not one of {', '.join(WIRING_FAULTS)}"
+            )
+        if self.battery not in BATTERY_STATES:
+            raise SimConfigError(
+                f"simulated drive option battery: {self.battery!r} is not one of {', '.join(BATTERY_STATES)}"
             )
         if not isinstance(self.actuator, str) or not self.actuator.strip():
             raise SimConfigError("simulated drive: an actuator model code is needed, e.g. FHA-25C-50-US250")
@@ -168,10 +200,66 @@ def parse_effects(specs: list[str]) -> dict[str, dict[str, float]]:
     return effects
 
 
+def parse_preset(text: str) -> tuple[tuple[str, int, int], ...]:
+    """``"system.8=1,system.6=1"`` -> ``(("system", 8, 1), ("system", 6, 1))``. Whether an item
+    and its value exist is checked by the drive's parameter model when it stores them."""
+    items: list[tuple[str, int, int]] = []
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        m = re.fullmatch(r"(monitor|tune|system|test)\.([0-9]+)\s*=\s*([+-]?[0-9]+)", part)
+        if m is None:
+            raise SimConfigError(f"simulated drive option preset: {part!r} is not MODE.NUMBER=VALUE "
+                                 "(MODE: tune, system or test), e.g. system.8=1")
+        items.append((m.group(1), int(m.group(2)), int(m.group(3))))
+    return tuple(items)
+
+
+@dataclass
+class TrainingRegistration:
+    """A training drive's hidden options and its journal (what the trainee did to the drive)."""
+
+    token: str
+    options: str  # a URL query string: the hidden faults
+    journal: Journal
+
+
+_TRAINING: dict[str, TrainingRegistration] = {}
+_TRAINING_LOCK = threading.Lock()
+
+
+def register_training(options: str) -> TrainingRegistration:
+    """Registers hidden options (a URL query string, checked now) for a training drive; its
+    address is then ``sim://ACTUATOR?training=TOKEN``, which says nothing of the faults.
+    Raises SimConfigError for a bad option."""
+    config_from_url(f"sim://{DEFAULT_ACTUATOR}?{options}")  # check them before anything uses them
+    registration = TrainingRegistration(secrets.token_hex(6), options, Journal())
+    with _TRAINING_LOCK:
+        _TRAINING[registration.token] = registration
+    return registration
+
+
+def training_registration(token: str) -> TrainingRegistration | None:
+    with _TRAINING_LOCK:
+        return _TRAINING.get(token)
+
+
+def forget_training(token: str) -> None:
+    with _TRAINING_LOCK:
+        _TRAINING.pop(token, None)
+
+
+def public_url(url: str) -> str:
+    """The address a person may see: a training drive's address without its options (they
+    could name the hidden faults); any other address as it is."""
+    parts = urlsplit(url)
+    if parts.scheme.lower() != "sim" or "training" not in parse_qs(parts.query):
+        return url
+    return f"sim://{parts.netloc or parts.path.lstrip('/')} (training)"
+
+
 _URL_KEYS = {
     "driver", "load_inertia", "load_inertia_kgm2", "brake", "sensors", "origin_deg", "ls1_deg",
     "ls2_deg", "effects", "effect", "eeprom", "paced", "quantised", "oww_clear_s",
-    "packed_trace", "profile",
+    "packed_trace", "profile", "wiring", "brake_supply", "battery", "preset", "training",
 }
 
 
@@ -189,6 +277,14 @@ def config_from_url(url: str) -> SimConfig:
         raise SimConfigError(
             f"{url!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_URL_KEYS))}"
         )
+    token = query["training"][-1] if "training" in query else None
+    if token is not None:
+        registration = training_registration(token)
+        if registration is None:
+            raise SimConfigError(f"{public_url(url)}: this training drive is no longer registered")
+        hidden = parse_qs(registration.options, keep_blank_values=True)
+        # the hidden options decide; the visible ones (paced, eeprom) add to them
+        query = {**query, **hidden}
 
     def last(key: str) -> str | None:
         return query[key][-1] if key in query else None
@@ -214,4 +310,14 @@ def config_from_url(url: str) -> SimConfig:
     profile = last("profile")
     if profile is not None:
         values["profile"] = profile.strip().lower()
+    for key in ("wiring", "battery"):
+        if last(key) is not None:
+            values[key] = last(key).strip().lower()  # type: ignore[union-attr]
+    if last("brake_supply") is not None:
+        values["brake_supply"] = _flag("brake_supply", last("brake_supply"))  # type: ignore[arg-type]
+    presets = query.get("preset", [])
+    if presets:
+        values["preset"] = sum((parse_preset(p) for p in presets), ())
+    if token is not None:
+        values["training"] = token
     return SimConfig(**values)
