@@ -72,7 +72,7 @@ def _show(args: argparse.Namespace) -> int:
     print(f"Level: {s.level}; time guide {s.time_guide_min:g} min")
     print(
         f"Actuator: {s.actuator}; driver: {s.driver or 'as the combination table gives'}; "
-        f"declared load inertia {s.load_inertia_kgm2:g} kg m^2"
+        f"declared load inertia {s.load_inertia_kgm2:g} kg·m²"
     )
     print()
     for paragraph in s.briefing.split("\n\n"):

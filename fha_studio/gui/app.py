@@ -90,6 +90,11 @@ def _parser() -> argparse.ArgumentParser:
         help="the register file (default: $FHA_STUDIO_REGISTER, else register.sqlite in the user data "
         "directory)",
     )
+    parser.add_argument(
+        "--training",
+        metavar="SCENARIO",
+        help="start a training scenario (an id of fha-studio training list, or a .toml file)",
+    )
     parser.add_argument("--quit-after-ms", type=int, default=None, help=argparse.SUPPRESS)
     return parser
 
@@ -165,6 +170,15 @@ def run(argv: Sequence[str] = ()) -> int:
     icon = resources_dir() / "icons" / "fha-studio.png"
     if icon.exists():
         app.setWindowIcon(QIcon(str(icon)))
+    scenario = None
+    if args.training:
+        from fha_studio.logic.training.scenario import ScenarioError, find_scenario
+
+        try:
+            scenario = find_scenario(args.training)
+        except ScenarioError as exc:
+            print(f"fha-studio: {exc}", file=sys.stderr)
+            return 2
     machine = _machine_window(args)
     if machine is not None:
         window = machine
@@ -179,7 +193,9 @@ def run(argv: Sequence[str] = ()) -> int:
         if args.page:
             window.show_page(args.page)
         window.show()
-        if not args.no_connect:
+        if scenario is not None:
+            window.training.start(scenario)
+        elif not args.no_connect:
             window.connect_to(args.url, args.baud)
     QTimer.singleShot(
         0,

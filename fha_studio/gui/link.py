@@ -36,6 +36,7 @@ from fha_studio.hardware.api import (
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import Mode, MonitorItem
 from fha_studio.hardware.protocol import INPUT_MASK, Command, IoBit
+from fha_studio.hardware.sim.options import public_url
 from fha_studio.hardware.transaction import LinkSettings
 
 log = logging.getLogger(__name__)
@@ -409,7 +410,7 @@ class LinkWorker(QObject):
         caps = client.capabilities
         extensions = set(caps.commands) - {Command.DGR, Command.OWW}
         return LinkInfo(
-            url=url,
+            url=public_url(url),  # a training drive's options name its hidden faults
             driver_model=ident.driver_model if ident else "",
             adjusted_for=ident.adjusted_for if ident else "",
             firmware=ident.firmware if ident else "",

@@ -60,6 +60,9 @@ class MainWindow(QMainWindow):
         if self._own_state:
             self.state.restore_settings(QSettings())
         self.session = Session(self.link, self.state, self)
+        from fha_studio.gui.training import TrainingController
+
+        self.training = TrainingController(self)
         self._closing_confirmed = False
         self._shut_down = False
         self._status_note = ""
@@ -93,6 +96,13 @@ class MainWindow(QMainWindow):
         self.disconnect_action = QAction("&Disconnect", self)
         self.disconnect_action.triggered.connect(self.disconnect_drive)
         bar.addAction(self.disconnect_action)
+        self.training_action = QAction("Training…", self)
+        self.training_action.setToolTip(
+            "Training on the simulated drive: choose a scenario; while one runs, its briefing, "
+            "your findings and Done"
+        )
+        self.training_action.triggered.connect(self.show_training)
+        bar.addAction(self.training_action)
         bar.addSeparator()
         self.servo_action = QAction("Servo O&N", self)
         self.servo_action.setCheckable(True)
@@ -308,6 +318,12 @@ class MainWindow(QMainWindow):
             self.connect_to(dialog.url(), dialog.baud_rate())
 
     @Slot()
+    def show_training(self) -> None:
+        from fha_studio.gui.training import open_training
+
+        open_training(self)
+
+    @Slot()
     def disconnect_drive(self) -> None:
         if self.link.connected and self.confirm_axis_release("disconnect"):
             self.link.close_link()
@@ -462,6 +478,7 @@ class MainWindow(QMainWindow):
         for page in self._pages():
             page.shutdown()
         self.link.shutdown()
+        self.training.shutdown()
 
 
 class LazyPage(QWidget):

@@ -64,10 +64,10 @@ def _write(tmp_path: Path, text: str, name: str = "error-allowance") -> Path:
         (('level = "intermediate"', 'level = "expert"'), r":\d+: \[scenario\]: level 'expert' is not one of"),
         (
             (
-                '{ kind = "parameter_read", item = "system.6" }',
-                '{ kind = "parameter_read", item = "system6" }',
+                '{ kind = "parameter_written", item = "system.6", minimum = 100 }',
+                '{ kind = "parameter_written", item = "system6" }',
             ),
-            r"parameter_read.*|item 'system6' must be MODE.NUMBER",
+            r"found_by 1: item 'system6' must be MODE.NUMBER",
         ),
         (
             ("time_guide_min = 25", "time_guide_min = 0"),
@@ -133,10 +133,23 @@ def test_score_fault_found_and_missed_steps_in_and_out_of_order_and_unsafe_acts(
     found = {r.fault.id: r.found for r in sheet.faults}
     assert found == {"brake-supply": False, "allowance": True}
     assert "wrote parameter item 6 = 500" in sheet.faults[1].evidence[0].text
+    in_order = score(
+        hunt,
+        TraineeRecord(
+            started_s=t0,
+            ended_s=t0 + 300,
+            journal=[
+                _entry(t0 + 40, "PWR", 500, item=("system", 6)),
+                _entry(t0 + 50, "JOG", 100, servo_on=True),
+            ],
+        ),
+    )
+    assert [s.in_order for s in in_order.steps] == [False, False, False]  # the wiring was never checked
     steps = {s.step.id: s for s in sheet.steps}
-    assert steps["jog"].in_order is False and "Wiring and brake checked" in steps["jog"].note
-    assert steps["parameters"].in_order is False  # the alarms were read after it
-    assert steps["alarms"].in_order and steps["wiring"].done_at_s is None
+    assert steps["wiring"].done_at_s is None and not steps["wiring"].in_order
+    assert steps["parameters"].done_at_s == pytest.approx(t0 + 40)
+    assert not steps["parameters"].in_order and "Wiring and brake checked" in steps["parameters"].note
+    assert steps["jog"].done_at_s == pytest.approx(t0 + 10) and not steps["jog"].in_order
     unsafe = {a.what: a.times for a in sheet.unsafe}
     assert unsafe == {"Moved the axis with the brake applied": 1, "Wrote a parameter with the servo on": 1}
     assert sheet.within_time_guide and sheet.time_taken_s == pytest.approx(300)

@@ -49,8 +49,7 @@ EVIDENCE_FIELDS: dict[str, tuple[str, ...]] = {
     "parameter_written": ("item", "value", "minimum", "maximum"),
     "alarm_seen": ("code",),
     "alarm_cleared": ("code",),
-    "alarm_history_read": (),
-    "absolute_read": (),
+    "multi_turn_cleared": (),
     "jog": ("direction",),
     "model_check": ("effect",),
     "said": ("words",),
@@ -85,9 +84,9 @@ class Evidence:
         """What counts, in plain words."""
         k = self.kind
         if k == "procedure":
-            what = f"procedure {self.procedure}"
+            what = f"in the procedure {procedure_title(self.procedure)}"
             if self.step:
-                what += f", step {self.step}"
+                what += f", the step {self.step.replace('-', ' ')}"
             if self.passed is not None:
                 what += " recorded as passed" if self.passed else " recorded as failed"
             if self.value is not None:
@@ -109,15 +108,13 @@ class Evidence:
             return f"alarm {self.code} came up"
         if k == "alarm_cleared":
             return f"alarm {self.code} cleared"
-        if k == "alarm_history_read":
-            return "alarm history read"
-        if k == "absolute_read":
-            return "absolute position read"
+        if k == "multi_turn_cleared":
+            return "cleared the multi-turn data (OWW)"
         if k == "jog":
             return f"jogged {self.direction.upper() or 'the axis'}".strip()
         if k == "model_check":
             return f"model check named {self.effect.replace('_', ' ')}"
-        return "said: " + " or ".join(self.words)
+        return "wrote in the findings: " + " or ".join(f"“{w}”" for w in self.words)
 
 
 @dataclass(frozen=True)
@@ -138,7 +135,7 @@ class Fault:
 
 
 @dataclass(frozen=True)
-class Step:
+class ExpectedStep:
     """One expected step, in the scenario's order; done when any of ``done_by`` is seen."""
 
     id: str
@@ -160,7 +157,7 @@ class Scenario:
     time_guide_min: float
     drive: dict[str, str]  # the drive as it is, without the faults: sim:// options
     faults: tuple[Fault, ...]
-    steps: tuple[Step, ...]
+    steps: tuple[ExpectedStep, ...]
     order: int = 100  # where the list shows it within its level
     path: Path | None = field(default=None, compare=False)
 
@@ -178,6 +175,16 @@ class Scenario:
         drive gets its faults through a training registration instead)."""
         query = "&".join(p for p in (self.sim_options(faults), *(f"{k}={v}" for k, v in extra.items())) if p)
         return f"sim://{self.actuator}?{query}"
+
+
+def procedure_title(procedure_id: str) -> str:
+    """The title of a procedure of resources/procedures (its id when there is no such file)."""
+    path = resources_dir() / "procedures" / f"{procedure_id}.toml"
+    try:
+        with path.open("rb") as f:
+            return str(tomllib.load(f)["procedure"]["title"])
+    except (OSError, KeyError, tomllib.TOMLDecodeError):
+        return procedure_id.replace("-", " ")
 
 
 def scenarios_dir() -> Path:
@@ -438,14 +445,14 @@ def load_scenario(source: str | Path) -> Scenario:
     raw_steps = data.get("step")
     if not isinstance(raw_steps, list) or not raw_steps:
         raise r.fail("[[step]]", 0, "a scenario needs its expected steps ([[step]] tables, in order)")
-    steps: list[Step] = []
+    steps: list[ExpectedStep] = []
     for i, s in enumerate(raw_steps):
         sline = r.line_of("[[step]]", i, None)
         where = f"[[step]] {i + 1}"
         _unknown(r, s, ("id", "title", "done_by"), where, sline)
         stid = _text(r, s, "id", where, sline)
         steps.append(
-            Step(
+            ExpectedStep(
                 stid,
                 _text(r, s, "title", where, sline),
                 _evidence_list(r, s.get("done_by"), f"[[step]] {stid}", sline, "done_by"),
@@ -483,10 +490,10 @@ __all__ = [
     "FAULT_KINDS",
     "LEVELS",
     "Evidence",
+    "ExpectedStep",
     "Fault",
     "Scenario",
     "ScenarioError",
-    "Step",
     "find_scenario",
     "list_scenarios",
     "load_scenario",

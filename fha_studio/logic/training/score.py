@@ -15,7 +15,7 @@ from datetime import UTC, datetime
 
 from fha_studio.hardware.sim.journal import JournalEntry
 from fha_studio.logic.procedures.session import COMPLETED, ProcedureSession
-from fha_studio.logic.training.scenario import Evidence, Fault, Scenario, Step
+from fha_studio.logic.training.scenario import Evidence, ExpectedStep, Fault, Scenario
 
 MOTION_COMMANDS = ("JOG", "MOV", "CN2_MOVE")
 #: repeats of one act closer than this are one act (a held jog sends JOG every 50 ms) [s]
@@ -55,7 +55,7 @@ class FaultResult:
 
 @dataclass(frozen=True)
 class StepResult:
-    step: Step
+    step: ExpectedStep
     done_at_s: float | None
     in_order: bool
     note: str = ""
@@ -179,13 +179,11 @@ def evidence_seen(evidence: Evidence, record: TraineeRecord) -> list[Seen]:
             lambda e: e.command in ("ACL", "PWC") and e.alarm_before == evidence.code and e.terminal == "q",
             lambda e: f"cleared alarm {evidence.code} ({'reset' if e.command == 'ACL' else 'power cycle'})",
         )
-    if k == "alarm_history_read":
+    if k == "multi_turn_cleared":
         return _journal(
-            record, lambda e: e.command == "AHS" and e.terminal == "q", lambda e: "read the alarm history"
-        )
-    if k == "absolute_read":
-        return _journal(
-            record, lambda e: e.command == "DGR" and e.terminal == "q", lambda e: "read the absolute position"
+            record,
+            lambda e: e.command == "OWW" and e.terminal in ("q", ""),  # "": the q comes 5 s later
+            lambda e: "cleared the multi-turn data",
         )
     if k == "jog":
 
@@ -204,7 +202,7 @@ def evidence_seen(evidence: Evidence, record: TraineeRecord) -> list[Seen]:
         ]
     if k == "said":
         text = record.findings.lower()
-        words = [w for w in evidence.words if w in text]
+        words = [w for w in evidence.words if w.lower() in text]
         return [Seen(record.ended_s, f"wrote in the findings: {', '.join(words)}")] if words else []
     return []
 

@@ -1,0 +1,77 @@
+"""A trainee's session in the GUI: the scenario's drive hides its faults on every page, and
+"done" gives a score sheet with one fault found and one missed, printed as the report's PDF."""
+
+from __future__ import annotations
+
+import re
+
+from fha_studio.gui.link import Cmd
+from fha_studio.gui.training import ScoreSheetDialog, briefing_html
+from fha_studio.logic.training.scenario import find_scenario
+from tests.gui.test_plain_words import visible_texts
+
+WAIT_MS = 20000  # generous: a loaded 2-core machine
+
+#: What would give a fault away on screen: the options that make them, and their words.
+GIVEAWAYS = re.compile(
+    r"preset|brake_supply|system\.6|training=|wiring=|parameter 6 .* too low|brake supply missing",
+    re.IGNORECASE,
+)
+
+
+def _send(qtbot, window, cmd, *args):
+    results = []
+    token = window.link.send(cmd, *args)
+    window.link.sigResult.connect(lambda r: results.append(r) if r.token == token else None)
+    qtbot.waitUntil(lambda: bool(results), timeout=WAIT_MS)
+    return results[0]
+
+
+def test_a_trainee_finds_one_fault_and_misses_the_other(make_window, qtbot, tmp_path):
+    scenario = find_scenario("fault-hunt")
+    window = make_window()
+    with qtbot.waitSignal(window.link.sigConnected, timeout=WAIT_MS):
+        window.training.start(scenario, "Ann", paced=False)
+    assert window.training.running
+
+    # nothing on screen gives the faults away: the Connection page, the title, tooltips, messages
+    window.show_page("connection")
+    qtbot.waitUntil(lambda: "(training)" in window.connection_page.link_label.text(), timeout=WAIT_MS)
+    seen = [text for _, text in visible_texts(window)]
+    seen += [window.windowTitle(), window.caps_label.toolTip(), window.link_lamp.toolTip()]
+    seen += [m.text for m in window.message_area.messages]
+    for text in seen:
+        assert not GIVEAWAYS.search(text), text
+    assert "FHA-25C-50-US250-B-L" in window.connection_page.link_label.text()
+    assert not GIVEAWAYS.search(briefing_html(scenario))
+
+    # the trainee reads parameter 6, sees it is far too low and writes the default back
+    read = _send(qtbot, window, Cmd.READ_PARAMETERS, [("system", 6)])
+    assert read.ok, read.error
+    wrote = _send(qtbot, window, Cmd.WRITE_PARAMETERS, [("system", 6, 500)])
+    assert wrote.ok, wrote.error
+    # ... but never checks the brake, and writes a parameter with the servo on (refused)
+    assert _send(qtbot, window, Cmd.SERVO, True).ok
+    refused = _send(qtbot, window, Cmd.WRITE_PARAMETERS, [("system", 8, 0)])
+    assert _send(qtbot, window, Cmd.SERVO, False).ok
+
+    sheet = window.training.finish("Parameter 6 was 1: alarm 60 on any move. Set it to 500.")
+    assert not window.training.running
+    results = {r.fault.id: r for r in sheet.faults}
+    assert results["allowance"].found and not results["brake-supply"].found
+    assert any("wrote parameter item 6 = 500" in e.text for e in results["allowance"].evidence)
+    assert "Wrote a parameter with the servo on" in {a.what for a in sheet.unsafe}, refused
+    steps = {s.step.id: s for s in sheet.steps}
+    assert steps["parameters"].done_at_s is not None and steps["wiring"].done_at_s is None
+
+    dialog = ScoreSheetDialog(sheet, window)
+    try:
+        text = dialog.view.toPlainText()
+        assert "TRAINING" in text and "found" in text and "missed" in text
+        assert "Brake supply missing" in text  # revealed now the session is over
+        pdf = dialog.save_pdf(tmp_path / "sheet.pdf")
+        assert pdf.read_bytes().startswith(b"%PDF")
+        assert "TRAINING" in dialog.save_html(tmp_path / "sheet.html").read_text()
+    finally:
+        dialog.close()
+        dialog.deleteLater()
