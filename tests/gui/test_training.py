@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import re
 
+from PySide6.QtWidgets import QWidget
+
 from fha_studio.gui.link import Cmd
+from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.training import ScoreSheetDialog, briefing_html
 from fha_studio.logic.training.scenario import find_scenario
 from tests.gui.test_plain_words import visible_texts
@@ -34,10 +37,15 @@ def test_a_trainee_finds_one_fault_and_misses_the_other(make_window, qtbot, tmp_
         window.training.start(scenario, "Ann", paced=False)
     assert window.training.running
 
-    # nothing on screen gives the faults away: the Connection page, the title, tooltips, messages
+    # nothing on screen gives the faults away: every page, the title, tooltips, messages
     window.show_page("connection")
     qtbot.waitUntil(lambda: "(training)" in window.connection_page.link_label.text(), timeout=WAIT_MS)
-    seen = [text for _, text in visible_texts(window)]
+    seen = []
+    for page in PageId:
+        window.show_page(page)
+        qtbot.wait(50)
+        seen += [text for _, text in visible_texts(window)]
+    seen += [w.toolTip() for w in window.findChildren(QWidget) if w.toolTip()]
     seen += [window.windowTitle(), window.caps_label.toolTip(), window.link_lamp.toolTip()]
     seen += [m.text for m in window.message_area.messages]
     for text in seen:
