@@ -392,7 +392,7 @@ class AxisDialog(QDialog):
         self.inertia_spin = QDoubleSpinBox()
         self.inertia_spin.setRange(0.0, 10000.0)
         self.inertia_spin.setDecimals(4)
-        self.inertia_spin.setSuffix(" kg m²")
+        self.inertia_spin.setSuffix(" kg·m²")
         self.serial_edit = QLineEdit()
         self.serial_edit.setPlaceholderText("from the actuator's label")
         self.notes_edit = QLineEdit()

@@ -13,6 +13,7 @@ UNIT_WORDS = {
     "kg m2": "kg·m²",
     "m^2": "m²",
     "N m s/rad": "N·m·s/rad",
+    "N m/rad": "N·m/rad",
     "deg": "°",
     "arcsec": "arc-sec",
 }

@@ -86,7 +86,7 @@ def test_the_effects_tab_speaks_plain_words_and_says_what_to_do_next(make_window
     headers = [table.horizontalHeaderItem(c).text() for c in range(table.columnCount())]
     assert headers[-1] == "What to do next"
     row = [table.item(0, c).text() for c in range(table.columnCount())]
-    assert row[0] == "Coulomb friction" and row[1].startswith("torque 8") and row[1].endswith("N m")
+    assert row[0] == "Coulomb friction" and row[1].startswith("torque 8") and row[1].endswith("N·m")
     assert row[3].startswith("add 8") and "Coulomb friction to the model" in row[3] and "brake" in row[3]
     # nothing a person reads uses the criterion's jargon or the program's identifiers
     shown = "\n".join([page.findings.toPlainText(), page.summary.toPlainText(), *row, *tabs])

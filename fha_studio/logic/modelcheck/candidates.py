@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from fha_studio.logic.modelcheck.signals import ARCSEC_PER_RAD, Signals
+from fha_studio.logic.wording import with_unit
 
 TORQUE = "torque"
 POSITION = "position"
@@ -588,16 +589,17 @@ PARAM_WORDS = {
     "velocity_rad_s": "fading by",
     "ratio": "torque per ampere / catalogue",
 }
-UNIT_WORDS = {"kg m^2": "kg m²", "1/rev": "", "1": ""}
+#: Units of a count or a ratio: the words before the number already say what it counts.
+DIMENSIONLESS_UNITS = frozenset({"1/rev", "1"})
 
 
 def param_words(name: str, value: float, unit: str, sigma: float | None = None) -> str:
-    """'torque 11.9 ± 0.1 N m': a fitted parameter as a person reads it."""
-    unit = UNIT_WORDS.get(unit, unit)
+    """'torque 11.9 ± 0.1 N·m': a fitted parameter as a person reads it (the unit in the manual's
+    spelling, :mod:`fha_studio.logic.wording`)."""
     text = f"{PARAM_WORDS.get(name, name.replace('_', ' '))} {value:.3g}"
     if sigma is not None and math.isfinite(sigma) and sigma > 0:
         text += f" ± {sigma:.2g}"
-    return f"{text} {unit}".rstrip()
+    return text if unit in DIMENSIONLESS_UNITS else with_unit(text, unit)
 
 
 def label_of(effect_ids: str) -> str:

@@ -125,7 +125,7 @@ class ModelCheckPage(BasePage):
         self.inertia_spin = QDoubleSpinBox()
         self.inertia_spin.setDecimals(4)
         self.inertia_spin.setRange(0.0, 10000.0)
-        self.inertia_spin.setSuffix(" kg m²")
+        self.inertia_spin.setSuffix(" kg·m²")
         self.inertia_spin.setKeyboardTracking(False)
         self.inertia_spin.setValue(self.state.load_inertia_kgm2)
         self.inertia_spin.setToolTip("The axis's declared load inertia (the same on the Sizing and Scope "
@@ -287,9 +287,9 @@ class ModelCheckPage(BasePage):
                                                         or (c == "vel" and recording.vel_rpm is not None)])
         self.source_label.setText(
             f"Recording: {label} — {m.actuator}, {len(recording)} samples over {recording.duration_s:.2f} s, "
-            f"columns {columns}. Declared load inertia {m.load_inertia_kgm2:g} kg m²."
+            f"columns {columns}. Declared load inertia {m.load_inertia_kgm2:g} kg·m²."
             + ("" if abs(declared - m.load_inertia_kgm2) <= 1e-12 else
-               f" The model check uses the axis's declared load inertia, {declared:g} kg m².")
+               f" The model check uses the axis's declared load inertia, {declared:g} kg·m².")
         )
 
     def _open_clicked(self) -> None:

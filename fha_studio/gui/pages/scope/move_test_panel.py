@@ -83,7 +83,7 @@ class MoveTestPanel(QWidget):
         self.load_inertia.setDecimals(4)
         self.load_inertia.setKeyboardTracking(False)
         self.load_inertia.setValue(load_inertia_kgm2)
-        self.load_inertia.setSuffix(" kg m²")
+        self.load_inertia.setSuffix(" kg·m²")
         self.load_inertia.setToolTip("The declared load inertia of the axis, written into recordings (the "
                                      "model check needs it); the same value as on the Sizing and Model check "
                                      "pages")
