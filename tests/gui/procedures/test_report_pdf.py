@@ -101,3 +101,14 @@ def test_a_page_starts_where_the_document_asks_for_one():
     assert page_breaks([], 1000.0, 1500.0, forced=[0.0, 1200.0]) == [0.0]
     # a full page still never cuts a span
     assert page_breaks([_Span(1400.0, 1600.0)], 3000.0, 1500.0) == [0.0, 1400.0, 2900.0]
+
+
+def test_a_report_aimed_at_a_folder_is_refused_before_anything_is_written(qapp, tmp_path):
+    from fha_studio.fileio import FileProblem
+
+    context = build_context(CODE)
+    session = ProcedureSession(actuator_code=CODE, operator="T. Trainee", site="Hall 2")
+    (tmp_path / "r.html").mkdir()  # the HTML's name is taken by a folder
+    with pytest.raises(FileProblem, match=r"r\.html: is a directory"):
+        write_report(build_report(session, context), tmp_path / "r.html", tmp_path / "r.pdf")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.html"]  # no PDF, no partial file

@@ -660,7 +660,11 @@ class ProceduresPage(BasePage):
             self, "Commissioning report (PDF)", str(base) + ".pdf", "PDF (*.pdf)"
         )
         if path:
-            html, pdf = self.write_report(Path(path).with_suffix(".html"), path)
+            try:
+                html, pdf = self.write_report(Path(path).with_suffix(".html"), path)
+            except (OSError, ValueError) as exc:  # a folder without permission, a full disk
+                self._message(f"The report was not written: {exc}")
+                return
             self._message(f"Report written: {pdf} and {html}")
 
     def _capture_clicked(self) -> None:

@@ -28,6 +28,7 @@ from PySide6.QtGui import (
     QTextTable,
 )
 
+from fha_studio import fileio
 from fha_studio.logic.procedures.report import CommissioningReport, render_html
 
 #: Dots per inch of the PDF's layout: text stays vector; images are placed at this resolution.
@@ -166,9 +167,11 @@ def write_pdf(
     html: str, path: str | Path, title: str = "Commissioning report", base_dir: Path | None = None
 ) -> Path:
     """Print ``html`` to an A4 PDF at ``path`` with page numbers; no row or line is cut across
-    pages. Images are found relative to ``base_dir``. The file appears only when complete."""
+    pages. Images are found relative to ``base_dir``. The file appears only when complete; a
+    target that cannot become a regular file raises :class:`fileio.FileProblem` before the work."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    fileio.check_output_path(path)  # the rename below must not replace a device or a folder
     partial = path.with_name(f".{path.name}.partial")
     writer = QPdfWriter(str(partial))
     writer.setTitle(title)
@@ -224,12 +227,12 @@ def write_pdf(
 def write_report(
     report: CommissioningReport, html_path: str | Path, pdf_path: str | Path | None = None
 ) -> tuple[Path, Path | None]:
-    """Write the report as HTML and (when ``pdf_path`` is given) as PDF; returns both paths."""
+    """Write the report as HTML and (when ``pdf_path`` is given) as PDF; returns both paths.
+    The HTML appears after the PDF is complete, each whole or not at all (:mod:`fha_studio.fileio`)."""
     html = render_html(report)
     html_path = Path(html_path)
     html_path.parent.mkdir(parents=True, exist_ok=True)
-    partial = html_path.with_name(f".{html_path.name}.partial")
-    partial.write_text(html, encoding="utf-8")
+    fileio.check_output_path(html_path)  # before the PDF's work
     pdf = write_pdf(html, pdf_path, report.title, html_path.parent) if pdf_path is not None else None
-    partial.replace(html_path)
+    fileio.write_text(html_path, html)
     return html_path, pdf
