@@ -51,6 +51,7 @@ from fha_studio.hardware.parameters import (
     ParameterItem,
     ParameterModel,
     ParameterValueError,
+    driver_family,
     load_parameter_model,
 )
 from fha_studio.hardware.protocol import Command, Reply
@@ -266,7 +267,7 @@ class DriveClient:
         if Command.IDN not in self._capabilities.commands:
             return None
         identity = self._transact(Command.IDN, parse=_identity)
-        driver = "HA-675" if identity.driver_model.upper().startswith("HA-675") else "HA-655"
+        driver = driver_family(identity.driver_model)
         if driver != self.model.driver:
             self.model = load_parameter_model(driver)
         return identity

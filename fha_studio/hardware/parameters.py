@@ -294,6 +294,12 @@ def _driver_file(driver: str) -> str:
         raise ValueError(f"unknown driver {driver!r}; known: {', '.join(_DRIVER_FILES)}") from None
 
 
+def driver_family(driver_model: str) -> str:
+    """The parameter and alarm tables a driver model uses: "HA-675-4-200" -> "HA-675"; "HA-655"
+    for anything else (also when the model is unknown)."""
+    return "HA-675" if driver_model.strip().upper().startswith("HA-675") else "HA-655"
+
+
 def load_parameter_model(driver: str = "HA-655") -> ParameterModel:
     """The items of ``driver`` ("HA-655" or "HA-675") from ``resources/drive/``.
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from fha_studio.hardware.parameters import driver_family
 from fha_studio.logic.session_log import SessionLog, WriteRecord
 
 if TYPE_CHECKING:
@@ -68,11 +69,6 @@ class FrontPanelEntry:
     @property
     def parameter_id(self) -> ParameterId:
         return (self.mode, self.number)
-
-
-def driver_family(driver_model: str) -> str:
-    """ "HA-675-4-200" -> "HA-675"; HA-655 for anything else (also when unknown)."""
-    return "HA-675" if driver_model.strip().upper().startswith("HA-675") else "HA-655"
 
 
 def driver_supply_voltage_v(driver_model: str) -> int | None:

@@ -36,6 +36,7 @@ from fha_studio import __version__ as _version
 from fha_studio.hardware.parameters import (
     Mode,
     MonitorItem,
+    driver_family,
     load_alarm_table,
     load_parameter_model,
     split_low_high,
@@ -116,7 +117,7 @@ class SimDrive:
         self.model = build_model(resolved, config)
         # a catalogue actuator always has its ratio (only a custom axis model lacks one)
         self.ratio: float = float(resolved.actuator.ratio)
-        family = "HA-675" if self.driver.startswith("HA-675") else "HA-655"
+        family = driver_family(self.driver)
         self.parameters = load_parameter_model(family)
         self.alarm_table = load_alarm_table(family)
 

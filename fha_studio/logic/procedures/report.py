@@ -116,11 +116,9 @@ def _parameter_rows(session: ProcedureSession) -> tuple[str, tuple[ParameterRow,
     values: Mapping[str, Any] = params.get("values", {})
     if not values:
         return str(params.get("file", "")), (), []
-    from fha_studio.hardware.parameters import load_parameter_model
+    from fha_studio.hardware.parameters import driver_family, load_parameter_model
 
-    driver_model = session.driver.get("model", "") or "HA-655"
-    family = "HA-675" if driver_model.startswith("HA-675") else "HA-655"
-    model = load_parameter_model(family)
+    model = load_parameter_model(driver_family(session.driver.get("model", "")))
     rows, problems = [], []
     for key, wire in values.items():
         try:

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import fileio
+from fha_studio.hardware.parameters import driver_family
 from fha_studio.logic.register.store import Axis, Register, RegisterError, utc_stamp
 
 
@@ -26,11 +27,6 @@ class ImportResult:
     procedures: int = 0
     snapshot: int | None = None
     not_taken: tuple[str, ...] = field(default_factory=tuple)
-
-
-def driver_family(driver_model: str) -> str:
-    """ "HA-675-..." -> "HA-675"; anything else (or unknown) -> "HA-655"."""
-    return "HA-675" if driver_model.strip().upper().startswith("HA-675") else "HA-655"
 
 
 def _procedures_for(actuator_code: str) -> list[Any]:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from functools import cache
 from typing import Any
 
-from fha_studio.logic.register.importers import driver_family
+from fha_studio.hardware.parameters import driver_family
 
 #: Where a known value comes from.
 SOURCE_WORDS = {
