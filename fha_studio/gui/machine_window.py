@@ -490,7 +490,11 @@ class MachineWindow(QMainWindow):
         bar.addWidget(QLabel("Operator: "))
         self.operator_edit = QLineEdit(str(QSettings().value("machine/operator", "")))
         self.operator_edit.setObjectName("operator")
-        self.operator_edit.setPlaceholderText(f"your name (the register records it; else {_login_name()!r})")
+        login = _login_name()
+        self.operator_edit.setPlaceholderText(
+            f"your name (the register records it; else the login name {login})" if login
+            else "your name (the register records it)"
+        )
         self.operator_edit.setMaximumWidth(200)
         self.operator_edit.editingFinished.connect(
             lambda: QSettings().setValue("machine/operator", self.operator_edit.text().strip())
