@@ -8,7 +8,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtGui import QImage
+from PySide6.QtCore import QBuffer, QIODevice
+from PySide6.QtGui import QImage, QImageWriter
+
+from fha_studio import fileio
 
 
 def for_paper(image: QImage) -> QImage:
@@ -27,15 +30,18 @@ def for_paper(image: QImage) -> QImage:
 
 
 def save_for_paper(png_path: str | Path) -> Path:
-    """Rewrite the PNG at ``png_path`` for paper (see :func:`for_paper`); returns the path."""
+    """Rewrite the PNG at ``png_path`` for paper (see :func:`for_paper`), whole or not at all
+    (:func:`fileio.write_bytes`); returns the path."""
     path = Path(png_path)
     image = QImage(str(path))
     if image.isNull():
         raise ValueError(f"{path}: not an image FHA Studio can read")
-    partial = path.with_name(f".{path.name}.partial.png")
-    if not for_paper(image).save(str(partial)):  # PNG, from the .png suffix
-        raise OSError(f"{path}: could not be written")
-    partial.replace(path)
+    buffer = QBuffer()
+    buffer.open(QIODevice.OpenModeFlag.WriteOnly)
+    writer = QImageWriter(buffer, b"PNG")
+    if not writer.write(for_paper(image)):
+        raise OSError(f"{path}: could not be turned into a PNG ({writer.errorString()})")
+    fileio.write_bytes(path, bytes(buffer.data().data()))
     return path
 
 
