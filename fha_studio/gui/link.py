@@ -231,11 +231,6 @@ def _message(exc: Exception) -> str:
     return next((plain for kind, plain in _PLAIN_FAILURES if isinstance(exc, kind)), "failed")
 
 
-def _is_link_failure(exc: Exception) -> bool:
-    """True for what ends a link: lost, or a timeout (the client has retried already)."""
-    return isinstance(exc, LinkLost | LinkTimeout)
-
-
 class LinkWorker(QObject):
     """Owns the DriveApi; lives in the link thread. Talk to it only through signals."""
 
