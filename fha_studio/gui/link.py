@@ -51,7 +51,7 @@ JOG_LEASE_RENEW_MS = 150
 #: leave the axis running), in s.
 JOG_LEASE_S = 0.5
 #: Idle probe period of a drive without status commands (a drive of the manual's DGR and OWW),
-#: in ms: one DGR about once a second, so a drive switched off or unplugged shows within 2 s
+#: in ms: one DGR about every 0.7 s, so a drive switched off or unplugged shows within 2 s
 #: (this period plus one failed exchange with its retry, about 1 s).
 PROBE_INTERVAL_MS = 700
 #: While the drive answers "servo on" (s), it is asked at most once a second.
