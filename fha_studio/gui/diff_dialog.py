@@ -3,7 +3,7 @@ applied until the user confirms."""
 
 from __future__ import annotations
 
-from PySide6.QtGui import QBrush, QColor
+from PySide6.QtGui import QBrush, QColor, QGuiApplication
 from PySide6.QtWidgets import (
     QComboBox,
     QDialog,
@@ -73,8 +73,10 @@ class ParameterDiffDialog(QDialog):
                 "file": loaded.values.get(key),
                 "default": item.default,
             }
-            known = {v for v in values.values() if v is not None}
-            differs = len(known) > 1
+            # what loading the file would change: the drive against the file (a value that only
+            # differs from the default is the drive's setting, not a difference to act on)
+            drive, in_file = values["drive"], values["file"]
+            differs = drive is not None and in_file is not None and drive != in_file
             self.differing += differs
             cells = [
                 f"{MODE_WORDS.get(str(item.mode))} {item.number}: {item.name}",
@@ -107,8 +109,8 @@ class ParameterDiffDialog(QDialog):
         layout.addWidget(self.table, 1)
 
         summary = QLabel(
-            f"{self.differing} of {len(items)} items differ between drive, file and default "
-            "(orange). Choose per row what to apply; nothing is written before <b>Apply</b>."
+            f"{self.differing} of {len(items)} items differ between the drive and the file (orange). "
+            "Choose per row what to apply; nothing is written before <b>Apply</b>."
         )
         summary.setWordWrap(True)
         layout.addWidget(summary)
@@ -141,7 +143,34 @@ class ParameterDiffDialog(QDialog):
         self.apply_button.clicked.connect(self.accept)
         self.buttons.rejected.connect(self.reject)
         layout.addWidget(self.buttons)
-        self.resize(900, 560)
+        self._fit_to_screen()
+
+    def _fit_to_screen(self) -> None:
+        """Wide enough for every column (the Apply and Differs columns in view without scrolling),
+        within the screen; on a narrow screen the item and value columns give up room (their
+        texts elided, whole in the tooltip), never Differs and Apply."""
+        table = self.table
+        header = table.horizontalHeader()
+        hints = [max(table.sizeHintForColumn(c), header.sectionSizeHint(c))
+                 for c in range(table.columnCount())]
+        chrome = table.verticalScrollBar().sizeHint().width() + 2 * table.frameWidth()
+        margins = self.layout().contentsMargins()
+        outside = margins.left() + margins.right() + chrome + 4
+        width, height = sum(hints) + outside, 560
+        screen = self.screen() or QGuiApplication.primaryScreen()
+        if screen is not None:
+            available = screen.availableGeometry()
+            width = min(width, int(available.width() * 0.95))
+            height = min(640, int(available.height() * 0.9))
+        width = max(640, width)
+        self.resize(width, height)
+        room = width - outside
+        if sum(hints) > room:
+            fixed = hints[4] + hints[5]
+            shrink = max(0.2, (room - fixed) / max(1, sum(hints[:4])))
+            for column in range(4):
+                header.setSectionResizeMode(column, QHeaderView.ResizeMode.Interactive)
+                table.setColumnWidth(column, int(hints[column] * shrink) - 1)
 
     def set_choice(self, key: str, choice: str) -> None:
         """Picks drive/file/default for the item called `key` (tests and keyboard users)."""

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from PySide6.QtCore import QAbstractTableModel, QModelIndex, QPoint, QSettings, Qt, Signal, Slot
+from PySide6.QtCore import QAbstractTableModel, QModelIndex, QPoint, QSettings, Qt, QTimer, Signal, Slot
 from PySide6.QtGui import QBrush, QColor, QFont
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QComboBox,
     QFileDialog,
+    QFrame,
     QHBoxLayout,
     QHeaderView,
     QLabel,
@@ -17,6 +18,8 @@ from PySide6.QtWidgets import (
     QMessageBox,
     QPlainTextEdit,
     QPushButton,
+    QScrollArea,
+    QSizePolicy,
     QSplitter,
     QStyledItemDelegate,
     QTableView,
@@ -342,16 +345,21 @@ class ParametersPage(BasePage):
         self.panel_bar.setVisible(False)
         layout.addWidget(self.panel_bar)
 
-        self.restart_banner = QWidget()
+        self.restart_banner = QFrame()
+        self.restart_banner.setObjectName("restartBanner")
         rb = QHBoxLayout(self.restart_banner)
         rb.setContentsMargins(6, 4, 6, 4)
         self.restart_label = QLabel("")
         self.restart_label.setWordWrap(True)
         self.power_cycle_button = QPushButton("&Power cycle the drive now")
+        # the button keeps its whole text whatever the label needs
+        self.power_cycle_button.setSizePolicy(QSizePolicy.Policy.Minimum, QSizePolicy.Policy.Fixed)
         rb.addWidget(self.restart_label, 1)
         rb.addWidget(self.power_cycle_button)
+        # the frame only: a style on the children (label, button) would box the text and squeeze the
+        # button's text out of its own frame
         self.restart_banner.setStyleSheet(
-            "background: #fff3cd; border: 1px solid #e0a000; border-radius: 4px;"
+            "QFrame#restartBanner { background: #fff3cd; border: 1px solid #e0a000; border-radius: 4px; }"
         )
         self.restart_banner.setVisible(False)
         layout.addWidget(self.restart_banner)
@@ -381,22 +389,32 @@ class ParametersPage(BasePage):
         header.setSectionResizeMode(2, QHeaderView.ResizeMode.Stretch)
         header.setMinimumSectionSize(self.table.fontMetrics().averageCharWidth() * 4)
         splitter.addWidget(self.table)
+        # the manual's description beside the session log (not above it): the table keeps the height,
+        # and a description longer than its room scrolls instead of losing its last lines
         log_box = QWidget()
-        lb = QVBoxLayout(log_box)
+        lb = QHBoxLayout(log_box)
         lb.setContentsMargins(0, 0, 0, 0)
         self.details = QLabel("Select an item to see the manual's description here.")
         self.details.setObjectName("parameterDetails")
         self.details.setWordWrap(True)
+        self.details.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
         self.details.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
-        self.details.setStyleSheet("background: palette(base); border: 1px solid palette(mid); padding: 4px;")
-        lb.addWidget(self.details)
-        lb.addWidget(QLabel("Session log (every write, verified by read-back):"))
+        self.details.setStyleSheet("background: palette(base); padding: 4px;")
+        self.details_scroll = QScrollArea()
+        self.details_scroll.setObjectName("parameterDetailsScroll")
+        self.details_scroll.setWidgetResizable(True)
+        self.details_scroll.setWidget(self.details)
+        lb.addWidget(self.details_scroll, 3)
+        log_column = QVBoxLayout()
+        log_column.addWidget(QLabel("Session log (every write, verified by read-back):"))
         self.log_view = QPlainTextEdit()
         self.log_view.setReadOnly(True)
         self.log_view.setObjectName("sessionLog")
-        lb.addWidget(self.log_view)
+        log_column.addWidget(self.log_view)
+        lb.addLayout(log_column, 2)
         splitter.addWidget(log_box)
-        splitter.setStretchFactor(0, 4)
+        splitter.setChildrenCollapsible(False)
+        splitter.setStretchFactor(0, 3)
         splitter.setStretchFactor(1, 1)
         layout.addWidget(splitter, 1)
         self.message = QLabel("Read the drive's parameters to begin (Read all).")
@@ -538,6 +556,17 @@ class ParametersPage(BasePage):
         self.restart_label.setText(f"<b>Takes effect after a power cycle:</b> {names}. {how}")
         self.power_cycle_button.setVisible(sim)
         self.restart_banner.setVisible(True)
+        self._keep_current_row_in_view()
+
+    def _keep_current_row_in_view(self) -> None:
+        """The row being edited stays on screen when a banner takes room above the table (once the
+        layout has given the table its new height)."""
+        def scroll() -> None:
+            current = self.table.currentIndex()
+            if current.isValid():
+                self.table.scrollTo(current)
+
+        QTimer.singleShot(0, scroll)
 
     @Slot()
     def power_cycle(self) -> None:

@@ -1,0 +1,61 @@
+"""Nothing clipped on the Parameters page and in the file comparison: the power-cycle banner's
+button whole and the edited row in view on a small screen, the comparison's columns in view, and
+only drive-versus-file differences flagged."""
+
+from __future__ import annotations
+
+import pytest
+from PySide6.QtCore import QRect
+
+SIM_URL = "sim://FHA-25C-50-US250?paced=0"
+
+
+@pytest.fixture
+def window(make_window, qtbot):
+    w = make_window(connect=SIM_URL)
+    qtbot.waitUntil(lambda: len(w.state.drive_values) >= 14, timeout=10000)
+    return w
+
+
+def write_rotary_direction_reversed(window, qtbot):
+    page = window.show_page("parameters")
+    model = page.model
+    row = model.row_of("rotary_direction")
+    page.table.selectRow(row)
+    model.setData(model.index(row, 3), "1")
+    with qtbot.waitSignal(window.session.sigWritesDone, timeout=10000):
+        page.write_changed()
+    qtbot.waitUntil(lambda: page.restart_banner.isVisible(), timeout=10000)
+    return page, row
+
+
+def test_the_power_cycle_banner_shows_its_button_whole_and_keeps_the_edited_row_in_view(window, qtbot):
+    window.resize(1024, 600)
+    page, row = write_rotary_direction_reversed(window, qtbot)
+    button = page.power_cycle_button
+    qtbot.waitUntil(lambda: button.isVisible(), timeout=10000)
+    # the whole text fits the button and the button fits the banner
+    assert button.width() >= button.sizeHint().width()
+    assert page.restart_banner.rect().contains(QRect(button.pos(), button.size()))
+    viewport = page.table.viewport().rect()
+    qtbot.waitUntil(lambda: viewport.contains(page.table.visualRect(page.model.index(row, 3))), timeout=10000)
+
+
+def test_the_file_comparison_shows_apply_and_differs_and_flags_drive_against_file(window, qtbot, tmp_path):
+    page, _row = write_rotary_direction_reversed(window, qtbot)  # the drive now differs from the default
+    saved = page.save_file(str(tmp_path / "axis.toml"))
+    lines = [ln if not ln.startswith("in_position_range ") else "in_position_range = 33"
+             for ln in saved.read_text().splitlines()]
+    (tmp_path / "edited.toml").write_text("\n".join(lines) + "\n")
+    dialog = page.load_file(str(tmp_path / "edited.toml"), exec_dialog=False)
+    dialog.show()
+    qtbot.waitExposed(dialog)
+    table = dialog.table
+    flagged = [table.item(r, 0).text() for r in range(table.rowCount()) if table.item(r, 4).text()]
+    assert flagged == ["tune 4: In-position range"]  # not the rotary direction: drive and file agree
+    assert dialog.differing == 1
+    assert table.horizontalScrollBar().maximum() == 0
+    right = table.columnViewportPosition(5) + table.columnWidth(5)
+    assert table.columnViewportPosition(4) >= 0 and right <= table.viewport().width()
+    dialog.close()
+    dialog.deleteLater()
