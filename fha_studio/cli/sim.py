@@ -61,8 +61,8 @@ def register(subparsers: Any) -> None:
                    help="trace blocks in text only (TRB), as a drive from before the packed encoding (TRP)")
     p.add_argument("--panel", action="store_true",
                    help="read the controller's side from stdin, one per line: 'servo on', 'servo off' "
-                   "(the CN2 servo-ON input), 'fwd DEG' (a command pulse train, servo on), 'turn DEG' "
-                   "(turn the output by hand, servo off), 'brake release', 'brake hold'")
+                   "(the CN2 servo-ON input), 'fwd DEG' or 'rev DEG' (a command pulse train, servo on), "
+                   "'turn DEG' (turn the output by hand, servo off), 'brake release', 'brake hold'")
     p.add_argument("--record", metavar="FILE.csv", type=output_path,
                    help="write what the axis does as an fha-recording/1 CSV (FILE.csv.partial until the "
                    "sim stops)")
