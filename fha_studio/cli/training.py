@@ -94,7 +94,9 @@ def _check(args: argparse.Namespace) -> int:
     from fha_studio.logic.training.check import check_scenario
 
     s = _scenario(args.file)
-    print(f"{s.path}: the file is valid: {s.title} ({len(s.faults)} faults, {len(s.steps)} steps)")
+    faults = f"{len(s.faults)} fault{'s' if len(s.faults) != 1 else ''}"
+    steps = f"{len(s.steps)} step{'s' if len(s.steps) != 1 else ''}"
+    print(f"{s.path}: the file is valid: {s.title} ({faults}, {steps})")
     if args.no_drive:
         return 0
     try:

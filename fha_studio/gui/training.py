@@ -185,6 +185,7 @@ class ChooseScenarioDialog(QDialog):
         row = QHBoxLayout()
         self.list = QListWidget()
         self.list.setObjectName("scenarioList")
+        self.list.setSpacing(3)
         self.briefing = QTextBrowser()
         self.briefing.setObjectName("scenarioBriefing")
         row.addWidget(self.list, 2)

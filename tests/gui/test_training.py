@@ -83,3 +83,12 @@ def test_a_trainee_finds_one_fault_and_misses_the_other(make_window, qtbot, tmp_
     finally:
         dialog.close()
         dialog.deleteLater()
+
+
+def test_the_gui_refuses_an_unknown_training_scenario_in_one_line(qtbot, capsys):
+    from fha_studio.gui.app import run
+
+    assert run(["--training", "nonesuch"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("fha-studio: no training scenario 'nonesuch'; scenarios: battery, ")
+    assert err.count("\n") == 1

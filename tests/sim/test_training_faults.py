@@ -249,3 +249,36 @@ def test_a_training_drive_hides_its_options_and_journals_what_was_done():
         forget_training(registration.token)
     with pytest.raises(SimConfigError, match="no longer registered"):
         config_from_url(url)
+
+
+def _holding_and_peak_torque_nm(query: str) -> tuple[float, float]:
+    """The output torque holding still after servo-on, and its peak starting a 20 r/min jog."""
+    client = _open(query, actuator="FHA-32C-50-US250")
+    try:
+        client.servo(True)
+        time.sleep(0.3)
+        holding = abs(client.read_monitor(MonitorItem.OUTPUT_TORQUE)) / 100.0
+        peak = 0.0
+        end = time.monotonic() + 0.6
+        while time.monotonic() < end:
+            client.jog(20.0)
+            peak = max(peak, abs(client.read_monitor(MonitorItem.OUTPUT_TORQUE)) / 100.0)
+            time.sleep(0.03)
+        client.stop()
+        return holding, peak
+    finally:
+        client.close()
+
+
+def test_hidden_gravity_unbalance_shows_in_the_holding_torque():
+    plain, _ = _holding_and_peak_torque_nm("load_inertia=2")
+    unbalanced, _ = _holding_and_peak_torque_nm(
+        "load_inertia=2&effects=gravity_load:amplitude_nm=30,phase_deg=90"
+    )
+    assert plain < 5.0 and unbalanced > 20.0  # 30 N·m of unbalance at the output's 0 degrees
+
+
+def test_a_load_heavier_than_declared_shows_in_the_torque_to_accelerate():
+    _, declared = _holding_and_peak_torque_nm("load_inertia=2")
+    _, heavier = _holding_and_peak_torque_nm("load_inertia=5")
+    assert heavier > 1.5 * declared
