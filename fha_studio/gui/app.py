@@ -160,6 +160,15 @@ def run(argv: Sequence[str] = ()) -> int:
     started = time.perf_counter()
     args = _parser().parse_args(list(argv))
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    scenario = None
+    if args.training:
+        from fha_studio.logic.training.scenario import ScenarioError, find_scenario
+
+        try:
+            scenario = find_scenario(args.training)
+        except ScenarioError as exc:
+            print(f"fha-studio: {exc}", file=sys.stderr)
+            return 2
     app = make_application()
     from PySide6.QtCore import QCoreApplication, QEvent, QTimer
     from PySide6.QtGui import QIcon
@@ -170,15 +179,6 @@ def run(argv: Sequence[str] = ()) -> int:
     icon = resources_dir() / "icons" / "fha-studio.png"
     if icon.exists():
         app.setWindowIcon(QIcon(str(icon)))
-    scenario = None
-    if args.training:
-        from fha_studio.logic.training.scenario import ScenarioError, find_scenario
-
-        try:
-            scenario = find_scenario(args.training)
-        except ScenarioError as exc:
-            print(f"fha-studio: {exc}", file=sys.stderr)
-            return 2
     machine = _machine_window(args)
     if machine is not None:
         window = machine
