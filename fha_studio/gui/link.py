@@ -38,6 +38,7 @@ from fha_studio.hardware.parameters import Mode, MonitorItem
 from fha_studio.hardware.protocol import INPUT_MASK, Command, IoBit
 from fha_studio.hardware.sim.options import public_url
 from fha_studio.hardware.transaction import LinkSettings
+from fha_studio.logic.absolute import SERVO_ON_TEXT, refusal_text
 
 log = logging.getLogger(__name__)
 
@@ -56,8 +57,8 @@ JOG_LEASE_S = 0.5
 PROBE_INTERVAL_MS = 700
 #: While the drive answers "servo on" (s), it is asked at most once a second.
 SERVO_ON_PROBE_MS = 1000
-#: What the technician is told while a drive answers s.
-SERVO_ON_NOTE = "servo on (controller): the drive does not answer over CN3 until servo off"
+#: What the technician is told while a drive answers s (the words of the DGR checks and the CLI).
+SERVO_ON_NOTE = SERVO_ON_TEXT
 #: Consecutive timeouts after which the link is declared lost (the client has retried already).
 TIMEOUTS_TO_LOST = 1
 #: The monitor items of the status poll: output position, output speed, motor current.
@@ -644,10 +645,10 @@ class LinkWorker(QObject):
             status["refused"] = True
             status["note"] = SERVO_ON_NOTE
             return max(self._poll_interval_ms, SERVO_ON_PROBE_MS)
-        except CommandRejected:
+        except CommandRejected as exc:
             # s comes to everything while the servo is on, so x means: servo off, no DGR
             status["servo_on"] = False
-            status["note"] = "the drive refuses DGR (x): no absolute position (an incremental encoder)"
+            status["note"] = refusal_text(exc, Command.DGR)
         return max(self._poll_interval_ms, PROBE_INTERVAL_MS)
 
     def _poll_monitors(self, client: DriveApi, status: dict[str, Any]) -> None:
