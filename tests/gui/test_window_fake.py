@@ -22,7 +22,7 @@ def fake():
 @pytest.fixture
 def window(make_window, fake, qtbot):
     w = make_window(open_client=lambda url, baud: fake, connect="fake://drive")
-    qtbot.waitUntil(lambda: bool(w.state.drive_values), timeout=5000)
+    qtbot.waitUntil(lambda: bool(w.state.drive_values), timeout=10000)
     return w
 
 

@@ -138,7 +138,7 @@ def test_inputs_shown_live(window, qtbot):
         window.link.send(Cmd.SET_INPUTS, {"fwd_inhibit": True})
     from fha_studio.hardware.protocol import IoBit
 
-    qtbot.waitUntil(lambda: page.signal_lamps[IoBit.FWD_INHIBIT].state is True, timeout=3000)
+    qtbot.waitUntil(lambda: page.signal_lamps[IoBit.FWD_INHIBIT].state is True, timeout=10000)
 
 
 def test_alarm_raised_highlighted_acknowledged_cleared(window, qtbot):
