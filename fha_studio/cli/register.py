@@ -26,8 +26,9 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from fha_studio import fileio
+from fha_studio import fileio, plausible
 from fha_studio.cli import CliError
+from fha_studio.cli._values import in_range
 from fha_studio.logic.register.words import (
     KIND_WORDS,
     SOURCE_WORDS,
@@ -122,7 +123,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument("--driver", default="", help="driver model, e.g. HA-655-2-200")
     s.add_argument("--port", default="", help="the port: /dev/ttyUSB0, COM3, socket://host:port, sim://...")
     s.add_argument(
-        "--load-inertia", type=float, default=None, metavar="KGM2", help="declared load inertia, kg m²"
+        "--load-inertia", type=in_range(plausible.LOAD_INERTIA_KGM2), default=None, metavar="KGM2",
+        help=f"declared load inertia [kg m^2], {plausible.LOAD_INERTIA_KGM2.allowed()}",
     )
     s.add_argument("--serial-number", default="", help="from the actuator's label")
     s.add_argument("--notes", default="")

@@ -120,6 +120,18 @@ def test_bad_input_is_one_line_and_exit_2(capsys, db, args, message):
         assert [a.name for a in reg.axes("Line 3")] == ["table", "table twin"]
 
 
+def test_a_load_inertia_that_is_no_number_is_refused_in_one_line(capsys, db):
+    refusals = (("nan", "nan is not a number"), ("1e400", "1e400 is too large"),
+                ("-1", "-1 is outside 0 ... 1500 kg m^2"))
+    for value, words in refusals:
+        with pytest.raises(SystemExit) as stop:
+            main(["register", "--db", str(db), "add-axis", "Line 3/roll", "--load-inertia", value])
+        err = capsys.readouterr().err
+        assert stop.value.code == 2 and err.count("\n") == 1 and f"--load-inertia: {words}" in err
+    with Register(db) as reg:
+        assert [a.name for a in reg.axes("Line 3")] == ["table", "table twin"]
+
+
 def test_a_parameter_file_needs_an_axis(capsys, db, tmp_path):
     path = tmp_path / "p.toml"
     path.write_text('format = "fha-parameters/1"\n[system]\nrotary_direction = 1\n')

@@ -62,6 +62,9 @@ def test_machines_and_axes_are_found_by_name(line3):
         line3.add_machine("A/B")
     with pytest.raises(RegisterError, match="load inertia -1"):
         line3.add_axis(M, "roll", load_inertia_kgm2=-1)
+    for value in (float("nan"), float("inf")):
+        with pytest.raises(RegisterError, match="load inertia"):
+            line3.add_axis(M, "roll", load_inertia_kgm2=value)
     with pytest.raises(RegisterError, match="axis 'roll': port /dev/ttyUSB2 is already axis 'tilt''s"):
         line3.add_axis(M, "roll", port_url="/dev/ttyUSB2")
     with pytest.raises(RegisterError, match="axis 'table': port /dev/ttyUSB2 is already axis 'tilt''s"):

@@ -19,6 +19,7 @@ import contextlib
 import datetime as _dt
 import hashlib
 import json
+import math
 import os
 import sqlite3
 import time
@@ -1119,7 +1120,9 @@ class Register:
 
 
 def _check_inertia(value: float | None) -> None:
-    if value is not None and (not isinstance(value, int | float) or isinstance(value, bool) or value < 0):
+    if value is not None and (
+        not isinstance(value, int | float) or isinstance(value, bool) or not math.isfinite(value) or value < 0
+    ):
         raise RegisterError(f"load inertia {value!r}: a number of kg m² >= 0 expected")
 
 
