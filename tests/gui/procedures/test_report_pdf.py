@@ -112,3 +112,21 @@ def test_a_report_aimed_at_a_folder_is_refused_before_anything_is_written(qapp, 
     with pytest.raises(FileProblem, match=r"r\.html: is a directory"):
         write_report(build_report(session, context), tmp_path / "r.html", tmp_path / "r.pdf")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.html"]  # no PDF, no partial file
+
+
+def test_a_report_that_cannot_be_written_is_refused_before_anything_is_written(qapp, tmp_path):
+    """A device-like target (a FIFO stands for /dev/full) or a path under a file: refused with the
+    file named, and neither the HTML nor the PDF nor a temporary file is left."""
+    import os
+
+    from fha_studio.fileio import FileProblem
+
+    os.mkfifo(tmp_path / "device")
+    (tmp_path / "afile").write_text("")
+    report = build_report(ProcedureSession(actuator_code=CODE), build_context(CODE))
+    for html, pdf, words in ((tmp_path / "r.html", tmp_path / "device", "not a regular file"),
+                             (tmp_path / "r.html", tmp_path / "afile" / "r.pdf", "not a directory"),
+                             (tmp_path / "device", tmp_path / "r.pdf", "not a regular file")):
+        with pytest.raises(FileProblem, match=words):
+            write_report(report, html, pdf)
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "device"]

@@ -8,6 +8,7 @@ drawn with a footer that says which report and which page it is.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -170,8 +171,9 @@ def write_pdf(
     pages. Images are found relative to ``base_dir``. The file appears only when complete; a
     target that cannot become a regular file raises :class:`fileio.FileProblem` before the work."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fileio.check_output_path(path)  # the rename below must not replace a device or a folder
+    if not os.path.lexists(path.parent):
+        path.parent.mkdir(parents=True, exist_ok=True)
+    fileio.check_output_path(path)  # a device or a path under a file: refused, never renamed over
     partial = path.with_name(f".{path.name}.partial")
     writer = QPdfWriter(str(partial))
     writer.setTitle(title)
@@ -231,8 +233,11 @@ def write_report(
     The HTML appears after the PDF is complete, each whole or not at all (:mod:`fha_studio.fileio`)."""
     html = render_html(report)
     html_path = Path(html_path)
-    html_path.parent.mkdir(parents=True, exist_ok=True)
-    fileio.check_output_path(html_path)  # before the PDF's work
+    if not os.path.lexists(html_path.parent):
+        html_path.parent.mkdir(parents=True, exist_ok=True)
+    for target in (html_path, pdf_path):
+        if target is not None:
+            fileio.check_output_path(target)  # before the work: a target that cannot be written
     pdf = write_pdf(html, pdf_path, report.title, html_path.parent) if pdf_path is not None else None
-    fileio.write_text(html_path, html)
+    fileio.write_text(html_path, html)  # whole or not at all
     return html_path, pdf

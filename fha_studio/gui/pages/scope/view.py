@@ -16,6 +16,7 @@ calls old data live: it checks the age of the newest sample itself on every fram
 from __future__ import annotations
 
 import dataclasses
+import io
 import logging
 import time
 from dataclasses import dataclass
@@ -34,6 +35,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio import fileio
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.hardware.parameters import load_parameter_model
 from fha_studio.logic.scope.acquisition import LiveMode, MoveTestResult, TraceResult, TraceSettings
@@ -618,7 +620,9 @@ class ScopeView(QWidget):
             raise ValueError("nothing on show to export")
         channels, rows = data
         header = ",".join(["t_s"] + [f"{c.key} [{c.unit}]" for c in channels])
-        np.savetxt(path, rows, delimiter=",", header=header, comments="", fmt="%.9g")
+        text = io.StringIO()
+        np.savetxt(text, rows, delimiter=",", header=header, comments="", fmt="%.9g")
+        fileio.write_text(path, text.getvalue())  # whole or not at all
         return Path(path)
 
     def open_recording(self, path) -> None:
