@@ -8,6 +8,7 @@ import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from fha_studio import fileio
 from fha_studio.hardware.parameters import MODE_WORDS, Mode, ParameterItem
 
 
@@ -67,7 +68,7 @@ class SessionLog:
     def read(cls, path: Path) -> SessionLog:
         """A log written before (one JSON object per line)."""
         log = cls(None)
-        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+        for number, line in enumerate(fileio.read_text(path).splitlines(), 1):
             if not line.strip():
                 continue
             try:
