@@ -59,3 +59,16 @@ def test_the_file_comparison_shows_apply_and_differs_and_flags_drive_against_fil
     assert table.columnViewportPosition(4) >= 0 and right <= table.viewport().width()
     dialog.close()
     dialog.deleteLater()
+
+
+def test_every_page_fits_a_1024_by_600_screen(window, qtbot):
+    """No page asks for more room than a 1024 x 600 screen: the window can be made that small on
+    every page (what does not fit scrolls inside the page)."""
+    from fha_studio.gui.pages.base import PageId
+
+    for page_id in PageId:
+        window.show_page(page_id)
+        hint = window.minimumSizeHint()
+        assert hint.width() <= 1024 and hint.height() <= 600, f"{page_id}: {hint.width()} x {hint.height()}"
+        window.resize(1024, 600)
+        qtbot.waitUntil(lambda: window.width() <= 1024 and window.height() <= 600, timeout=10000)

@@ -148,12 +148,17 @@ class ModelCheckPage(BasePage):
         self.save_model_button.clicked.connect(self._save_model_clicked)
         self.save_report_button = QPushButton("Save report (JSON)…")
         self.save_report_button.clicked.connect(self._save_report_clicked)
-        bar = QHBoxLayout()
+        # two rows, so that the page fits a 1024-pixel-wide screen: what to check, then what to do
+        bar = QVBoxLayout()
+        inputs, actions = QHBoxLayout(), QHBoxLayout()
         for w in (self.open_button, self.scope_button, QLabel("Declared load inertia:"), self.inertia_spin,
-                  QLabel("Bandwidth:"), self.bandwidth_spin, self.run_button, self.save_model_button,
-                  self.save_report_button):
-            bar.addWidget(w)
-        bar.addStretch(1)
+                  QLabel("Bandwidth:"), self.bandwidth_spin):
+            inputs.addWidget(w)
+        for w in (self.run_button, self.save_model_button, self.save_report_button):
+            actions.addWidget(w)
+        for row in (inputs, actions):
+            row.addStretch(1)
+            bar.addLayout(row)
         self.source_label = QLabel("No recording loaded. Open an fha-recording/1 file, or capture a move "
                                    "in the Scope page and take it from there.")
         self.source_label.setWordWrap(True)
@@ -200,8 +205,10 @@ class ModelCheckPage(BasePage):
         controls.addWidget(self.where_channel)
         controls.addWidget(QLabel("against:"))
         controls.addWidget(self.where_variable)
-        controls.addWidget(QLabel("dots: residual of the nominal model; lines: mean per bin before "
-                                  "(red) and after (green) adding the effects"))
+        key = QLabel("dots: residual of the nominal model; lines: mean per bin before (red) and after "
+                     "(green) adding the effects")
+        key.setWordWrap(True)  # the page fits a 1024-pixel-wide screen
+        controls.addWidget(key, 1)
         controls.addStretch(1)
         box = QWidget()
         layout = QVBoxLayout(box)

@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (
     QListWidgetItem,
     QMessageBox,
     QPushButton,
+    QScrollArea,
     QSplitter,
     QStackedWidget,
     QTableWidget,
@@ -287,7 +288,12 @@ class ProceduresPage(BasePage):
         buttons.addWidget(self.sign_button)
         m.addLayout(buttons)
         m.addWidget(self.message_label)
-        split.addWidget(middle)
+        # the step scrolls rather than making the window taller than a 1024 x 600 screen
+        middle_scroll = QScrollArea()
+        middle_scroll.setWidgetResizable(True)
+        middle_scroll.setFrameShape(QScrollArea.Shape.NoFrame)
+        middle_scroll.setWidget(middle)
+        split.addWidget(middle_scroll)
 
         self.history = QTableWidget(0, 5)
         self.history.setObjectName("history")

@@ -28,7 +28,7 @@ class ChannelTable(QTableWidget):
         header.setSectionResizeMode(1, header.ResizeMode.ResizeToContents)
         header.setSectionResizeMode(2, header.ResizeMode.Fixed)
         self.setColumnWidth(2, 78)
-        self.setMinimumWidth(300)
+        self.setMinimumWidth(240)
         self.itemChanged.connect(self._item_changed)
 
     def fill(self, channels: Sequence[ScopeChannel], visible: Mapping[str, bool], scale: Mapping[str, float],

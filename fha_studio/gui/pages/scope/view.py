@@ -29,6 +29,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QProgressBar,
+    QScrollArea,
     QSplitter,
     QTabWidget,
     QVBoxLayout,
@@ -92,6 +93,17 @@ def _actuator_text(context: ScopeContext) -> str:
     if context.actuator_declared:
         return context.actuator
     return f"{context.actuator} (assumed: no actuator given on the Connection page)"
+
+
+def _scrolling(panel: QWidget) -> QScrollArea:
+    """``panel`` in a scroll area: on a small screen (1024 x 600) the side panels scroll instead of
+    widening the window past the screen."""
+    area = QScrollArea()
+    area.setWidgetResizable(True)
+    area.setFrameShape(QScrollArea.Shape.NoFrame)
+    area.setWidget(panel)
+    area.setMinimumWidth(240)
+    return area
 
 
 @dataclass
@@ -198,13 +210,13 @@ class ScopeView(QWidget):
         self.trigger = TriggerPanel(self.all_channels)
         self.trigger.sigArm.connect(self.arm_trace)
         self.trigger.sigCancel.connect(lambda: self.controller.send(ScopeCmd.CANCEL_TRACE))
-        side.addTab(self.trigger, "Trigger")
+        side.addTab(_scrolling(self.trigger), "Trigger")
         self.tests = MoveTestPanel(_actuator_text(self.context), float(self._actuator.max_speed_rpm),
                                    self.context.load_inertia_kgm2)
         self.tests.load_inertia.valueChanged.connect(self._load_inertia_edited)
         self.tests.sigRun.connect(self.run_test)
         self.tests.sigAbort.connect(lambda: self.controller.send(ScopeCmd.ABORT_TEST))
-        side.addTab(self.tests, "Tests")
+        side.addTab(_scrolling(self.tests), "Tests")
         split.addWidget(side)
         split.setSizes([300, 760, 300])
         split.setStretchFactor(1, 1)
