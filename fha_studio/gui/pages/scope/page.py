@@ -14,7 +14,7 @@ from PySide6.QtWidgets import QVBoxLayout
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.link import POLL_INTERVAL_MS, Cmd, LinkInfo
 from fha_studio.gui.pages.base import BasePage
-from fha_studio.gui.pages.jog_panel import JogPanel
+from fha_studio.gui.pages.scope.jog_panel import JogPanel
 from fha_studio.gui.widgets import space_jogs_only
 
 from .driver import ScopeCmd, ScopeController, ScopeRequest
