@@ -296,17 +296,9 @@ def test_the_sensor_dog_wizard_does_not_claim_to_watch_and_reads_dgr(make_window
 
 
 def _answer(page, step):
-    from tests.procedures.walk import good_answer
+    from tests.gui.procedure_answers import answer_by_hand
 
-    if step.kind == "confirm":
-        page.yes_button.click()
-    elif step.kind in ("measure", "text"):
-        page.value_edit.setText(str(good_answer(step)))
-        page.value_button.click()
-    elif step.kind == "choose":
-        page.choice_combo.setCurrentText(str(good_answer(step)))
-        page.choice_button.click()
-    else:
+    if not answer_by_hand(page, step):
         raise AssertionError(step.kind)
 
 

@@ -17,7 +17,7 @@ from fha_studio.gui.link import Cmd
 from fha_studio.logic.machine import MachineProject
 from fha_studio.logic.register import Register
 from fha_studio.logic.register.words import value_text
-from tests.procedures.walk import good_answer
+from tests.gui.procedure_answers import answer_by_hand
 
 MACHINE = "Line 3 positioner"
 TABLE = "FHA-25C-50-US250"
@@ -67,15 +67,7 @@ def _walk(page, qtbot, procedure_id, limit=80):
         step = page.current_step()
         if step is None or page.run.stopped:
             return
-        if step.kind == "confirm":
-            page.yes_button.click()
-        elif step.kind in ("measure", "text"):
-            page.value_edit.setText(str(good_answer(step)))
-            page.value_button.click()
-        elif step.kind == "choose":
-            page.choice_combo.setCurrentText(str(good_answer(step)))
-            page.choice_button.click()
-        else:
+        if not answer_by_hand(page, step):
             with qtbot.waitSignal(page.sigLiveDone, timeout=20000):
                 page.live_button.click()
     raise AssertionError("procedure did not end")

@@ -11,7 +11,7 @@ import pytest
 from fha_studio.gui.link import Cmd
 from fha_studio.hardware.protocol import IoBit
 from fha_studio.logic.procedures import ProcedureSession
-from tests.procedures.walk import good_answer
+from tests.gui.procedure_answers import answer_by_hand
 
 CODE = "FHA-25C-50-US250-B-L"
 SIM_URL = f"sim://{CODE}?paced=0&ls1_deg=-30&ls2_deg=30&origin_deg=0"
@@ -27,15 +27,7 @@ def window(make_window, qtbot):
 def _answer_by_hand(page):
     """What a trainee types or clicks for the step on the screen (live steps: the button)."""
     step = page.current_step()
-    if step.kind == "confirm":
-        page.yes_button.click()
-    elif step.kind in ("measure", "text"):
-        page.value_edit.setText(str(good_answer(step)))
-        page.value_button.click()
-    elif step.kind == "choose":
-        page.choice_combo.setCurrentText(str(good_answer(step)))
-        page.choice_button.click()
-    else:
+    if not answer_by_hand(page, step):
         raise AssertionError(step.kind)
 
 
