@@ -78,8 +78,8 @@ def test_the_window_closes_while_connecting_to_a_hostile_line(make_window, qtbot
 
 @pytest.mark.e2e
 def test_the_program_exits_cleanly_when_closed_while_connecting_to_a_flood(tmp_path):
-    """The report's repro: a TCP server that sends A without end, the GUI pointed at it, the
-    window closed while it connects. It used to abort (exit 134, "QThread: Destroyed while
+    """The whole program, in its own process: a TCP server that sends A without end, the GUI
+    pointed at it, the window closed while it connects. It used to abort (exit 134, "QThread: Destroyed while
     thread 'fha-link' is still running")."""
     import os
     import subprocess
