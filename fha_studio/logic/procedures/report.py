@@ -231,7 +231,8 @@ def _e(value: Any) -> str:
     return html.escape("" if value is None else str(value))
 
 
-def _value(record: CheckRecord) -> str:
+def value_text(record: CheckRecord) -> str:
+    """A check's value as a person reads it: yes / no, or the value with its unit."""
     if record.kind == "confirm" or isinstance(record.value, bool):
         return "yes" if record.value else "no"
     if isinstance(record.value, float):
@@ -307,7 +308,7 @@ def render_html(report: CommissioningReport) -> str:
             [
                 _e(r.section),
                 _e(r.text),
-                _e(_value(r)),
+                _e(value_text(r)),
                 _e(r.expected),
                 "<span class='pass'>pass</span>" if r.passed else "<span class='fail'>FAIL</span>",
                 _e(r.who),

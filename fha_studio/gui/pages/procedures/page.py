@@ -53,7 +53,7 @@ from fha_studio.logic.procedures import (
     StepInputError,
     load_all,
 )
-from fha_studio.logic.procedures.report import SignError, build_report, sign
+from fha_studio.logic.procedures.report import SignError, build_report, sign, value_text
 
 log = logging.getLogger(__name__)
 
@@ -782,9 +782,8 @@ class ProceduresPage(BasePage):
         records = self.run.state.records if self.run else []
         self.history.setRowCount(len(records))
         for row, r in enumerate(records):
-            value = ("yes" if r.value else "no") if r.kind == "confirm" else f"{r.value} {r.unit}".strip()
             for column, text in enumerate(
-                (r.step_id, value, "pass" if r.passed else "FAIL", r.who, r.at_utc)
+                (r.step_id, value_text(r), "pass" if r.passed else "FAIL", r.who, r.at_utc)
             ):
                 self.history.setItem(row, column, QTableWidgetItem(text))
 
