@@ -266,8 +266,7 @@ def test_the_gui_opens_a_machine_of_the_register_or_says_why_not(qtbot, tmp_path
 
 @pytest.mark.slow
 def test_alarms_recordings_and_model_checks_go_into_the_register(make_machine, qtbot, tmp_path):
-    from fha_studio.hardware import protocol as p
-    from tests.gui.test_modelcheck_page import URL, _back_and_forth
+    from tests.gui.test_modelcheck_page import URL, capture_a_move
 
     register = Register(tmp_path / "register.sqlite")
     project = MachineProject("Press 7")
@@ -288,16 +287,7 @@ def test_alarms_recordings_and_model_checks_go_into_the_register(make_machine, q
     qtbot.waitUntil(lambda: feed.link.status is not None and feed.link.status.alarm_code == 0, timeout=15000)
 
     # a move captured in the scope, handed to the model check
-    scope = feed.show_page("scope").view
-    scope.trace_rate.setValue(1000)
-    scope.trace_samples.setValue(p.TRACE_MAX_SAMPLES)
-    scope.trace_pre.setValue(2)
-    scope.trigger_kind.setCurrentIndex(scope.trigger_kind.findData(p.TriggerKind.IO_BIT_RISES))
-    scope.trigger_channel.setCurrentIndex(scope.trigger_channel.findData("moving"))
-    scope.arm_trace()
-    qtbot.waitUntil(lambda: "waiting for the trigger" in scope.trace_state.text(), timeout=10000)
-    with qtbot.waitSignal(scope.sigTraceDone, timeout=30000):
-        feed.link.send(Cmd.CALL, _back_and_forth)
+    capture_a_move(feed, qtbot)
     page = feed.show_page("modelcheck")
     path = page.take_scope_capture()
     recordings = [e for e in register.history(ref) if e.kind == "recording"]

@@ -34,6 +34,20 @@ def _back_and_forth(client) -> None:
         time.sleep(0.15)
 
 
+def capture_a_move(window, qtbot) -> None:
+    """A 1 kHz trace in the scope, triggered as the axis starts moving, of :func:`_back_and_forth`."""
+    scope = window.show_page("scope").view
+    scope.trace_rate.setValue(1000)
+    scope.trace_samples.setValue(p.TRACE_MAX_SAMPLES)
+    scope.trace_pre.setValue(2)
+    scope.trigger_kind.setCurrentIndex(scope.trigger_kind.findData(p.TriggerKind.IO_BIT_RISES))
+    scope.trigger_channel.setCurrentIndex(scope.trigger_channel.findData("moving"))
+    scope.arm_trace()
+    qtbot.waitUntil(lambda: "waiting for the trigger" in scope.trace_state.text(), timeout=10000)
+    with qtbot.waitSignal(scope.sigTraceDone, timeout=30000):
+        window.link.send(Cmd.CALL, _back_and_forth)
+
+
 @pytest.mark.slow
 def test_a_move_captured_in_the_scope_tells_the_missing_friction(make_window, qtbot, tmp_path):
     window = make_window(connect=URL)
@@ -44,15 +58,7 @@ def test_a_move_captured_in_the_scope_tells_the_missing_friction(make_window, qt
 
     scope = window.show_page("scope").view
     scope.load_inertia.setValue(0.5)  # the trainee declares the load, as written into recordings
-    scope.trace_rate.setValue(1000)
-    scope.trace_samples.setValue(p.TRACE_MAX_SAMPLES)
-    scope.trace_pre.setValue(2)
-    scope.trigger_kind.setCurrentIndex(scope.trigger_kind.findData(p.TriggerKind.IO_BIT_RISES))
-    scope.trigger_channel.setCurrentIndex(scope.trigger_channel.findData("moving"))
-    scope.arm_trace()
-    qtbot.waitUntil(lambda: "waiting for the trigger" in scope.trace_state.text(), timeout=10000)
-    with qtbot.waitSignal(scope.sigTraceDone, timeout=30000):
-        window.link.send(Cmd.CALL, _back_and_forth)
+    capture_a_move(window, qtbot)
 
     page = window.show_page("modelcheck")
     path = page.take_scope_capture()
