@@ -37,6 +37,10 @@ def test_the_power_cycle_banner_shows_its_button_whole_and_keeps_the_edited_row_
     # the whole text fits the button and the button fits the banner
     assert button.width() >= button.sizeHint().width()
     assert page.restart_banner.rect().contains(QRect(button.pos(), button.size()))
+    # the manual's description: in words, and scrolling rather than cut when longer than its room
+    details = page.details.text()
+    assert "power cycle" in details and "restart_required" not in details
+    assert page.details_scroll.widget() is page.details
     viewport = page.table.viewport().rect()
     qtbot.waitUntil(lambda: viewport.contains(page.table.visualRect(page.model.index(row, 3))), timeout=10000)
 

@@ -47,6 +47,21 @@ SERVO_ON_WRITE_REASON = (
 _ROOT = QModelIndex()
 
 
+#: The item fields the public manual does not state, in words (the help pane names them).
+ASSUMED_FIELD_WORDS = {
+    "restart_required": "whether it needs a power cycle",
+    "minimum": "the lowest value",
+    "maximum": "the highest value",
+    "default": "the default",
+    "scale": "the value step",
+    "unit": "the unit",
+    "writable": "whether it can be written over CN3",
+    "choices": "the choices",
+    "number": "the item number",
+    "mode": "the mode",
+}
+
+
 class ParameterTableModel(QAbstractTableModel):
     """Items x (mode, number, name, value, unit, range, default, state). Edits stay here until
     written; the drive's values come from the session."""
@@ -166,7 +181,8 @@ class ParameterTableModel(QAbstractTableModel):
                 tip += "<br>" + "<br>".join(f"{k}: {v}" for k, v in item.choices.items())
             tip += f"<br><i>Source: {item.source}</i>"
             if not item.certain:
-                tip += f"<br><i>Uncertain ({', '.join(item.assumed)}): {item.note}</i>"
+                fields = ", ".join(ASSUMED_FIELD_WORDS.get(f, f.replace("_", " ")) for f in item.assumed)
+                tip += f"<br><i>Not stated in the public manual ({fields}): {item.note}</i>"
             if item.restart_required:
                 tip += "<br><b>Takes effect after the driver's control power is cycled.</b>"
             return tip
