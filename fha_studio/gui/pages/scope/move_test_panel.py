@@ -65,17 +65,21 @@ class MoveTestPanel(QWidget):
         lay.addLayout(row)
         box = QGroupBox("Result")
         res = QFormLayout(box)
+        res.setRowWrapPolicy(QFormLayout.RowWrapPolicy.WrapLongRows)  # fits the side panel's width
         self.result_labels: dict[str, QLabel] = {}
         for key, text in RESULTS:
             label = QLabel("—")
             label.setObjectName(f"scopeResult_{key}")
             label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+            label.setWordWrap(True)
             self.result_labels[key] = label
             res.addRow(text, label)
         lay.addWidget(box)
         files = QGroupBox("Recordings")
         ff = QFormLayout(files)
+        ff.setRowWrapPolicy(QFormLayout.RowWrapPolicy.WrapLongRows)
         self.actuator_label = QLabel(actuator)
+        self.actuator_label.setWordWrap(True)
         ff.addRow("Actuator", self.actuator_label)
         self.load_inertia = QDoubleSpinBox()
         self.load_inertia.setObjectName("scopeLoadInertia")

@@ -218,7 +218,7 @@ class ScopeView(QWidget):
         self.tests.sigAbort.connect(lambda: self.controller.send(ScopeCmd.ABORT_TEST))
         side.addTab(_scrolling(self.tests), "Tests")
         split.addWidget(side)
-        split.setSizes([300, 760, 300])
+        split.setSizes([270, 730, 340])  # the trigger panel whole at 1366 px wide
         split.setStretchFactor(1, 1)
         outer.addWidget(split, 1)
         bottom = QHBoxLayout()
