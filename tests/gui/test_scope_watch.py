@@ -127,3 +127,14 @@ def test_the_cursor_table_has_a_row_per_channel_with_the_values_at_a_and_b(scope
     assert got["Motor current"] == ["0.5 A", "1.5 A", "1 A", "0.5 A/s"]
     # each unit its own plot, time axes linked for still data too
     assert len(view.time_plot.plot_items()) == 3
+
+
+def test_the_toolbar_does_not_shift_when_the_indicator_text_changes(scope_window, qtbot):
+    _window, page = scope_window
+    bar = page.view.toolbar
+    bar.set_indicator("live", "LIVE")
+    qtbot.waitUntil(lambda: bar.indicator.text() == "LIVE", timeout=10000)
+    width, next_x = bar.indicator.width(), bar.live_button.x()
+    bar.set_indicator("not", "NOT LIVE: no new sample for 12.3 s, the line is quiet and the drive may be off")
+    assert bar.indicator.width() == width and bar.live_button.x() == next_x
+    assert bar.indicator.toolTip().endswith("may be off")  # the whole text, when it is elided

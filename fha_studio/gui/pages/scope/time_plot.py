@@ -86,6 +86,8 @@ class TimePlot(QWidget):
         self._x_offset = 0.0  # live: the time shown as 0 (now) [s]; still data: 0
         self._live_span: float | None = None
         self.autoscale = True
+        self._legend_entries: list[str] = []  # the shown channels, as rich text
+        self._still_grid = False
         self._set_units([""])
 
     # -- the stack of plots ------------------------------------------------------------------------
@@ -144,7 +146,7 @@ class TimePlot(QWidget):
         self._apply_grid()
 
     def _apply_grid(self) -> None:
-        still = getattr(self, "_still_grid", False)
+        still = self._still_grid
         self._grid_on = not still
         for plot in self._plots:
             plot.item.showGrid(x=still, y=still, alpha=0.3)
@@ -207,6 +209,12 @@ class TimePlot(QWidget):
             self._curves[c.key] = curve
             entries.append(f"<span style='color:{color(c.key)}; font-weight:bold'>━━</span>&nbsp;"
                            f"{html.escape(label)}")
+        self._legend_entries = entries
+        self.set_note(note)
+
+    def set_note(self, note: str) -> None:
+        """The line under the legend: what the plots show, and why."""
+        entries = self._legend_entries
         text = " &nbsp; ".join(entries) if entries else "No channel ticked: tick one in the table."
         if note:
             text += f"<br><span style='color:#555'>{html.escape(note)}</span>"

@@ -332,6 +332,7 @@ class ScopeView(QWidget):
         self._status = None
         self.toolbar.set_live(False)
         self._update_indicator()
+        self.time_plot.set_note(self._shown_note())
         self.sigLiveChanged.emit(False)
 
     def set_paused(self, paused: bool) -> None:
