@@ -138,3 +138,21 @@ def test_the_toolbar_does_not_shift_when_the_indicator_text_changes(scope_window
     bar.set_indicator("not", "NOT LIVE: no new sample for 12.3 s, the line is quiet and the drive may be off")
     assert bar.indicator.width() == width and bar.live_button.x() == next_x
     assert bar.indicator.toolTip().endswith("may be off")  # the whole text, when it is elided
+
+
+def test_space_on_the_scope_page_acts_only_on_the_jog_buttons(scope_window, qtbot):
+    window, page = scope_window
+    panel = page.jog_panel
+    window.link.send(Cmd.SERVO, True)
+    qtbot.waitUntil(lambda: panel.move_button.isEnabled(), timeout=10000)
+    pressed = []
+    for button in (panel.move_button, panel.servo_off_button, page.view.live_button):
+        button.clicked.connect(lambda *_a, b=button: pressed.append(b.text()))
+        button.setFocus()
+        qtbot.keyClick(button, Qt.Key.Key_Space)
+    assert pressed == []  # Space does not move, switch the servo off or start the live view
+    panel.fwd_button.setFocus()
+    qtbot.keyPress(panel.fwd_button, Qt.Key.Key_Space)
+    assert panel.fwd_button.held  # but it holds a jog button
+    qtbot.keyRelease(panel.fwd_button, Qt.Key.Key_Space)
+    assert not panel.fwd_button.held
