@@ -50,7 +50,7 @@ def test_edit_write_changed_verifies_and_logs_with_backup_first(window, fake, qt
     index = model.index(model.row_of("in_position_range"), 3)
     assert model.setData(index, "25")
     assert "edited, not written" in model.state_text(index.row())
-    with qtbot.waitSignal(window.session.sigWritesDone, timeout=5000) as done:
+    with qtbot.waitSignal(window.session.sigWritesDone, timeout=10000) as done:
         page.write_changed_button.click()
     assert done.args[0][0]["verified"]
     assert fake.values[("tune", 4)] == 25
@@ -64,7 +64,7 @@ def test_rotary_direction_written_read_back_and_power_cycle_offered(window, fake
     page = window.show_page("direction")
     page.ccw_radio.setChecked(True)
     assert page.write_button.isEnabled()
-    with qtbot.waitSignal(window.session.sigWritesDone, timeout=5000):
+    with qtbot.waitSignal(window.session.sigWritesDone, timeout=10000):
         page.write_button.click()
     assert fake.values[("system", 8)] == 1
     assert page.drive_value() == 1
@@ -75,34 +75,34 @@ def test_jog_hold_runs_release_stops_and_stop_key(window, fake, qtbot):
     page = window.show_page("jog")
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO):
         page.servo_on_button.click()
-    qtbot.waitUntil(lambda: page.fwd_button.isEnabled(), timeout=3000)
+    qtbot.waitUntil(lambda: page.fwd_button.isEnabled(), timeout=10000)
     qtbot.mousePress(page.fwd_button, Qt.MouseButton.LeftButton)
-    qtbot.waitUntil(lambda: sum(1 for c in fake.calls if c[0] == "jog") >= 3, timeout=3000)  # keep-alive
+    qtbot.waitUntil(lambda: sum(1 for c in fake.calls if c[0] == "jog") >= 3, timeout=10000)  # keep-alive
     qtbot.mouseRelease(page.fwd_button, Qt.MouseButton.LeftButton)
-    qtbot.waitUntil(lambda: fake.calls[-1] == ("stop",), timeout=3000)
+    qtbot.waitUntil(lambda: fake.calls[-1] == ("stop",), timeout=10000)
     n = len(fake.calls)
     qtbot.keyClick(window, Qt.Key.Key_Escape)
-    qtbot.waitUntil(lambda: len(fake.calls) > n and fake.calls[-1] == ("stop",), timeout=3000)
+    qtbot.waitUntil(lambda: len(fake.calls) > n and fake.calls[-1] == ("stop",), timeout=10000)
 
 
 def test_alarm_shown_highlighted_acknowledged_and_cleared(window, fake, qtbot):
     page = window.show_page("alarms")
     fake.raise_alarm(20)
-    qtbot.waitUntil(lambda: page.current_code == 20, timeout=3000)
-    qtbot.waitUntil(window.alarm_banner.isVisible, timeout=1000)
+    qtbot.waitUntil(lambda: page.current_code == 20, timeout=10000)
+    qtbot.waitUntil(window.alarm_banner.isVisible, timeout=10000)
     assert "Overload" in page.code_label.text()
     assert window.alarm_lamp.state is True
     page.ack_button.click()
-    qtbot.waitUntil(lambda: not window.alarm_banner.isVisible(), timeout=1000)
+    qtbot.waitUntil(lambda: not window.alarm_banner.isVisible(), timeout=10000)
     page.clear_button.click()
-    qtbot.waitUntil(lambda: page.current_code == 0, timeout=3000)
-    qtbot.waitUntil(lambda: page.history_table.rowCount() == 1, timeout=3000)
+    qtbot.waitUntil(lambda: page.current_code == 0, timeout=10000)
+    qtbot.waitUntil(lambda: page.history_table.rowCount() == 1, timeout=10000)
     assert page.history_table.item(0, 0).text() == "20"
 
 
 def test_lost_link_is_shown_within_a_second(window, fake, qtbot):
     fake.close()
-    with qtbot.waitSignal(window.link.sigDisconnected, timeout=1000) as lost:
+    with qtbot.waitSignal(window.link.sigDisconnected, timeout=10000) as lost:
         pass
     assert lost.args[1] is True
     assert "LINK LOST" in window.caps_label.text()
@@ -114,7 +114,7 @@ def test_closing_with_the_servo_on_asks_and_cancel_keeps_the_window(window, fake
 
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO):
         window.jog_page.servo_on_button.click()
-    qtbot.waitUntil(lambda: window.link.servo_on, timeout=3000)
+    qtbot.waitUntil(lambda: window.link.servo_on, timeout=10000)
     asked = []
 
     def answer(parent, title, text, *args):
