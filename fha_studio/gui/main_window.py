@@ -41,6 +41,9 @@ log = logging.getLogger(__name__)
 STOP_KEY = Qt.Key.Key_Escape
 #: Room for the link summary in the status bar [px]; the messages get the rest.
 CAPS_WIDTH_PX = 420
+#: ... but never more than this share of the window's width, so that a narrow screen (1024 px)
+#: still leaves room for the message line.
+CAPS_WIDTH_SHARE = 0.25
 
 
 class MainWindow(QMainWindow):
@@ -227,9 +230,23 @@ class MainWindow(QMainWindow):
 
     def _set_caps(self, text: str) -> None:
         """The link summary at the right of the status bar, elided to its room; full in the tooltip."""
+        self._caps_text = text
+        width = self._caps_width()
+        self.caps_label.setMaximumWidth(width)
         metrics = self.caps_label.fontMetrics()
-        self.caps_label.setText(metrics.elidedText(text, Qt.TextElideMode.ElideRight, CAPS_WIDTH_PX - 8))
+        self.caps_label.setText(metrics.elidedText(text, Qt.TextElideMode.ElideRight, width - 8))
         self.caps_label.setToolTip(text)
+
+    def _caps_width(self) -> int:
+        return max(120, min(CAPS_WIDTH_PX, int(self.width() * CAPS_WIDTH_SHARE)))
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        text = getattr(self, "_caps_text", None)
+        if text is not None:
+            tooltip = self.caps_label.toolTip()
+            self._set_caps(text)
+            self.caps_label.setToolTip(tooltip)  # a connected drive's tooltip says more than the text
 
     # -- settings -------------------------------------------------------------------------------
     def _restore_layout(self) -> None:

@@ -255,3 +255,12 @@ def test_a_direction_confirmed_on_its_page_is_done_in_the_report(window, qtbot, 
     assert "Rotary direction (1-10) — done" in procedures.procedure_list.item(
         [p.id for p in procedures.procedures].index("rotary-direction")
     ).text()
+
+
+def test_the_message_line_keeps_room_on_a_1024_pixel_screen(window, qtbot):
+    window.resize(1024, 600)
+    qtbot.waitUntil(lambda: window.width() <= 1024, timeout=10000)
+    window.show_message("STOP done: the drive decelerated the axis and holds it (servo stays on).")
+    qtbot.waitUntil(lambda: window.message_area.text_label.width() >= 200, timeout=10000)
+    assert window.caps_label.width() <= 1024 * 0.25 + 1
+    assert not window.message_area.text_label.visibleRegion().isEmpty()
