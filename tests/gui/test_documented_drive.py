@@ -111,8 +111,8 @@ def test_a_silent_drive_turns_the_link_lamp_red_within_2_s(make_window, qtbot):
         assert lost.args[1] is True
         assert window.link_lamp.state is True and window.link_lamp.toolTip().startswith("Link: LOST")
         assert "Link lost" in window.message_area.latest().text
-        print(f"link lost shown {took:.2f} s after the drive fell silent")
-        assert took < 2.0 + 1.0  # 2 s by design; the extra second is for a loaded test machine
+        # 2 s by design; the extra second is for a loaded test machine
+        assert took < 2.0 + 1.0, f"link lost shown {took:.2f} s after the drive fell silent"
         assert p.Command.DGR.value in scripted.commands()
     finally:
         scripted.close()

@@ -299,11 +299,10 @@ def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_w
     arrived, result = stops[0]
     assert result.ok, result.error
     # one block (~0.15 s) at most, not the ~5 s of the rest of the read-out (generous for a loaded host)
-    assert arrived - pressed < 2.0
+    assert arrived - pressed < 2.0, f"STOP arrived {arrived - pressed:.2f} s after it was pressed"
     qtbot.waitUntil(lambda: view.trace_state.text().startswith("abandoned by STOP"), timeout=10000)
     read = int(view.trace_state.text().split("(")[1].split(" of ")[0])
     assert 64 <= read < 2048 and "of 2048 samples read" in view.trace_state.text() and not done
     qtbot.waitUntil(lambda: link.status is not None and abs(link.status.speed_rpm or 0.0) < 0.1
                     and not link.status.moving, timeout=10000)  # the axis stopped and holds
     assert link.servo_on
-    print(f"STOP arrived {arrived - pressed:.2f} s after it was pressed; {view.trace_state.text()}")

@@ -50,7 +50,7 @@ def test_rotary_direction_written_power_cycled_and_read_back(window, qtbot):
     assert "power cycle" in page.status_label.text()
     assert page.power_cycle_button.isVisible()
     with qtbot.waitSignal(
-        window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.POWER_CYCLE, timeout=8000
+        window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.POWER_CYCLE, timeout=10000
     ):
         page.power_cycle_button.click()
     # read back from the drive after the power cycle: the value is still there (EEPROM)
