@@ -15,7 +15,8 @@ from fha_studio import fileio
 
 
 def for_paper(image: QImage) -> QImage:
-    """``image`` with its HSL lightness inverted, hue and saturation kept (a new image).
+    """``image`` with its HSL lightness inverted, hue and saturation kept (a new image), when it
+    is mostly dark; a picture that is light already (a plot on white) is returned as it is.
 
     In RGB that is ``c + (1 - max - min)`` for each channel: an inversion (``1 - c``) followed by
     a half turn of the hue (``max + min - c``)."""
@@ -23,7 +24,10 @@ def for_paper(image: QImage) -> QImage:
     width, height, stride = rgb.width(), rgb.height(), rgb.bytesPerLine()
     buffer = np.frombuffer(rgb.constBits(), dtype=np.uint8, count=stride * height)
     pixels = buffer.reshape(height, stride)[:, : width * 3].reshape(height, width, 3).astype(np.int16)
-    shift = 255 - pixels.max(axis=2, keepdims=True) - pixels.min(axis=2, keepdims=True)
+    lightness_x2 = pixels.max(axis=2, keepdims=True) + pixels.min(axis=2, keepdims=True)
+    if np.median(lightness_x2) >= 255:  # a light background: fit for paper as it is
+        return rgb.copy()
+    shift = 255 - lightness_x2
     turned = np.ascontiguousarray(np.clip(pixels + shift, 0, 255).astype(np.uint8))
     out = QImage(turned.data, width, height, width * 3, QImage.Format.Format_RGB888)
     return out.copy()  # own the pixels: ``turned`` goes away with this function

@@ -33,3 +33,14 @@ def test_a_dark_plot_prints_light_with_its_colours(qapp, tmp_path):
     assert again.pixelColor(5, 90).lightnessF() > 0.9 and not list(tmp_path.glob(".*partial*"))
     data = np.array([again.pixelColor(x, 90).lightnessF() for x in range(0, 200, 10)])
     assert data.min() > 0.9
+
+
+def test_a_light_plot_is_left_as_it_is(qapp):
+    image = QImage(50, 20, QImage.Format.Format_RGB32)
+    image.fill(QColor("#ffffff"))
+    painter = QPainter(image)
+    painter.setPen(QPen(QColor("#1565c0"), 3))
+    painter.drawLine(0, 10, 50, 10)
+    painter.end()
+    paper = for_paper(image)
+    assert paper.pixelColor(5, 2) == QColor("#ffffff") and paper.pixelColor(25, 10) == QColor("#1565c0")
