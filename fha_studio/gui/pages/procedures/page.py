@@ -54,6 +54,7 @@ from fha_studio.logic.procedures import (
     load_all,
 )
 from fha_studio.logic.procedures.report import SignError, build_report, sign, value_text
+from fha_studio.logic.register.words import when_text
 
 log = logging.getLogger(__name__)
 
@@ -782,10 +783,13 @@ class ProceduresPage(BasePage):
         records = self.run.state.records if self.run else []
         self.history.setRowCount(len(records))
         for row, r in enumerate(records):
+            # the step as the checklist words it (its id is for files), the time as the report gives it
             for column, text in enumerate(
-                (r.step_id, value_text(r), "pass" if r.passed else "FAIL", r.who, r.at_utc)
+                (r.text, value_text(r), "pass" if r.passed else "FAIL", r.who, when_text(r.at_utc))
             ):
-                self.history.setItem(row, column, QTableWidgetItem(text))
+                item = QTableWidgetItem(text)
+                item.setToolTip(f"{r.section}: {r.text}" if column == 0 and r.section else text)
+                self.history.setItem(row, column, item)
 
     # -- settings (called by the main window) --------------------------------------------------
     def save_settings(self, settings) -> None:
