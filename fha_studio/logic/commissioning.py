@@ -247,7 +247,7 @@ class CommissioningState:
         """Raises ValueError (and changes nothing) for a negative or non-finite value."""
         value = float(load_inertia_kgm2)
         if not math.isfinite(value) or value < 0:
-            raise ValueError(f"load inertia: {load_inertia_kgm2!s} kg m² is not a value >= 0")
+            raise ValueError(f"load inertia: {load_inertia_kgm2!s} kg·m² is not a value >= 0")
         if value == self._load_inertia_kgm2:
             return
         self._load_inertia_kgm2 = value

@@ -29,7 +29,7 @@ LEAKS = (
     (re.compile(r"\b(None|True|False)\b"), "a Python constant"),
     (re.compile(r"Traceback|Error\(|Exception\("), "a Python exception"),
     (re.compile(r"\(not processed\)|\b[A-Z]{3}[+-]\d+\b|\b[A-Z]{3}: (refused|rejected)"), "a CN3 frame"),
-    (re.compile(r"\bkg m\^2\b|\bN m\b|\bm\^2\b"), "a unit in ASCII (the manual writes N·m, kg·m²)"),
+    (re.compile(r"\bkg m(\^2|²)|\bN m\b|\bm\^2\b"), "a unit not as the manual writes it (N·m, kg·m²)"),
 )
 #: snake_case words (two or more parts); a path, a URL or a file name may hold them.
 SNAKE = re.compile(r"(?<![\w/.:?=&-])[a-z][a-z0-9]*(?:_[a-z0-9]+)+(?![\w/.=-])")

@@ -299,7 +299,7 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         limit_in_param=_per_rms(lambda c: c.sig.accel_rad_s2),
         model_params=_inertia_model_params,
         advice=lambda p: (
-            f"{'add' if p['inertia_kgm2'] > 0 else 'take off'} {abs(p['inertia_kgm2']):.3g} kg m² "
+            f"{'add' if p['inertia_kgm2'] > 0 else 'take off'} {abs(p['inertia_kgm2']):.3g} kg·m² "
             f"{'to' if p['inertia_kgm2'] > 0 else 'from'} the declared load inertia; check what is mounted "
             "on the output (a part missed in the sizing)"
         ),
