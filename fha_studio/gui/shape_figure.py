@@ -134,6 +134,15 @@ class ShapeFigure(QWidget):
         for a, b, text in dims:
             self._dimension(painter, a, b, text)
 
+    @staticmethod
+    def _across(rect: QRectF, width: str, height: str) -> list[tuple[QPointF, QPointF, str]]:
+        """The two dimensions of a cross-section's bounding ``rect``: its width under it (along y),
+        its height at its right (along z)."""
+        return [
+            (QPointF(rect.left(), rect.bottom() + 8), QPointF(rect.right(), rect.bottom() + 8), width),
+            (QPointF(rect.right() + 8, rect.top()), QPointF(rect.right() + 8, rect.bottom()), height),
+        ]
+
     def _square(self, section: QRectF, fraction: float = 0.7) -> QRectF:
         size = min(section.width(), section.height()) * fraction
         return QRectF(section.center().x() - size / 2, section.center().y() - size / 2, size, size)
@@ -178,18 +187,7 @@ class ShapeFigure(QWidget):
             letters,
             path,
             letters["length_m"],
-            [
-                (
-                    QPointF(ellipse.left(), ellipse.bottom() + 8),
-                    QPointF(ellipse.right(), ellipse.bottom() + 8),
-                    letters["b_m"],
-                ),
-                (
-                    QPointF(ellipse.right() + 8, ellipse.top()),
-                    QPointF(ellipse.right() + 8, ellipse.bottom()),
-                    letters["c_m"],
-                ),
-            ],
+            self._across(ellipse, letters["b_m"], letters["c_m"]),
         )
 
     def _rect_section(self, painter, side, section, letters, length, width, height) -> None:
@@ -206,10 +204,7 @@ class ShapeFigure(QWidget):
             letters,
             path,
             length,
-            [
-                (QPointF(rect.left(), rect.bottom() + 8), QPointF(rect.right(), rect.bottom() + 8), width),
-                (QPointF(rect.right() + 8, rect.top()), QPointF(rect.right() + 8, rect.bottom()), height),
-            ],
+            self._across(rect, width, height),
         )
 
     def _draw_rectangular_pillar(self, painter, side, section, letters) -> None:
@@ -327,18 +322,11 @@ class ShapeFigure(QWidget):
             letters,
             pts,
             letters["length_m"],
-            [
-                (
-                    QPointF(pts[0].x(), r.bottom() + 8),
-                    QPointF(pts[2].x(), r.bottom() + 8),
-                    letters["diagonal_b_m"],
-                ),
-                (
-                    QPointF(pts[2].x() + 8, r.top()),
-                    QPointF(pts[2].x() + 8, r.bottom()),
-                    letters["diagonal_c_m"],
-                ),
-            ],
+            self._across(
+                QRectF(QPointF(pts[0].x(), r.top()), QPointF(pts[2].x(), r.bottom())),
+                letters["diagonal_b_m"],
+                letters["diagonal_c_m"],
+            ),
         )
 
     def _draw_hexagonal_pillar(self, painter, side, section, letters) -> None:
@@ -365,10 +353,7 @@ class ShapeFigure(QWidget):
             letters,
             pts,
             letters["length_m"],
-            [
-                (QPointF(r.left(), r.bottom() + 8), QPointF(r.right(), r.bottom() + 8), letters["base_m"]),
-                (QPointF(r.right() + 8, r.top()), QPointF(r.right() + 8, r.bottom()), letters["height_m"]),
-            ],
+            self._across(r, letters["base_m"], letters["height_m"]),
         )
 
     def _draw_right_triangle_pillar(self, painter, side, section, letters) -> None:
