@@ -94,7 +94,8 @@ __all__ = [
     "WriteResult",
 ]
 
-_SELECT = {Mode.TUNE: Command.TSL, Mode.SYSTEM: Command.PSL, Mode.TEST: Command.JSL}
+#: The command that selects an item of each front-panel mode before PRD/PWR.
+SELECT_COMMAND = {Mode.TUNE: Command.TSL, Mode.SYSTEM: Command.PSL, Mode.TEST: Command.JSL}
 _SENSOR_COMMANDS = {SensorName.ORIGIN: Command.SNO, SensorName.LS1: Command.SNA, SensorName.LS2: Command.SNB}
 
 
@@ -289,7 +290,7 @@ class DriveClient:
         mode = Mode(mode)
         if mode is Mode.MONITOR:
             return self.read_monitor(number)
-        select = _SELECT[mode]
+        select = SELECT_COMMAND[mode]
         self._require(select, Command.PRD)
         with self._lock:
             self._transact(select, number)
@@ -320,7 +321,7 @@ class DriveClient:
         if not item.writable:
             raise ParameterValueError(f"{item.label} is read-only")
         item.check(value)
-        select = _SELECT[item.mode]
+        select = SELECT_COMMAND[item.mode]
         self._require(select, Command.PRD, Command.PWR)
         with self._lock:
             self._transact(select, number)

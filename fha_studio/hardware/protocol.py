@@ -149,6 +149,17 @@ def command_words(command: Command | str, value: int | None = None) -> str:
     return f"{words} {value}" if value is not None and command in NUMBERED_COMMANDS else words
 
 
+def servo_on_text(command: Command | str) -> str:
+    """What a refusal ``s`` (servo on) says to a person: "the drive does not move by an angle
+    while the servo is on"."""
+    return f"the drive does not {command_words(command)} while the servo is on"
+
+
+def rejected_text(command: Command | str, value: int | None = None) -> str:
+    """What a refusal ``x`` says to a person: "the drive refused to select parameter-mode item 5"."""
+    return f"the drive refused to {command_words(command, value)}"
+
+
 #: The commands a real HA-655 is known to answer (its public manual, p.21).
 DOCUMENTED_COMMANDS = frozenset({Command.DGR, Command.OWW})
 #: Commands that only the simulated drive has (a real drive answers x).

@@ -44,7 +44,16 @@ from fha_studio.hardware.errors import (
     ReadAborted,
     ServoOnRefused,
 )
-from fha_studio.hardware.protocol import Command, Garbage, Reply, Request, Status, command_words
+from fha_studio.hardware.protocol import (
+    Command,
+    Garbage,
+    Reply,
+    Request,
+    Status,
+    command_words,
+    rejected_text,
+    servo_on_text,
+)
 from fha_studio.hardware.transport import GuardedTransport, Transport
 
 __all__ = [
@@ -271,11 +280,11 @@ class Transaction:
                     if reply.status is Status.SERVO_ON:
                         self._succeeded()
                         raise ServoOnRefused(
-                            f"the drive does not {command_words(command)} while the servo is on"
+                            servo_on_text(command)
                         )
                     if reply.status is Status.REJECTED:
                         self._succeeded()
-                        raise CommandRejected(f"the drive refused to {command_words(command, value)}")
+                        raise CommandRejected(rejected_text(command, value))
                     try:
                         result = parse(reply)
                     except ValueError as exc:

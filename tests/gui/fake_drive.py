@@ -28,6 +28,7 @@ from fha_studio.hardware.api import (
     TraceStatus,
     WriteResult,
 )
+from fha_studio.hardware.client import SELECT_COMMAND
 from fha_studio.hardware.parameters import (
     Mode,
     MonitorItem,
@@ -35,7 +36,7 @@ from fha_studio.hardware.parameters import (
     ParameterValueError,
     load_parameter_model,
 )
-from fha_studio.hardware.protocol import Command, IoBit
+from fha_studio.hardware.protocol import Command, IoBit, rejected_text, servo_on_text
 
 #: What the fake answers: the manual's commands, parameters, monitors, motion, alarms, I/O and the
 #: simulated power cycle; no trace capture and no simulated inputs or sensors.
@@ -134,7 +135,7 @@ class FakeDriveClient:
         try:
             return self.values[(mode.value, number)]
         except KeyError:
-            raise CommandRejected(f"{mode.value} {number}: no such item (x)") from None
+            raise CommandRejected(rejected_text(SELECT_COMMAND[mode], number)) from None
 
     def read_all_parameters(self, mode: Mode | str) -> dict[int, int | None]:
         values: dict[int, int | None] = {}
@@ -153,7 +154,7 @@ class FakeDriveClient:
             raise ParameterValueError(f"{item.label} is read-only")
         item.check(value)
         if mode is Mode.SYSTEM and self.servo_on:
-            raise ServoOnRefused("PWR: refused, the servo is on (not processed)")
+            raise ServoOnRefused(servo_on_text(Command.PWR))
         key = (mode.value, number)
         previous = self.values[key]
         self.values[key] = value
@@ -174,7 +175,7 @@ class FakeDriveClient:
             return round((0.5 if self.jog_speed_rpm else 0.0) / self.model.item(Mode.MONITOR, item).scale)
         if item == MonitorItem.IO_STATE:
             return self._io_bits()
-        raise CommandRejected(f"MON{item:+06d}: rejected by the drive (x)")
+        raise CommandRejected(rejected_text(Command.MON, item))
 
     def read_monitor(self, item: int) -> int:
         self._check(Command.MON)
@@ -188,13 +189,13 @@ class FakeDriveClient:
     def servo(self, on: bool) -> None:
         self._check(Command.SVO)
         if on and self.alarm_code:
-            raise CommandRejected("SVO+00001: rejected by the drive (x)")
+            raise CommandRejected(rejected_text(Command.SVO))
         self.servo_on = bool(on)
 
     def jog(self, speed_rpm: float) -> None:
         self._check(Command.JOG)
         if not self.servo_on:
-            raise CommandRejected("JOG: rejected by the drive (x)")
+            raise CommandRejected(rejected_text(Command.JOG))
         self.calls.append(("jog", speed_rpm))
         self.jog_speed_rpm = speed_rpm
         self.jog_until = time.monotonic() + p.JOG_HOLD_S
@@ -208,7 +209,7 @@ class FakeDriveClient:
     def move_by(self, angle_deg: float) -> None:
         self._check(Command.MOV)
         if not self.servo_on:
-            raise CommandRejected("MOV: rejected by the drive (x)")
+            raise CommandRejected(rejected_text(Command.MOV))
         self.position_pulse += angle_deg / 360 * 1_000_000
 
     def stop(self) -> None:
@@ -234,7 +235,7 @@ class FakeDriveClient:
     def clear_alarm(self) -> None:
         self._check(Command.ACL)
         if self.alarm_code not in (0, 20, 60):
-            raise CommandRejected("ACL: rejected by the drive (x): needs a power cycle")
+            raise CommandRejected(f"{rejected_text(Command.ACL)}: it needs a power cycle")
         self.alarm_code = 0
 
     def _io_bits(self) -> int:
@@ -261,7 +262,7 @@ class FakeDriveClient:
     def power_cycle(self) -> None:
         self._check(Command.PWC)
         if self.servo_on:
-            raise ServoOnRefused("PWC: refused, the servo is on (not processed)")
+            raise ServoOnRefused(servo_on_text(Command.PWC))
         self.effective = dict(self.values)
         self.alarm_code = 0
 
@@ -280,13 +281,13 @@ class FakeDriveClient:
     def absolute_position(self) -> int:
         self._check(Command.DGR)
         if self.servo_on:
-            raise ServoOnRefused("DGR: refused, the servo is on (not processed)")
+            raise ServoOnRefused(servo_on_text(Command.DGR))
         return int(self.position_pulse)
 
     def clear_multiturn(self) -> None:
         self._check(Command.OWW)
         if self.servo_on:
-            raise CommandRejected("OWW: rejected by the drive (x)")
+            raise CommandRejected(rejected_text(Command.OWW))
 
     # --- trace capture (not modelled: a drive without the extension) --------------------------
     def configure_trace(
