@@ -2,14 +2,55 @@
 
 from __future__ import annotations
 
+import datetime as _dt
 import os
 import threading
 import time
 
 import pytest
 
+from fha_studio import clock
+
 # GUI tests run headless; the environment can override (e.g. xcb under xvfb-run).
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+# FHA_TEST_TRAVEL_DAYS=400 (or -400) runs the whole session with the calendar moved that far
+# (time.time, datetime.now, date.today; the monotonic clock is untouched): a test that holds only
+# on today's date fails.
+_travel = None
+
+
+def pytest_configure(config):
+    global _travel
+    days = os.environ.get("FHA_TEST_TRAVEL_DAYS", "").strip()
+    if days:
+        import time_machine
+
+        start = _dt.datetime.now(_dt.UTC) + _dt.timedelta(days=float(days))
+        _travel = time_machine.travel(start, tick=True)
+        _travel.start()
+
+
+def pytest_unconfigure(config):
+    global _travel
+    if _travel is not None:
+        _travel.stop()
+        _travel = None
+
+
+def pytest_report_header(config):
+    if _travel is not None:
+        days = os.environ["FHA_TEST_TRAVEL_DAYS"]
+        return f"calendar moved {days} days: today is {_dt.datetime.now(_dt.UTC):%Y-%m-%d}"
+    return None
+
+
+@pytest.fixture
+def fixed_clock():
+    """The one clock every stamp reads (fha_studio.clock), standing at 2026-11-30 07:00 UTC
+    until the test sets or advances it; the calendar's clock returns afterwards."""
+    with clock.use(clock.FixedClock("2026-11-30T07:00:00Z")) as fixed:
+        yield fixed
 
 
 @pytest.fixture(autouse=True)

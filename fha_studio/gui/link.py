@@ -22,6 +22,7 @@ from typing import Any, TypedDict
 
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
+from fha_studio import clock
 from fha_studio.hardware.api import (
     AlarmRecord,
     CommandNotSupported,
@@ -447,7 +448,7 @@ class LinkWorker(QObject):
         done: list[WriteEntry] = []
         for mode, number, value in writes:
             entry: WriteEntry = {
-                "time": time.time(),
+                "time": clock.now_s(),
                 "mode": mode,
                 "number": number,
                 "new": value,

@@ -24,6 +24,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio import clock
+
 #: Most messages kept in the log (oldest dropped first).
 MESSAGE_LOG_LENGTH = 500
 
@@ -81,7 +83,7 @@ class MessageArea(QFrame):
     @Slot(str)
     def show_message(self, text: str, level: Level = Level.INFO) -> Message:
         """Show ``text`` (one line; the full text is in the tooltip and the log) and keep it."""
-        message = Message(time.time(), level, " ".join(str(text).split()))
+        message = Message(clock.now_s(), level, " ".join(str(text).split()))
         self.messages.append(message)
         del self.messages[:-MESSAGE_LOG_LENGTH]
         self.text_label.setText(f"{message.clock}  {message.text}")

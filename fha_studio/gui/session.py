@@ -5,13 +5,12 @@ writing parameters with the automatic backup before the first write. What is kno
 
 from __future__ import annotations
 
-import datetime as _dt
 import logging
 from pathlib import Path
 
 from PySide6.QtCore import QObject, QStandardPaths, Signal, Slot
 
-from fha_studio import fileio
+from fha_studio import clock, fileio
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.link import Cmd, CommandResult, LinkController, LinkInfo
 from fha_studio.gui.state import AxisState
@@ -34,7 +33,7 @@ def data_dir() -> Path:
 
 def new_axis_state(parent: QObject | None = None) -> AxisState:
     """A commissioning state whose write log goes to a new file in the data directory."""
-    stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    stamp = clock.file_stamp()
     log = SessionLog(data_dir() / "sessions" / f"session-{stamp}.jsonl")
     return AxisState(CommissioningState(write_log=log), parent)
 
@@ -118,7 +117,7 @@ class Session(QObject):
 
     def write_backup(self) -> Path:
         """Saves the drive's values as read before the first write of the session."""
-        stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+        stamp = clock.file_stamp()
         directory = data_dir() / "backups"
         directory.mkdir(parents=True, exist_ok=True)
         base = f"backup-{self.state.actuator_code or 'unknown-actuator'}-{stamp}"

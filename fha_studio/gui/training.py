@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import html
 import tempfile
-import time
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +31,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio import clock
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
 from fha_studio.hardware.sim.options import TrainingRegistration, forget_training, register_training
@@ -92,7 +92,7 @@ class TrainingController(QObject):
         self._end_registration()
         self._registration = register_training(scenario.sim_options())
         self.scenario, self.trainee = scenario, trainee.strip()
-        self.started_s = time.time()
+        self.started_s = clock.now_s()
         self._effects = []
         self.last_sheet = None
         self.draft_findings = ""
@@ -119,7 +119,7 @@ class TrainingController(QObject):
     @Slot(object)
     def _on_model_check(self, result: object) -> None:
         if self.running:
-            now = time.time()
+            now = clock.now_s()
             self._effects.extend((e.id, now) for e in getattr(result, "effects", []))
 
     def record(self, findings: str = "") -> TraineeRecord:
@@ -129,11 +129,11 @@ class TrainingController(QObject):
         page = self.window.built_page(PageId.MODELCHECK)
         result = getattr(page, "result", None) if page is not None else None
         if result is not None and not effects:  # a check run before this controller could listen
-            effects = [(e.id, time.time()) for e in result.effects]
+            effects = [(e.id, clock.now_s()) for e in result.effects]
         procedures = self.window.built_page(PageId.PROCEDURES)
         return TraineeRecord(
             started_s=self.started_s,
-            ended_s=time.time(),
+            ended_s=clock.now_s(),
             journal=self._registration.journal.entries(),
             session=getattr(procedures, "session", None),
             model_check_effects=effects,
@@ -276,7 +276,7 @@ class RunningDialog(QDialog):
         scenario = self.controller.scenario
         if scenario is None:
             return
-        seconds = max(0, round(time.time() - self.controller.started_s))
+        seconds = max(0, round(clock.now_s() - self.controller.started_s))
         self.clock.setText(
             f"Time so far: {seconds // 60} min {seconds % 60:02d} s (guide {scenario.time_guide_min:g} min)"
         )

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from datetime import datetime
 from typing import Any
 
+from fha_studio import clock
 from fha_studio.catalog import ModelCodeError, parse_model_code
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.api import Capabilities, DriveApi
@@ -221,7 +221,7 @@ CHECK_TITLES = {
 
 
 def now_text() -> str:
-    return datetime.now().astimezone().isoformat(timespec="seconds")
+    return clock.local_iso()
 
 
 def encoder_check(before: int, after: int, turned_deg: float, ratio: int

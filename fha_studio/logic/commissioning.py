@@ -14,7 +14,6 @@ is an ordinary object, never a module-level singleton.
 
 from __future__ import annotations
 
-import datetime as _dt
 import enum
 import math
 import types
@@ -23,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from fha_studio import clock
 from fha_studio.hardware.parameters import driver_family
 from fha_studio.logic.session_log import SessionLog, WriteRecord
 
@@ -78,7 +78,7 @@ def driver_supply_voltage_v(driver_model: str) -> int | None:
 
 
 def _now() -> str:
-    return _dt.datetime.now().astimezone().isoformat(timespec="seconds")
+    return clock.local_iso()
 
 
 Listener = Callable[[Change], None]

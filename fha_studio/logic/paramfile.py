@@ -26,6 +26,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from fha_studio import clock
 from fha_studio.hardware.parameters import ParameterItem, ParameterModel
 
 FORMAT = "fha-parameters/1"
@@ -67,7 +68,7 @@ def dump_parameter_file(
     ``front_panel`` ({(mode, number): entry with ``who`` and ``time``}) marks the values that were
     entered from the drive's front panel (a drive without parameter access over CN3): the file
     says so in its ``source`` line and beside each such value."""
-    saved = saved or _dt.datetime.now(_dt.UTC)
+    saved = saved or clock.now_utc()
     front_panel = front_panel or {}
     lines = [
         "# FHA Studio parameter file: the tune and parameter (system) values of a HA-655/HA-675 driver.",

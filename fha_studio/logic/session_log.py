@@ -3,12 +3,11 @@ value, verified or not), kept as JSON lines so the commissioning report can prin
 
 from __future__ import annotations
 
-import datetime as _dt
 import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from fha_studio import fileio
+from fha_studio import clock, fileio
 from fha_studio.hardware.parameters import MODE_WORDS, Mode, ParameterItem
 
 
@@ -62,7 +61,7 @@ class SessionLog:
 
     @staticmethod
     def now() -> str:
-        return _dt.datetime.now().astimezone().isoformat(timespec="seconds")
+        return clock.local_iso()
 
     @classmethod
     def read(cls, path: Path) -> SessionLog:

@@ -10,7 +10,8 @@ from fha_studio.logic.register import Register
 
 
 @pytest.fixture
-def filled(tmp_path):
+def filled(tmp_path, fixed_clock):
+    # the axes are added at the clock's 07:00, before the stamped snapshots and the write
     reg = Register(tmp_path / "r.sqlite")
     reg.add_machine("Cell 2")
     for name in ("x", "x twin", "z"):

@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
 )
 
+from fha_studio import clock
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
@@ -222,7 +223,7 @@ class AlarmsPage(BasePage):
             lines.append(f"The lamps (D C B A = {bits:04b}) do not match alarm {code} ({alarm.alm_code}); "
                          f"they belong to {', '.join(map(str, same)) or 'no alarm of the table'}. "
                          "Read both again.")
-        entry = {"code": code, "alm_bits": bits, "time": time.time()}
+        entry = {"code": code, "alm_bits": bits, "time": clock.now_s()}
         self.panel_entries.insert(0, entry)
         self.current_code = code
         self._show(code)
@@ -250,7 +251,7 @@ class AlarmsPage(BasePage):
             return
         previous, self.current_code = self.current_code, code
         if code:
-            self._appeared_at[code] = time.time() if previous is not None else 0.0
+            self._appeared_at[code] = clock.now_s() if previous is not None else 0.0
             self.unacknowledged = code
             self.sigAlarmAttention.emit(code, True)
             self.link.send(Cmd.ALARM_HISTORY)

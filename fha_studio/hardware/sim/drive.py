@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import __version__ as _version
+from fha_studio import clock
 from fha_studio.hardware.parameters import (
     Mode,
     MonitorItem,
@@ -860,7 +861,7 @@ class SimDrive:
         state = before if before is not None else self._journal_state()
         item = state["item"]
         self.journal.append(JournalEntry(
-            at_s=time.time(), command=name, value=int(value), terminal=terminal,
+            at_s=clock.now_s(), command=name, value=int(value), terminal=terminal,
             item=(str(item[0]), int(item[1])) if item is not None else None,
             servo_on=state["servo_on"], brake_holding=state["brake_holding"],
             blocked_fwd=state["blocked_fwd"], blocked_rev=state["blocked_rev"],

@@ -8,8 +8,9 @@ new :class:`SimDrive` that writes on in the same journal.
 from __future__ import annotations
 
 import threading
-import time
 from dataclasses import dataclass
+
+from fha_studio import clock
 
 
 @dataclass(frozen=True)
@@ -36,7 +37,7 @@ class Journal:
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._entries: list[JournalEntry] = []
-        self.started_s = time.time()
+        self.started_s = clock.now_s()
 
     def append(self, entry: JournalEntry) -> None:
         with self._lock:

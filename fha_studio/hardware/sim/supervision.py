@@ -5,8 +5,8 @@ the checks made every :data:`SUPERVISION_PERIOD_S` (10 over speed, 20 overload b
 from __future__ import annotations
 
 from dataclasses import dataclass
-from datetime import UTC, datetime
 
+from fha_studio import clock
 from fha_studio.hardware.parameters import AlarmTable
 from fha_studio.hardware.sim.constants import SimConstants
 from fha_studio.hardware.sim.reply import rejected
@@ -76,7 +76,7 @@ class AlarmSupervisor:
         if self.code:
             return False
         self.code = code
-        stamp = datetime.now(UTC).isoformat(timespec="seconds")
+        stamp = clock.now_utc().isoformat(timespec="seconds")
         self.history.insert(0, SimAlarmRecord(code, time_s, stamp))
         del self.history[self.constants.alarm_history_length:]
         return True

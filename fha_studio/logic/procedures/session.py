@@ -12,11 +12,10 @@ import json
 import math
 import os
 from dataclasses import asdict, dataclass, field
-from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from fha_studio import fileio, plausible
+from fha_studio import clock, fileio, plausible
 
 FORMAT = "fha-session/1"
 #: Bound on a session file's size: a fully walked session is some tens of kB.
@@ -32,7 +31,7 @@ class SessionError(ValueError):
 
 def utc_now() -> str:
     """Now, UTC, ISO 8601 to the second."""
-    return datetime.now(UTC).replace(microsecond=0).isoformat()
+    return clock.utc_iso()
 
 
 @dataclass

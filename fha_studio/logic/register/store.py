@@ -28,6 +28,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
+from fha_studio import clock
 from fha_studio.logic.register.schema import MIGRATIONS, SCHEMA_VERSION
 from fha_studio.paths import user_data_dir
 
@@ -61,7 +62,7 @@ def utc_stamp(when: str | _dt.datetime | None = None) -> str:
     order). ``when`` may be ISO text with an offset (a naive time is taken as UTC) or a datetime;
     None is now. Raises RegisterError for text that is not a time."""
     if when is None:
-        moment = _dt.datetime.now(_dt.UTC)
+        moment = clock.now_utc()
     elif isinstance(when, _dt.datetime):
         moment = when
     else:

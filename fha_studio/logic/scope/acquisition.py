@@ -32,6 +32,7 @@ from enum import Enum
 
 import numpy as np
 
+from fha_studio import clock
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.api import Capabilities, CapabilityLevel, DriveApi, TraceStatus
 from fha_studio.hardware.errors import (
@@ -395,7 +396,7 @@ class TraceResult:
     sample_rate_hz: float
     pre_trigger: int
     trigger: str
-    captured_at: float  # wall clock (time.time()) of the read-out
+    captured_at: float  # wall clock (clock.now_s()) of the read-out
     method: str = "trace"  # "trace" (drive-side) or "polling" (host-side, uneven)
 
     def column(self, key: str) -> np.ndarray:
@@ -488,7 +489,7 @@ class TraceAcquisition:
         rate = self.actual_rate_hz(settings)
         t = (np.arange(len(values)) - settings.pre_trigger) / rate
         return TraceResult(settings.channels, t, values, rate, settings.pre_trigger,
-                           settings.trigger.describe(), time.time())
+                           settings.trigger.describe(), clock.now_s())
 
 
 # --- the built-in tests: move and step response ------------------------------------------------------
@@ -700,7 +701,7 @@ class MoveTest:
             rows = poller.ring.window().copy()
             t = rows[:, 0] - rows[0, 0]
             capture = TraceResult(tuple(poller.channels), t, rows[:, 1:], poller.rate_hz, 0,
-                                  "polled around the MOV", time.time(), "polling")
+                                  "polled around the MOV", clock.now_s(), "polling")
             self._analyse(capture)
 
     def _analyse(self, capture: TraceResult) -> None:

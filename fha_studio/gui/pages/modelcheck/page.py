@@ -32,7 +32,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio import fileio
+from fha_studio import clock, fileio
 from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.state import AxisState
 from fha_studio.logic.modelcheck import ModelCheckError, ModelCheckResult, run_modelcheck
@@ -323,7 +323,7 @@ class ModelCheckPage(BasePage):
         folder = Path(QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation))
         folder = folder / "captures"
         folder.mkdir(parents=True, exist_ok=True)
-        path = view.save_capture(folder / f"capture-{time.strftime('%Y%m%d-%H%M%S')}.csv")
+        path = view.save_capture(folder / f"capture-{clock.file_stamp()}.csv")
         self._set_recording(read_recording(path), f"the scope's capture ({path})")
         self.recording_path = Path(path)
         return path
