@@ -20,18 +20,18 @@ URL = f"sim://FHA-25C-50-US250?paced=0&load_inertia=0.5&effects=coulomb_friction
 
 
 def _back_and_forth(client) -> None:
-    """Runs in the link thread: servo on, +90 deg then -90 deg at 20 r/min, waiting in between."""
+    """Runs in the link thread: servo on, +90 deg then -90 deg at 20 r/min, each move until the
+    drive says the output stands still (the moving bit clears after its standstill time)."""
     import time
 
     client.servo(True)
     client.set_move_speed(20.0)
     for angle in (90.0, -90.0):
-        client.move_by(angle)
-        deadline = time.monotonic() + 3.0
-        time.sleep(0.05)
-        while client.io_state().moving and time.monotonic() < deadline:
-            time.sleep(0.02)
-        time.sleep(0.15)
+        client.move_by(angle)  # the moving bit is set with the command
+        deadline = time.monotonic() + 30.0  # only a hang: a move takes about 1 s
+        while client.io_state().moving:
+            assert time.monotonic() < deadline, f"a {angle} deg move at 20 r/min still runs after 30 s"
+            time.sleep(0.02)  # a look at the bit every 20 ms, not a hold of the motion
 
 
 def capture_a_move(window, qtbot) -> None:

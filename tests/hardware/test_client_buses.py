@@ -5,8 +5,9 @@ The same tests talk to the simulated drive embedded in this process (``sim://``)
 another process (a pseudo-terminal). Each subprocess is started once per module. Every test
 leaves the drive as it found it (servo off, no alarm, inputs released, values restored).
 
-The jog loop repeats JOG every 50 ms like a held jog button; that pacing is the behaviour under
-test (the drive's 100 ms watchdog), not a wait for a condition.
+The held jog repeats JOG on every pass of its loop (one read of the monitors a pass, a few ms)
+and stops when the monitors show the motion, not after a time: a pass that comes late on a loaded
+machine lets the drive's 100 ms watchdog stop the axis, and the next JOG starts it again.
 """
 
 from __future__ import annotations
@@ -37,6 +38,8 @@ from fha_studio.hardware.parameters import Mode, MonitorItem
 ROOT = Path(__file__).resolve().parents[2]
 #: An absolute-encoder actuator, so that DGR answers a position.
 ACTUATOR = "FHA-25C-50-S248"
+#: Only a hang takes this long: the output reaches the jog speed within some 0.1 s.
+HELD_JOG_LIMIT_S = 15.0
 BUSES = ["sim", pytest.param("tcp", marks=pytest.mark.e2e), pytest.param("pty", marks=pytest.mark.e2e)]
 
 
@@ -130,19 +133,19 @@ def test_the_servo_on_refuses_parameter_mode_writes_and_dgr(drive):
 
 
 def test_a_held_jog_moves_the_output_and_the_monitors_see_it(drive):
+    items = [MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.IO_STATE]
+    speed = drive.model.item(Mode.MONITOR, MonitorItem.OUTPUT_SPEED)
     start = drive.read_monitors([MonitorItem.FEEDBACK_POSITION])[MonitorItem.FEEDBACK_POSITION]
     drive.servo(True)
-    end = time.monotonic() + 0.5
-    while time.monotonic() < end:
+    deadline = time.monotonic() + HELD_JOG_LIMIT_S
+    while True:  # the button held: JOG again on every pass, each pass one read of the monitors
         drive.jog(30.0)
-        time.sleep(0.05)
-    values = drive.read_monitors(
-        [MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.IO_STATE]
-    )
+        values = drive.read_monitors(items)
+        turning_rpm = speed.to_unit(values[MonitorItem.OUTPUT_SPEED])
+        if values[MonitorItem.FEEDBACK_POSITION] > start and turning_rpm > 25:
+            break
+        assert time.monotonic() < deadline, f"a jog held {HELD_JOG_LIMIT_S} s: {turning_rpm:g} r/min"
     drive.stop()
-    assert values[MonitorItem.FEEDBACK_POSITION] > start
-    speed = drive.model.item(Mode.MONITOR, MonitorItem.OUTPUT_SPEED)
-    assert speed.to_unit(values[MonitorItem.OUTPUT_SPEED]) > 1
     assert IoState(values[MonitorItem.IO_STATE]).servo_on
 
 

@@ -1,4 +1,5 @@
-"""Fixtures of the simulated-drive tests: drives in stepped mode, closed after each test."""
+"""Fixtures of the simulated-drive tests: drives in stepped mode, closed after each test; the
+clock of a stepped drive behind a client."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import dataclasses
 
 import pytest
 
+from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.sim import SimDrive
 from fha_studio.hardware.sim.constants import load_sim_constants
 
@@ -36,3 +38,10 @@ def jog_for(drive: SimDrive, speed_rpm: float, seconds: float, repeat_s: float =
         step = min(repeat_s, seconds - t)
         drive.advance(step)
         t += step
+
+
+def advance(client: DriveClient, seconds: float) -> None:
+    """Let ``seconds`` of drive time pass on the stepped drive behind a client of
+    ``sim://...?stepped=1`` (its time stands still otherwise, however loaded the machine)."""
+    port = client.transaction.transport.inner
+    port.sim_drive.advance(seconds)

@@ -94,8 +94,7 @@ def test_a_sim_in_another_process_offers_packed_trace_blocks_unless_told_not_to(
             deadline = time.monotonic() + 20
             while client.trace_status().state is not p.TraceState.DONE:
                 assert time.monotonic() < deadline, "the capture did not finish"
-                client.jog(20.0)
-                time.sleep(0.02)
+                client.jog(20.0)  # held: JOG again on every look at the capture
             seen = []
             capture = client.read_trace(progress=lambda done, total: seen.append((done, total)))
         assert len(capture.samples) == 200 and seen[0] == (0, 200) and seen[-1] == (200, 200)

@@ -1,7 +1,8 @@
 """End to end: ``fha-studio sim --pty --unpaced`` in its own process, DriveClient over the pty.
 
-The jog loops repeat JOG every 50 ms like a held jog button; that pacing is the behaviour under
-test (the drive's 100 ms watchdog), not a wait for a condition.
+The jog loops repeat JOG on every pass (a held jog button) until the drive shows what the test
+waits for, not for a time: a pass that comes late on a loaded machine lets the drive's 100 ms
+watchdog stop the axis, and the next JOG starts it again. Only a hang takes LIMIT_S.
 """
 
 from __future__ import annotations
@@ -67,11 +68,20 @@ def sim(tmp_path_factory):
     assert proc.returncode == 0  # SIGTERM ends it cleanly (EEPROM saved, threads stopped)
 
 
-def jog(client: DriveClient, speed_rpm: float, seconds: float) -> None:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
+#: Only a hang takes this long (a jog turns the output 1000 pulses in some 0.1 s).
+LIMIT_S = 15.0
+
+
+def jog_until_moved(client: DriveClient, speed_rpm: float, pulses: int) -> int:
+    """Hold a jog until the load encoder (monitor 107) has counted ``pulses`` either way, then
+    STOP; returns the count it moved."""
+    start = client.read_monitor(107)
+    deadline = time.monotonic() + LIMIT_S
+    while abs(moved := client.read_monitor(107) - start) < pulses:
+        assert time.monotonic() < deadline, f"a jog held {LIMIT_S} s moved {moved} pulses"
         client.jog(speed_rpm)
-        time.sleep(0.05)
+    client.stop()
+    return moved
 
 
 def test_reads_every_parameter_and_monitor(sim):
@@ -95,16 +105,12 @@ def test_writes_rotary_direction_and_reads_it_back(sim):
 
 def test_jog_turns_the_way_the_rotary_direction_says(sim):
     sim.servo(True)
-    start = sim.read_monitor(107)  # the load encoder: CW seen from the flange counts up
-    jog(sim, 10.0, 0.4)
-    assert sim.read_monitor(107) > start + 1000
+    assert jog_until_moved(sim, 10.0, 1000) > 0  # the load encoder: CW seen from the flange counts up
     sim.servo(False)
     sim.write_parameter(Mode.SYSTEM, 8, 1)
     sim.power_cycle()
     sim.servo(True)
-    start = sim.read_monitor(107)
-    jog(sim, 10.0, 0.4)
-    assert sim.read_monitor(107) < start - 1000
+    assert jog_until_moved(sim, 10.0, 1000) < 0
     sim.servo(False)
     sim.write_parameter(Mode.SYSTEM, 8, 0)
     sim.power_cycle()
@@ -114,13 +120,12 @@ def test_raises_and_clears_an_alarm(sim):
     previous = sim.read_parameter(Mode.SYSTEM, 6)
     sim.write_parameter(Mode.SYSTEM, 6, 1)  # error allowance 100 pulses
     sim.servo(True)
-    deadline = time.monotonic() + 3.0
-    while sim.alarm() == 0 and time.monotonic() < deadline:
+    deadline = time.monotonic() + LIMIT_S
+    while sim.alarm() == 0 and time.monotonic() < deadline:  # held until the alarm
         try:
             sim.jog(40.0)
         except CommandRejected:
             break
-        time.sleep(0.05)
     assert sim.alarm() == 60
     assert sim.io_state().alm_bits == 0b0010
     sim.clear_alarm()

@@ -139,3 +139,17 @@ def test_oww_acknowledges_later_through_the_url_in_real_time(tmp_path):
         assert port.read(2) == b"x\r"  # repeated before the first q
         port.timeout = 2.0
         assert port.read(2) == b"q\r"
+
+
+def test_a_stepped_url_drive_takes_only_the_time_its_holder_gives_it(tmp_path):
+    register_url_handler()
+    url = f"sim://FHA-25C-50-S248?paced=0&stepped=1&oww_clear_s=0.2&eeprom={tmp_path / 'e.json'}"
+    with serial.serial_for_url(url, timeout=0.3) as port:
+        drive = port.sim_drive
+        assert not drive.running  # no real-time thread
+        port.write(b"OWW+00000\r")
+        assert port.read(2) == b""  # 0.3 s of wall clock: no drive time has passed
+        drive.advance(0.19)
+        assert port.read(2) == b""
+        drive.advance(0.02)
+        assert port.read(2) == b"q\r"  # the multi-turn data cleared after 0.2 s of drive time

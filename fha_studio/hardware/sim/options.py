@@ -20,6 +20,10 @@ Options (all optional):
 ``eeprom``         EEPROM file; ``user`` = the user data directory; default: a temporary file
                    removed when the drive closes
 ``paced``          1 (default): replies paced like a 19200 baud line; 0: at memory speed
+``stepped``        0 (default): the drive runs in real time in its own thread; 1: its time
+                   stands still until the port's holder advances it
+                   (``port.sim_drive.advance(seconds)``), so a test holds a motion for exactly
+                   that much drive time however loaded the machine is
 ``quantised``      1 (default): the servo loops see whole encoder pulses (a real drive's current
                    noise); 0: ideal feedback
 ``oww_clear_s``    how long OWW takes to clear the multi-turn data [s] (default 5)
@@ -83,6 +87,8 @@ class SimConfig:
     effects: dict[str, dict[str, float]] = field(default_factory=dict)
     eeprom: str | None = None
     paced: bool = True
+    #: the drive's time advances only by SimDrive.advance (no real-time thread)
+    stepped: bool = False
     quantised: bool = True
     oww_clear_s: float | None = None
     packed_trace: bool = True
@@ -258,7 +264,7 @@ def public_url(url: str) -> str:
 
 _URL_KEYS = {
     "driver", "load_inertia", "load_inertia_kgm2", "brake", "sensors", "origin_deg", "ls1_deg",
-    "ls2_deg", "effects", "effect", "eeprom", "paced", "quantised", "oww_clear_s",
+    "ls2_deg", "effects", "effect", "eeprom", "paced", "stepped", "quantised", "oww_clear_s",
     "packed_trace", "profile", "wiring", "brake_supply", "battery", "preset", "training",
 }
 
@@ -295,7 +301,7 @@ def config_from_url(url: str) -> SimConfig:
     inertia = last("load_inertia_kgm2") if last("load_inertia_kgm2") is not None else last("load_inertia")
     if inertia is not None:
         values["load_inertia_kgm2"] = _ranged("load_inertia", inertia, plausible.LOAD_INERTIA_KGM2)
-    for key in ("brake", "sensors", "paced", "quantised", "packed_trace"):
+    for key in ("brake", "sensors", "paced", "stepped", "quantised", "packed_trace"):
         flag = last(key)
         if flag is not None:
             values[key] = _flag(key, flag)

@@ -4,7 +4,9 @@
 once ``fha_studio.hardware.sim`` is in ``serial.protocol_handler_packages`` (the transport layer
 registers it; :func:`fha_studio.hardware.sim.register_url_handler` does it too). Options: see
 :mod:`fha_studio.hardware.sim.options`. The drive runs in real time in its own thread from
-``open()`` to ``close()``; every byte goes through the CN3 codec (no shortcut around the protocol).
+``open()`` to ``close()`` (with ``stepped=1`` its time stands still until the holder calls
+``port.sim_drive.advance(seconds)``); every byte goes through the CN3 codec (no shortcut around
+the protocol).
 
 ``port.sim_drive`` is the SimDrive (for a training GUI that wants to show the hidden state).
 """
@@ -47,7 +49,8 @@ class Serial(SerialBase):
         self.sim_drive = drive
         # paced at the CN3 rate whatever the host asked for: the line is the drive's
         self.sim_server = SimProtocolServer(drive, paced=config.paced)
-        drive.start()
+        if not config.stepped:
+            drive.start()
         self.is_open = True
 
     def close(self) -> None:
