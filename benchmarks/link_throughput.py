@@ -93,7 +93,7 @@ def trace_rate(port: serial.Serial, mask: int, samples: int, command: str = "TRB
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("--seconds", type=float, default=3.0, help="duration of each rate measurement")
     args = parser.parse_args()
     mmr = f"MMR+{p.monitor_mask([100, 101, 103, 104]) if hasattr(p, 'monitor_mask') else 0b11011:05d}\r"

@@ -109,7 +109,7 @@ def measure(seconds: float, startup_runs: int, load: float, repeat: int = 3) -> 
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("--seconds", type=float, default=6.0,
                         help="measuring time per polling/drawing case [s]")
     parser.add_argument("--startup-runs", type=int, default=5, help="fresh GUI processes for the start-up")

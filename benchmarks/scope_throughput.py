@@ -212,7 +212,7 @@ def isolate_settings() -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("--seconds", type=float, default=10.0, help="measuring time per case [s]")
     parser.add_argument("--switch-interval", type=float, default=None,
                         help="sys.setswitchinterval for the run [s] (default: the GUI's, "

@@ -56,7 +56,7 @@ def speedup(samples: int = 1024) -> dict:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("--samples", type=int, default=1024, help="samples per capture (4 channels)")
     args = parser.parse_args()
     r = speedup(args.samples)

@@ -14,7 +14,7 @@ import os
 import pkgutil
 import sys
 from collections.abc import Sequence
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from fha_studio.fileio import FileProblem, os_reason
 
@@ -24,7 +24,15 @@ class CliError(Exception):
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """An argument parser whose refusal is one line (what, and what is allowed), exit status 2."""
+    """An argument parser whose refusal is one line (what, and what is allowed), exit status 2.
+
+    Options are taken only as written: argparse's prefix matching (``--model`` taken as
+    ``--model-out``) would let a mistyped flag overwrite a file, so it is off (``allow_abbrev``).
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs["allow_abbrev"] = False
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")

@@ -56,7 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "else register.sqlite in the user data directory)",
     )
     p.add_argument("--json", action="store_true", help="print JSON")
-    common = argparse.ArgumentParser(add_help=False)
+    common = argparse.ArgumentParser(add_help=False, allow_abbrev=False)
     # also accepted after the action; SUPPRESS keeps the action from resetting what came before it
     common.add_argument("--db", type=Path, metavar="FILE", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     common.add_argument("--json", action="store_true", default=argparse.SUPPRESS, help="print JSON")

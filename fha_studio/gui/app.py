@@ -7,7 +7,7 @@ import logging
 import sys
 import time
 from collections.abc import Sequence
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.session import DEFAULT_SIM_URL
@@ -27,7 +27,12 @@ BAUD_RATES = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
 
 
 class _OneLineParser(argparse.ArgumentParser):
-    """A refusal is one line saying what is allowed, exit status 2 (as the CLI's)."""
+    """A refusal is one line saying what is allowed, exit status 2 (as the CLI's); options only
+    as written (no prefix matching, as the CLI's)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs["allow_abbrev"] = False
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see fha-studio gui --help)\n")
