@@ -14,12 +14,15 @@ from __future__ import annotations
 import signal
 import sys
 import threading
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fha_studio import plausible
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.cli import CliError
 from fha_studio.cli._values import in_range, output_path, tcp_port, text
+
+if TYPE_CHECKING:
+    from fha_studio.hardware.sim.responder import SimResponder
 
 ORDER = 30
 
@@ -121,7 +124,7 @@ def run(args: Any) -> int:
                 raise CliError(f"--record: {exc}") from None
         drive.start()
         if args.panel:
-            threading.Thread(target=_panel, args=(drive, sys.stdin, stop), name="sim-panel",
+            threading.Thread(target=_panel, args=(server.responder, sys.stdin, stop), name="sim-panel",
                              daemon=True).start()
         if args.pty:
             serve_pty(server, stop, announce)
@@ -137,8 +140,9 @@ def run(args: Any) -> int:
     return 0
 
 
-def panel_line(drive: Any, line: str) -> str:
-    """Do one line of ``--panel`` input on ``drive``; returns what happened (one line)."""
+def panel_line(sim: SimResponder, line: str) -> str:
+    """Do one line of ``--panel`` input on the drive behind ``sim`` (which journals what a training
+    drive is done to); returns what happened (one line)."""
     from fha_studio.hardware import protocol
     from fha_studio.hardware.sim import SimRefused
 
@@ -146,19 +150,19 @@ def panel_line(drive: Any, line: str) -> str:
     try:
         match words:
             case ["servo", ("on" | "off") as state]:
-                drive.set_servo(state == "on")
+                sim.set_servo(state == "on")
                 return f"servo {state} (CN2)"
             case ["fwd" | "rev" as sense, angle]:
                 sign = 1.0 if sense == "fwd" else -1.0
-                drive.controller_command(sign * float(angle))
+                sim.controller_command(sign * float(angle))
                 return f"controller: {sense.upper()} {float(angle):g} deg"
             case ["turn", angle]:
-                drive.turn_by_hand(float(angle))
+                sim.turn_by_hand(float(angle))
                 return f"turned by hand by {float(angle):g} deg"
             case ["brake", ("release" | "hold") as state]:
                 bit = 1 << protocol.IoBit.BRAKE_RELEASED
-                mask = drive.io_bits() & protocol.INPUT_MASK & ~bit
-                drive.set_inputs(mask | (bit if state == "release" else 0))
+                mask = sim.drive.io_bits() & protocol.INPUT_MASK & ~bit
+                sim.drive.set_inputs(mask | (bit if state == "release" else 0))
                 return f"brake {'released' if state == 'release' else 'holds'}"
             case []:
                 return ""
@@ -169,10 +173,10 @@ def panel_line(drive: Any, line: str) -> str:
     return f"not understood: {line.strip()!r} (servo on|off, fwd DEG, rev DEG, turn DEG, brake release|hold)"
 
 
-def _panel(drive: Any, stream: Any, stop: threading.Event) -> None:
+def _panel(sim: SimResponder, stream: Any, stop: threading.Event) -> None:
     for line in stream:
         if stop.is_set():
             return
-        answer = panel_line(drive, line)
+        answer = panel_line(sim, line)
         if answer:
             print(f"# {answer}", file=sys.stderr, flush=True)

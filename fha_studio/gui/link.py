@@ -570,20 +570,21 @@ class LinkWorker(QObject):
 
     def _do_sim_panel(self, action: SimPanelAction, value: Any) -> str:
         """Do what the embedded simulated drive's panel asks; one line saying what happened."""
-        drive = _embedded_sim(self.client)
-        if drive is None:
+        sim = _embedded_sim(self.client)
+        if sim is None:
             raise NotConnected("this is not an embedded simulated drive: it has no panel")
         from fha_studio.hardware.sim import SimRefused
 
+        drive = sim.drive
         try:
             if action is SimPanelAction.SERVO:
-                drive.set_servo(bool(value))
+                sim.set_servo(bool(value))
                 return f"servo-ON input (CN2) {'on' if value else 'off'}"
             if action is SimPanelAction.COMMAND:
-                drive.controller_command(float(value))
+                sim.controller_command(float(value))
                 return f"controller: {'FWD' if value > 0 else 'REV'} command of {abs(float(value)):g}°"
             if action is SimPanelAction.TURN_BY_HAND:
-                drive.turn_by_hand(float(value))
+                sim.turn_by_hand(float(value))
                 text = f"output turned by hand by {float(value):+g}°"
                 if drive.has_sensors:  # what the technician would see on the sensors' indicators
                     bits = drive.io_bits()
@@ -673,11 +674,11 @@ class LinkWorker(QObject):
 
 
 def _embedded_sim(client: DriveApi) -> Any | None:
-    """The SimDrive behind an embedded ``sim://`` port, None for any other drive. Only the link
-    thread uses it (its panel), like the port itself."""
+    """The SimResponder behind an embedded ``sim://`` port (its panel actions, its drive), None for
+    any other drive. Only the link thread uses it (its panel), like the port itself."""
     transport = getattr(getattr(client, "transaction", None), "transport", None)
     port = getattr(transport, "inner", transport)
-    return getattr(port, "sim_drive", None)
+    return getattr(port, "sim_responder", None)
 
 
 def _forget_dummy_thread() -> None:

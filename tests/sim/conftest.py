@@ -4,12 +4,32 @@ clock of a stepped drive behind a client."""
 from __future__ import annotations
 
 import dataclasses
+import weakref
 
 import pytest
 
 from fha_studio.hardware.client import DriveClient
-from fha_studio.hardware.sim import SimDrive
+from fha_studio.hardware.protocol import Command, Request, UnknownRequest, decode_request
+from fha_studio.hardware.sim import SimDrive, SimReply, SimResponder
 from fha_studio.hardware.sim.constants import load_sim_constants
+
+_RESPONDERS: weakref.WeakKeyDictionary[SimDrive, SimResponder] = weakref.WeakKeyDictionary()
+
+
+def responder(drive: SimDrive) -> SimResponder:
+    """The CN3 face of ``drive``, one per drive as a server holds it (so OWW's q comes to it)."""
+    if drive not in _RESPONDERS:
+        _RESPONDERS[drive] = SimResponder(drive)
+    return _RESPONDERS[drive]
+
+
+def ask(drive: SimDrive, command: Command | str, value: int = 0) -> SimReply | None:
+    """One CN3 command by its name, decoded from its frame as the server does (a name that is no
+    command comes as an unknown request)."""
+    frame = f"{command}{'-' if value < 0 else '+'}{abs(value):05d}\r".encode("ascii")
+    _, request = decode_request(frame)
+    assert isinstance(request, Request | UnknownRequest), frame
+    return responder(drive).respond(request)
 
 
 @pytest.fixture

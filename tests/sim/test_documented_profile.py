@@ -19,32 +19,33 @@ from fha_studio.hardware.client import CapabilityLevel, DriveClient
 from fha_studio.hardware.errors import ServoOnRefused
 from fha_studio.hardware.protocol import EXTENSION_COMMANDS
 from fha_studio.hardware.sim import SimConfigError, SimDrive, config_from_url
+from tests.sim.conftest import ask, responder
 
 ROOT = Path(__file__).resolve().parents[2]
 COUNTS_PER_DEG_50 = 8192 * 50 / 360  # DGR counts per output degree at ratio 50
 
 
 def dgr(drive: SimDrive) -> int:
-    reply = drive.execute("DGR", 0)
+    reply = ask(drive, "DGR", 0)
     assert reply is not None and reply.terminal == "q", reply
     return int(reply.lines[0])
 
 
 def test_answers_only_dgr_and_oww(make_drive):
     drive = make_drive("FHA-25C-50-S248", profile="documented")
-    assert drive.documented_only and drive.capabilities() == []
+    assert responder(drive).documented_only and responder(drive).capabilities() == []
     for command in EXTENSION_COMMANDS:
-        assert drive.execute(command, 0).terminal == "x", command
-    assert drive.execute("DGR", 0).terminal == "q"
+        assert ask(drive, command, 0).terminal == "x", command
+    assert ask(drive, "DGR", 0).terminal == "q"
 
 
 def test_servo_on_from_cn2_answers_s_to_everything(make_drive):
     drive = make_drive("FHA-25C-50-S248", profile="documented")
     drive.set_servo(True)
     for command in ("DGR", "OWW", "CAP", "SVO", "MON"):
-        assert drive.execute(command, 0).terminal == "s", command
+        assert ask(drive, command, 0).terminal == "s", command
     drive.set_servo(False)
-    assert drive.execute("DGR", 0).terminal == "q"
+    assert ask(drive, "DGR", 0).terminal == "q"
 
 
 def test_turning_by_hand_changes_dgr_by_ratio_x_8192_per_motor_turn(make_drive):
@@ -61,9 +62,9 @@ def test_turning_by_hand_changes_dgr_by_ratio_x_8192_per_motor_turn(make_drive):
 
 def test_a_held_brake_cannot_be_turned_by_hand(make_drive):
     drive = make_drive("FHA-25C-50-S248-B", profile="documented")
-    assert "refused: the brake holds" in panel_line(drive, "turn 5")
-    assert panel_line(drive, "brake release") == "brake released"
-    assert panel_line(drive, "turn 5") == "turned by hand by 5 deg"
+    assert "refused: the brake holds" in panel_line(responder(drive), "turn 5")
+    assert panel_line(responder(drive), "brake release") == "brake released"
+    assert panel_line(responder(drive), "turn 5") == "turned by hand by 5 deg"
 
 
 @pytest.mark.parametrize("rotary_direction, sign", [(0, 1), (1, -1)])
@@ -72,10 +73,10 @@ def test_a_fwd_command_turns_cw_unless_parameter_8_reverses_it(make_drive, rotar
     drive.write_parameter("system", 8, rotary_direction)  # on the front panel
     drive.power_cycle()
     before = dgr(drive)
-    assert panel_line(drive, "servo on") == "servo on (CN2)"
-    assert panel_line(drive, "fwd 5") == "controller: FWD 5 deg"
+    assert panel_line(responder(drive), "servo on") == "servo on (CN2)"
+    assert panel_line(responder(drive), "fwd 5") == "controller: FWD 5 deg"
     drive.advance(2.0)
-    assert panel_line(drive, "servo off") == "servo off (CN2)"
+    assert panel_line(responder(drive), "servo off") == "servo off (CN2)"
     assert (dgr(drive) - before) * sign == pytest.approx(5 * COUNTS_PER_DEG_50, rel=0.02)
 
 
@@ -84,19 +85,19 @@ def test_oww_clears_the_multi_turn_data_about_5_s_later(make_drive):
     drive.turn_by_hand(3 * 360 / 50 + 1.0)  # three motor turns and a bit
     assert dgr(drive) // 8192 == 3
     single = dgr(drive) % 8192
-    assert drive.execute("OWW", 0) is None  # the q comes later
-    assert drive.execute("OWW", 0).terminal == "x"  # repeated before the first acknowledgement
+    assert ask(drive, "OWW", 0) is None  # the q comes later
+    assert ask(drive, "OWW", 0).terminal == "x"  # repeated before the first acknowledgement
     drive.advance(4.9)
-    assert drive.take_deferred_replies() == []
+    assert responder(drive).take_deferred_replies() == []
     drive.advance(0.2)
-    assert [r.terminal for r in drive.take_deferred_replies()] == ["q"]
+    assert [r.terminal for r in responder(drive).take_deferred_replies()] == ["q"]
     assert dgr(drive) == single
 
 
 def test_an_incremental_encoder_answers_x_to_dgr_and_oww(make_drive):
     drive = make_drive("FHA-25C-50-US250", profile="documented")
-    assert drive.execute("DGR", 0).terminal == "x"
-    assert drive.execute("OWW", 0).terminal == "x"
+    assert ask(drive, "DGR", 0).terminal == "x"
+    assert ask(drive, "OWW", 0).terminal == "x"
 
 
 def test_url_option_and_its_check():

@@ -18,7 +18,7 @@ from fha_studio.hardware.sim.io import (
     BIT_READY,
     BIT_SERVO_ON,
 )
-from tests.sim.conftest import jog_for
+from tests.sim.conftest import ask, jog_for, responder
 
 RPM = 2 * math.pi / 60
 
@@ -33,9 +33,9 @@ def bit(drive, n: int) -> int:
 
 def test_nothing_moves_with_the_servo_off_and_jog_is_refused(make_drive):
     drive = make_drive(effects={"gravity_load": {"amplitude_nm": 0.0}})
-    reply = drive.execute("JOG", 1000)
+    reply = ask(drive, "JOG", 1000)
     assert reply.terminal == "x" and "servo is off" in reply.reason
-    assert drive.execute("MOV", 9000).terminal == "x"
+    assert ask(drive, "MOV", 9000).terminal == "x"
     drive.advance(0.2)
     assert drive.feedback_pulses == 0 and drive.monitor(103) == 0
 
@@ -62,17 +62,17 @@ def test_jog_held_by_repeats_then_the_watchdog_stops_within_100_ms(make_drive):
 
 def test_servo_on_is_refused_while_an_alarm_is_active(make_drive):
     drive = make_drive()
-    assert drive.execute("FLT", 50).terminal == "q"
+    assert ask(drive, "FLT", 50).terminal == "q"
     assert drive.alarm == 50
-    reply = drive.execute("SVO", 1)
+    reply = ask(drive, "SVO", 1)
     assert reply.terminal == "x" and "alarm" in reply.reason
     assert bit(drive, BIT_SERVO_ON) == 0 and bit(drive, BIT_READY) == 0 and bit(drive, BIT_ALARM) == 1
     # the 4-bit code on ALM-A..D: 50 is 1101 (D C B A)
     assert drive.io_bits() >> 11 & 0xF == 0b1101
-    assert drive.execute("ACL", 0).terminal == "x"  # encoder failure needs a power cycle
-    assert drive.execute("PWC", 0).terminal == "q"
-    assert drive.alarm == 0 and drive.execute("SVO", 1).terminal == "q"
-    assert drive.execute("AHS", 0).lines[0].startswith("50,")
+    assert ask(drive, "ACL", 0).terminal == "x"  # encoder failure needs a power cycle
+    assert ask(drive, "PWC", 0).terminal == "q"
+    assert drive.alarm == 0 and ask(drive, "SVO", 1).terminal == "q"
+    assert ask(drive, "AHS", 0).lines[0].startswith("50,")
 
 
 def test_alarm_20_overload_raises_and_clears(make_drive):
@@ -86,14 +86,14 @@ def test_alarm_20_overload_raises_and_clears(make_drive):
     assert drive.alarm == 20
     assert not drive.servo_on  # de-energised on the alarm
     assert bit(drive, BIT_ALARM) == 1 and drive.io_bits() >> 11 & 0xF == 0b0001
-    assert drive.execute("ACL", 0).terminal == "q"
+    assert ask(drive, "ACL", 0).terminal == "q"
     assert drive.alarm == 0 and drive.monitor(105) == 0
-    assert drive.execute("SVO", 1).terminal == "q"
+    assert ask(drive, "SVO", 1).terminal == "q"
 
 
 def jog_until_alarm(drive, speed_rpm: float, seconds: float) -> None:
     for _ in range(round(seconds / 0.05)):
-        if drive.execute("JOG", round(speed_rpm * 100)).terminal != "q":
+        if ask(drive, "JOG", round(speed_rpm * 100)).terminal != "q":
             break
         drive.advance(0.05)
 
@@ -104,8 +104,8 @@ def test_alarm_60_error_counter_overflow_raises_and_clears(make_drive):
     drive.set_servo(True)
     jog_until_alarm(drive, 40.0, 0.3)
     assert drive.alarm == 60
-    assert drive.execute("JOG", 1000).terminal == "x"
-    assert drive.execute("ACL", 0).terminal == "q"
+    assert ask(drive, "JOG", 1000).terminal == "x"
+    assert ask(drive, "ACL", 0).terminal == "q"
     assert drive.alarm == 0 and drive.error_pulses == 0
     # the CLEAR input (CN2-2) clears it too
     drive.set_servo(True)
@@ -120,7 +120,7 @@ def test_alarm_10_over_speed_needs_a_power_cycle(make_drive):
     drive = make_drive(effects={"load_torque_offset": {"torque_nm": 100.0}})
     drive.advance(0.5)
     assert drive.alarm == 10
-    reply = drive.execute("ACL", 0)
+    reply = ask(drive, "ACL", 0)
     assert reply.terminal == "x" and "power cycle" in reply.reason
     assert drive.alarm == 10
     drive.power_cycle()
@@ -136,8 +136,8 @@ def test_alarm_41_abnormal_regeneration_needs_a_power_cycle(make_drive):
     assert drive.alarm == 0
     drive.advance(0.5)
     assert drive.alarm == 41
-    assert drive.execute("ACL", 0).terminal == "x"
-    assert drive.execute("PWC", 0).terminal == "q"
+    assert ask(drive, "ACL", 0).terminal == "x"
+    assert ask(drive, "PWC", 0).terminal == "q"
     assert drive.alarm == 0
 
 
@@ -189,11 +189,11 @@ def test_absolute_position_survives_a_power_cycle_incremental_does_not(make_driv
         drive.set_servo(False)
         before = drive.feedback_pulses
         assert before > 10000
-        dgr = drive.execute("DGR", 0)
+        dgr = ask(drive, "DGR", 0)
         drive.power_cycle()
         if keeps:
             assert drive.feedback_pulses == pytest.approx(before, abs=2)
-            assert drive.execute("DGR", 0) == dgr and int(dgr.lines[0]) > 8192
+            assert ask(drive, "DGR", 0) == dgr and int(dgr.lines[0]) > 8192
         else:
             assert drive.feedback_pulses == 0
             assert dgr.terminal == "x"
@@ -204,31 +204,31 @@ def test_dgr_answers_s_with_the_servo_on_and_oww_clears_the_multi_turn_data(make
     drive.set_servo(True)
     jog_for(drive, 30.0, 0.5)
     drive.advance(0.3)
-    assert drive.execute("DGR", 0).terminal == "s"
-    assert drive.execute("OWW", 0).terminal == "x"  # servo on
+    assert ask(drive, "DGR", 0).terminal == "s"
+    assert ask(drive, "OWW", 0).terminal == "x"  # servo on
     drive.set_servo(False)
-    counts = int(drive.execute("DGR", 0).lines[0])
+    counts = int(ask(drive, "DGR", 0).lines[0])
     assert counts // 8192 >= 1
-    assert drive.execute("OWW", 0) is None  # the q comes later
-    assert drive.execute("OWW", 0).terminal == "x"  # repeated before the first q
-    assert drive.take_deferred_replies() == []
+    assert ask(drive, "OWW", 0) is None  # the q comes later
+    assert ask(drive, "OWW", 0).terminal == "x"  # repeated before the first q
+    assert responder(drive).take_deferred_replies() == []
     drive.advance(0.06)
-    assert [r.terminal for r in drive.take_deferred_replies()] == ["q"]
-    after = int(drive.execute("DGR", 0).lines[0])
+    assert [r.terminal for r in responder(drive).take_deferred_replies()] == ["q"]
+    after = int(ask(drive, "DGR", 0).lines[0])
     assert 0 <= after < 8192 and abs(after - counts % 8192) < 16  # the multi-turn data is gone
 
 
 def test_rotary_direction_applies_only_after_a_power_cycle(make_drive):
     drive = make_drive()
-    assert drive.execute("PSL", 8).terminal == "q"
-    assert drive.execute("PWR", 1).terminal == "q"
-    assert drive.execute("PRD", 0).lines == ("1",)
+    assert ask(drive, "PSL", 8).terminal == "q"
+    assert ask(drive, "PWR", 1).terminal == "q"
+    assert ask(drive, "PRD", 0).lines == ("1",)
     assert drive.active_parameter("rotary_direction") == 0
     drive.set_servo(True)
     jog_for(drive, 10.0, 0.3)
     assert drive.monitor(107) > 0  # FWD still turns CW (the load encoder is physical)
     drive.set_servo(False)
-    assert drive.execute("PWC", 0).terminal == "q"
+    assert ask(drive, "PWC", 0).terminal == "q"
     assert drive.active_parameter("rotary_direction") == 1
     start = drive.monitor(107)
     drive.set_servo(True)
@@ -239,16 +239,16 @@ def test_rotary_direction_applies_only_after_a_power_cycle(make_drive):
 
 def test_parameter_writes_refused_as_the_protocol_says(make_drive):
     drive = make_drive()
-    assert drive.execute("PRD", 0).terminal == "x"  # nothing selected
-    assert drive.execute("PSL", 7).terminal == "x"  # no such item
-    assert drive.execute("PSL", 8).terminal == "q"
-    assert drive.execute("PWR", 2).terminal == "x"  # out of range
+    assert ask(drive, "PRD", 0).terminal == "x"  # nothing selected
+    assert ask(drive, "PSL", 7).terminal == "x"  # no such item
+    assert ask(drive, "PSL", 8).terminal == "q"
+    assert ask(drive, "PWR", 2).terminal == "x"  # out of range
     drive.set_servo(True)
-    assert drive.execute("PWR", 1).terminal == "s"  # parameter mode with the servo on
-    assert drive.execute("TSL", 4).terminal == "q"
-    assert drive.execute("PWR", 20).terminal == "q"  # tune items are allowed
+    assert ask(drive, "PWR", 1).terminal == "s"  # parameter mode with the servo on
+    assert ask(drive, "TSL", 4).terminal == "q"
+    assert ask(drive, "PWR", 20).terminal == "q"  # tune items are allowed
     assert drive.active_parameter("in_position_range") == 20
-    assert drive.execute("ZZZ", 0).terminal == "x"
+    assert ask(drive, "ZZZ", 0).terminal == "x"
 
 
 def test_eeprom_persists_across_instances(make_drive, tmp_path):
@@ -280,9 +280,9 @@ def test_corrupt_eeprom_names_the_file(make_drive, tmp_path):
 def test_move_by_angle_reaches_the_target_and_is_in_position(make_drive):
     drive = make_drive()
     drive.set_servo(True)
-    assert drive.execute("SPD", 3000).terminal == "q"  # 30 r/min
-    assert drive.execute("MOV", 9000).terminal == "q"  # +90 deg
-    assert drive.execute("MOV", 100).terminal == "x"  # moving
+    assert ask(drive, "SPD", 3000).terminal == "q"  # 30 r/min
+    assert ask(drive, "MOV", 9000).terminal == "q"  # +90 deg
+    assert ask(drive, "MOV", 100).terminal == "x"  # moving
     drive.advance(1.5)
     assert not drive.moving
     assert drive.feedback_pulses == pytest.approx(drive.output_ppr // 4, abs=20)
@@ -293,46 +293,46 @@ def test_trace_capture_in_blocks(make_drive):
     drive = make_drive()
     drive.set_servo(True)
     for cmd, value in (("TCH", 0b1001), ("TDV", 5), ("TTG", 0), ("TPR", 0), ("TAR", 100)):
-        assert drive.execute(cmd, value).terminal == "q", cmd
-    assert drive.execute("TST", 0).lines[0].startswith("2,")
+        assert ask(drive, cmd, value).terminal == "q", cmd
+    assert ask(drive, "TST", 0).lines[0].startswith("2,")
     jog_for(drive, 10.0, 0.1)  # 100 samples x 5 periods at 5 kHz = 0.1 s
-    assert drive.execute("TST", 0).lines == ("3,100",)
-    block0 = drive.execute("TRB", 0).lines
-    block1 = drive.execute("TRB", 1).lines
+    assert ask(drive, "TST", 0).lines == ("3,100",)
+    block0 = ask(drive, "TRB", 0).lines
+    block1 = ask(drive, "TRB", 1).lines
     assert len(block0) == 64 and len(block1) == 36
-    assert drive.execute("TRB", 2).terminal == "x"
+    assert ask(drive, "TRB", 2).terminal == "x"
     positions = [int(line.split(",")[0]) for line in block0 + block1]
     assert positions == sorted(positions) and positions[-1] > positions[0]
-    assert drive.execute("TCH", 0b11111).terminal == "x"  # more than 4 channels
+    assert ask(drive, "TCH", 0b11111).terminal == "x"  # more than 4 channels
 
 
 def test_packed_trace_blocks_carry_the_text_blocks_values_in_fewer_characters(make_drive):
     from fha_studio.hardware import protocol as p
 
     drive = make_drive()
-    assert "TRP" in drive.execute("CAP", 0).lines[0].split()
+    assert "TRP" in ask(drive, "CAP", 0).lines[0].split()
     drive.set_servo(True)
     for cmd, value in (("TCH", 0b11011), ("TDV", 5), ("TTG", 0), ("TPR", 0), ("TAR", 100)):
-        assert drive.execute(cmd, value).terminal == "q", cmd
+        assert ask(drive, cmd, value).terminal == "q", cmd
     jog_for(drive, 20.0, 0.15)
     for block, samples in ((0, 64), (1, 36)):
-        text = drive.execute("TRB", block).lines
-        packed = drive.execute("TRP", block).lines
+        text = ask(drive, "TRB", block).lines
+        packed = ask(drive, "TRP", block).lines
         assert p.decode_packed_block(packed, samples, 4) == [tuple(p.parse_values(line)) for line in text]
         assert all(2 <= len(line) <= p.PACKED_LINE_CHARS for line in packed)
         assert sum(len(line) + 1 for line in packed) * 2 < sum(len(line) + 1 for line in text)
-    assert drive.execute("TRP", 2).terminal == "x"
+    assert ask(drive, "TRP", 2).terminal == "x"
 
 
 def test_a_drive_from_before_the_packed_encoding_has_no_trp(make_drive):
     drive = make_drive(packed_trace=False)
-    assert "TRP" not in drive.execute("CAP", 0).lines[0].split()
-    assert "TRB" in drive.execute("CAP", 0).lines[0].split()
+    assert "TRP" not in ask(drive, "CAP", 0).lines[0].split()
+    assert "TRB" in ask(drive, "CAP", 0).lines[0].split()
     for cmd, value in (("TCH", 0b1), ("TTG", 0), ("TAR", 10)):
-        drive.execute(cmd, value)
+        ask(drive, cmd, value)
     drive.advance(0.01)
-    assert drive.execute("TRP", 0).terminal == "x"
-    assert len(drive.execute("TRB", 0).lines) == 10
+    assert ask(drive, "TRP", 0).terminal == "x"
+    assert len(ask(drive, "TRB", 0).lines) == 10
 
 
 def test_trace_level_trigger_keeps_pretrigger_samples(make_drive):
@@ -340,12 +340,12 @@ def test_trace_level_trigger_keeps_pretrigger_samples(make_drive):
     drive.set_servo(True)
     for cmd, value in (("TCH", 0b1000), ("TDV", 10), ("TTG", 1), ("TTC", 103), ("TTL", 500),
                        ("TPR", 20), ("TAR", 60)):
-        assert drive.execute(cmd, value).terminal == "q", cmd
+        assert ask(drive, cmd, value).terminal == "q", cmd
     drive.advance(0.1)
-    assert drive.execute("TST", 0).lines[0].startswith("1,")
+    assert ask(drive, "TST", 0).lines[0].startswith("1,")
     jog_for(drive, 10.0, 0.3)
-    assert drive.execute("TST", 0).lines == ("3,60",)
-    speeds = [int(line) for line in drive.execute("TRB", 0).lines]
+    assert ask(drive, "TST", 0).lines == ("3,60",)
+    speeds = [int(line) for line in ask(drive, "TRB", 0).lines]
     assert speeds[19] < 500 <= speeds[20]
 
 
@@ -379,7 +379,7 @@ def test_driver_from_the_combination_table_and_supply_voltage(make_drive):
     assert make_drive("FHA-25C-50-US250-A").driver == "HA-655-4-100"  # 100 V (option A), 1-3
     assert make_drive("FHA-32C-100-S248").driver == "HA-655-4A-200"
     drive = make_drive("FHA-17C-50-US250", driver="HA-675-2-200")
-    assert drive.execute("IDN", 0).lines[0] == "HA-675-2-200"
+    assert ask(drive, "IDN", 0).lines[0] == "HA-675-2-200"
     assert drive.parameters.driver == "HA-675"
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from fha_studio.hardware.protocol import Command, Status
 from fha_studio.hardware.sim.journal import JournalEntry
 from fha_studio.logic.procedures.session import CheckRecord, ProcedureSession, utc_now
 from fha_studio.logic.training.scenario import ScenarioError, list_scenarios, load_scenario, scenarios_dir
@@ -112,7 +113,8 @@ def _entry(at_s: float, command: str, value: int = 0, **state) -> JournalEntry:
         "alarm_after": 0,
     }
     fields.update(state)
-    return JournalEntry(at_s=at_s, command=command, value=value, **fields)
+    fields["terminal"] = Status(fields["terminal"])
+    return JournalEntry(at_s=at_s, command=Command(command), value=value, **fields)
 
 
 def test_score_fault_found_and_missed_steps_in_and_out_of_order_and_unsafe_acts():

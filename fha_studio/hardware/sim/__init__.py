@@ -4,8 +4,9 @@
   monitors, absolute / incremental encoder); stepped (``advance(seconds)``) or real time
   (``start()`` ... ``close()``). Its other jobs: items and EEPROM (:mod:`.memory`, :mod:`.eeprom`),
   I/O, brake and option-L sensors (:mod:`.io`), alarms and supervision (:mod:`.supervision`),
-  the CN3 command table (:mod:`.commands`), trace capture (:mod:`.trace`), recording
-  (:mod:`.recorder`).
+  trace capture (:mod:`.trace`), recording (:mod:`.recorder`).
+- :class:`SimResponder` (:mod:`.responder`): its face on CN3: a decoded request in, a reply out;
+  the command table and its narrowing by profile, CAP, deferred replies, the training journal.
 - :class:`SimProtocolServer`: CN3 bytes in, bytes out, through the codec, paced like the line.
 - ``sim://ACTUATOR?options``: the pyserial URL handler (:mod:`.protocol_sim`), options in
   :mod:`.options`.
@@ -18,6 +19,7 @@ from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.eeprom import EepromError
 from fha_studio.hardware.sim.options import SimConfig, SimConfigError, config_from_url, parse_effects
 from fha_studio.hardware.sim.reply import SimRefused, SimReply
+from fha_studio.hardware.sim.responder import SimResponder
 from fha_studio.hardware.sim.server import SimProtocolServer
 from fha_studio.hardware.sim.supervision import SimAlarmRecord
 
@@ -39,6 +41,7 @@ __all__ = [
     "SimProtocolServer",
     "SimRefused",
     "SimReply",
+    "SimResponder",
     "config_from_url",
     "parse_effects",
     "register_url_handler",

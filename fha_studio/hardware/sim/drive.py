@@ -7,8 +7,9 @@ captures traces. The axis itself is :mod:`fha_studio.physics`, stepped at the se
 
 This module holds the servo, motion, positions, monitors and time; the other jobs have their own
 modules: :mod:`.memory` (items and EEPROM), :mod:`.io` (inputs, sensors, brake, I/O bits),
-:mod:`.supervision` (alarms and their checks), :mod:`.commands` (the CN3 command table),
-:mod:`.trace` (trace capture) and :mod:`.recorder` (``fha-recording/1`` output).
+:mod:`.supervision` (alarms and their checks), :mod:`.trace` (trace capture) and
+:mod:`.recorder` (``fha-recording/1`` output). The drive's methods speak units (r/min, degrees,
+item values); its CN3 face is :class:`fha_studio.hardware.sim.responder.SimResponder`.
 
 Time: in *stepped* mode nothing moves until :meth:`SimDrive.advance` is called (deterministic,
 for tests); :meth:`SimDrive.start` runs a thread that advances in real time until :meth:`close`.
@@ -18,7 +19,7 @@ sense is CW seen from the output flange positive (FHA-C manual 1-10): with rotar
 (system item 8) FWD = CW, with 1 FWD = CCW. The encoder's own counts (``DGR``) and the external
 load encoder (monitor 107) are physical: they do not follow the rotary-direction setting.
 
-Everything is reachable through :meth:`SimDrive.execute` (a CN3 command and its integer value ->
+Every CN3 command reaches the drive through :class:`SimResponder` (a decoded request ->
 :class:`SimReply`), which is what :class:`SimProtocolServer` calls after decoding bytes.
 """
 
@@ -28,12 +29,10 @@ import math
 import tempfile
 import threading
 import time
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from fha_studio import __version__ as _version
-from fha_studio import clock
 from fha_studio.hardware.parameters import (
     Mode,
     MonitorItem,
@@ -42,7 +41,7 @@ from fha_studio.hardware.parameters import (
     load_parameter_model,
     split_low_high,
 )
-from fha_studio.hardware.protocol import ABSOLUTE_COUNTS_PER_TURN, EXTENSION_COMMANDS, Command
+from fha_studio.hardware.protocol import ABSOLUTE_COUNTS_PER_TURN
 from fha_studio.hardware.sim.axis import (
     DEFAULT_SERVO_RATE_HZ,
     build_axis,
@@ -50,17 +49,15 @@ from fha_studio.hardware.sim.axis import (
     resolve_actuator,
     servo_settings,
 )
-from fha_studio.hardware.sim.commands import COMMANDS, DEFERRED, DOCUMENTED_ONLY, Handler
 from fha_studio.hardware.sim.constants import SimConstants, load_sim_constants
 from fha_studio.hardware.sim.eeprom import EepromFile, default_eeprom_dir
 from fha_studio.hardware.sim.io import SimIo
-from fha_studio.hardware.sim.journal import Journal, JournalEntry
 from fha_studio.hardware.sim.memory import ItemId, ParameterMemory, PersistentState
-from fha_studio.hardware.sim.options import SimConfig, SimConfigError, training_registration
+from fha_studio.hardware.sim.options import SimConfig, SimConfigError
 from fha_studio.hardware.sim.recorder import SimRecorder
-from fha_studio.hardware.sim.reply import SimRefused, SimReply, rejected
+from fha_studio.hardware.sim.reply import SimRefused, SimReply, rejected, servo_is_on
 from fha_studio.hardware.sim.supervision import SUPERVISION_PERIOD_S, AlarmSupervisor, SimAlarmRecord
-from fha_studio.hardware.sim.trace import SimTrace, TraceError
+from fha_studio.hardware.sim.trace import SimTrace
 from fha_studio.physics import ServoAxis, ServoSettings
 
 TWO_PI = 2.0 * math.pi
@@ -77,9 +74,6 @@ class SimDrive:
     Raises SimConfigError for a bad option, EepromError for an unreadable EEPROM file.
     """
 
-    #: The commands this drive speaks and their handlers (a drive profile may narrow it).
-    command_table: Mapping[Command, Handler] = COMMANDS
-
     def __init__(
         self,
         actuator: str | None = None,
@@ -94,13 +88,11 @@ class SimDrive:
         elif actuator is not None or options:
             config = config.replace(**({"actuator": actuator} if actuator else {}), **options)
         self.config = config
-        if not config.packed_trace:  # a drive from before the packed encoding: no TRP
-            self.command_table = {c: h for c, h in self.command_table.items() if c is not Command.TRP}
-        if config.profile == "documented":
-            self.command_table = DOCUMENTED_ONLY
         self.constants = constants or load_sim_constants()
         self.servo_rate_hz = float(servo_rate_hz)
-        self._lock = threading.RLock()
+        #: held by every method; hold it to make several calls one step (the responder does, for
+        #: each command and what its journal writes of it)
+        self.lock = threading.RLock()
         self._thread: threading.Thread | None = None
         self._stop_event = threading.Event()
         self._closed = False
@@ -135,9 +127,6 @@ class SimDrive:
         if config.battery != "ok" and not self.absolute_encoder:
             raise SimConfigError(f"simulated drive option battery={config.battery}: {self.actuator_code} "
                                  "has an incremental encoder (no backup battery)")
-        # a training drive writes what is done to it in its registration's journal
-        registration = training_registration(config.training) if config.training else None
-        self.journal: Journal | None = registration.journal if registration is not None else None
         # the encoder's A/B leads swapped: it counts the other way (docs/sim.md, wiring faults)
         self._encoder_sign = -1.0 if config.wiring == "encoder_swapped" else 1.0
         self._faulty_motion_s = 0.0  # how long a motion has been commanded into a wiring fault
@@ -176,9 +165,9 @@ class SimDrive:
             self.model, self._settings(self.memory.stored), persistent.mechanical_angle_rad
         )
 
-        self.selected_item: ItemId | None = None  # the item PSL / TSL / JSL selected
         self.trace = SimTrace()
-        self._deferred: list[SimReply] = []
+        #: clears of the multi-turn data finished (OWW's ``q`` comes when one finishes)
+        self.multi_turn_clears_done = 0
         self.clock_s = 0.0  # simulated time since the drive was built (not reset by PWC)
         self._recorder: SimRecorder | None = None
         self._power_on()
@@ -268,9 +257,9 @@ class SimDrive:
     def power_cycle(self) -> None:
         """Simulated control-power cycle (PWC): restart-required items take effect, alarms clear,
         an incremental position is lost. Refused (``s``) while the servo is on."""
-        with self._lock:
+        with self.lock:
             if self.servo_on:
-                raise SimRefused("s", "servo on: switch it off before a power cycle")
+                raise servo_is_on("servo on: switch it off before a power cycle")
             self._save_eeprom()
             self._power_on()
 
@@ -281,30 +270,30 @@ class SimDrive:
     def _accel_rad_s2(self) -> float:
         return self._param("jog_acceleration") * RPM
 
-    def select_item(self, mode: Mode, number: int) -> None:
-        """Select the item PRD reads and PWR writes (PSL / TSL / JSL); ``x`` for an unknown one."""
-        with self._lock:
-            try:
-                item = self.parameters.item(mode, number)
-            except KeyError as exc:
-                raise rejected(str(exc.args[0])) from None
-            self.selected_item = (item.mode, item.number)
+    def item_id(self, mode: Mode, number: int) -> ItemId:
+        """The item ``number`` of ``mode`` this drive has (PSL / TSL / JSL select it); ``x`` for
+        one it does not have."""
+        try:
+            item = self.parameters.item(mode, number)
+        except KeyError as exc:
+            raise rejected(str(exc.args[0])) from None
+        return (item.mode, item.number)
 
     def read_parameter(self, mode: Mode | str, number: int) -> int:
         """The stored (EEPROM) value of an item; for restart-required items it may differ from
         the active one until the next power cycle."""
-        with self._lock:
+        with self.lock:
             return self.memory.stored_value(mode, number)
 
     def active_parameter(self, key: str) -> int:
         """The value in effect now (restart-required items: as of the last power-on)."""
-        with self._lock:
+        with self.lock:
             return self._param(key)
 
     def write_parameter(self, mode: Mode | str, number: int, value: int) -> None:
         """Store a tune / parameter / test item in the EEPROM. Raises SimRefused: ``x`` for an
         unknown, read-only or out-of-range value, ``s`` for a parameter-mode item with servo on."""
-        with self._lock:
+        with self.lock:
             active_changed = self.memory.write(mode, number, value, servo_on=self.servo_on)
             self._save_eeprom()
             if active_changed:
@@ -385,7 +374,7 @@ class SimDrive:
         """Set the simulated CN2 inputs (INP): bits 4, 5, 9, 10. Bits 6-8 (origin, limit switches)
         set sensor signals of an actuator without option L; with option L the sensors drive them
         and INP's bits 6-8 are ignored (so a client's read-modify-write of IOS latches nothing)."""
-        with self._lock:
+        with self.lock:
             if self.io.set_inputs(mask):
                 self._clear_error_counter()
             self._update_brake()
@@ -425,7 +414,7 @@ class SimDrive:
 
     def io_bits(self) -> int:
         """The I/O bit mask of IOS / monitor 106 (docs/protocol.md, I/O table)."""
-        with self._lock:
+        with self.lock:
             in_position = self.servo_on and abs(self.error_pulses) <= self._param("in_position_range")
             return self.io.bits(
                 self._angle_deg,
@@ -436,10 +425,15 @@ class SimDrive:
                 moving=self.moving,
             )
 
+    def blocked_directions(self) -> tuple[bool, bool]:
+        """(FWD blocked, REV blocked): an inhibit input or a limit switch stops a motion that way."""
+        with self.lock:
+            return self.io.blocked(self._angle_deg, self._direction)
+
     def set_sensor_angle(self, which: str, angle_deg: float) -> None:
         """Move the origin slit (``"origin"``) or a limit-switch dog (``"ls1"``, ``"ls2"``), as in
         the sensor adjustment procedure of FHA-C manual 4-7-2 (sim only)."""
-        with self._lock:
+        with self.lock:
             self.io.set_sensor_angle(which, angle_deg)
 
     # ------------------------------------------------------------------ servo and motion
@@ -447,7 +441,7 @@ class SimDrive:
         """Servo on / off: SVO over CN3 (full profile), or the controller's servo-ON input on CN2
         (any profile; the only way with the ``documented`` one). On is refused (``x``) while an
         alarm is active; a holding brake is not an error (the motor then works against it)."""
-        with self._lock:
+        with self.lock:
             if on:
                 if self.alarm:
                     raise rejected(f"alarm {self.supervisor.describe()} is active: clear it first")
@@ -462,20 +456,18 @@ class SimDrive:
         """Someone turns the output flange by ``angle_deg`` (CW positive seen from the flange)
         with the servo off, as in the encoder check or the sensor-dog adjustment (FHA-C manual
         4-7-2). Refused (``x``) with the servo on or while the brake holds."""
-        with self._lock:
+        with self.lock:
             if self.servo_on:
                 raise rejected("the servo is on: the axis cannot be turned by hand")
             if self.brake_holding:
                 raise rejected("the brake holds: release it (24 V on the brake) to turn the axis by hand")
             self.axis.turn_by_hand(math.radians(angle_deg))
-            self._journal_entry("HAND_TURN", round(angle_deg), "q", self.alarm)
 
     def controller_command(self, angle_deg: float) -> None:
         """The controller's pulse train on CN2: turn the output by ``angle_deg`` in the command
         sense (FWD positive; the rotary direction, system 8, decides CW or CCW). Needs the servo
         on (``x`` otherwise), as on a real drive."""
-        with self._lock:
-            self._journal_call("CN2_MOVE", round(angle_deg), lambda: self.move_by(angle_deg))
+        self.move_by(angle_deg)
 
     def _servo_off(self) -> None:
         self.servo_on = False
@@ -490,7 +482,7 @@ class SimDrive:
 
     def jog(self, speed_rpm: float) -> None:
         """Jog at ``speed_rpm`` (output, command sense) for 100 ms; repeat to keep jogging."""
-        with self._lock:
+        with self.lock:
             self._check_can_move("JOG")
             max_rpm = self.model.max_speed_rpm or 0.0
             if abs(speed_rpm) > max_rpm + 1e-9:
@@ -508,7 +500,7 @@ class SimDrive:
 
     def set_move_speed(self, speed_rpm: float) -> None:
         """The speed of the next MOV (SPD), output r/min."""
-        with self._lock:
+        with self.lock:
             max_rpm = self.model.max_speed_rpm or 0.0
             if not 0 < speed_rpm <= max_rpm + 1e-9:
                 raise rejected(f"SPD {speed_rpm:g} r/min outside 0 ... {max_rpm:g}")
@@ -516,7 +508,7 @@ class SimDrive:
 
     def move_by(self, angle_deg: float) -> None:
         """Move by ``angle_deg`` (output, command sense) at the SPD speed."""
-        with self._lock:
+        with self.lock:
             self._check_can_move("MOV")
             if self.moving:
                 raise rejected("MOV: the axis is moving")
@@ -529,7 +521,7 @@ class SimDrive:
 
     def stop(self) -> None:
         """Decelerate to standstill and hold (servo stays on)."""
-        with self._lock:
+        with self.lock:
             if self.moving and self.servo_on:
                 self.axis.stop(self._accel_rad_s2())
                 self._motion = "stop"
@@ -557,7 +549,7 @@ class SimDrive:
 
     def raise_alarm(self, code: int) -> None:
         """Raise an alarm (as the drive's supervision does, or injected for training: FLT)."""
-        with self._lock:
+        with self.lock:
             if not self.supervisor.record(code, self.time_s):
                 return
             # on an alarm the motor is de-energised and coasts (HA-655 manual p.10)
@@ -566,7 +558,7 @@ class SimDrive:
 
     def clear_alarm(self) -> None:
         """ACL: clears alarms 20 and 60 (as the real driver); others need a power cycle (``x``)."""
-        with self._lock:
+        with self.lock:
             if self.supervisor.clear() == 60:
                 self.axis.clear_error()
 
@@ -583,7 +575,7 @@ class SimDrive:
     # ------------------------------------------------------------------ absolute encoder
     def clear_multi_turn(self) -> None:
         """OWW: starts clearing the multi-turn data; the ``q`` comes ``oww_clear_s`` later."""
-        with self._lock:
+        with self.lock:
             if self.servo_on:
                 raise rejected("OWW: the servo is on")
             if not self.absolute_encoder:
@@ -599,20 +591,14 @@ class SimDrive:
         self._feedback_zero_rad = self._absolute_zero_rad
         self._oww_done_at = None
         self._save_eeprom()
-        self._deferred.append(SimReply("q"))
-
-    def take_deferred_replies(self) -> list[SimReply]:
-        """Replies that came later than their command (OWW's ``q``), oldest first."""
-        with self._lock:
-            replies, self._deferred = self._deferred, []
-            return replies
+        self.multi_turn_clears_done += 1
 
     # ------------------------------------------------------------------ time
     def advance(self, seconds: float) -> None:
         """Advance the simulation by ``seconds`` of drive time (stepped mode)."""
         if self._thread is not None and threading.current_thread() is not self._thread:
             raise RuntimeError("SimDrive.advance() is for stepped mode; this drive runs in real time")
-        with self._lock:
+        with self.lock:
             self._advance(seconds)
 
     def _advance(self, seconds: float) -> None:
@@ -704,7 +690,7 @@ class SimDrive:
 
     def start(self) -> None:
         """Run in real time in a thread (``sim-drive``) until :meth:`close`."""
-        with self._lock:
+        with self.lock:
             if self._thread is not None or self._closed:
                 return
             self._stop_event.clear()
@@ -718,7 +704,7 @@ class SimDrive:
             # a stalled machine makes the simulation lag instead of jumping
             elapsed = min(now - last, 0.05)
             last = now
-            with self._lock:
+            with self.lock:
                 self._advance(elapsed)
 
     @property
@@ -733,7 +719,7 @@ class SimDrive:
             self._stop_event.set()
             thread.join(timeout=5.0)
             self._thread = None
-        with self._lock:
+        with self.lock:
             if self._closed:
                 return
             self._closed = True
@@ -754,7 +740,7 @@ class SimDrive:
     def start_recording(self, path: str | Path, sample_rate_hz: float = 1000.0) -> None:
         """Write what the axis does to an ``fha-recording/1`` CSV (t, pos, current, cmd_pos,
         load_pos, vel; physical frame, CW positive) until :meth:`stop_recording` or :meth:`close`."""
-        with self._lock:
+        with self.lock:
             self.stop_recording()
             self._recorder = SimRecorder(
                 Path(path),
@@ -766,7 +752,7 @@ class SimDrive:
             )
 
     def stop_recording(self) -> None:
-        with self._lock:
+        with self.lock:
             recorder, self._recorder = self._recorder, None
             if recorder is not None:
                 recorder.close()
@@ -775,7 +761,7 @@ class SimDrive:
     def monitor(self, item: int) -> int:
         """Wire value of monitor item ``item`` (docs/protocol.md, monitor table); SimRefused
         (``x``) for an item the drive does not have."""
-        with self._lock:
+        with self.lock:
             return self._monitor(item)
 
     def _monitor(self, item: int) -> int:
@@ -815,85 +801,6 @@ class SimDrive:
             low, high = split_low_high(count)
             return low if item in (3, 7, 9) else high
         raise rejected(f"no monitor item {item}")
-
-    # ------------------------------------------------------------------ the protocol
-    @property
-    def documented_only(self) -> bool:
-        """True for the ``documented`` profile: DGR and OWW only, ``s`` to all while the servo is on."""
-        return self.command_table is DOCUMENTED_ONLY
-
-    def execute(self, command: Command | str, value: int) -> SimReply | None:
-        """Do one CN3 command (a :class:`Command` or its name). Returns its reply, or None when
-        the reply comes later (OWW: see :meth:`take_deferred_replies`)."""
-        with self._lock:
-            if self.journal is None:
-                return self._execute(command, value)
-            name = command.value if isinstance(command, Command) else str(command)
-            before = self._journal_state()
-            reply = self._execute(command, value)
-            self._journal_entry(name, value, reply.terminal if reply is not None else "", self.alarm, before)
-            return reply
-
-    def _journal_call(self, name: str, value: int, call: Any) -> None:
-        """Run ``call`` and write it in the training journal with the state before it."""
-        if self.journal is None:
-            call()
-            return
-        before = self._journal_state()
-        terminal = "q"
-        try:
-            call()
-        except SimRefused as exc:
-            terminal = exc.terminal
-            raise
-        finally:
-            self._journal_entry(name, value, terminal, self.alarm, before)
-
-    def _journal_state(self) -> dict[str, Any]:
-        fwd, rev = self.io.blocked(self._angle_deg, self._direction)
-        return {"item": self.selected_item, "servo_on": self.servo_on, "brake_holding": self.brake_holding,
-                "blocked_fwd": fwd, "blocked_rev": rev, "alarm_before": self.alarm}
-
-    def _journal_entry(self, name: str, value: int, terminal: str, alarm_after: int,
-                       before: dict[str, Any] | None = None) -> None:
-        if self.journal is None:
-            return
-        state = before if before is not None else self._journal_state()
-        item = state["item"]
-        self.journal.append(JournalEntry(
-            at_s=clock.now_s(), command=name, value=int(value), terminal=terminal,
-            item=(str(item[0]), int(item[1])) if item is not None else None,
-            servo_on=state["servo_on"], brake_holding=state["brake_holding"],
-            blocked_fwd=state["blocked_fwd"], blocked_rev=state["blocked_rev"],
-            alarm_before=state["alarm_before"], alarm_after=alarm_after,
-        ))
-
-    def _execute(self, command: Command | str, value: int) -> SimReply | None:
-        with self._lock:
-            if self.documented_only and self.servo_on:
-                # HA-655 manual p.21: with the servo on the drive processes nothing over CN3
-                return SimReply("s", reason=f"{command}: the servo is on (CN2)")
-            try:
-                handler = self.command_table[Command(command)]
-            except (ValueError, KeyError):
-                return SimReply("x", reason=f"unknown command {command}")
-            try:
-                result = handler(self, value)
-            except SimRefused as exc:
-                return SimReply(exc.terminal, reason=exc.reason)
-            except (TraceError, SimConfigError) as exc:
-                return SimReply("x", reason=str(exc))
-            if result is DEFERRED:
-                return None
-            if result is None:
-                return SimReply("q")
-            if isinstance(result, str):
-                return SimReply("q", (result,))
-            return SimReply("q", tuple(result))
-
-    def capabilities(self) -> list[str]:
-        """The extension commands this drive answers (CAP), in the codec's order."""
-        return [c.value for c in Command if c in EXTENSION_COMMANDS and c in self.command_table]
 
 
 __all__ = ["SimAlarmRecord", "SimDrive", "SimRefused", "SimReply"]

@@ -9,8 +9,18 @@ from __future__ import annotations
 
 import threading
 from dataclasses import dataclass
+from enum import StrEnum
 
 from fha_studio import clock
+from fha_studio.hardware.parameters import Mode
+from fha_studio.hardware.protocol import Command, Status
+
+
+class PanelAction(StrEnum):
+    """What is done to the drive from outside CN3 (its panel, or ``fha-studio sim --panel``)."""
+
+    HAND_TURN = "HAND_TURN"  # the output turned by hand; value: degrees, CW positive
+    CN2_MOVE = "CN2_MOVE"  # the controller's pulse train on CN2; value: degrees, FWD positive
 
 
 @dataclass(frozen=True)
@@ -19,10 +29,10 @@ class JournalEntry:
     the drive's just before the command, ``alarm_after`` just after it."""
 
     at_s: float
-    command: str  # the CN3 command's name (JOG, PWR, ...), or a panel action (HAND_TURN, CN2_MOVE)
-    value: int
-    terminal: str  # q, s, x ("" when the reply comes later)
-    item: tuple[str, int] | None  # the item selected for PRD / PWR: (mode, number)
+    command: Command | PanelAction  # the CN3 command (JOG, PWR, ...) or the panel action
+    value: int  # the command's value as sent; a panel action's in whole degrees
+    terminal: Status | None  # q, s, x (None when the reply comes later: OWW)
+    item: tuple[Mode, int] | None  # the item selected for PRD / PWR: (mode, number)
     servo_on: bool
     brake_holding: bool
     blocked_fwd: bool  # a FWD inhibit input or the CW-end limit switch is active
@@ -49,4 +59,4 @@ class Journal:
             return list(self._entries)
 
 
-__all__ = ["Journal", "JournalEntry"]
+__all__ = ["Journal", "JournalEntry", "PanelAction"]

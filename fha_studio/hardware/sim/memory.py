@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 from fha_studio.hardware.parameters import Mode, ParameterItem, ParameterModel, ParameterValueError
 from fha_studio.hardware.sim.eeprom import EepromError, EepromFile
-from fha_studio.hardware.sim.reply import SimRefused, rejected
+from fha_studio.hardware.sim.reply import rejected, servo_is_on
 from fha_studio.hardware.sim.supervision import SimAlarmRecord
 
 ItemId = tuple[Mode, int]
@@ -79,7 +79,7 @@ class ParameterMemory:
         if not item.writable or item.mode is Mode.MONITOR:
             raise rejected(f"{item.label} is read-only")
         if item.mode is Mode.SYSTEM and servo_on:
-            raise SimRefused("s", f"{item.label}: parameter-mode items are written with the servo off")
+            raise servo_is_on(f"{item.label}: parameter-mode items are written with the servo off")
         try:
             item.check(value)
         except ParameterValueError as exc:

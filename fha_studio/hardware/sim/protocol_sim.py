@@ -8,7 +8,8 @@ registers it; :func:`fha_studio.hardware.sim.register_url_handler` does it too).
 ``port.sim_drive.advance(seconds)``); every byte goes through the CN3 codec (no shortcut around
 the protocol).
 
-``port.sim_drive`` is the SimDrive (for a training GUI that wants to show the hidden state).
+``port.sim_drive`` is the SimDrive (for a training GUI that wants to show the hidden state);
+``port.sim_responder`` its CN3 face, whose panel actions a training drive journals.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from serial.serialutil import PortNotOpenError, SerialBase, SerialException, to_
 from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.eeprom import EepromError
 from fha_studio.hardware.sim.options import SimConfigError, config_from_url
+from fha_studio.hardware.sim.responder import SimResponder
 from fha_studio.hardware.sim.server import SimProtocolServer
 
 _POLL_S = 0.005  # longest wait between looks at the drive (a deferred reply is not foreseen)
@@ -59,6 +61,11 @@ class Serial(SerialBase):
         if drive is not None:
             drive.close()
         super().close()
+
+    @property
+    def sim_responder(self) -> SimResponder | None:
+        """The drive's CN3 face (its command table, journal and panel actions), None when closed."""
+        return self.sim_server.responder if self.sim_drive is not None and self.sim_server else None
 
     def from_url(self, url: str) -> str:
         config_from_url(url)

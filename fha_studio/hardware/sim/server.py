@@ -1,4 +1,4 @@
-"""`SimProtocolServer`: bytes in -> codec -> SimDrive -> codec -> bytes out, paced like the line.
+"""`SimProtocolServer`: bytes in -> codec -> SimResponder -> codec -> bytes out, paced like the line.
 
 A real CN3 line carries 1920 characters/s (19200 bit/s, 8N1 = 10 bits per character). Paced (the
 default), each byte the host writes *arrives* one character time after the previous one (a
@@ -29,15 +29,14 @@ from fha_studio.hardware import protocol
 from fha_studio.hardware.protocol import (
     Garbage,
     Request,
-    Status,
     UnknownRequest,
     decode_request,
     encode_reply,
 )
 from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.reply import SimReply
+from fha_studio.hardware.sim.responder import SimResponder
 
-_STATUS = {"q": Status.DONE, "s": Status.SERVO_ON, "x": Status.REJECTED}
 #: Bytes written by the host that may wait for the line (1024 characters: 0.53 s at 19200 baud).
 INPUT_BACKLOG_BYTES = 1024
 #: Reply bytes that may wait for the host to read them.
@@ -45,7 +44,8 @@ OUTPUT_BACKLOG_BYTES = 64 * 1024
 
 
 class SimProtocolServer:
-    """Speaks CN3 for one :class:`SimDrive`. Thread-safe: feed and read may come from two threads.
+    """Speaks CN3 for one :class:`SimDrive`, through its :class:`SimResponder` (``responder``).
+    Thread-safe: feed and read may come from two threads.
 
     ``on_transaction(request_text, reply)`` is called for every command handled (a bus monitor).
     """
@@ -60,6 +60,7 @@ class SimProtocolServer:
         on_transaction: Callable[[str, SimReply], None] | None = None,
     ):
         self.drive = drive
+        self.responder = SimResponder(drive)
         self.paced = paced
         self.char_s = protocol.character_time_s(baudrate) if paced else 0.0
         self._clock = clock
@@ -162,7 +163,7 @@ class SimProtocolServer:
             self._rx += self._incoming[:count]
             del self._incoming[:count]
             self._decode(at)
-        for reply in self.drive.take_deferred_replies():
+        for reply in self.responder.take_deferred_replies():
             self._send(reply, now)
 
     def _decode(self, at: float) -> None:
@@ -174,22 +175,20 @@ class SimProtocolServer:
             if isinstance(message, Garbage):
                 self.garbage_bytes += len(message.data)
                 continue
-            if isinstance(message, UnknownRequest):
-                name, value = message.name, message.value
-            elif isinstance(message, Request):
-                name, value = message.command.value, message.value
-            else:  # pragma: no cover - the codec returns only these
-                continue
-            reply = self.drive.execute(name, value)
+            if not isinstance(message, Request | UnknownRequest):  # pragma: no cover - the codec
+                continue  # returns only these
+            reply = self.responder.respond(message)
             self.transactions += 1
             if reply is not None:
                 self._send(reply, at)
             if self._on_transaction is not None:
+                name = message.command.value if isinstance(message, Request) else message.name
+                value = message.value
                 self._on_transaction(f"{name}{'-' if value < 0 else '+'}{abs(value):05d}",
-                                     reply or SimReply("q", reason="deferred"))
+                                     reply or SimReply(reason="deferred"))
 
     def _send(self, reply: SimReply, at: float) -> None:
-        data = encode_reply(protocol.Reply(tuple(reply.lines), _STATUS[reply.terminal]))
+        data = encode_reply(reply.on_the_wire())
         if len(self._out) + len(data) > OUTPUT_BACKLOG_BYTES:  # the host does not read: drop
             self.dropped_reply_bytes += len(data)
             return

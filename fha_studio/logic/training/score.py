@@ -13,11 +13,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 
-from fha_studio.hardware.sim.journal import JournalEntry
+from fha_studio.hardware.parameters import Mode
+from fha_studio.hardware.protocol import Command, Status
+from fha_studio.hardware.sim.journal import JournalEntry, PanelAction
 from fha_studio.logic.procedures.session import COMPLETED, ProcedureSession
 from fha_studio.logic.training.scenario import Evidence, ExpectedStep, Fault, Scenario
 
-MOTION_COMMANDS = ("JOG", "MOV", "CN2_MOVE")
+MOTION_COMMANDS = frozenset({Command.JOG, Command.MOV, PanelAction.CN2_MOVE})
 #: repeats of one act closer than this are one act (a held jog sends JOG every 50 ms) [s]
 EPISODE_GAP_S = 2.0
 
@@ -113,7 +115,7 @@ def _item_text(item: tuple[str, int] | None) -> str:
     if item is None:
         return "an item"
     mode, number = item
-    return f"{'parameter' if mode == 'system' else mode} item {number}"
+    return f"{'parameter' if mode == Mode.SYSTEM else mode} item {number}"
 
 
 def _journal(
@@ -152,15 +154,15 @@ def evidence_seen(evidence: Evidence, record: TraineeRecord) -> list[Seen]:
     if k == "parameter_read":
         return _journal(
             record,
-            lambda e: e.command == "PRD" and e.terminal == "q" and e.item == evidence.item,
+            lambda e: e.command is Command.PRD and e.terminal is Status.DONE and e.item == evidence.item,
             lambda e: f"read {_item_text(e.item)}",
         )
     if k == "parameter_written":
 
         def wrote(e: JournalEntry) -> bool:
             return (
-                e.command == "PWR"
-                and e.terminal == "q"
+                e.command is Command.PWR
+                and e.terminal is Status.DONE
                 and e.item == evidence.item
                 and (evidence.value is None or e.value == evidence.value)
                 and (evidence.minimum is None or e.value >= evidence.minimum)
@@ -176,19 +178,25 @@ def evidence_seen(evidence: Evidence, record: TraineeRecord) -> list[Seen]:
     if k == "alarm_cleared":
         return _journal(
             record,
-            lambda e: e.command in ("ACL", "PWC") and e.alarm_before == evidence.code and e.terminal == "q",
-            lambda e: f"cleared alarm {evidence.code} ({'reset' if e.command == 'ACL' else 'power cycle'})",
+            lambda e: (
+                e.command in (Command.ACL, Command.PWC)
+                and e.alarm_before == evidence.code
+                and e.terminal is Status.DONE
+            ),
+            lambda e: f"cleared alarm {evidence.code} "
+            f"({'reset' if e.command is Command.ACL else 'power cycle'})",
         )
     if k == "multi_turn_cleared":
         return _journal(
             record,
-            lambda e: e.command == "OWW" and e.terminal in ("q", ""),  # "": the q comes 5 s later
+            # None: the q comes 5 s later
+            lambda e: e.command is Command.OWW and e.terminal in (Status.DONE, None),
             lambda e: "cleared the multi-turn data",
         )
     if k == "jog":
 
         def jogged(e: JournalEntry) -> bool:
-            if e.command not in MOTION_COMMANDS or e.terminal != "q" or e.value == 0:
+            if e.command not in MOTION_COMMANDS or e.terminal is not Status.DONE or e.value == 0:
                 return False
             return evidence.direction == "" or (e.value > 0) == (evidence.direction == "fwd")
 
@@ -227,7 +235,7 @@ def unsafe_acts(record: TraineeRecord) -> list[UnsafeAct]:
     """Writing parameters with the servo on, moving with the brake applied, jogging into an
     active limit switch or inhibit input; each run of repeats counted once."""
     kinds: list[tuple[str, Callable[[JournalEntry], bool]]] = [
-        ("Wrote a parameter with the servo on", lambda e: e.command == "PWR" and e.servo_on),
+        ("Wrote a parameter with the servo on", lambda e: e.command is Command.PWR and e.servo_on),
         (
             "Moved the axis with the brake applied",
             lambda e: e.command in MOTION_COMMANDS and e.value != 0 and e.servo_on and e.brake_holding,
