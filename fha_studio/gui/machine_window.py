@@ -360,7 +360,7 @@ class AxisRecorder(QObject):
             )
 
     def _on_model_check(self, page, result) -> None:
-        lines = result.summary_lines()
+        lines = result.summary_lines(manual_units=True)
         summary = "; ".join(lines[:3]) if lines else "model check run"
         source = page.recording_path or ""
         self._record(

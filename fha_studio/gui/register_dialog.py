@@ -126,7 +126,7 @@ class RegisterDialog(QDialog):
         row = QHBoxLayout()
         self.find_parameter = QComboBox()
         for item in parameter_items():
-            self.find_parameter.addItem(f"{item.mode.value} {item.number} {item.name}", item.key)
+            self.find_parameter.addItem(parameter_name(item.key), item.key)
         self.find_parameter.currentIndexChanged.connect(self._parameter_chosen)
         self.find_value = QComboBox()
         self.find_value.setEditable(True)

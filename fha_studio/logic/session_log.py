@@ -28,7 +28,7 @@ class WriteRecord:
 
     def line(self, item: ParameterItem | None = None) -> str:
         """One line for people, in the front panel's words and units when ``item`` (this record's
-        parameter item) is given: ``17:05:02 parameter 6, position error allowance: 50000 pulse ->
+        parameter item) is given: ``17:05:02 parameter 6, position error allowance: 50000 pulse →
         100 pulse, verified``. Without it the values are the drive's raw numbers."""
         def value(wire: int | None) -> str:
             if wire is None:
@@ -42,7 +42,7 @@ class WriteRecord:
             what = f"{mode} {self.number}, {self.name}"
         outcome = "verified" if self.verified else f"NOT verified ({self.error or 'the read-back differs'})"
         clock = self.time[11:19] if len(self.time) >= 19 else self.time
-        return f"{clock} {what}: {value(self.old)} -> {value(self.new)}, {outcome}"
+        return f"{clock} {what}: {value(self.old)} → {value(self.new)}, {outcome}"
 
 
 class SessionLog:

@@ -69,3 +69,25 @@ def make_window(qtbot):
     for w in leaked:
         w.close()
     assert not leaked, f"top-level widgets left open: {[type(w).__name__ for w in leaked]}"
+
+
+@pytest.fixture(scope="session")
+def friction_file(tmp_path_factory):
+    """A recording of FHA-25C-50 moves (1.5 kg·m² load) with 8 N·m of Coulomb friction the
+    model lacks: what the model check finds and words."""
+    import sys
+    from pathlib import Path
+
+    from fha_studio.physics import AxisModel, Effects
+    from fha_studio.recording import write_recording
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "modelcheck"))
+    from modelcheck_gen import moves_for, record, trapezoid_moves
+
+    code = "FHA-25C-50-US250"
+    model = AxisModel.from_code(code, load_inertia_kgm2=1.5)
+    t, cmd = trapezoid_moves(moves_for(model, n_moves=5), 1000.0)
+    rec = record(model, Effects().with_effect("coulomb_friction", torque_nm=8.0), t, cmd, actuator_code=code)
+    path = tmp_path_factory.mktemp("rec") / "friction.csv"
+    write_recording(path, rec.recording)
+    return path

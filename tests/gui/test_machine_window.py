@@ -22,6 +22,8 @@ from tests.gui.procedure_answers import answer_by_hand
 MACHINE = "Line 3 positioner"
 TABLE = "FHA-25C-50-US250"
 TILT = "FHA-32C-100-S248-B"
+#: The rotary direction's write, as the register's history says it.
+WRITTEN = "parameter 8 Rotary direction: 0 → 1: reversed: FWD turns CCW, verified"
 
 
 @pytest.fixture
@@ -133,7 +135,7 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     # the register: history, diff against the twin, find
     history = register.history(f"{MACHINE}/table")
     writes = [e for e in history if e.kind == "write"]
-    assert [w.text for w in writes] == ["system 8 rotary_direction: 0 -> 1 verified"]
+    assert [w.text for w in writes] == [WRITTEN]
     assert writes[0].who == "ana"
     checks = [e for e in history if e.kind == "check"]
     assert len(checks) >= 5 and all("pass" in c.text for c in checks)
@@ -162,7 +164,7 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     # the same questions in the GUI, on the axis on show
     dialog = window.show_register()
     history = [dialog.history_table.item(r, 3).text() for r in range(dialog.history_table.rowCount())]
-    assert "system 8 rotary_direction: 0 -> 1 verified" in history
+    assert WRITTEN in history
     assert dialog.compare_a.currentText() == "table: latest known values"
     assert dialog.compare_b.currentText() == "table twin: latest known values"  # its twin
     compared = {
@@ -173,7 +175,10 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
         for r in range(dialog.compare_table.rowCount())
     }
     assert compared == {
-        "system 8 Rotary direction": (value_text("rotary_direction", 1), value_text("rotary_direction", 0)),
+        "parameter 8 Rotary direction": (
+            value_text("rotary_direction", 1),
+            value_text("rotary_direction", 0),
+        ),
         "tune 4 In-position range": ("10 pulse", "20 pulse"),
     }
     dialog.tabs.setCurrentIndex(2)
@@ -211,8 +216,8 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     qtbot.waitUntil(lambda: len(dgr.records) > before, timeout=15000)
     origin = register.latest_origin(f"{MACHINE}/tilt")
     assert origin["text"].startswith("absolute origin set (OWW), read back at") and origin["who"] == "ana"
-    assert [e.text.split(":")[0] for e in register.history(f"{MACHINE}/tilt") if e.kind == "check"] == [
-        "dgr-checks / absolute_origin"
+    assert [e.text.split(": ")[:2] for e in register.history(f"{MACHINE}/tilt") if e.kind == "check"] == [
+        ["DGR checks", "Absolute origin (OWW)"]
     ]
 
     # the machine report: every axis in the summary, then each axis's report

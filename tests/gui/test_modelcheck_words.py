@@ -4,17 +4,11 @@ what to do next beside each effect, numbered steps, and the analysis bandwidth s
 from __future__ import annotations
 
 import re
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from fha_studio.gui.link import Cmd
-
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "modelcheck"))
-
-from modelcheck_gen import moves_for, record, trapezoid_moves
 
 CODE = "FHA-25C-50-US250"
 SNAKE_CASE = re.compile(r"\b[a-z]+(?:_[a-z0-9]+)+\b")
@@ -53,19 +47,6 @@ def test_the_readme_flow_with_the_default_capture_is_not_refused(make_window, qt
     assert result.channel_status["torque"].status in ("checked", "too little signal")
     assert result.channel_status["position"].status in ("absent", "too little signal", "checked")
     assert [e.id for e in result.effects if not e.alternatives] in ([], ["inertia_error"]), text
-
-
-@pytest.fixture(scope="module")
-def friction_file(tmp_path_factory):
-    from fha_studio.physics import AxisModel, Effects
-    from fha_studio.recording import write_recording
-
-    model = AxisModel.from_code(CODE, load_inertia_kgm2=1.5)
-    t, cmd = trapezoid_moves(moves_for(model, n_moves=5), 1000.0)
-    rec = record(model, Effects().with_effect("coulomb_friction", torque_nm=8.0), t, cmd, actuator_code=CODE)
-    path = tmp_path_factory.mktemp("rec") / "friction.csv"
-    write_recording(path, rec.recording)
-    return path
 
 
 def test_the_effects_tab_speaks_plain_words_and_says_what_to_do_next(make_window, qtbot, friction_file):

@@ -43,7 +43,8 @@ def test_history_compare_find_and_open(qtbot, filled):
     dialog = RegisterDialog(filled, "Cell 2", "x twin")
     qtbot.addWidget(dialog)
     assert dialog.history_axis.currentText().startswith("x twin")
-    assert _column(dialog.history_table, 3)[0] == "tune 4 in_position_range: 10 -> 25 verified"  # newest
+    newest = _column(dialog.history_table, 3)[0]
+    assert newest == "tune 4 In-position range: 10 → 25 pulse, verified"
     # the axis chosen against its twin (the next axis with the same actuator, here the first)
     assert (dialog.compare_a.currentText(), dialog.compare_b.currentText()) == (
         "x twin: latest known values",

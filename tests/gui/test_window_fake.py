@@ -57,7 +57,7 @@ def test_edit_write_changed_verifies_and_logs_with_backup_first(window, fake, qt
     assert window.state.backup_path is not None and window.state.backup_path.exists()
     assert re.search(r"^in_position_range\s*= 10\b", window.state.backup_path.read_text(), re.M)  # before
     assert not model.edits
-    assert "tune 4, in-position range: 10 pulse -> 25 pulse, verified" in page.log_view.toPlainText()
+    assert "tune 4, in-position range: 10 pulse → 25 pulse, verified" in page.log_view.toPlainText()
 
 
 def test_rotary_direction_written_read_back_and_power_cycle_offered(window, fake, qtbot):

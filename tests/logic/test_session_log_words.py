@@ -14,7 +14,7 @@ def test_a_write_is_logged_in_the_front_panels_words_and_units():
         old=item.to_wire(50000), new=item.to_wire(100), read_back=item.to_wire(100), verified=True,
     )
     line = record.line(item)
-    assert line == "04:20:01 parameter 6, position error allowance: 50000 pulse -> 100 pulse, verified"
+    assert line == "04:20:01 parameter 6, position error allowance: 50000 pulse → 100 pulse, verified"
     assert "system" not in line and "position_error_allowance" not in line
     raw = record.line()  # an item this driver's model does not have: its own numbers, still no key
     assert raw.startswith("04:20:01 parameter 6, Position error allowance: ") and "_" not in raw
@@ -28,6 +28,6 @@ def test_a_failed_write_says_so():
         old=0, new=1, read_back=0, verified=False, error="the servo is on",
     )
     assert record.line(item).endswith(
-        "parameter 8, rotary direction: 0: FWD turns CW (seen from the flange) -> "
+        "parameter 8, rotary direction: 0: FWD turns CW (seen from the flange) → "
         "1: reversed: FWD turns CCW, NOT verified (the servo is on)"
     )

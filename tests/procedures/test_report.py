@@ -45,7 +45,7 @@ def test_report_of_a_finished_session_signs_and_reproduces(context, tmp_path):
         "Signed by T. Trainee",
         "rotary direction",
         str(plot),
-        "None.",  # no open warnings
+        "No open warnings.",
     ):
         assert text.lower() in html.lower(), text
     changed = {p.key for p in build_report(session, context).changed_parameters}
@@ -58,7 +58,9 @@ def test_open_warnings_block_the_signature(context, tmp_path):
     run.submit(True)
     run.submit("FHA-25C-50-US250")  # the label lacks -B-L: not what was ordered
     report = build_report(session, context)
-    assert any("stopped at 'actuator-type-label'" in w for w in report.warnings)
+    # the step in the checklist's words, not its file id
+    assert any("stopped at 'A label is attached on the right side" in w for w in report.warnings)
+    assert not any("actuator-type-label" in w for w in report.warnings)
     assert any("Location and installation (3-3): not done" in w for w in report.warnings)
     with pytest.raises(SignError, match="cannot sign while these are open"):
         sign(session, "T. Trainee", context)

@@ -58,7 +58,7 @@ def test_a_v1_register_is_upgraded_with_its_data(tmp_path):
         # what v2 added works on the old data
         reg.update_axis(feed, who="ben", serial_number="S/N 0012345")
         assert reg.axis(feed.id).serial_number == "S/N 0012345"
-        assert reg.history(feed)[-1].text == "serial number: (none) -> S/N 0012345"
+        assert reg.history(feed)[-1].text == "serial number: not given → S/N 0012345"
         plan = reg._db.execute(
             "EXPLAIN QUERY PLAN SELECT * FROM snapshot_value WHERE key = 'rotary_direction' AND value = 1"
         ).fetchall()

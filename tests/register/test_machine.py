@@ -72,7 +72,7 @@ def test_the_project_goes_into_the_register_and_comes_back(register):
     project.axis("tilt").state.set_load_inertia(4.5)
     project.save_to(register, who="ben")
     tilt_history = register.history("Line 3 positioner/tilt")
-    assert tilt_history[-1].text == "load inertia: 4.0 -> 4.5" and tilt_history[-1].who == "ben"
+    assert tilt_history[-1].text == "load inertia: 4 kg·m² → 4.5 kg·m²" and tilt_history[-1].who == "ben"
     back = MachineProject.from_register(register, "Line 3 positioner")
     assert back.to_json() == project.to_json()
     # an axis added on the command line, without a load inertia: opening and saving changes nothing

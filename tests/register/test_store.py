@@ -106,12 +106,12 @@ def test_history_of_an_axis_in_time_order(line3):
     events = [e for e in history if e.kind != "axis"]  # the axis events are stamped now
     assert [e.kind for e in events] == ["snapshot", "write", "alarm"]  # 09:01+01:00 is 08:01 UTC
     assert events[0].ref == first and "3 values" in events[0].text and events[0].who == "ana"
-    assert events[1].text == "system 8 rotary_direction: 0 -> 1 verified"
+    assert events[1].text == "parameter 8 Rotary direction: 0 → 1: reversed: FWD turns CCW, verified"
     assert events[1].at_utc == "2026-11-30T08:01:00.000000+00:00"
     axis_events = [e for e in history if e.kind == "axis"]
     assert axis_events[0].text.startswith("axis added: FHA-25C-50-US250") and axis_events[0].who == "ana"
     assert (
-        axis_events[1].text == "actuator: FHA-25C-50-US250 -> FHA-25C-100-US250"
+        axis_events[1].text == "actuator: FHA-25C-50-US250 → FHA-25C-100-US250"
         and axis_events[1].who == "ben"
     )
     later = [e.kind for e in line3.history(table, since="2026-11-30T08:15:00Z") if e.kind != "axis"]
@@ -194,7 +194,7 @@ def test_open_checks_and_unsigned_reports(line3, tmp_path):
     line3.record_report(report, axis=table, open_warnings=1)
     items = {(i.axis.name, i.kind, i.text) for i in line3.open_items(M)}
     assert ("table", "check", "Installation (3-3): paused") in items
-    assert ("table", "check", "wiring / v (1-14): failed, not checked again") in items
+    assert ("table", "check", "Wiring: check v (1-14): failed, not checked again") in items
     assert not any("wiring / u" in text for _, _, text in items)  # checked again, passed
     assert ("table", "report", f"report {report.resolve()} is not signed") in items
     assert ("tilt", "check", "no procedure recorded yet") in items

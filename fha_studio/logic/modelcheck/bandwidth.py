@@ -115,7 +115,7 @@ def choose_bandwidth(
     if chosen is first:
         reason = (
             "the shortest window where the acceleration noise falls to the current monitor's noise; "
-            f"the rigid model explains the data up to there ({_fmt(first.unexplained_nm)} N m rms "
+            f"the rigid model explains the data up to there ({_fmt(first.unexplained_nm)} N·m rms "
             "unexplained)"
         )
     else:
@@ -123,7 +123,7 @@ def choose_bandwidth(
         reason = (
             f"the highest bandwidth where the rigid model still explains the data: above it the "
             f"unexplained torque grows from {_fmt(chosen.unexplained_nm)} to {_fmt(above.unexplained_nm)} "
-            f"N m rms ({above.bandwidth_hz:.3g} Hz), drive-train dynamics the rigid model lacks"
+            f"N·m rms ({above.bandwidth_hz:.3g} Hz), drive-train dynamics the rigid model lacks"
         )
     return BandwidthChoice(chosen.window, reason, tuple(profile))
 

@@ -281,7 +281,7 @@ def _ratio_model_params(params: dict[str, float], model: Any) -> dict[str, float
 
 
 def _nm(x: float) -> str:
-    return f"{x:.3g} N m"
+    return f"{x:.3g} N·m"
 
 
 TORQUE_CANDIDATES: tuple[Candidate, ...] = (
@@ -336,7 +336,7 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         limit_in_param=_per_rms(lambda c: c.sig.speed_rad_s),
         model_params=_clamp_nonnegative,
         advice=lambda p: (
-            f"add {p['coefficient_nm_s_per_rad']:.3g} N m s/rad viscous friction to the model; a cold gear "
+            f"add {p['coefficient_nm_s_per_rad']:.3g} N·m·s/rad viscous friction to the model; a cold gear "
             "is stiffer: compare after a warm-up run"
         ),
     ),
@@ -516,7 +516,7 @@ POSITION_CANDIDATES: tuple[Candidate, ...] = (
         primary="amplitude_arcsec",
         needs_ratio=True,
         advice=lambda p: (
-            f"add {p['amplitude_arcsec']:.3g} arcsec kinematic error at "
+            f"add {p['amplitude_arcsec']:.3g} arc-sec kinematic error at "
             f"{p['cycles_per_motor_rev']:.3g} cycles per motor turn to the model; compare with the gear's "
             "accuracy in the catalogue (1-9-1)"
         ),
@@ -541,7 +541,7 @@ POSITION_CANDIDATES: tuple[Candidate, ...] = (
             else None
         ),
         advice=lambda p: (
-            f"add the gear's wind-up (K1 {p['stiffness_nm_per_rad']:.3g} N m/rad) to the model; if it is "
+            f"add the gear's wind-up (K1 {p['stiffness_nm_per_rad']:.3g} N·m/rad) to the model; if it is "
             "softer than the catalogue's, check the load's mounting and its screws' torque"
         ),
     ),
@@ -559,7 +559,7 @@ POSITION_CANDIDATES: tuple[Candidate, ...] = (
         limit_in_param=lambda size, c: 2.0 * size,
         model_params=_clamp_nonnegative,
         advice=lambda p: (
-            f"add {p['width_arcsec']:.3g} arcsec lost motion to the model; a harmonic gear has almost none: "
+            f"add {p['width_arcsec']:.3g} arc-sec lost motion to the model; a harmonic gear has almost none: "
             "check the load's coupling and keys for play"
         ),
     ),

@@ -49,6 +49,7 @@ from fha_studio.logic.modelcheck.signals import (
     build_signals,
     window_bounds,
 )
+from fha_studio.logic.wording import unit_words
 from fha_studio.physics import AxisModel, Effects, ServoSettings, simulate
 from fha_studio.recording import Recording
 
@@ -261,17 +262,21 @@ class ModelCheckResult:
     def found(self) -> bool:
         return bool(self.effects)
 
-    def summary_lines(self) -> list[str]:
-        """The human summary (one finding per line)."""
+    def summary_lines(self, manual_units: bool = False) -> list[str]:
+        """The human summary (one finding per line). ``manual_units``: units as the FHA-C manual
+        prints them (N·m, kg·m²) and "→" for a change, for a page and the register; the default
+        keeps plain ASCII for a terminal and a log (:mod:`fha_studio.logic.wording`)."""
+        unit = unit_words if manual_units else str
+        to = " → " if manual_units else " -> "
         lines = self._status_lines()
         by_channel: dict[str, Effect] = {}
         for e in self.effects:
             by_channel.setdefault(e.channel, e)
         for e in self.effects:
             p = next(iter(e.params))
-            main = _fmt_pm(e.params[p], e.uncertainty[p], e.units[p])
+            main = _fmt_pm(e.params[p], e.uncertainty[p], unit(e.units[p]))
             others = ", ".join(
-                f"{PARAM_WORDS.get(k, k)} {_fmt_pm(v, e.uncertainty[k], e.units[k])}"
+                f"{PARAM_WORDS.get(k, k)} {_fmt_pm(v, e.uncertainty[k], unit(e.units[k]))}"
                 for k, v in e.params.items()
                 if k != p
             )
@@ -282,7 +287,7 @@ class ModelCheckResult:
             gap = self.gap.get(e.channel)
             if gap is not None and by_channel.get(e.channel) is e:
                 text += (
-                    f"; {e.channel} gap {_fmt(gap.rms_before)} -> {_fmt(gap.rms_after)} {gap.unit} rms "
+                    f"; {e.channel} gap {_fmt(gap.rms_before)}{to}{_fmt(gap.rms_after)} {unit(gap.unit)} rms "
                     "on held-out data"
                 )
             lines.append(text)
@@ -301,36 +306,36 @@ class ModelCheckResult:
                 peak = max(p for _, _, p in s.spans)
                 lines.append(
                     f"Structured residual in the {s.channel} channel that no candidate explains: "
-                    f"{len(s.spans)} burst{'s' if len(s.spans) > 1 else ''} up to {_fmt(peak)} {s.unit} at "
-                    f"t = {where}{more} ({100 * s.fraction:.0f} % of the residual): a disturbance the "
-                    "recording does not measure; not forced onto a named effect"
+                    f"{len(s.spans)} burst{'s' if len(s.spans) > 1 else ''} up to "
+                    f"{_fmt(peak)} {unit(s.unit)} at t = {where}{more} ({100 * s.fraction:.0f} % of the "
+                    "residual): a disturbance the recording does not measure; not forced onto a named effect"
                 )
                 continue
             lines.append(
                 f"Structured residual in the {s.channel} channel that no candidate explains: "
-                f"{_fmt(s.rms)} {s.unit} rms organised by {s.variable} ({100 * s.fraction:.0f} % of the "
-                "residual); not forced onto a named effect"
+                f"{_fmt(s.rms)} {unit(s.unit)} rms organised by {s.variable.replace('_', ' ')} "
+                f"({100 * s.fraction:.0f} % of the residual); not forced onto a named effect"
             )
         if not self.effects and any(st.checked for st in self.channel_status.values()):
             lines.append("No missing effect found.")
             for ch, gap in self.gap.items():
                 lines.append(
-                    f"  {ch} gap {_fmt(gap.rms_before)} -> {_fmt(gap.rms_after)} {gap.unit} rms "
+                    f"  {ch} gap {_fmt(gap.rms_before)}{to}{_fmt(gap.rms_after)} {unit(gap.unit)} rms "
                     "on held-out data"
                 )
         if self.detection_limits:
             limits = ", ".join(
                 f"{LABELS[d.id]} ±{100 * d.value:.2g} %"
                 if d.param_unit == "1"  # a ratio's distance from 1
-                else f"{LABELS[d.id]} {_fmt(d.value)} {d.param_unit}"
+                else f"{LABELS[d.id]} {_fmt(d.value)} {unit(d.param_unit)}"
                 for d in self.detection_limits
             )
             lines.append(f"Detection limit (smallest effect this recording could have revealed): {limits}")
         if self.resimulation is not None:
             r = self.resimulation
             lines.append(
-                f"Re-simulation of the recorded {r.command}: torque {_fmt(r.rms_nominal_nm)} -> "
-                f"{_fmt(r.rms_updated_nm)} N m rms (nominal -> updated model)"
+                f"Re-simulation of the recorded {r.command}: torque {_fmt(r.rms_nominal_nm)}{to}"
+                f"{_fmt(r.rms_updated_nm)} {unit('N m')} rms (nominal{to}updated model)"
             )
         lines.extend(self.notes)
         return lines

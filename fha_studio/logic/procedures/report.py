@@ -98,16 +98,19 @@ def open_warnings(session: ProcedureSession, procedures: list[Procedure]) -> lis
         if state is None or not state.records:
             warnings.append(f"{procedure.title} ({procedure.section}): not done")
             continue
-        if state.status == STOPPED:
-            warnings.append(f"{procedure.title}: stopped at '{state.stop_step_id}': {state.stop_warning}")
-        elif state.status != COMPLETED:
-            warnings.append(f"{procedure.title} ({procedure.section}): not finished ({state.status})")
         last = {}
         for record in state.records:
             last[record.step_id] = record
+        # a step as the checklist words it (its id is for files)
+        stopped = last[state.stop_step_id].text if state.stop_step_id in last else state.stop_step_id
+        if state.status == STOPPED:
+            warnings.append(f"{procedure.title}: stopped at '{stopped}': {state.stop_warning}")
+        elif state.status != COMPLETED:
+            status = str(state.status).replace("_", " ")
+            warnings.append(f"{procedure.title} ({procedure.section}): not finished ({status})")
         for record in last.values():
             if not record.passed and not (state.status == STOPPED and record.step_id == state.stop_step_id):
-                warnings.append(f"{procedure.title}: '{record.step_id}' failed and was not checked again")
+                warnings.append(f"{procedure.title}: '{record.text}' failed and was not checked again")
     return warnings
 
 
@@ -291,7 +294,7 @@ def render_html(report: CommissioningReport) -> str:
     if report.warnings:
         out.append("<ul>" + "".join(f"<li class='warn'>{_e(w)}</li>" for w in report.warnings) + "</ul>")
     else:
-        out.append("<p class='pass'>None.</p>")
+        out.append("<p class='pass'>No open warnings.</p>")
 
     out.append("<h2>Checklists</h2>")
     for result in report.procedures:

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from fha_studio import clock
+from fha_studio.logic.register import words
 from fha_studio.logic.register.schema import MIGRATIONS, SCHEMA_VERSION
 from fha_studio.paths import user_data_dir
 
@@ -452,7 +453,7 @@ class Register:
                         current.id,
                         now,
                         who,
-                        f"{self._AXIS_FIELDS[key]}: {_shown(old)} -> {_shown(value)}",
+                        f"{self._AXIS_FIELDS[key]}: {_field_text(key, old)} → {_field_text(key, value)}",
                     ),
                 )
         return self.axis(current.id)
@@ -916,14 +917,15 @@ class Register:
                 )
             )
         for r in db.execute("SELECT * FROM parameter_write WHERE axis_id = ?", (a,)):
-            old = "?" if r["old"] is None else str(r["old"])
             outcome = "verified" if r["verified"] else f"NOT verified ({r['error'] or 'read-back differs'})"
+            name = words.parameter_name(r["key"], current.driver_model, (r["mode"], r["number"]))
+            change = words.change_text(r["key"], r["old"], r["new"], current.driver_model)
             events.append(
                 Event(
                     r["at_utc"],
                     "write",
                     r["who"],
-                    f"{r['mode']} {r['number']} {r['key']}: {old} -> {r['new']} {outcome}",
+                    f"{name}: {change}, {outcome}",
                     r["id"],
                     {
                         k: r[k]
@@ -931,19 +933,19 @@ class Register:
                     },
                 )
             )
+        titles = self._procedure_titles(a)
         for r in db.execute("SELECT * FROM check_result WHERE axis_id = ?", (a,)):
             value = json.loads(r["value_json"])
             shown = ("yes" if value else "no") if r["kind"] == "confirm" else f"{value} {r['unit']}".strip()
             verdict = "pass" if r["passed"] else "FAIL"
-            section = f" ({r['section']})" if r["section"] else ""
             if isinstance(value, dict):  # a check with several readings: its own sentence says them
-                shown = r["detail"] or ", ".join(f"{k} {v}" for k, v in value.items())
+                shown = r["detail"] or words.readings_text(value)
             events.append(
                 Event(
                     r["at_utc"],
                     "check",
                     r["who"],
-                    f"{r['procedure_id']} / {r['step_id']}{section}: {shown} — {verdict}",
+                    f"{_check_name(r, titles)}: {shown} — {verdict}",
                     r["id"],
                     {
                         "procedure_id": r["procedure_id"],
@@ -1017,6 +1019,11 @@ class Register:
         }
         return sorted(events, key=lambda e: (e.at_utc, order[e.kind], e.ref or 0))
 
+    def _procedure_titles(self, axis_id: int) -> dict[str, str]:
+        """{procedure id: its title} of the procedures recorded for the axis."""
+        rows = self._db.execute("SELECT procedure_id, title FROM procedure_run WHERE axis_id = ?", (axis_id,))
+        return {r["procedure_id"]: r["title"] for r in rows if r["title"]}
+
     def procedure_status(self, axis: Axis | str | int) -> list[dict[str, Any]]:
         current = self.axis(axis)
         rows = self._db.execute("SELECT * FROM procedure_run WHERE axis_id = ? ORDER BY rowid", (current.id,))
@@ -1064,21 +1071,17 @@ class Register:
                         OpenItem(axis, "check", f"{run['title']}{section}: {run['status'].replace('_', ' ')}")
                     )
             failed = self._db.execute(
-                "SELECT procedure_id, step_id, section FROM check_result c WHERE axis_id = ? AND passed = 0"
+                "SELECT procedure_id, step_id, section, text FROM check_result c"
+                " WHERE axis_id = ? AND passed = 0"
                 " AND NOT EXISTS (SELECT 1 FROM check_result d WHERE d.axis_id = c.axis_id"
                 " AND d.procedure_id = c.procedure_id AND d.step_id = c.step_id"
                 " AND (d.at_utc > c.at_utc OR (d.at_utc = c.at_utc AND d.id > c.id)))"
                 " ORDER BY at_utc",
                 (axis.id,),
             ).fetchall()
+            titles = self._procedure_titles(axis.id)
             for r in failed:
-                out.append(
-                    OpenItem(
-                        axis,
-                        "check",
-                        f"{r['procedure_id']} / {r['step_id']} ({r['section']}): failed, not checked again",
-                    )
-                )
+                out.append(OpenItem(axis, "check", f"{_check_name(r, titles)}: failed, not checked again"))
             if (
                 not runs
                 and not self._db.execute(
@@ -1129,6 +1132,28 @@ def _check_inertia(value: float | None) -> None:
 
 def _shown(value: Any) -> str:
     return "(none)" if value in (None, "") else str(value)
+
+
+def _field_text(key: str, value: Any) -> str:
+    """An axis field's value for its history: "not given" for none, a load inertia with its unit."""
+    if value in (None, ""):
+        return "not given"
+    if key == "load_inertia_kgm2":
+        return f"{float(value):g} kg·m²"
+    return str(value)
+
+
+#: The checks recorded outside the procedures, by the page that makes them.
+_CHECK_SOURCES = {"dgr-checks": "DGR checks"}
+
+
+def _check_name(row: sqlite3.Row, titles: Mapping[str, str]) -> str:
+    """A check as the checklist words it: "Receiving inspection: Actuator type label (3-1)" (the
+    procedure's title and the step's text; their ids are for files)."""
+    procedure_id = row["procedure_id"]
+    procedure = titles.get(procedure_id) or _CHECK_SOURCES.get(procedure_id, procedure_id)
+    section = f" ({row['section']})" if row["section"] else ""
+    return f"{procedure}: {row['text'] or row['step_id']}{section}"
 
 
 def _short(at_utc: str) -> str:

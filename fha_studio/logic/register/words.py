@@ -6,7 +6,7 @@ from __future__ import annotations
 from functools import cache
 from typing import Any
 
-from fha_studio.hardware.parameters import driver_family
+from fha_studio.hardware.parameters import MODE_WORDS, driver_family
 
 #: Where a known value comes from.
 SOURCE_WORDS = {
@@ -50,10 +50,48 @@ def parameter_items(driver_model: str = "") -> list[Any]:
     return [i for i in model if i.mode.value in ("tune", "system") and i.writable]
 
 
-def parameter_name(key: str, driver_model: str = "") -> str:
-    """``"system 8 Rotary direction"``; the key itself for an item the driver does not have."""
+def parameter_name(key: str, driver_model: str = "", where: tuple[str, int] | None = None) -> str:
+    """``"parameter 8 Rotary direction"``, in the front panel's words (its "parameter mode" is
+    ``Mode.SYSTEM``); for an item the driver does not have, its mode and number when ``where``
+    gives them, else the key itself."""
     item = parameter_item(key, driver_model)
-    return f"{item.mode.value} {item.number} {item.name}" if item is not None else key
+    if item is not None:
+        return f"{MODE_WORDS[item.mode]} {item.number} {item.name}"
+    if where is not None:
+        mode, number = where
+        return f"{MODE_WORDS.get(mode, mode)} {number}"
+    return key
+
+
+def change_text(key: str, old: int | None, new: int, driver_model: str = "") -> str:
+    """``"10 → 25 pulse"``, ``"0 → 1: reversed: FWD turns CCW"``: a
+    change of a parameter's value in the item's words ("unknown" for a value nobody read)."""
+    item = parameter_item(key, driver_model)
+    after = value_text(key, new, driver_model)
+    if old is None:
+        return f"unknown → {after}"
+    if item is not None and (item.choices or item.unit):
+        before = str(old) if item.choices else item.format(old).removesuffix(f" {item.unit}")
+    else:
+        before = value_text(key, old, driver_model)
+    return f"{before} → {after}"  # the meaning or the unit once, after the new value
+
+
+#: How a reading's name ends -> its unit (a check's readings: ``{"position_deg": 0.01}``).
+_READING_UNITS = {"_deg": "°", "_counts": " counts", "_s": " s"}
+
+
+def readings_text(values: dict[str, Any]) -> str:
+    """``"position 0.01°, oww 0.5 s"``: a check's readings for people, when no sentence says them."""
+    out = []
+    for key, value in values.items():
+        name, unit = key, ""
+        for ending, words in _READING_UNITS.items():
+            if key.endswith(ending):
+                name, unit = key[: -len(ending)], words
+                break
+        out.append(f"{name.replace('_', ' ')} {value}{unit}")
+    return ", ".join(out)
 
 
 def value_text(key: str, value: int | None, driver_model: str = "") -> str:

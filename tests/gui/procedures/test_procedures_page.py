@@ -185,7 +185,7 @@ def test_from_boxed_actuator_to_signed_report(make_window, qtbot, tmp_path):
     text = html.read_text()
     for wanted in (
         "Signed by T. Trainee",
-        "None.",
+        "No open warnings.",
         "HA-655-2-200",
         "Scope after the direction check",
         "rotary direction",

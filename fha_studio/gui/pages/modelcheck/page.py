@@ -38,6 +38,7 @@ from fha_studio.gui.state import AxisState
 from fha_studio.logic.modelcheck import ModelCheckError, ModelCheckResult, run_modelcheck
 from fha_studio.logic.modelcheck.candidates import LABELS, label_of, param_words
 from fha_studio.logic.modelcheck.signals import bandwidth_bounds_hz, window_for_bandwidth
+from fha_studio.logic.wording import unit_words
 from fha_studio.recording import Recording, RecordingError, read_recording
 
 COLORS = {"measured": "#1f77b4", "nominal": "#d62728", "updated": "#2ca02c", "residual": "#555555"}
@@ -189,7 +190,9 @@ class ModelCheckPage(BasePage):
         layout.addWidget(split, 1)
 
     def _build_residual_tab(self) -> QWidget:
-        self.torque_plot = _plot("Motor torque (Kt x current) and what the nominal model needs", "N m")
+        self.torque_plot = _plot(
+            "Motor torque (Kt x current) and what the nominal model needs", unit_words("N m")
+        )
         self.residual_plot = _plot("Residual: measured - nominal", "")
         self.residual_plot.setXLink(self.torque_plot)
         return _stack(self.torque_plot, self.residual_plot)
@@ -238,8 +241,8 @@ class ModelCheckPage(BasePage):
         return self.gap_box
 
     def _build_resim_tab(self) -> QWidget:
-        self.resim_torque_plot = _plot("Re-simulation of the recorded command: torque", "N m")
-        self.resim_pos_plot = _plot("Position: simulated - measured", "arcsec")
+        self.resim_torque_plot = _plot("Re-simulation of the recorded command: torque", unit_words("N m"))
+        self.resim_pos_plot = _plot("Position: simulated - measured", unit_words("arcsec"))
         self.resim_pos_plot.setXLink(self.resim_torque_plot)
         return _stack(self.resim_torque_plot, self.resim_pos_plot)
 
@@ -373,7 +376,7 @@ class ModelCheckPage(BasePage):
     def _on_done(self, result: ModelCheckResult, seconds: float) -> None:
         self._running = False
         self.result = result
-        lines = result.summary_lines()
+        lines = result.summary_lines(manual_units=True)
         lines.append(f"Analysis bandwidth {result.bandwidth_hz:.3g} Hz: {result.window_reason}.")
         self.summary.setPlainText("\n".join(lines) + f"\n\n(analysis took {seconds:.1f} s)")
         self._draw_residual(result)
@@ -404,10 +407,10 @@ class ModelCheckPage(BasePage):
                               name="nominal model (J x acceleration)")
         self.residual_plot.clear()
         self.residual_plot.plot(t, res["torque_residual_nm"], pen=pg.mkPen(COLORS["residual"], width=1),
-                                name="torque residual [N m]")
+                                name=f"torque residual ({unit_words('N m')})")
         if "load_diff_arcsec" in res:
             self.residual_plot.plot(t, res["load_diff_arcsec"], pen=pg.mkPen(COLORS["updated"], width=1),
-                                    name="load encoder - motor encoder [arcsec]")
+                                    name=f"load encoder - motor encoder ({unit_words('arcsec')})")
         # where a residual no effect explains sits in time (an unmeasured disturbance)
         self.burst_regions = []
         for structure in r.structures:
@@ -448,11 +451,11 @@ class ModelCheckPage(BasePage):
         where = self.result.where[channel]
         plot = self.where_plot
         plot.clear()
-        unit = where.variable_units.get(var, "")
+        unit = unit_words(where.variable_units.get(var, ""))
         plot.getPlotItem().setTitle(f"{channel} residual against {VARIABLE_LABELS.get(var, var)}",
                                     color="#222", size="10pt")
         plot.getPlotItem().setLabel("bottom", f"{VARIABLE_LABELS.get(var, var)} ({unit})")
-        plot.getPlotItem().setLabel("left", f"residual ({where.unit})")
+        plot.getPlotItem().setLabel("left", f"residual ({unit_words(where.unit)})")
         x = where.variables[var]
         plot.plot(x, where.residual_before, pen=None, symbol="o", symbolSize=3,
                   symbolBrush=pg.mkBrush(120, 120, 120, 90), symbolPen=None, name="residual (nominal)")
@@ -489,9 +492,10 @@ class ModelCheckPage(BasePage):
             plot.deleteLater()
         self.gap_plots.clear()
         for name, gap in r.gap.items():
-            plot = _plot(f"{CHANNEL_WORDS.get(name, name)}: {_num(gap.rms_before)} -> {_num(gap.rms_after)} "
-                         f"{gap.unit} rms on held-out stretches (shaded): how much better the updated model "
-                         "explains data it was not fitted on", gap.unit)
+            unit = unit_words(gap.unit)
+            plot = _plot(f"{CHANNEL_WORDS.get(name, name)}: {_num(gap.rms_before)} → {_num(gap.rms_after)} "
+                         f"{unit} rms on held-out stretches (shaded): how much better the updated model "
+                         "explains data it was not fitted on", unit)
             for start, stop in gap.blocks:
                 region = pg.LinearRegionItem((start, stop), movable=False,
                                              brush=pg.mkBrush(255, 200, 0, 40), pen=pg.mkPen(None))
@@ -511,8 +515,9 @@ class ModelCheckPage(BasePage):
             self.resim_torque_plot.getPlotItem().setTitle("No re-simulation for this recording")
             return
         self.resim_torque_plot.getPlotItem().setTitle(
-            f"Re-simulation of the recorded {s.command}: torque {_num(s.rms_nominal_nm)} -> "
-            f"{_num(s.rms_updated_nm)} N m rms (nominal -> updated)", color="#222", size="10pt")
+            f"Re-simulation of the recorded {s.command}: torque {_num(s.rms_nominal_nm)} → "
+            f"{_num(s.rms_updated_nm)} {unit_words('N m')} rms (nominal → updated)", color="#222", size="10pt"
+        )
         for y, color, label in ((s.torque_measured_nm, COLORS["measured"], "measured"),
                                 (s.torque_nominal_nm, COLORS["nominal"], "nominal model"),
                                 (s.torque_updated_nm, COLORS["updated"], "updated model")):
@@ -601,7 +606,7 @@ def _better(before: float, after: float) -> str:
     if before <= 0 or not np.isfinite(before) or not np.isfinite(after):
         return "does not change how well held-out data are explained"
     change = 100.0 * (before - after) / before
-    return f"explains held-out data {change:.0f} % better ({before:.3g} -> {after:.3g}"
+    return f"explains held-out data {change:.0f} % better ({before:.3g} → {after:.3g}"
 
 
 def _findings_in_words(r: ModelCheckResult) -> list[str]:
@@ -628,8 +633,9 @@ def _findings_in_words(r: ModelCheckResult) -> list[str]:
                 continue
             chosen = next((t for t in step.trials if t.id == step.chosen), None)
             if chosen is not None:
-                out.append(f"  Step {number}: {label_of(chosen.id)} named: it "
-                           f"{_better(chosen.cv_rms_before, chosen.cv_rms_after)} {report.unit} rms).")
+                better = _better(chosen.cv_rms_before, chosen.cv_rms_after)
+                unit = unit_words(report.unit)
+                out.append(f"  Step {number}: {label_of(chosen.id)} named: it {better} {unit} rms).")
             else:
                 out.append(f"  Step {number}: no further effect passes every test.")
             for t in step.trials:
