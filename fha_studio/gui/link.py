@@ -36,7 +36,7 @@ from fha_studio.hardware.api import (
 )
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import Mode, MonitorItem
-from fha_studio.hardware.protocol import INPUT_MASK, Command, IoBit
+from fha_studio.hardware.protocol import EXTENSION_COMMANDS, INPUT_MASK, Command, IoBit
 from fha_studio.hardware.sim.options import public_url
 from fha_studio.hardware.transaction import LinkSettings
 from fha_studio.logic.absolute import SERVO_ON_TEXT, refusal_text
@@ -405,7 +405,7 @@ class LinkWorker(QObject):
         except LinkError as exc:
             log.info("identify failed: %s", exc)
         caps = client.capabilities
-        extensions = set(caps.commands) - {Command.DGR, Command.OWW}
+        extensions = set(caps.commands) & EXTENSION_COMMANDS
         return LinkInfo(
             url=public_url(url),  # a training drive's options name its hidden faults
             driver_model=ident.driver_model if ident else "",

@@ -32,7 +32,7 @@ from fha_studio.hardware.errors import (
     ServoOnRefused,
 )
 from fha_studio.hardware.parameters import Mode, ParameterItem, ParameterModel
-from fha_studio.hardware.protocol import Command
+from fha_studio.hardware.protocol import TRACE_COMMANDS, Command
 
 __all__ = [
     "INPUT_NAMES",
@@ -60,22 +60,6 @@ __all__ = [
     "TraceStatus",
     "WriteResult",
 ]
-
-#: The commands of a drive-side trace capture.
-TRACE_COMMANDS = frozenset(
-    {
-        Command.TCH,
-        Command.TDV,
-        Command.TTG,
-        Command.TTC,
-        Command.TTL,
-        Command.TPR,
-        Command.TAR,
-        Command.TST,
-        Command.TRB,
-    }
-)
-
 
 class CapabilityLevel(Enum):
     """What a drive can give, best first (the degrade chain of docs/protocol.md)."""

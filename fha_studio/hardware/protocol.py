@@ -30,7 +30,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from enum import IntEnum, StrEnum
+from enum import Enum, IntEnum, StrEnum
 from typing import Generic, TypeVar
 
 CR = 0x0D
@@ -51,123 +51,45 @@ def character_time_s(baudrate: int = BAUDRATE) -> float:
 
 
 class Command(StrEnum):
-    """Every command of docs/protocol.md. DGR and OWW are the documented ones; the rest extend."""
+    """Every command of docs/protocol.md; what is known of each is its row in :data:`COMMAND_FACTS`."""
 
-    DGR = "DGR"  # absolute position (documented)
-    OWW = "OWW"  # clear multi-turn data (documented)
-    IDN = "IDN"  # identification
-    CAP = "CAP"  # supported extensions
-    PSL = "PSL"  # select a parameter-mode (system) item
-    TSL = "TSL"  # select a tune-mode item
-    JSL = "JSL"  # select a test-mode (jog) item
-    PRD = "PRD"  # read the selected item
-    PWR = "PWR"  # write the selected item
-    MON = "MON"  # read one monitor item
-    MMR = "MMR"  # read several monitor items 100-115
-    SVO = "SVO"  # servo on/off
-    JOG = "JOG"  # jog at a speed, held by repetition
-    SPD = "SPD"  # speed for MOV
-    MOV = "MOV"  # relative move
-    STP = "STP"  # stop
-    ALM = "ALM"  # current alarm
-    AHS = "AHS"  # alarm history
-    ACL = "ACL"  # alarm clear
-    IOS = "IOS"  # I/O state
-    INP = "INP"  # simulated inputs (sim only)
-    PWC = "PWC"  # simulated power cycle (sim only)
-    TCH = "TCH"  # trace channels
-    TDV = "TDV"  # trace divider
-    TTG = "TTG"  # trace trigger kind
-    TTC = "TTC"  # trace trigger channel
-    TTL = "TTL"  # trace trigger level
-    TPR = "TPR"  # trace pre-trigger samples
-    TAR = "TAR"  # arm trace
-    TST = "TST"  # trace status
-    TRB = "TRB"  # read trace block
-    TRP = "TRP"  # read trace block, packed encoding
-    FLT = "FLT"  # inject an alarm (sim only)
-    SNO = "SNO"  # move the origin slit (sim only)
-    SNA = "SNA"  # move the dog of limit switch 1 (sim only)
-    SNB = "SNB"  # move the dog of limit switch 2 (sim only)
-    SNQ = "SNQ"  # read the sensor angles (sim only)
-
-
-#: What each command asks the drive to do, in words for a person ("the drive refused to ...").
-COMMAND_WORDS: dict[Command, str] = {
-    Command.DGR: "report the absolute position",
-    Command.OWW: "clear the multi-turn data",
-    Command.IDN: "say what it is",
-    Command.CAP: "list the commands it has",
-    Command.PSL: "select parameter-mode item",
-    Command.TSL: "select tune-mode item",
-    Command.JSL: "select test-mode item",
-    Command.PRD: "read the selected item",
-    Command.PWR: "write the selected item",
-    Command.MON: "read monitor item",
-    Command.MMR: "read the monitor items",
-    Command.SVO: "switch the servo",
-    Command.JOG: "jog",
-    Command.SPD: "set the move speed",
-    Command.MOV: "move by an angle",
-    Command.STP: "stop",
-    Command.ALM: "report the alarm",
-    Command.AHS: "report the alarm history",
-    Command.ACL: "clear the alarm",
-    Command.IOS: "report its inputs and outputs",
-    Command.INP: "set the simulated inputs",
-    Command.PWC: "power-cycle",
-    Command.TCH: "set the trace channels",
-    Command.TDV: "set the trace sample rate",
-    Command.TTG: "set the trace trigger",
-    Command.TTC: "set the trace trigger channel",
-    Command.TTL: "set the trace trigger level",
-    Command.TPR: "set the trace pre-trigger",
-    Command.TAR: "arm the trace",
-    Command.TST: "report the trace state",
-    Command.TRB: "send a trace block",
-    Command.TRP: "send a trace block",
-    Command.FLT: "raise alarm",
-    Command.SNO: "move the origin slit",
-    Command.SNA: "move the dog of limit switch 1",
-    Command.SNB: "move the dog of limit switch 2",
-    Command.SNQ: "report the sensor angles",
-}
-
-
-#: Commands whose value names what they act on (an item or alarm number): said with the words.
-NUMBERED_COMMANDS = frozenset({Command.PSL, Command.TSL, Command.JSL, Command.MON, Command.FLT})
-
-
-def command_words(command: Command | str, value: int | None = None) -> str:
-    """What ``command`` asks the drive to do, in words ("move by an angle", "select
-    parameter-mode item 8" with its ``value`` where the value names the item)."""
-    try:
-        command = Command(command)
-        words = COMMAND_WORDS[command]
-    except (KeyError, ValueError):
-        return f"answer {command}"
-    return f"{words} {value}" if value is not None and command in NUMBERED_COMMANDS else words
-
-
-def servo_on_text(command: Command | str) -> str:
-    """What a refusal ``s`` (servo on) says to a person: "the drive does not move by an angle
-    while the servo is on"."""
-    return f"the drive does not {command_words(command)} while the servo is on"
-
-
-def rejected_text(command: Command | str, value: int | None = None) -> str:
-    """What a refusal ``x`` says to a person: "the drive refused to select parameter-mode item 5"."""
-    return f"the drive refused to {command_words(command, value)}"
-
-
-#: The commands a real HA-655 is known to answer (its public manual, p.21).
-DOCUMENTED_COMMANDS = frozenset({Command.DGR, Command.OWW})
-#: Commands that only the simulated drive has (a real drive answers x).
-SIM_ONLY_COMMANDS = frozenset({
-    Command.INP, Command.PWC, Command.FLT, Command.SNO, Command.SNA, Command.SNB, Command.SNQ,
-})
-#: Extension commands a drive lists in its CAP reply.
-EXTENSION_COMMANDS = frozenset(Command) - DOCUMENTED_COMMANDS
+    DGR = "DGR"
+    OWW = "OWW"
+    IDN = "IDN"
+    CAP = "CAP"
+    PSL = "PSL"
+    TSL = "TSL"
+    JSL = "JSL"
+    PRD = "PRD"
+    PWR = "PWR"
+    MON = "MON"
+    MMR = "MMR"
+    SVO = "SVO"
+    JOG = "JOG"
+    SPD = "SPD"
+    MOV = "MOV"
+    STP = "STP"
+    ALM = "ALM"
+    AHS = "AHS"
+    ACL = "ACL"
+    IOS = "IOS"
+    INP = "INP"
+    PWC = "PWC"
+    TCH = "TCH"
+    TDV = "TDV"
+    TTG = "TTG"
+    TTC = "TTC"
+    TTL = "TTL"
+    TPR = "TPR"
+    TAR = "TAR"
+    TST = "TST"
+    TRB = "TRB"
+    TRP = "TRP"
+    FLT = "FLT"
+    SNO = "SNO"
+    SNA = "SNA"
+    SNB = "SNB"
+    SNQ = "SNQ"
 
 
 class Status(StrEnum):
@@ -532,6 +454,148 @@ def monitor_mask(items: Iterable[int]) -> int:
 def mask_items(mask: int) -> list[int]:
     """The monitor items of an MMR/TCH mask, in item order (the order of the reply's values)."""
     return [MONITOR_MASK_BASE + k for k in range(MONITOR_MASK_ITEMS) if mask >> k & 1]
+
+
+# ---------------------------------------------------------------------------------------------
+# Each command's facts: one row per command (docs/protocol.md, the Commands table)
+# ---------------------------------------------------------------------------------------------
+
+
+class SlowReply(Enum):
+    """Why a command's reply may take longer than the response timeout; the link's settings say
+    how long each may take (``LinkSettings.slow_reply_timeout_s``)."""
+
+    MULTI_TURN_CLEAR = "clearing the multi-turn data"  # OWW: "q about 5 s later" (manual p.21)
+    POWER_CYCLE = "a power cycle"
+    EEPROM_WRITE = "an EEPROM write"
+
+
+class TraceRole(Enum):
+    """A command's part in a drive-side trace capture."""
+
+    CAPTURE = "capture"  # a drive that lists every one of these records traces
+    PACKED_READ = "packed read"  # the packed block read: used when listed, TRB otherwise
+
+
+#: Longest reply of a trace block: 64 lines of 4 values of up to 11 characters and their commas,
+#: each line with its CR, then the terminal line.
+TRACE_BLOCK_REPLY_CHARS = TRACE_BLOCK_SAMPLES * (TRACE_MAX_CHANNELS * 12 + 1) + 2
+#: Longest reply of a command without a longer one in its row: CAP, IDN, MMR of 16 items and
+#: every one-line reply fit.
+DEFAULT_REPLY_CHARS = 256
+
+
+@dataclass(frozen=True)
+class CommandFacts:
+    """What is known of one CN3 command: its row in :data:`COMMAND_FACTS`."""
+
+    #: what the command asks the drive to do, in words for a person ("the drive refused to ...")
+    words: str
+    #: the public HA-655 manual documents it (p.21): a real drive answers it. Every other command
+    #: is an extension, which a drive lists in its CAP reply.
+    documented: bool = False
+    #: only the simulated drive has it (a real drive answers x)
+    sim_only: bool = False
+    #: its value names what it acts on (an item or alarm number): said with the words
+    numbered: bool = False
+    #: False when a repetition could act twice: sent once, never retried
+    retried: bool = True
+    #: why its reply may come later than the response timeout, None when it does not
+    slow: SlowReply | None = None
+    #: its part in a drive-side trace capture, None for none
+    trace: TraceRole | None = None
+    #: the longest reply it may give, in characters
+    longest_reply_chars: int = DEFAULT_REPLY_CHARS
+
+
+_CAPTURE = TraceRole.CAPTURE
+
+#: One row per command: everything the codec, the client, the transaction layer, the simulated
+#: drive and the test fakes need to know of it (docs/protocol.md, the Commands table).
+COMMAND_FACTS: dict[Command, CommandFacts] = {
+    Command.DGR: CommandFacts("report the absolute position", documented=True),
+    Command.OWW: CommandFacts("clear the multi-turn data", documented=True, retried=False,
+                              slow=SlowReply.MULTI_TURN_CLEAR),
+    Command.IDN: CommandFacts("say what it is"),
+    Command.CAP: CommandFacts("list the commands it has"),
+    Command.PSL: CommandFacts("select parameter-mode item", numbered=True),
+    Command.TSL: CommandFacts("select tune-mode item", numbered=True),
+    Command.JSL: CommandFacts("select test-mode item", numbered=True),
+    Command.PRD: CommandFacts("read the selected item"),
+    Command.PWR: CommandFacts("write the selected item", slow=SlowReply.EEPROM_WRITE),
+    Command.MON: CommandFacts("read monitor item", numbered=True),
+    Command.MMR: CommandFacts("read the monitor items"),
+    Command.SVO: CommandFacts("switch the servo"),
+    Command.JOG: CommandFacts("jog"),  # at a speed, held by repetition
+    Command.SPD: CommandFacts("set the move speed"),  # for MOV
+    Command.MOV: CommandFacts("move by an angle", retried=False),
+    Command.STP: CommandFacts("stop"),
+    Command.ALM: CommandFacts("report the alarm"),
+    Command.AHS: CommandFacts("report the alarm history", longest_reply_chars=1024),  # a line per alarm
+    Command.ACL: CommandFacts("clear the alarm"),
+    Command.IOS: CommandFacts("report its inputs and outputs"),
+    Command.INP: CommandFacts("set the simulated inputs", sim_only=True),
+    Command.PWC: CommandFacts("power-cycle", sim_only=True, retried=False, slow=SlowReply.POWER_CYCLE),
+    Command.TCH: CommandFacts("set the trace channels", trace=_CAPTURE),
+    Command.TDV: CommandFacts("set the trace sample rate", trace=_CAPTURE),
+    Command.TTG: CommandFacts("set the trace trigger", trace=_CAPTURE),
+    Command.TTC: CommandFacts("set the trace trigger channel", trace=_CAPTURE),
+    Command.TTL: CommandFacts("set the trace trigger level", trace=_CAPTURE),
+    Command.TPR: CommandFacts("set the trace pre-trigger", trace=_CAPTURE),
+    Command.TAR: CommandFacts("arm the trace", trace=_CAPTURE),
+    Command.TST: CommandFacts("report the trace state", trace=_CAPTURE),
+    Command.TRB: CommandFacts("send a trace block", trace=_CAPTURE,
+                              longest_reply_chars=TRACE_BLOCK_REPLY_CHARS),
+    Command.TRP: CommandFacts("send a trace block", trace=TraceRole.PACKED_READ,
+                              longest_reply_chars=TRACE_BLOCK_REPLY_CHARS),
+    Command.FLT: CommandFacts("raise alarm", sim_only=True, numbered=True),  # inject one
+    Command.SNO: CommandFacts("move the origin slit", sim_only=True),
+    Command.SNA: CommandFacts("move the dog of limit switch 1", sim_only=True),
+    Command.SNB: CommandFacts("move the dog of limit switch 2", sim_only=True),
+    Command.SNQ: CommandFacts("report the sensor angles", sim_only=True),
+}
+
+
+def _commands(test: Callable[[CommandFacts], bool]) -> frozenset[Command]:
+    return frozenset(c for c, facts in COMMAND_FACTS.items() if test(facts))
+
+
+#: What each command asks the drive to do, in words for a person.
+COMMAND_WORDS: dict[Command, str] = {c: facts.words for c, facts in COMMAND_FACTS.items()}
+#: Commands whose value names what they act on (an item or alarm number): said with the words.
+NUMBERED_COMMANDS = _commands(lambda f: f.numbered)
+#: The commands a real HA-655 is known to answer (its public manual, p.21).
+DOCUMENTED_COMMANDS = _commands(lambda f: f.documented)
+#: Commands that only the simulated drive has (a real drive answers x).
+SIM_ONLY_COMMANDS = _commands(lambda f: f.sim_only)
+#: Extension commands a drive lists in its CAP reply.
+EXTENSION_COMMANDS = _commands(lambda f: not f.documented)
+#: Commands whose repetition could act twice; sent once, never retried.
+NOT_RETRIED = _commands(lambda f: not f.retried)
+#: The commands of a drive-side trace capture (a drive that lists them all records traces).
+TRACE_COMMANDS = _commands(lambda f: f.trace is TraceRole.CAPTURE)
+
+
+def command_words(command: Command | str, value: int | None = None) -> str:
+    """What ``command`` asks the drive to do, in words ("move by an angle", "select
+    parameter-mode item 8" with its ``value`` where the value names the item)."""
+    try:
+        command = Command(command)
+        words = COMMAND_WORDS[command]
+    except (KeyError, ValueError):
+        return f"answer {command}"
+    return f"{words} {value}" if value is not None and command in NUMBERED_COMMANDS else words
+
+
+def servo_on_text(command: Command | str) -> str:
+    """What a refusal ``s`` (servo on) says to a person: "the drive does not move by an angle
+    while the servo is on"."""
+    return f"the drive does not {command_words(command)} while the servo is on"
+
+
+def rejected_text(command: Command | str, value: int | None = None) -> str:
+    """What a refusal ``x`` says to a person: "the drive refused to select parameter-mode item 5"."""
+    return f"the drive refused to {command_words(command, value)}"
 
 
 # ---------------------------------------------------------------------------------------------

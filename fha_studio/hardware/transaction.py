@@ -11,7 +11,8 @@ received), when the reply is marked corrupt by the codec, or when its lines do n
 the command defines (the parser raises ``ValueError``). A failed attempt is retried
 ``settings.retries`` times, after waiting until the line has been quiet for
 ``settings.response_timeout_s`` (so a late reply is dropped, not taken for the next request's).
-Commands whose repetition could act twice (MOV, OWW, PWC) are never retried. ``s`` and ``x`` are
+Commands whose repetition could act twice (``protocol.NOT_RETRIED``: MOV, OWW, PWC, from their rows
+in ``protocol.COMMAND_FACTS``) are never retried. ``s`` and ``x`` are
 answers, not failures: raised at once as ``ServoOnRefused`` / ``CommandRejected``, never retried.
 After ``settings.max_consecutive_failures`` failed transactions in a row the link is marked lost
 (``LinkLost``); one success resets the count.
@@ -45,6 +46,7 @@ from fha_studio.hardware.errors import (
     ServoOnRefused,
 )
 from fha_studio.hardware.protocol import (
+    NOT_RETRIED,
     Command,
     Garbage,
     Reply,
@@ -72,16 +74,9 @@ T = TypeVar("T")
 #: A bus monitor: called with every block written (True) and read (False).
 PacketMonitor = Callable[[bool, bytes], None]
 
-#: Longest reply of a trace block: 64 lines of 4 values of up to 11 characters and their commas,
-#: each line with its CR, then the terminal line.
-_TRACE_BLOCK_CHARS = p.TRACE_BLOCK_SAMPLES * (p.TRACE_MAX_CHANNELS * 12 + 1) + 2
-#: Longest reply of each command, in characters; others have one short line (DEFAULT_REPLY_CHARS).
-LONGEST_REPLY_CHARS = {
-    Command.TRB: _TRACE_BLOCK_CHARS,
-    Command.TRP: _TRACE_BLOCK_CHARS,
-    Command.AHS: 1024,  # the history, one code,seconds line per alarm
-}
-DEFAULT_REPLY_CHARS = 256  # CAP, IDN, MMR of 16 items and every one-line reply fit
+
+def _longest_reply_chars(command: Command) -> int:
+    return p.COMMAND_FACTS[command].longest_reply_chars
 
 
 @dataclass(frozen=True)
@@ -97,7 +92,8 @@ class LinkSettings:
     response_timeout_s: float = 0.3
     retries: int = 2
     max_consecutive_failures: int = 3
-    #: first-byte timeouts of the slow commands
+    #: first-byte timeouts of the slow replies (a command's row in protocol.COMMAND_FACTS says
+    #: whether its reply is one and why: slow_reply_timeout_s)
     oww_timeout_s: float = 6.5  # OWW: "q about 5 s later" (HA-655 manual p.21)
     power_cycle_timeout_s: float = 5.0
     eeprom_write_timeout_s: float = 0.5
@@ -121,21 +117,25 @@ class LinkSettings:
         """Time ``characters`` take on the line."""
         return characters * self.character_time_s
 
+    def slow_reply_timeout_s(self, slow: p.SlowReply) -> float:
+        """How long the first byte of a reply that is ``slow`` may take."""
+        return {
+            p.SlowReply.MULTI_TURN_CLEAR: self.oww_timeout_s,
+            p.SlowReply.POWER_CYCLE: self.power_cycle_timeout_s,
+            p.SlowReply.EEPROM_WRITE: self.eeprom_write_timeout_s,
+        }[slow]
+
     def first_byte_timeout_s(self, command: Command) -> float:
         """How long an attempt of ``command`` waits for the first byte of the reply."""
-        slow = {
-            Command.OWW: self.oww_timeout_s,
-            Command.PWC: self.power_cycle_timeout_s,
-            Command.PWR: self.eeprom_write_timeout_s,
-        }
-        wait = max(self.response_timeout_s, slow.get(command, 0.0))
+        slow = p.COMMAND_FACTS[command].slow
+        wait = max(self.response_timeout_s, self.slow_reply_timeout_s(slow) if slow is not None else 0.0)
         return self.transfer_time_s(p.FRAME_LENGTH) + wait
 
     def reply_time_limit_s(self, command: Command) -> float:
         """How long an attempt of ``command`` may go on after its first-byte timeout: twice the
         line time of the command's longest reply plus one response timeout, at most
         ``max_reply_s``. A line still sending then is babbling, not replying."""
-        chars = LONGEST_REPLY_CHARS.get(command, DEFAULT_REPLY_CHARS)
+        chars = _longest_reply_chars(command)
         return min(self.max_reply_s, 2 * self.transfer_time_s(chars) + self.response_timeout_s)
 
     def transaction_limit_s(self, command: Command) -> float:
@@ -145,10 +145,6 @@ class LinkSettings:
         attempt = self.first_byte_timeout_s(command) + self.reply_time_limit_s(command)
         quiet = self.response_timeout_s + self.reply_time_limit_s(command)
         return attempts * (attempt + quiet)
-
-
-#: Commands whose repetition could act twice; sent once, never retried.
-NOT_RETRIED = frozenset({Command.MOV, Command.OWW, Command.PWC})
 
 
 class ReplyShapeError(ValueError):
@@ -360,13 +356,13 @@ class Transaction:
                 drained += len(data)
                 quiet_until = time.monotonic() + self.settings.response_timeout_s
                 # a late reply is a reply: the line carries frames (only not in time)
-                if drained <= LONGEST_REPLY_CHARS.get(command, DEFAULT_REPLY_CHARS) and any(
+                if drained <= _longest_reply_chars(command) and any(
                     not isinstance(m, Garbage) for m in self._decoder.feed(data)
                 ):
                     self._framed = True
         self.transport.reset_input_buffer()
         self._decoder.clear()
-        flooding = quiet_until > give_up and drained > LONGEST_REPLY_CHARS.get(command, DEFAULT_REPLY_CHARS)
+        flooding = quiet_until > give_up and drained > _longest_reply_chars(command)
         return not flooding
 
     def _drain_quietly(self, command: Command) -> None:

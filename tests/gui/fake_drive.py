@@ -39,14 +39,10 @@ from fha_studio.hardware.parameters import (
 from fha_studio.hardware.protocol import Command, IoBit, rejected_text, servo_on_text
 
 #: What the fake answers: the manual's commands, parameters, monitors, motion, alarms, I/O and the
-#: simulated power cycle; no trace capture and no simulated inputs or sensors.
+#: simulated power cycle; no trace capture and no other sim-only command (inputs, alarms, sensors).
 FAKE_COMMANDS = frozenset(
-    {
-        Command.DGR, Command.OWW, Command.IDN, Command.CAP, Command.PSL, Command.TSL, Command.JSL,
-        Command.PRD, Command.PWR, Command.MON, Command.MMR, Command.SVO, Command.JOG, Command.SPD,
-        Command.MOV, Command.STP, Command.ALM, Command.AHS, Command.ACL, Command.IOS, Command.PWC,
-    }
-)
+    c for c, facts in p.COMMAND_FACTS.items() if facts.trace is None and not facts.sim_only
+) | {Command.PWC}
 
 
 class FakeDriveClient:

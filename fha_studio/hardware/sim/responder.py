@@ -29,6 +29,7 @@ from fha_studio import __version__ as _version
 from fha_studio import clock
 from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.protocol import (
+    DOCUMENTED_COMMANDS,
     EXTENSION_COMMANDS,
     Command,
     Request,
@@ -399,7 +400,7 @@ COMMANDS: Mapping[Command, Handler] = {
 }
 
 #: What a drive of the public HA-655 manual speaks (the ``documented`` profile): DGR and OWW.
-DOCUMENTED_ONLY: Mapping[Command, Handler] = {c: COMMANDS[c] for c in (Command.DGR, Command.OWW)}
+DOCUMENTED_ONLY: Mapping[Command, Handler] = {c: h for c, h in COMMANDS.items() if c in DOCUMENTED_COMMANDS}
 
 __all__ = ["COMMANDS", "DEFERRED", "DOCUMENTED_ONLY", "IDENTIFICATION", "Handler", "HandlerResult",
            "SimResponder"]
