@@ -10,6 +10,7 @@ import os
 import select
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -115,6 +116,23 @@ def test_the_client_sees_a_drive_of_the_manual(tmp_path):
         assert isinstance(client.absolute_position(), int)
 
 
+def said_by(proc: subprocess.Popen, words: bytes, limit_s: float = 30.0) -> None:
+    """Wait until ``proc`` says ``words`` on its stderr; fail naming what it said when it ends
+    first or stays silent ``limit_s``."""
+    said = b""
+    deadline = time.monotonic() + limit_s
+    while words not in said:
+        ready, _, _ = select.select([proc.stderr], [], [], max(0.0, deadline - time.monotonic()))
+        if not ready:
+            pytest.fail(f"the sim did not say {words.decode()!r} within {limit_s:g} s; "
+                        f"it said {said.decode()!r}")
+        chunk = os.read(proc.stderr.fileno(), 4096)  # the pipe's bytes, no buffer select cannot see
+        if not chunk:
+            pytest.fail(f"the sim ended (exit code {proc.wait(10)}) before it said {words.decode()!r}; "
+                        f"it said {said.decode()!r}")
+        said += chunk
+
+
 @pytest.mark.e2e
 def test_probe_a_documented_sim_in_another_process_and_switch_its_servo(tmp_path):
     """``fha-studio sim --profile documented --panel`` over a pty; servo-ON typed on its stdin."""
@@ -137,10 +155,7 @@ def test_probe_a_documented_sim_in_another_process_and_switch_its_servo(tmp_path
         assert '"documented_only": true' in done.stdout and '"servo": "off"' in done.stdout
         sim.stdin.write(b"servo on\n")
         sim.stdin.flush()
-        ready, _, _ = select.select([sim.stderr], [], [], 30.0)
-        assert ready
-        while b"servo on (CN2)" not in sim.stderr.readline():
-            pass
+        said_by(sim, b"servo on (CN2)")
         done = fha("position", "--actuator", "FHA-25C-50-S248")
         assert done.returncode == 4 and "servo on (controller)" in done.stderr
         with pytest.raises(ServoOnRefused), DriveClient.open(path) as client:
