@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 
-from PySide6.QtCore import QEvent, QObject, QPointF, QRectF, QSize, Qt
+from PySide6.QtCore import QEvent, QObject, QPointF, QRectF, QSize, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont, QPainter, QPainterPath, QPen, QPolygonF
 from PySide6.QtWidgets import QAbstractButton, QLabel, QPushButton, QSizePolicy, QWidget
 
@@ -67,7 +67,13 @@ class Lamp(QLabel):
 
 
 class StopButton(QPushButton):
-    """The big red STOP. Always enabled: stopping is never refused."""
+    """The big red STOP. Always enabled: stopping is never refused.
+
+    The window's toolbar has the STOP; a STOP shown elsewhere (the scope's Move panel) follows it
+    (``follow``): it says what the toolbar's says and a click is a click on the toolbar's."""
+
+    #: can_send changed (True: STOP goes to the drive; False: the drive has no stop command).
+    sigCanSendChanged = Signal(bool)
 
     def __init__(self, parent: QWidget | None = None):
         super().__init__("STOP  (Esc)", parent)
@@ -99,6 +105,14 @@ class StopButton(QPushButton):
             self.setToolTip(self.NO_STOP_TEXT)
         self.setAccessibleDescription(self.toolTip())
         self._apply_style()
+        self.sigCanSendChanged.emit(can_send)
+
+    def follow(self, leader: StopButton) -> None:
+        """Be a second view of ``leader`` (the toolbar's STOP): the same words and looks at every
+        moment, and a click here is a click there (whatever that STOP is wired to do)."""
+        self.set_can_send(leader.can_send)
+        leader.sigCanSendChanged.connect(self.set_can_send)
+        self.clicked.connect(leader.click)
 
     def _apply_style(self) -> None:
         if self.can_send:

@@ -205,6 +205,12 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
         "tilt: no STOP over the link, the controller stops it."
     )
     assert window.stop_all() == ["table", "table twin"]
+    with qtbot.waitSignals(
+        [table.link.sigResult, twin.link.sigResult],
+        timeout=10000,
+        check_params_cbs=[lambda r: r.cmd is Cmd.STOP] * 2,
+    ):
+        twin.show_page("scope").jog_panel.stop_button.click()  # the scope's Move panel: the same STOP
 
     # the tilt's absolute origin, set with OWW on its DGR checks page, is the axis's origin
     window.select_axis("tilt")

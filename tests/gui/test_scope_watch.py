@@ -88,6 +88,29 @@ def test_on_a_documented_only_drive_the_panel_is_disabled_and_says_why(make_wind
     assert not any(b.isEnabled() for b in buttons)
 
 
+def test_on_a_documented_only_drive_the_panels_stop_says_and_does_what_the_toolbars_does(make_window, qtbot):
+    window = make_window(connect="sim://FHA-25C-50-S248?paced=0&profile=documented")
+    page = window.show_page("scope")
+    stop, toolbar_stop = page.jog_panel.stop_button, window.stop_button
+    qtbot.waitUntil(lambda: not toolbar_stop.can_send, timeout=10000)
+    assert "servo-OFF" in toolbar_stop.text()
+    assert not stop.can_send
+    assert (stop.text(), stop.toolTip(), stop.styleSheet()) == (
+        toolbar_stop.text(), toolbar_stop.toolTip(), toolbar_stop.styleSheet())
+    sent: list[bytes] = []
+    window.link._worker._client.trace_packet = lambda sending, data: sending and sent.append(bytes(data))
+    try:
+        stop.click()
+        latest = window.message_area.latest().text
+        assert "nothing was sent" in latest and "emergency stop" in latest
+    finally:
+        window.link._worker._client.trace_packet = None
+    assert all(data == b"DGR+00000\r" for data in sent)  # no STOP went out, only the idle probe
+    window.link.close_link()
+    qtbot.waitUntil(lambda: not window.link.connected, timeout=10000)
+    assert stop.can_send and stop.text() == toolbar_stop.text()  # not connected: a live STOP again
+
+
 def test_channels_of_different_units_are_in_different_plots_on_one_linked_time_axis(scope_window, qtbot):
     _window, page = scope_window
     view = page.view

@@ -1,18 +1,16 @@
 """A compact servo / jog / move / STOP panel, docked where the axis is watched (the scope), so
 that a technician can move the axis and watch it at once. Same behaviour as the Jog page: jog is
 hold-to-run (release, focus loss, hiding or another window stop it), nothing moves without
-servo on, STOP is the main window's."""
+servo on, STOP is the main window's (the toolbar's STOP, shown again)."""
 
 from __future__ import annotations
-
-from collections.abc import Callable
 
 from PySide6.QtCore import QEvent, Slot
 from PySide6.QtWidgets import QDoubleSpinBox, QGridLayout, QGroupBox, QHBoxLayout, QLabel, QPushButton
 
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo
 from fha_studio.gui.pages.jog import HoldButton
-from fha_studio.gui.widgets import AMBER, Lamp
+from fha_studio.gui.widgets import AMBER, Lamp, StopButton
 
 #: Why the panel is disabled on a drive that answers only the documented CN3 commands.
 CANNOT_MOVE_TEXT = ("This drive answers only the documented CN3 commands: servo, jog and moves come "
@@ -24,9 +22,11 @@ SERVO_OFF_TEXT = "Servo OFF: switch it ON to jog or move."
 class JogPanel(QGroupBox):
     """Servo ON/OFF, hold-to-run REV/FWD at a speed, move by an angle, STOP.
 
-    ``stop``: what STOP does (the main window's ``stop_axis``: it releases every held jog too)."""
+    ``window_stop``: the window's STOP (its toolbar's), which the panel's STOP follows: the same
+    words, and what it does (the main window's ``stop_axis`` releases every held jog too; a
+    machine window's stops every axis)."""
 
-    def __init__(self, link: LinkController, stop: Callable[[], None], parent=None):
+    def __init__(self, link: LinkController, window_stop: StopButton | None, parent=None):
         super().__init__("Move (hold to jog)", parent)
         self.setObjectName("jogPanel")
         self.link = link
@@ -65,12 +65,11 @@ class JogPanel(QGroupBox):
         self.move_button.setToolTip("Move the output by the angle (+ = FWD) at the speed, then hold")
         grid.addWidget(self.move_button, 3, 0)
         grid.addWidget(self.angle_spin, 3, 1)
-        self.stop_button = QPushButton("STOP (Esc)")
-        self.stop_button.setObjectName("panelStopButton")
-        self.stop_button.setToolTip("Stop the axis now: decelerate and hold (the servo stays on). Key: Esc")
-        self.stop_button.setStyleSheet("QPushButton#panelStopButton { background: #c62828; color: white;"
-                                       " font-weight: bold; border: 2px solid #7f0000; border-radius: 4px;"
-                                       " padding: 4px; }")
+        self.stop_button = StopButton()
+        if window_stop is not None:
+            self.stop_button.follow(window_stop)
+        else:  # a panel outside a window: STOP goes to the drive itself
+            self.stop_button.clicked.connect(link.stop_now)
         grid.addWidget(self.stop_button, 4, 0, 1, 2)
         self.message = QLabel("")
         self.message.setObjectName("jogPanelMessage")
@@ -86,7 +85,6 @@ class JogPanel(QGroupBox):
         self.fwd_button.sigReleased.connect(self._released)
         self.rev_button.sigReleased.connect(self._released)
         self.move_button.clicked.connect(self.move_by)
-        self.stop_button.clicked.connect(stop)
         link.sigStatus.connect(self._on_status)
         link.sigResult.connect(self._on_result)
         self._set_enabled(link.connected, link.servo_on)

@@ -44,8 +44,7 @@ class ScopePage(BasePage):
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.view)
         # move and watch at once: the jog panel beside the plot, STOP as the window's
-        stop = main_window.stop_axis if main_window is not None else link.stop_now
-        self.jog_panel = JogPanel(link, stop)
+        self.jog_panel = JogPanel(link, main_window.stop_button if main_window is not None else None)
         self.view.dock_under_channels(self.jog_panel)
         space_jogs_only(self, (self.jog_panel.fwd_button, self.jog_panel.rev_button))
         # the axis's actuator, driver and load decide the scaling and what is recorded, at every moment
