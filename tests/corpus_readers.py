@@ -43,6 +43,13 @@ def read_machine(path: Path) -> None:
     MachineProject.load(path)
 
 
+def read_register(path: Path) -> None:
+    from fha_studio.logic.register import Register
+
+    with Register(path, create=False, read_only=True) as register:  # a question: the file stays
+        register.axes()
+
+
 READERS = {
     "recording": read_recording,
     "parameters": read_parameters,
@@ -50,4 +57,5 @@ READERS = {
     "eeprom": read_eeprom,
     "model": read_model,
     "machine": read_machine,
+    "register": read_register,
 }

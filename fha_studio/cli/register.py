@@ -9,6 +9,7 @@
 - ``open [MACHINE]``: open checks and unsigned reports.
 - ``report MACHINE [-o FILE.html]``: the machine report (the GUI writes it as PDF too).
 - ``export [--machine M] [-o FILE]``: everything as JSON.
+- ``check``: SQLite's integrity check, and what a damaged register still holds.
 - ``add-machine NAME``, ``add-axis MACHINE/AXIS``, ``import FILE... --machine M``: fill it.
 
 Every action takes ``--json``. The register is ``--db FILE``, else ``$FHA_STUDIO_REGISTER``, else
@@ -112,6 +113,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument("machine", metavar="MACHINE")
     s.add_argument("-o", "--output", type=Path, metavar="FILE", help="HTML file (default: MACHINE.html here)")
     s.set_defaults(func=_report)
+    s = sub.add_parser(
+        "check",
+        parents=[common],
+        help="SQLite's integrity check of the register, and what a damaged one still holds",
+        description="Runs SQLite's integrity check on the register file (opened read-only, never "
+        "changed) and says, table by table, how many entries can still be read, and which machines "
+        "and axes. Exit 0 when the file is sound, 1 when it is damaged.",
+    )
+    s.set_defaults(func=_check)
     s = sub.add_parser("add-machine", parents=[common], help="add a machine")
     s.add_argument("name", metavar="NAME")
     s.add_argument("--site", default="")
@@ -154,10 +164,13 @@ def _open_register(args):
     # a question asked of a register that is not there is a mistake (a typed path), not an empty
     # answer; adding or importing creates it
     create = args.action in ("add-machine", "add-axis", "import")
+    # a question changes nothing in the file (the report records itself: it writes)
+    question = not create and args.action != "report"
     try:
-        reg = Register(args.db, create=create)
+        reg = Register(args.db, create=create, read_only=question)
     except RegisterError as exc:
-        hint = "" if create else " (start one: fha-studio register add-machine NAME)"
+        none = "there is no register" in str(exc)
+        hint = " (start one: fha-studio register add-machine NAME)" if none else ""
         raise CliError(f"{exc}{hint}") from None
     try:
         yield reg
@@ -425,10 +438,19 @@ def _report(args) -> int:
             output.parent.mkdir(parents=True, exist_ok=True)
         fileio.check_output_path(output)  # before the work: a target that cannot be written
         report = build_machine_report(project, register=reg)
-        fileio.write_text(output, render_machine_html(report))  # whole or not at all
-        reg.record_report(
-            output, machine=project.name, open_warnings=sum(s.open_warnings for s in report.summaries)
-        )
+        existed = os.path.lexists(output)
+        # the register's write is begun first: a read-only or locked register refuses before
+        # the report is written, and a report the register could not record is taken back
+        try:
+            with reg.batch():
+                fileio.write_text(output, render_machine_html(report))  # whole or not at all
+                reg.record_report(
+                    output, machine=project.name, open_warnings=sum(s.open_warnings for s in report.summaries)
+                )
+        except BaseException:
+            if not existed:
+                output.unlink(missing_ok=True)
+            raise
     if args.json:
         _print_json(
             {
@@ -444,6 +466,42 @@ def _report(args) -> int:
     for problem in report.problems:
         print(f"  - {problem}", file=sys.stderr)
     return 0
+
+
+def _check(args) -> int:
+    from fha_studio.logic.register import RegisterError, default_register_path
+    from fha_studio.logic.register.check import check_register
+    from fha_studio.names import quoted
+
+    path = args.db if args.db is not None else default_register_path()
+    try:
+        result = check_register(path)
+    except RegisterError as exc:
+        raise CliError(str(exc)) from None
+    if args.json:
+        _print_json({**asdict(result), "path": str(result.path)})
+        return 0 if result.ok else 1
+    if result.ok:
+        rows = sum(t.rows for t in result.tables)
+        print(f"{path}: sound (SQLite's integrity check: ok); {len(result.machines)} machine(s), "
+              f"{len(result.axes)} axes, {rows} entries in all.")
+        return 0
+    more = f" (and {len(result.findings) - 1} more)" if len(result.findings) > 1 else ""
+    print(f"{path}: DAMAGED. SQLite's integrity check: {quoted(result.findings[0], 200, False)}{more}")
+    print("What can still be read:")
+    for t in result.tables:
+        if t.complete:
+            state = f"{t.rows} (all)"
+        elif t.rows:
+            state = f"{t.rows}, then damaged"
+        else:
+            state = "none: damaged"
+        print(f"  {t.words:<22} {state}")
+    print(f"Machines that can be read: {', '.join(map(quoted, result.machines)) or 'none'}")
+    print(f"Axes that can be read: {', '.join(map(quoted, result.axes)) or 'none'}")
+    print(f"To save what can be read into a new file, SQLite's own tool: "
+          f"sqlite3 {path} .recover | sqlite3 saved.sqlite")
+    return 1
 
 
 def _add_machine(args) -> int:

@@ -450,9 +450,18 @@ class MachineWindow(QMainWindow):
         self._register_dialog: RegisterDialog | None = None
         self._build_toolbar()
         self._build_body(open_client)
+        not_recorded = None
         if register is not None:
-            project.save_to(register, who=self.operator)
+            try:
+                project.save_to(register, who=self.operator)
+            except (RegisterError, OSError) as exc:  # read-only, locked, damaged: said, not raised
+                log.warning("register: machine %s not recorded: %s", project.name, exc)
+                not_recorded = exc
         self.axis_list.setCurrentRow(0)
+        if not_recorded is not None:
+            self.current_window.show_message(
+                f"Register: the machine was not recorded ({not_recorded}).", Level.WARNING
+            )
         self.resize(1366, 740)
 
     # -- building -------------------------------------------------------------------------------------

@@ -368,3 +368,39 @@ def test_closing_with_a_servo_on_asks_and_cancel_keeps_every_link(make_machine, 
     monkeypatch.setattr(QMessageBox, "warning", lambda *args: QMessageBox.StandardButton.Ok)
     assert window.close()
     assert not x.link._thread.isRunning() and not y.link._thread.isRunning()
+
+
+def test_a_read_only_register_is_a_message_in_the_machine_window(make_machine, qtbot, tmp_path, monkeypatch):
+    from fha_studio.logic.register import guard
+
+    path = tmp_path / "plant.sqlite"
+    with Register(path) as register:
+        register.add_machine("Press 7")
+    before = path.read_bytes()
+    monkeypatch.setattr(guard, "writable", lambda p: False)
+    project = MachineProject("Press 9")
+    project.add_axis("feed", "FHA-17C-50-US250", port_url="sim://FHA-17C-50-US250?paced=0")
+    window = make_machine(project, Register(path))
+    shown = window.current_window.message_area.text_label.text()
+    assert shown.endswith(f"  Register: the machine was not recorded (the register {path} is "
+                          "read-only: nothing was changed (it needs write access to the file and its "
+                          "folder)).")
+    window.register.close()
+    assert path.read_bytes() == before
+
+
+def test_the_gui_on_a_read_only_register_opens_a_new_machine_file(qtbot, tmp_path, monkeypatch):
+    from fha_studio.gui.app import run
+    from fha_studio.logic.register import guard
+
+    path = tmp_path / "plant.sqlite"
+    with Register(path) as register:
+        register.add_machine("Press 7")
+    before = path.read_bytes()
+    monkeypatch.setattr(guard, "writable", lambda p: False)
+    project = MachineProject("Press 9")
+    project.add_axis("feed", "FHA-17C-50-US250", port_url="sim://FHA-17C-50-US250?paced=0")
+    machine_file = project.save(tmp_path / "press9.json")
+    assert run(["--machine-file", str(machine_file), "--register", str(path), "--no-connect",
+                "--quit-after-ms", "200"]) == 0
+    assert path.read_bytes() == before

@@ -240,7 +240,7 @@ def test_refusals_name_what_is_wrong(register, tmp_path):
     assert register.snapshots("m/a") == []  # nothing half-written
     garbage = tmp_path / "garbage.sqlite"
     garbage.write_bytes(b"this is not a database" * 100)
-    with pytest.raises(RegisterError, match=r"garbage\.sqlite: not a usable register file"):
+    with pytest.raises(RegisterError, match=r"garbage\.sqlite is not a register \(not an SQLite database"):
         Register(garbage)
     with pytest.raises(RegisterError, match="is a directory"):
         Register(tmp_path)

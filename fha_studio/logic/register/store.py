@@ -28,8 +28,9 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
-from fha_studio import clock
-from fha_studio.logic.register import words
+from fha_studio import clock, fileio
+from fha_studio.logic.register import guard, words
+from fha_studio.logic.register.guard import RegisterError as RegisterError
 from fha_studio.logic.register.schema import MIGRATIONS, SCHEMA_VERSION
 from fha_studio.paths import user_data_dir
 
@@ -46,10 +47,6 @@ _SOURCE_WORDS = {
 _COMPLETED = "completed"
 _ORIGIN_PREFIX = "origin: "
 _NOT_APPLICABLE = "not applicable"
-
-
-class RegisterError(ValueError):
-    """The register cannot be used or a request does not fit it; the message says what and where."""
 
 
 def default_register_path() -> Path:
@@ -189,31 +186,61 @@ class Found:
 # -- the register ------------------------------------------------------------------------------------
 
 
+@guard.in_words
 class Register:
-    """One register file, open. Use as a context manager or call :meth:`close`."""
+    """One register file, open. Use as a context manager or call :meth:`close`.
 
-    def __init__(self, path: str | Path | None = None, busy_timeout_s: float = 30.0, create: bool = True):
+    Every public method turns SQLite's errors into one :class:`RegisterError` line naming the
+    file (read-only, damaged, locked, full; :mod:`.guard`); every write is one transaction.
+    """
+
+    def __init__(
+        self,
+        path: str | Path | None = None,
+        busy_timeout_s: float = 30.0,
+        create: bool = True,
+        read_only: bool = False,
+    ):
         """Opens the register at ``path`` (default: :func:`default_register_path`), created when
-        missing unless ``create`` is False (then RegisterError says there is none)."""
+        missing unless ``create`` is False (then RegisterError says there is none). ``read_only``:
+        for questions only; the file is not changed (a register this user may not write is
+        opened so anyway)."""
         self.path = Path(path) if path is not None else default_register_path()
-        if self.path.is_dir():
-            raise RegisterError(f"register {self.path}: is a directory, not a register file")
-        if not create and not self.path.exists():
-            raise RegisterError(f"there is no register at {self.path}")
+        self.busy_timeout_s = busy_timeout_s
+        # a device, a FIFO or a file that is no database is refused before SQLite opens it
+        cannot_write = guard.check_before_opening(self.path, create and not read_only)
+        if read_only and not cannot_write:
+            _upgrade_if_older(self.path, busy_timeout_s)
+        self.read_only = cannot_write or read_only
         try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._db = sqlite3.connect(self.path, timeout=busy_timeout_s, isolation_level=None)
-        except (OSError, sqlite3.Error) as exc:
-            raise RegisterError(f"register {self.path}: cannot open it: {exc}") from None
+            if create and not self.read_only:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._db = sqlite3.connect(
+                guard.connect_uri(self.path, self.read_only, create and not read_only), uri=True,
+                timeout=busy_timeout_s, isolation_level=None,
+            )
+        except OSError as exc:
+            raise RegisterError(f"register {guard.shown_path(self.path)}: cannot open it: "
+                                f"{fileio.os_reason(exc)}") from None
+        except sqlite3.Error as exc:
+            raise guard.problem(self.path, exc, opening=True) from None
         try:
             self._db.row_factory = sqlite3.Row
             self._db.execute("PRAGMA foreign_keys = ON")
-            self._db.execute("PRAGMA synchronous = FULL")
-            self.journal_mode = self._set_wal(busy_timeout_s)
-            self._migrate()
-        except sqlite3.DatabaseError as exc:
+            if self.read_only:  # questions only: the file stays as it is
+                self.journal_mode = str(self._db.execute("PRAGMA journal_mode").fetchone()[0]).lower()
+                if self.version != SCHEMA_VERSION:
+                    raise RegisterError(
+                        f"the register {guard.shown_path(self.path)} is read-only and was written by "
+                        f"another FHA Studio (schema {self.version}; this one reads {SCHEMA_VERSION})")
+            else:
+                self._db.execute("PRAGMA synchronous = FULL")
+                self.journal_mode = self._set_wal(busy_timeout_s)
+                self._migrate()
+        except sqlite3.Error as exc:
+            failure = guard.problem(self.path, exc, self._db, busy_timeout_s, opening=True)
             self._db.close()
-            raise RegisterError(f"register {self.path}: not a usable register file ({exc})") from None
+            raise failure from None
         except RegisterError:
             self._db.close()
             raise
@@ -265,13 +292,26 @@ class Register:
         if self._db.in_transaction:
             yield self._db
             return
-        self._db.execute("BEGIN IMMEDIATE")
+        try:
+            self._db.execute("BEGIN IMMEDIATE")
+        except sqlite3.Error as exc:
+            raise self._problem(exc) from None
         try:
             yield self._db
         except BaseException:
-            self._db.execute("ROLLBACK")
+            with contextlib.suppress(sqlite3.Error):  # the error that ended it is the one to tell
+                self._db.execute("ROLLBACK")
             raise
-        self._db.execute("COMMIT")
+        try:
+            self._db.execute("COMMIT")
+        except sqlite3.Error as exc:
+            with contextlib.suppress(sqlite3.Error):
+                self._db.execute("ROLLBACK")
+            raise self._problem(exc) from None
+
+    def _problem(self, exc: sqlite3.Error) -> RegisterError:
+        """SQLite's error as one line naming this register and what to do."""
+        return guard.problem(self.path, exc, self._db, self.busy_timeout_s)
 
     def close(self) -> None:
         self._db.close()
@@ -317,8 +357,11 @@ class Register:
         except RegisterError:
             try:
                 return self.add_machine(name, site)
-            except RegisterError:
-                return self.machine(name)  # another process added it in between
+            except RegisterError as refused:
+                try:
+                    return self.machine(name)  # another process added it in between
+                except RegisterError:
+                    raise refused from None  # why it could not be added (read-only, a bad name)
 
     def machines(self) -> list[Machine]:
         return [Machine(**dict(r)) for r in self._db.execute("SELECT * FROM machine ORDER BY name")]
@@ -407,8 +450,11 @@ class Register:
         except RegisterError:
             try:
                 return self.add_axis(machine, name, **fields)
-            except RegisterError:
-                axis = self.axis(f"{machine.strip()}/{name.strip()}")
+            except RegisterError as refused:
+                try:
+                    axis = self.axis(f"{machine.strip()}/{name.strip()}")  # added in between
+                except RegisterError:
+                    raise refused from None
         empty = {
             k: v for k, v in fields.items() if k != "who" and v not in (None, "") and not getattr(axis, k)
         }
@@ -1121,6 +1167,17 @@ class Register:
             ]
             out["machines"].append({**asdict(m), "axes": axes, "machine_reports": reports})
         return out
+
+
+def _upgrade_if_older(path: Path, busy_timeout_s: float) -> None:
+    """A register of an older schema is brought up to date before it is read (its data kept)."""
+    try:
+        with contextlib.closing(sqlite3.connect(guard.connect_uri(path, True, False), uri=True)) as db:
+            older = int(db.execute("PRAGMA user_version").fetchone()[0]) < SCHEMA_VERSION
+    except sqlite3.Error:
+        return  # opening it read-only says what is wrong
+    if older:
+        Register(path, busy_timeout_s=busy_timeout_s, create=False).close()
 
 
 def _check_inertia(value: float | None) -> None:
