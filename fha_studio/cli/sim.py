@@ -22,7 +22,7 @@ from fha_studio.cli import CliError
 from fha_studio.cli._values import in_range, output_path, tcp_port, text
 
 if TYPE_CHECKING:
-    from fha_studio.hardware.sim.responder import SimResponder
+    from fha_studio.hardware.api import SimPanel
 
 ORDER = 30
 
@@ -140,10 +140,9 @@ def run(args: Any) -> int:
     return 0
 
 
-def panel_line(sim: SimResponder, line: str) -> str:
+def panel_line(sim: SimPanel, line: str) -> str:
     """Do one line of ``--panel`` input on the drive behind ``sim`` (which journals what a training
     drive is done to); returns what happened (one line)."""
-    from fha_studio.hardware import protocol
     from fha_studio.hardware.sim import SimRefused
 
     words = line.strip().lower().split()
@@ -160,9 +159,7 @@ def panel_line(sim: SimResponder, line: str) -> str:
                 sim.turn_by_hand(float(angle))
                 return f"turned by hand by {float(angle):g} deg"
             case ["brake", ("release" | "hold") as state]:
-                bit = 1 << protocol.IoBit.BRAKE_RELEASED
-                mask = sim.drive.io_bits() & protocol.INPUT_MASK & ~bit
-                sim.drive.set_inputs(mask | (bit if state == "release" else 0))
+                sim.release_brake(state == "release")
                 return f"brake {'released' if state == 'release' else 'holds'}"
             case []:
                 return ""
@@ -173,7 +170,7 @@ def panel_line(sim: SimResponder, line: str) -> str:
     return f"not understood: {line.strip()!r} (servo on|off, fwd DEG, rev DEG, turn DEG, brake release|hold)"
 
 
-def _panel(sim: SimResponder, stream: Any, stop: threading.Event) -> None:
+def _panel(sim: SimPanel, stream: Any, stop: threading.Event) -> None:
     for line in stream:
         if stop.is_set():
             return

@@ -33,10 +33,11 @@ from fha_studio.hardware.api import (
     LinkLost,
     LinkTimeout,
     ServoOnRefused,
+    SimPanel,
 )
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import Mode, MonitorItem
-from fha_studio.hardware.protocol import EXTENSION_COMMANDS, INPUT_MASK, Command, IoBit
+from fha_studio.hardware.protocol import EXTENSION_COMMANDS, Command, IoBit
 from fha_studio.hardware.sim.options import public_url
 from fha_studio.hardware.transaction import LinkSettings
 from fha_studio.logic.absolute import SERVO_ON_TEXT, refusal_text
@@ -575,7 +576,6 @@ class LinkWorker(QObject):
             raise NotConnected("this is not an embedded simulated drive: it has no panel")
         from fha_studio.hardware.sim import SimRefused
 
-        drive = sim.drive
         try:
             if action is SimPanelAction.SERVO:
                 sim.set_servo(bool(value))
@@ -586,15 +586,14 @@ class LinkWorker(QObject):
             if action is SimPanelAction.TURN_BY_HAND:
                 sim.turn_by_hand(float(value))
                 text = f"output turned by hand by {float(value):+g}°"
-                if drive.has_sensors:  # what the technician would see on the sensors' indicators
-                    bits = drive.io_bits()
-                    lit = [name for bit, name in ((IoBit.LIMIT_SWITCH_1, "limit switch 1"),
-                                                  (IoBit.LIMIT_SWITCH_2, "limit switch 2"),
-                                                  (IoBit.ORIGIN_SENSOR, "origin sensor")) if bits >> bit & 1]
+                if sim.has_sensors:  # what the technician would see on the sensors' indicators
+                    state = sim.io_state()
+                    lit = [name for on, name in ((state.limit_switch_1, "limit switch 1"),
+                                                 (state.limit_switch_2, "limit switch 2"),
+                                                 (state.origin_sensor, "origin sensor")) if on]
                     text += f"; sensor indicators on: {', '.join(lit) if lit else 'none'}"
                 return text
-            bit = 1 << IoBit.BRAKE_RELEASED
-            drive.set_inputs(drive.io_bits() & INPUT_MASK & ~bit | (bit if value else 0))
+            sim.release_brake(bool(value))
             return "brake released (24 V on the brake)" if value else "brake holds (no 24 V)"
         except SimRefused as exc:
             raise PanelRefused(exc.reason) from None
@@ -673,12 +672,10 @@ class LinkWorker(QObject):
         status["current_a"] = scaled(MonitorItem.MOTOR_CURRENT)
 
 
-def _embedded_sim(client: DriveApi) -> Any | None:
-    """The SimResponder behind an embedded ``sim://`` port (its panel actions, its drive), None for
-    any other drive. Only the link thread uses it (its panel), like the port itself."""
-    transport = getattr(getattr(client, "transaction", None), "transport", None)
-    port = getattr(transport, "inner", transport)
-    return getattr(port, "sim_responder", None)
+def _embedded_sim(client: DriveApi) -> SimPanel | None:
+    """The panel of an embedded ``sim://`` drive, None for any other drive (a test fake too). Only
+    the link thread uses it, like the port itself."""
+    return client.sim_panel if isinstance(client, DriveClient) else None
 
 
 def _forget_dummy_thread() -> None:

@@ -43,7 +43,9 @@ __all__ = [
     "CommandNotSupported",
     "CommandRejected",
     "DriveApi",
+    "DriveLink",
     "DriveRefused",
+    "ExtensionCommands",
     "Held",
     "Identity",
     "IoState",
@@ -53,10 +55,14 @@ __all__ = [
     "LinkLost",
     "LinkSilent",
     "LinkTimeout",
+    "ManualCommands",
     "ReadAborted",
     "SensorName",
     "ServoOnRefused",
+    "SimPanel",
+    "SimulatedDriveControls",
     "TraceCapture",
+    "TraceCommands",
     "TraceStatus",
     "WriteResult",
 ]
@@ -294,19 +300,12 @@ class WriteResult:
 
 
 @runtime_checkable
-class DriveApi(Protocol):
-    """One drive, whatever carries it. Methods raise the ``LinkError`` family only (plus
-    ``ValueError`` / ``ParameterValueError`` for an argument refused before anything is sent).
-
-    ``CommandNotSupported`` means the drive lacks the extension (nothing was sent);
-    ``ServoOnRefused`` / ``CommandRejected`` that it answered ``s`` / ``x``; ``LinkTimeout`` /
-    ``LinkLost`` that the link failed.
-    """
+class DriveLink(Protocol):
+    """The link to one drive and what the drive is (asked once, kept)."""
 
     #: The driver's parameter model (items, units, ranges, monitor items).
     model: ParameterModel
 
-    # --- the link ----------------------------------------------------------------------------
     @property
     def port(self) -> str: ...
     @property
@@ -314,11 +313,23 @@ class DriveApi(Protocol):
     @property
     def link_lost(self) -> bool: ...
     def close(self) -> None: ...
-
-    # --- what the drive is -----------------------------------------------------------------
     @property
     def capabilities(self) -> Capabilities: ...
     def detect_capabilities(self) -> Capabilities: ...
+
+
+@runtime_checkable
+class ManualCommands(Protocol):
+    """What the public HA-655 manual documents (``protocol.DOCUMENTED_COMMANDS``): every drive."""
+
+    def absolute_position(self) -> int: ...
+    def clear_multiturn(self) -> None: ...
+
+
+@runtime_checkable
+class ExtensionCommands(Protocol):
+    """The extensions a drive lists in CAP: identity, parameters, monitors, motion, alarms, I/O."""
+
     def identify(self) -> Identity | None: ...
 
     # --- parameters ----------------------------------------------------------------------------
@@ -342,17 +353,12 @@ class DriveApi(Protocol):
     def alarm_history(self) -> list[AlarmRecord]: ...
     def clear_alarm(self) -> None: ...
     def io_state(self) -> IoState: ...
-    def set_inputs(self, **inputs: bool) -> IoState: ...
-    def power_cycle(self) -> None: ...
-    def inject_alarm(self, code: int) -> None: ...
-    def set_sensor_angle(self, which: str, angle_deg: float) -> None: ...
-    def sensor_angles(self) -> dict[str, float]: ...
 
-    # --- the documented commands ------------------------------------------------------------
-    def absolute_position(self) -> int: ...
-    def clear_multiturn(self) -> None: ...
 
-    # --- trace capture -------------------------------------------------------------------------
+@runtime_checkable
+class TraceCommands(Protocol):
+    """A drive-side trace capture (``protocol.TRACE_COMMANDS``, read in packed blocks when listed)."""
+
     def configure_trace(
         self,
         channels: Iterable[int],
@@ -371,3 +377,42 @@ class DriveApi(Protocol):
         should_abort: Callable[[], bool] | None = None,
         progress: Callable[[int, int], None] | None = None,
     ) -> TraceCapture: ...
+
+
+@runtime_checkable
+class SimulatedDriveControls(Protocol):
+    """The simulated drive's own commands (``protocol.SIM_ONLY_COMMANDS``): what a test or a
+    training plays on CN2, the supervision and the sensors."""
+
+    def set_inputs(self, **inputs: bool) -> IoState: ...
+    def power_cycle(self) -> None: ...
+    def inject_alarm(self, code: int) -> None: ...
+    def set_sensor_angle(self, which: str, angle_deg: float) -> None: ...
+    def sensor_angles(self) -> dict[str, float]: ...
+
+
+@runtime_checkable
+class DriveApi(DriveLink, ManualCommands, ExtensionCommands, TraceCommands, SimulatedDriveControls, Protocol):
+    """One drive, whatever carries it: every part above. Methods raise the ``LinkError`` family
+    only (plus ``ValueError`` / ``ParameterValueError`` for an argument refused before anything
+    is sent).
+
+    ``CommandNotSupported`` means the drive lacks the extension (nothing was sent);
+    ``ServoOnRefused`` / ``CommandRejected`` that it answered ``s`` / ``x``; ``LinkTimeout`` /
+    ``LinkLost`` that the link failed.
+    """
+
+
+@runtime_checkable
+class SimPanel(Protocol):
+    """An embedded simulated drive's panel: what a real drive gets from outside CN3, the
+    controller's CN2 and the technician's hands (``DriveClient.sim_panel``). Raises the sim's
+    ``SimRefused`` when the drive does not allow it now."""
+
+    @property
+    def has_sensors(self) -> bool: ...
+    def set_servo(self, on: bool) -> None: ...
+    def controller_command(self, angle_deg: float) -> None: ...
+    def turn_by_hand(self, angle_deg: float) -> None: ...
+    def release_brake(self, released: bool) -> None: ...
+    def io_state(self) -> IoState: ...

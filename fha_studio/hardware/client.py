@@ -29,6 +29,7 @@ from fha_studio.hardware.api import (
     Identity,
     IoState,
     SensorName,
+    SimPanel,
     TraceCapture,
     TraceStatus,
     WriteResult,
@@ -194,6 +195,15 @@ class DriveClient:
     @property
     def link_lost(self) -> bool:
         return self.transaction.link_lost
+
+    @property
+    def sim_panel(self) -> SimPanel | None:
+        """The panel of the embedded simulated drive behind a ``sim://`` port (its CN2 and the
+        technician's hands), None for any other drive. For the thread that uses the link."""
+        from fha_studio.hardware.sim.protocol_sim import Serial as SimPort
+
+        port = self.transaction.transport.inner
+        return port.sim_responder if isinstance(port, SimPort) else None
 
     @property
     def statistics(self) -> dict[str, int]:

@@ -27,11 +27,14 @@ from typing import Final
 
 from fha_studio import __version__ as _version
 from fha_studio import clock
+from fha_studio.hardware.api import IoState
 from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.protocol import (
     DOCUMENTED_COMMANDS,
     EXTENSION_COMMANDS,
+    INPUT_MASK,
     Command,
+    IoBit,
     Request,
     Status,
     UnknownRequest,
@@ -150,6 +153,23 @@ class SimResponder:
         self.selected_item = self.drive.item_id(mode, number)
 
     # ------------------------------------------------------------------ the panel (outside CN3)
+    # (an api.SimPanel: what the GUI's panel and ``fha-studio sim --panel`` do)
+    @property
+    def has_sensors(self) -> bool:
+        """The actuator has option L (origin sensor, limit switches)."""
+        return self.drive.has_sensors
+
+    def io_state(self) -> IoState:
+        """The I/O bits as the drive's indicators show them."""
+        return IoState(self.drive.io_bits())
+
+    def release_brake(self, released: bool) -> None:
+        """24 V on the brake (released) or not (it holds); the other inputs stay as they are."""
+        bit = 1 << IoBit.BRAKE_RELEASED
+        with self.drive.lock:
+            others = self.drive.io_bits() & INPUT_MASK & ~bit
+            self.drive.set_inputs(others | (bit if released else 0))
+
     def set_servo(self, on: bool) -> None:
         """The controller's servo-ON input on CN2 (any profile; the only way with ``documented``)."""
         self.drive.set_servo(on)
