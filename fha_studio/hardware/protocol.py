@@ -477,11 +477,9 @@ class TraceRole(Enum):
     PACKED_READ = "packed read"  # the packed block read: used when listed, TRB otherwise
 
 
-#: Longest reply of a trace block: 64 lines of 4 values of up to 11 characters and their commas,
-#: each line with its CR, then the terminal line.
+#: Longest trace block reply: 64 lines of 4 values of up to 11 characters, commas, CRs, terminal.
 TRACE_BLOCK_REPLY_CHARS = TRACE_BLOCK_SAMPLES * (TRACE_MAX_CHANNELS * 12 + 1) + 2
-#: Longest reply of a command without a longer one in its row: CAP, IDN, MMR of 16 items and
-#: every one-line reply fit.
+#: Longest reply of the other commands: CAP, IDN, MMR of 16 items and every one-line reply fit.
 DEFAULT_REPLY_CHARS = 256
 
 
@@ -491,8 +489,7 @@ class CommandFacts:
 
     #: what the command asks the drive to do, in words for a person ("the drive refused to ...")
     words: str
-    #: the public HA-655 manual documents it (p.21): a real drive answers it. Every other command
-    #: is an extension, which a drive lists in its CAP reply.
+    #: the public HA-655 manual documents it (p.21); every other command is an extension (in CAP)
     documented: bool = False
     #: only the simulated drive has it (a real drive answers x)
     sim_only: bool = False
@@ -508,7 +505,7 @@ class CommandFacts:
     longest_reply_chars: int = DEFAULT_REPLY_CHARS
 
 
-_CAPTURE = TraceRole.CAPTURE
+_CAPTURE, _BLOCK = TraceRole.CAPTURE, TRACE_BLOCK_REPLY_CHARS
 
 #: One row per command: everything the codec, the client, the transaction layer, the simulated
 #: drive and the test fakes need to know of it (docs/protocol.md, the Commands table).
@@ -544,10 +541,8 @@ COMMAND_FACTS: dict[Command, CommandFacts] = {
     Command.TPR: CommandFacts("set the trace pre-trigger", trace=_CAPTURE),
     Command.TAR: CommandFacts("arm the trace", trace=_CAPTURE),
     Command.TST: CommandFacts("report the trace state", trace=_CAPTURE),
-    Command.TRB: CommandFacts("send a trace block", trace=_CAPTURE,
-                              longest_reply_chars=TRACE_BLOCK_REPLY_CHARS),
-    Command.TRP: CommandFacts("send a trace block", trace=TraceRole.PACKED_READ,
-                              longest_reply_chars=TRACE_BLOCK_REPLY_CHARS),
+    Command.TRB: CommandFacts("send a trace block", trace=_CAPTURE, longest_reply_chars=_BLOCK),
+    Command.TRP: CommandFacts("send a trace block", trace=TraceRole.PACKED_READ, longest_reply_chars=_BLOCK),
     Command.FLT: CommandFacts("raise alarm", sim_only=True, numbered=True),  # inject one
     Command.SNO: CommandFacts("move the origin slit", sim_only=True),
     Command.SNA: CommandFacts("move the dog of limit switch 1", sim_only=True),
