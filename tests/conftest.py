@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as _dt
+import json
 import os
 import threading
 import time
@@ -73,3 +74,21 @@ def _no_leaked_threads():
             break
         time.sleep(0.01)
     assert not leaked, f"threads left running: {[t.name for t in leaked]}"
+
+
+@pytest.fixture
+def time_ceiling(request):
+    """``time_ceiling(what, seconds, ceiling_s)``: a time a test measured stays below a ceiling
+    that only a hang reaches (at least 10 x the typical figure). With FHA_TEST_TIMINGS=FILE the
+    figure is appended to FILE (a JSON object a line): benchmarks/timing_ceilings.py runs these
+    tests several times and prints the typical figures beside their ceilings."""
+
+    def check(what: str, seconds: float, ceiling_s: float) -> None:
+        path = os.environ.get("FHA_TEST_TIMINGS")
+        if path:
+            fact = {"test": request.node.nodeid, "what": what, "seconds": seconds, "ceiling_s": ceiling_s}
+            with open(path, "a", encoding="utf-8") as out:
+                out.write(json.dumps(fact) + "\n")
+        assert seconds < ceiling_s, f"{what}: {seconds:.2f} s; only a hang takes {ceiling_s:g} s"
+
+    return check

@@ -85,13 +85,18 @@ def test_stop_says_what_stops_this_axis_and_sends_nothing(window, qtbot):
     window.link._worker._client.trace_packet = None
 
 
-def test_a_silent_drive_turns_the_link_lamp_red_within_2_s(make_window, qtbot):
+def test_a_silent_drive_turns_the_link_lamp_red_at_its_first_unanswered_probe(make_window, qtbot,
+                                                                                time_ceiling):
     host, drive_end = pipe_pair("documented")
     alive = {"on": True}
+    unanswered: list[str] = []
     handler = documented_only()
 
     def answer(request):
-        return handler(request) if alive["on"] else None
+        if alive["on"]:
+            return handler(request)
+        unanswered.append(request.command.value)
+        return None
 
     scripted = ScriptedDrive(drive_end, answer)
 
@@ -104,16 +109,17 @@ def test_a_silent_drive_turns_the_link_lamp_red_within_2_s(make_window, qtbot):
         window = make_window(open_client=open_client, connect="documented")
         qtbot.waitUntil(lambda: window.link.status is not None, timeout=10000)
         assert window.link_lamp.state is True
-        with qtbot.waitSignal(window.link.sigDisconnected, timeout=10000) as lost:
+        with qtbot.waitSignal(window.link.sigDisconnected, timeout=30000) as lost:
             alive["on"] = False
             switched_off = time.monotonic()
         took = time.monotonic() - switched_off
         assert lost.args[1] is True
         assert window.link_lamp.state is True and window.link_lamp.toolTip().startswith("Link: LOST")
         assert "Link lost" in window.message_area.latest().text
-        # 2 s by design; the extra second is for a loaded test machine
-        assert took < 2.0 + 1.0, f"link lost shown {took:.2f} s after the drive fell silent"
-        assert p.Command.DGR.value in scripted.commands()
+        # lost at the first probe left unanswered and its one retry, not later: within the probe
+        # interval (0.7 s) and two timeouts (0.5 s) by design; the time only catches a hang
+        assert unanswered == [p.Command.DGR.value] * 2
+        time_ceiling("the link lamp red after the drive fell silent", took, 20.0)
     finally:
         scripted.close()
 

@@ -11,7 +11,8 @@ from collections.abc import Iterator
 
 import pytest
 
-#: The window's close may take this long on a loaded machine (it used to take a minute).
+#: Only a hang takes this long (the close used to take a minute; typical figure:
+#: benchmarks/timing_ceilings.py).
 CLOSE_LIMIT_S = 8.0
 
 
@@ -63,7 +64,7 @@ def line(request) -> Iterator[LineServer]:
     server.close()
 
 
-def test_the_window_closes_while_connecting_to_a_hostile_line(make_window, qtbot, line):
+def test_the_window_closes_while_connecting_to_a_hostile_line(make_window, qtbot, line, time_ceiling):
     window = make_window()
     window.connect_to(line.url)
     qtbot.waitUntil(line.accepted.is_set, timeout=10000)  # the link thread is inside the connect
@@ -72,7 +73,7 @@ def test_the_window_closes_while_connecting_to_a_hostile_line(make_window, qtbot
     window.close()
     elapsed = time.monotonic() - t0
     assert not window.link._thread.isRunning()
-    assert elapsed < CLOSE_LIMIT_S
+    time_ceiling("closing the window while it connects", elapsed, CLOSE_LIMIT_S)
     assert not window.link.connected
 
 

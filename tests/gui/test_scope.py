@@ -262,7 +262,7 @@ PACED_URL = f"sim://{ACTUATOR}?paced=1"
 
 
 @pytest.mark.slow
-def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_window, qtbot):
+def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_window, qtbot, time_ceiling):
     """The read-out of a trace holds the link thread for seconds on a real line; a STOP pressed
     then must reach the drive at the next block (TRP), and the capture is abandoned, not shown."""
     window = make_window(connect=PACED_URL)
@@ -298,8 +298,9 @@ def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_w
     qtbot.waitUntil(lambda: bool(stops), timeout=10000)
     arrived, result = stops[0]
     assert result.ok, result.error
-    # one block (~0.15 s) at most, not the ~5 s of the rest of the read-out (generous for a loaded host)
-    assert arrived - pressed < 2.0, f"STOP arrived {arrived - pressed:.2f} s after it was pressed"
+    # one block (~0.15 s) at most, not the ~5 s of the rest of the read-out; the read-out
+    # abandoned after a few blocks (below) is the behaviour, the time only catches a hang
+    time_ceiling("STOP during a trace read-out", arrived - pressed, 2.0)
     qtbot.waitUntil(lambda: view.trace_state.text().startswith("abandoned by STOP"), timeout=10000)
     read = int(view.trace_state.text().split("(")[1].split(" of ")[0])
     assert 64 <= read < 2048 and "of 2048 samples read" in view.trace_state.text() and not done

@@ -264,14 +264,15 @@ def test_many_threads_share_one_client(client_for, mini):
 # --- faults: timeouts, garbage, half frames, s, unplugging -------------------------------------
 
 
-def test_silence_times_out_after_the_retries(client_for, mini):
+def test_silence_times_out_after_the_retries(client_for, mini, time_ceiling):
     mini.override["ALM"] = lambda r: None
     client, drive = client_for(mini)
     t0 = time.monotonic()
     with pytest.raises(LinkSilent, match=r"nothing arrives on test:host \(to .*: 3 attempt"):
         client.alarm()
-    assert drive.commands().count("ALM") == 3
-    assert time.monotonic() - t0 < 2.0
+    assert drive.commands().count("ALM") == 3  # the retries are counted, not timed
+    # 3 x 0.08 s of timeouts by design
+    time_ceiling("three silent attempts at 0.08 s", time.monotonic() - t0, 10.0)
     assert not client.link_lost
 
 
@@ -429,12 +430,13 @@ def test_drive_silent_to_cap_but_answering_dgr(client_for):
     assert "did not answer CAP" in client.capabilities.describe()
 
 
-def test_no_drive_at_all_fails_to_attach_and_closes(pipes, scripted):
-    scripted(lambda r: None)
+def test_no_drive_at_all_fails_to_attach_and_closes(pipes, scripted, time_ceiling):
+    drive = scripted(lambda r: None)
     t0 = time.monotonic()
     with pytest.raises(LinkTimeout, match="no drive answers on test:host"):
         DriveClient.attach(pipes[0], LinkSettings(response_timeout_s=0.03, retries=1))
-    assert time.monotonic() - t0 < 2.0
+    time_ceiling("attaching to no drive at 0.03 s a try", time.monotonic() - t0, 5.0)
+    assert drive.commands() == ["CAP", "CAP", "DGR", "DGR"]  # each asked twice, then given up
     assert not pipes[0].is_open
 
 

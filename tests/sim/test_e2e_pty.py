@@ -134,7 +134,7 @@ def test_raises_and_clears_an_alarm(sim):
     sim.write_parameter(Mode.SYSTEM, 6, previous)
 
 
-def test_killing_the_sim_gives_a_clean_link_error(tmp_path):
+def test_killing_the_sim_gives_a_clean_link_error(tmp_path, time_ceiling):
     proc, path = start_sim(tmp_path)
     client = DriveClient.open(path, LinkSettings(response_timeout_s=0.3, retries=1))
     try:
@@ -145,7 +145,7 @@ def test_killing_the_sim_gives_a_clean_link_error(tmp_path):
         with pytest.raises((LinkLost, LinkTimeout)):
             for _ in range(5):
                 client.read_monitor(100)
-        assert time.monotonic() - started < 5.0
+        time_ceiling("a link error after the sim is killed", time.monotonic() - started, 10.0)
     finally:
         client.close()
         stop_sim(proc)

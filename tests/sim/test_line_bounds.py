@@ -103,7 +103,7 @@ def _ask(conn: socket.socket, frame: bytes, wanted: bytes, limit_s: float = 15.0
     return got
 
 
-def test_nothing_of_a_closed_connection_reaches_the_next(tcp_drive):
+def test_nothing_of_a_closed_connection_reaches_the_next(tcp_drive, time_ceiling):
     _server, address = tcp_drive
     with socket.create_connection(address, timeout=10) as first:
         first.sendall(b"x" * 100_000)  # a flood (most of it dropped) ...
@@ -113,7 +113,8 @@ def test_nothing_of_a_closed_connection_reaches_the_next(tcp_drive):
         got = _ask(second, b"00\rIDN+00000\r", IDN_REPLY)
         # the first host's half frame did not join this one's "00\r": the only reply is to IDN
         assert got.startswith(IDN_REPLY), got[:80]
-        assert time.monotonic() - started < 10.0  # was 12 s and more after a 20 kB burst
+        # the bound backlog's line time is asserted on a fake clock above; here only a hang fails
+        time_ceiling("the next host's answer after a flood", time.monotonic() - started, 10.0)
 
 
 def test_a_second_host_is_told_at_once_that_the_line_is_taken(tcp_drive):
