@@ -50,7 +50,14 @@ def read_register(path: Path) -> None:
         register.axes()
 
 
+def read_capture(path: Path) -> None:
+    from fha_studio.hardware.bench.readers import read_capture
+
+    read_capture(path)
+
+
 READERS = {
+    "capture": read_capture,
     "recording": read_recording,
     "parameters": read_parameters,
     "session": read_session,

@@ -1,0 +1,610 @@
+"""Capture files of bench instruments, read into :class:`~.capture.Capture`.
+
+- **sigrok session** (``.sr``, as ``sigrok-cli`` and PulseView write it): a zip holding
+  ``version``, ``metadata`` (an ini file: ``samplerate``, ``probeN`` = the name of logic bit
+  N-1, ``analogN`` = the name of an analog channel, ``unitsize``), the logic samples in chunks
+  ``logic-1-1``, ``logic-1-2``... (``unitsize`` bytes per sample, little-endian) and each analog
+  channel's float32 samples in ``analog-1-N-1``, ``analog-1-N-2``...
+- **VCD** (IEEE 1364 value change dump): ``$timescale``, ``$var wire 1 ID NAME $end`` per
+  channel, then ``#TIME`` and ``0ID`` / ``1ID`` changes (``x`` and ``z`` read as 0). The sample
+  rate is the one sigrok states in its ``$comment`` ("at 1 MHz") or else the finest step between
+  changes.
+- **sigrok-cli's CSV** (``-O csv``): ``;`` comment lines naming the channels and the sample rate,
+  an optional label row (units or channel names), an optional time column, one row per sample.
+- **a generic CSV** (oscilloscopes, DAQs, controller traces): a header row of column names, one
+  of them the time (``time``, ``t``, ``x-axis``...), in s unless its header or a units row says
+  ``ms``, ``us`` or ``ns`` (``Time [ms]``, ``time (s)``, ``time_ms``); optionally a units row after
+  the header; comment lines starting with ``#`` (or ``;`` when ``;`` is not the separator);
+  ``,``, ``;`` (then decimal commas are read) or tab separated. Every other column is an analog
+  channel named by its header; the samples must be at one rate.
+
+Everything is read through :mod:`fha_studio.fileio` (regular files only, at most
+:data:`MAX_CAPTURE_BYTES`). A file of another shape raises :class:`~.capture.CaptureError`: one
+line naming the file, the line (or the part of the zip) and what was expected.
+"""
+
+from __future__ import annotations
+
+import configparser
+import io
+import math
+import os
+import re
+import zipfile
+from collections.abc import Sequence
+
+import numpy as np
+
+from fha_studio import fileio
+from fha_studio.hardware.bench import _numbers
+from fha_studio.hardware.bench.capture import Capture, CaptureError, SampleBlock, logic_dtype, pack_logic
+
+#: What a capture file may weigh (a minute of 8 channels at 24 MS/s is about 1.4 GB as .sr).
+MAX_CAPTURE_BYTES = 4 * 1024**3
+#: Samples a capture may expand to (VCD and CSV): a minute at 24 MS/s and more.
+MAX_SAMPLES = 2_000_000_000
+#: A generic CSV's time column may stray this fraction of a sample interval from a steady rate.
+TIME_JITTER = 0.5
+
+_PREFIX = {"": 1.0, "k": 1e3, "m": 1e6, "g": 1e9, "K": 1e3, "M": 1e6, "G": 1e9}
+_RATE_RE = re.compile(r"^\s*([0-9]+(?:\.[0-9]*)?)\s*([kKmMgG]?)\s*hz\s*$", re.IGNORECASE)
+_TIME_UNITS = {"s": 1.0, "sec": 1.0, "second": 1.0, "seconds": 1.0, "ms": 1e-3, "msec": 1e-3,
+               "millisecond": 1e-3, "milliseconds": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6,
+               "microsecond": 1e-6, "microseconds": 1e-6, "ns": 1e-9, "nanosecond": 1e-9,
+               "nanoseconds": 1e-9, "ps": 1e-12, "fs": 1e-15}
+_TIME_NAMES = ("time", "t", "x-axis", "x_axis", "timestamp", "zeit", "temps")
+
+
+def read_capture(path: str | os.PathLike[str]) -> Capture:
+    """The capture in ``path``, its form found from its content (a zip is a sigrok session, a
+    ``$`` keyword first is VCD, ``libsigrok`` in the first comment is sigrok's CSV, else CSV)."""
+    name = os.fspath(path)
+    data = fileio.read_bytes(name, limit_bytes=MAX_CAPTURE_BYTES)
+    if data.startswith(b"PK\x03\x04"):
+        return parse_sr(data, name)
+    head = data[:4096].lstrip()
+    if head.startswith(b"$"):
+        return parse_vcd(data, name)
+    if b"libsigrok" in head[:200] or head.startswith(b"; Channels"):
+        return parse_sigrok_csv(data, name)
+    if name.lower().endswith((".sr", ".vcd")):
+        kind = "sigrok session (a zip)" if name.lower().endswith(".sr") else "VCD ($ keywords first)"
+        raise CaptureError(f"{name}: line 1: not a {kind}")
+    return parse_csv(data, name)
+
+
+def parse_rate(text: str) -> float | None:
+    """sigrok's sample rate text (``200 kHz``, ``24 MHz``, ``1 Hz``) in Hz, None if it is not one."""
+    match = _RATE_RE.match(text)
+    if not match:
+        return None
+    rate = float(match.group(1)) * _PREFIX[match.group(2)]
+    return rate if rate > 0 else None
+
+
+# ------------------------------------------------------------------------------------- sigrok .sr
+
+
+def parse_sr(data: bytes, name: str) -> Capture:
+    """A sigrok session file (srzip, version 2)."""
+    try:
+        archive = zipfile.ZipFile(io.BytesIO(data))
+        members = set(archive.namelist())
+    except (zipfile.BadZipFile, ValueError) as exc:
+        raise CaptureError(f"{name}: not a readable sigrok session (zip): {exc}") from None
+    if "metadata" not in members:
+        raise CaptureError(f"{name}: no 'metadata' in the zip: not a sigrok session")
+    try:
+        with archive:
+            return _parse_sr(archive, members, name)
+    except (zipfile.BadZipFile, OSError, EOFError) as exc:
+        raise CaptureError(f"{name}: a part of the zip cannot be read: {exc}") from None
+
+
+def _parse_sr(archive: zipfile.ZipFile, members: set[str], name: str) -> Capture:
+    version = archive.read("version").decode("ascii", "replace").strip() if "version" in members else "?"
+    if version != "2":
+        raise CaptureError(f"{name}: version: sigrok session version '{version}', expected 2")
+    text = archive.read("metadata").decode("utf-8", "replace")
+    parser = configparser.ConfigParser(interpolation=None, strict=False)
+    try:
+        parser.read_string(text)
+    except configparser.Error as exc:
+        raise CaptureError(f"{name}: metadata: not an ini file ({str(exc).splitlines()[0]})") from None
+    devices = [s for s in parser.sections() if s.startswith("device ")]
+    if not devices:
+        raise CaptureError(f"{name}: metadata: no [device 1] section")
+    device = parser[devices[0]]
+    rate = parse_rate(device.get("samplerate", ""))
+    if rate is None:
+        raise CaptureError(f"{name}: metadata: samplerate '{device.get('samplerate', '')}' is not a "
+                           "rate like '1 MHz'")
+    probes: dict[int, str] = {}
+    analogs: dict[int, str] = {}
+    for key, value in device.items():
+        if key.startswith("probe") and key[5:].isdigit():
+            probes[int(key[5:])] = value.strip()
+        elif key.startswith("analog") and key[6:].isdigit():
+            analogs[int(key[6:])] = value.strip()
+    capturefile = device.get("capturefile", "logic-1").strip()
+    logic_names: tuple[str, ...] = ()
+    logic = np.zeros(0, np.uint8)
+    n: int | None = None
+    if probes:
+        try:
+            unitsize = int(device.get("unitsize", "1"))
+        except ValueError:
+            unitsize = 0
+        if unitsize not in (1, 2, 4, 8):
+            raise CaptureError(f"{name}: metadata: unitsize '{device.get('unitsize')}', "
+                               "expected 1, 2, 4 or 8")
+        raw = _chunks(archive, members, capturefile, name)
+        if len(raw) % unitsize:
+            raise CaptureError(f"{name}: {capturefile}: {len(raw)} bytes are not whole samples of "
+                               f"{unitsize} bytes")
+        words = np.frombuffer(raw, dtype=f"<u{unitsize}")
+        # channels are named per bit: probeN is bit N-1; pack the named ones, in bit order
+        order = sorted(probes)
+        if max(order) > 8 * unitsize:
+            raise CaptureError(f"{name}: metadata: probe{max(order)} beyond the {8 * unitsize} bits "
+                               "of a sample")
+        logic_names = tuple(probes[k] for k in order)
+        if order == list(range(1, len(order) + 1)):
+            logic = (words & np.array((1 << len(order)) - 1, words.dtype)).astype(logic_dtype(len(order)))
+        else:
+            logic = pack_logic([((words >> (k - 1)) & 1).astype(bool) for k in order])
+        n = int(logic.shape[0])
+    analog: dict[str, np.ndarray] = {}
+    for index in sorted(analogs):
+        raw = _chunks(archive, members, f"analog-1-{index}", name)
+        if len(raw) % 4:
+            raise CaptureError(f"{name}: analog-1-{index}: {len(raw)} bytes are not whole float32 samples")
+        values = np.frombuffer(raw, dtype="<f4").astype(np.float32)
+        if n is None:
+            n = int(values.shape[0])
+        elif values.shape[0] != n:
+            # sigrok ends analog and logic at the same sample; cut to the shorter to stay aligned
+            n = min(n, int(values.shape[0]))
+        analog[analogs[index]] = values
+    if n is None:
+        raise CaptureError(f"{name}: metadata: no channels (probeN or analogN)")
+    logic = logic[:n] if logic_names else logic
+    analog = {k: v[:n] for k, v in analog.items()}
+    block = SampleBlock(rate, logic_names, logic, analog)
+    return Capture(name, block, {k: "V" for k in analog}, 0.0, "sigrok session")
+
+
+def _chunks(archive: zipfile.ZipFile, members: set[str], base: str, name: str) -> bytes:
+    numbered = sorted((int(m[len(base) + 1:]), m) for m in members
+                      if m.startswith(base + "-") and m[len(base) + 1:].isdigit())
+    names = [m for _, m in numbered]
+    if not names and base in members:
+        names = [base]
+    if not names:
+        raise CaptureError(f"{name}: no '{base}-1' in the zip for the channels its metadata names")
+    return b"".join(archive.read(m) for m in names)
+
+
+# -------------------------------------------------------------------------------------------- VCD
+
+
+_VCD_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "ps": 1e-12, "fs": 1e-15}
+_TIMESCALE_RE = re.compile(r"^\s*(1|10|100)\s*(s|ms|us|ns|ps|fs)\s*$")
+_SIGROK_ANALOG_LINES = re.compile(rb"(?m)^[A-Za-z_][\w.-]*: [-+0-9.eE]+(?: [^\n]*)?\n?")
+_SIGROK_ANALOG_LINE = re.compile(rb"(?m)^[A-Za-z_][\w.-]*: [-+0-9.eE]+(?: [^\n]*)?$")
+_AT_RATE_RE = re.compile(r"\bat\s+([0-9.]+\s*[kKmMgG]?Hz)")
+
+
+def parse_vcd(data: bytes, name: str) -> Capture:
+    """A value change dump of 1-bit wires."""
+    end = data.find(b"$enddefinitions")
+    if end < 0:
+        raise CaptureError(f"{name}: line 1: no '$enddefinitions $end': not a VCD file")
+    header = data[:end].decode("utf-8", "replace")
+    body_start = data.find(b"$end", end + 15)
+    body_start = len(data) if body_start < 0 else body_start + 4
+    header_lines = data[:body_start].count(b"\n")
+    timescale = 1e-6
+    rate: float | None = None
+    ids: dict[str, str] = {}
+    for match in re.finditer(r"\$(\w+)(.*?)\$end", header, re.DOTALL):
+        keyword, content = match.group(1), match.group(2)
+        line = header.count("\n", 0, match.start()) + 1
+        if keyword == "timescale":
+            ts = _TIMESCALE_RE.match(content)
+            if not ts:
+                raise CaptureError(f"{name}: line {line}: $timescale '{content.strip()}', "
+                                   "expected like '1 us'")
+            timescale = int(ts.group(1)) * _VCD_UNITS[ts.group(2)]
+        elif keyword == "comment":
+            at = _AT_RATE_RE.search(content)
+            if at:
+                rate = parse_rate(at.group(1))
+        elif keyword == "var":
+            parts = content.split()
+            if len(parts) < 4:
+                raise CaptureError(f"{name}: line {line}: $var '{content.strip()}', expected "
+                                   "'$var wire 1 ID NAME $end'")
+            if parts[1] != "1":
+                raise CaptureError(f"{name}: line {line}: $var {parts[3]} is {parts[1]} bits wide; only "
+                                   "1-bit wires (logic channels) are read")
+            ids.setdefault(parts[2], parts[3])
+    if not ids:
+        raise CaptureError(f"{name}: line {header_lines}: no $var: the file names no channels")
+    names = list(dict.fromkeys(ids.values()))
+    if len(names) > 64:
+        raise CaptureError(f"{name}: {len(names)} channels; at most 64 are read")
+    # libsigrok 0.5.2 prints a session's analog samples ('A0: 10.00 V DC' lines) into its VCD too
+    body = _SIGROK_ANALOG_LINES.sub(b"", data[body_start:])
+    # $dumpvars / $end and other keywords in the body carry no samples of their own
+    tokens = np.array(re.sub(rb"\$\w+|\$end", b" ", body).split(), dtype=object)
+    if tokens.size == 0:
+        raise CaptureError(f"{name}: line {header_lines + 1}: no samples after $enddefinitions")
+    first = np.array([t[:1] for t in tokens], dtype="S1")
+    is_time = first == b"#"
+    if not is_time[0]:
+        raise CaptureError(f"{name}: line {header_lines + 1}: '{_tok(tokens[0])}' before the first "
+                           "'#time'")
+    try:
+        times = np.array([int(t[1:]) for t in tokens[is_time]], dtype=np.int64)
+    except ValueError:
+        bad = next(t for t in tokens[is_time] if not t[1:].isdigit())
+        raise CaptureError(f"{name}: line {_line_of(data, body_start, bad)}: '{_tok(bad)}' is not a "
+                           "time ('#' and a whole number)") from None
+    if np.any(np.diff(times) < 0):
+        i = int(np.flatnonzero(np.diff(times) < 0)[0]) + 1
+        raise CaptureError(f"{name}: the time goes back at #{times[i]} (after #{times[i - 1]})")
+    changes = tokens[~is_time]
+    when = (np.cumsum(is_time) - 1)[~is_time]
+    value = np.array([t[:1] for t in changes], dtype="S1")
+    ident = np.array([t[1:].decode("ascii", "replace") for t in changes], dtype=object)
+    bad_value = ~np.isin(value, [b"0", b"1", b"x", b"z", b"X", b"Z"])
+    if np.any(bad_value):
+        bad = changes[int(np.flatnonzero(bad_value)[0])]
+        raise CaptureError(f"{name}: line {_line_of(data, body_start, bad)}: '{_tok(bad)}' is not a "
+                           "change of a 1-bit wire (0, 1, x or z and the wire's id)")
+    unknown = [i for i in set(ident.tolist()) if i not in ids]
+    if unknown:
+        raise CaptureError(f"{name}: a change of '{unknown[0]}', which no $var declares")
+    t0 = int(times[0])
+    span = int(times[-1]) - t0
+    if rate is not None:
+        step_units = 1.0 / (rate * timescale)
+    else:
+        deltas = np.diff(np.unique(times))
+        step_units = float(np.gcd.reduce(deltas)) if deltas.size else 1.0
+        rate = 1.0 / (step_units * timescale)
+    # a last '#time' with no change after it marks the end of the capture (sigrok writes one)
+    ends_with_marker = bool(is_time[-1])
+    n = round(span / step_units) + (0 if ends_with_marker else 1)
+    if n > MAX_SAMPLES:
+        raise CaptureError(f"{name}: {n} samples at {_rate_text(rate)}: more than the {MAX_SAMPLES} "
+                           "a capture may hold")
+    sample_of_time = np.rint((times - t0) / step_units).astype(np.int64)
+    sample = np.minimum(sample_of_time[when], n - 1)
+    high = (value == b"1")
+    bits = []
+    for channel in names:
+        own = np.isin(ident, [i for i, nm in ids.items() if nm == channel])
+        bits.append(_levels_from_changes(sample[own], high[own], n))
+    block = SampleBlock(rate, tuple(names), pack_logic(bits), {})
+    return Capture(name, block, {}, t0 * timescale, "VCD")
+
+
+def _levels_from_changes(at: np.ndarray, high: np.ndarray, n: int) -> np.ndarray:
+    """The level at each of ``n`` samples from (sample, level) changes in time order; 0 before
+    the first change; the last change at one sample wins."""
+    levels = np.zeros(n, bool)
+    if at.size == 0:
+        return levels
+    last_at_sample = np.ones(at.size, bool)
+    last_at_sample[:-1] = at[1:] != at[:-1]
+    at, high = at[last_at_sample], high[last_at_sample]
+    lengths = np.diff(np.append(at, n))
+    levels[at[0]:] = np.repeat(high, lengths)
+    return levels
+
+
+def _tok(token: bytes) -> str:
+    text = token.decode("utf-8", "replace")
+    return text if len(text) <= 30 else text[:29] + "…"
+
+
+def _line_of(data: bytes, start: int, token: bytes) -> int:
+    at = data.find(token, start)
+    return data.count(b"\n", 0, max(at, 0)) + 1
+
+
+def _rate_text(rate: float) -> str:
+    for factor, unit in ((1e9, "GHz"), (1e6, "MHz"), (1e3, "kHz")):
+        if rate >= factor:
+            return f"{rate / factor:g} {unit}"
+    return f"{rate:g} Hz"
+
+
+# -------------------------------------------------------------------------------------------- CSV
+
+
+
+
+def parse_sigrok_csv(data: bytes, name: str) -> Capture:
+    """``sigrok-cli -O csv`` output (with or without the time column and the label row)."""
+    if b": " in data:  # libsigrok 0.5.2 prints analog samples as 'A0: 10.00 V DC' lines as well
+        data = _SIGROK_ANALOG_LINE.sub(b"", data)
+    lines = data.split(b"\n")
+    names: list[str] = []
+    rate: float | None = None
+    index = 0
+    for index, raw in enumerate(lines):  # noqa: B007 - the index of the first data line is used
+        line = raw.strip()
+        if not line:
+            continue
+        if line.startswith(b";"):
+            text = line[1:].decode("utf-8", "replace").strip()
+            if text.startswith("Channels"):
+                names = [c.strip() for c in text.partition(":")[2].split(",") if c.strip()]
+            elif text.startswith("Samplerate:"):
+                rate = parse_rate(text.partition(":")[2])
+            continue
+        if line.startswith(b"META samplerate:"):  # how 0.5.2 states the rate of a converted VCD
+            rate = parse_rate(line.partition(b":")[2].decode("ascii", "replace").strip() + " Hz")
+            continue
+        if _SIGROK_ANALOG_LINE.match(line):
+            continue  # libsigrok 0.5.2 prints live analog samples as 'A0: 1.0 V DC' lines too
+        break
+    else:
+        index = len(lines)
+    if not names:
+        raise CaptureError(f"{name}: line 1: no '; Channels (n/m): ...' comment naming the channels")
+    if rate is None:
+        raise CaptureError(f"{name}: line 1: no '; Samplerate: ...' comment (like '1 MHz')")
+    first = lines[index].decode("utf-8", "replace").strip() if index < len(lines) else ""
+    labels = [c.strip() for c in first.split(",")]
+    has_label_row = bool(first) and not all(_numbers_like(c) for c in labels)
+    width = len(labels)
+    has_time = width == len(names) + 1
+    if width not in (len(names), len(names) + 1):
+        raise CaptureError(f"{name}: line {index + 1}: {width} columns, expected {len(names)} (the "
+                           f"channels {', '.join(names)}) or one more for the time")
+    start = index + 1 if has_label_row else index
+    table = _table(lines, start, width, name, b",")
+    values = table[:, 1:] if has_time else table
+    units = labels[1:] if has_time and has_label_row else (labels if has_label_row else [""] * len(names))
+    logic_names: list[str] = []
+    bits: list[np.ndarray] = []
+    analog: dict[str, np.ndarray] = {}
+    unit_of: dict[str, str] = {}
+    for column, (channel, unit) in enumerate(zip(names, units, strict=True)):
+        col = values[:, column]
+        is_logic = unit == "logic" or (unit in ("", channel) and _is_bits(col))
+        if is_logic:
+            if not _is_bits(col):
+                row = int(np.flatnonzero((col != 0) & (col != 1))[0])
+                raise CaptureError(f"{name}: line {_data_line(lines, start, row)}: logic channel {channel} "
+                                   f"is {col[row]:g}, expected 0 or 1")
+            logic_names.append(channel)
+            bits.append(col == 1)
+        else:
+            analog[channel] = col.astype(np.float32)
+            unit_of[channel] = _sigrok_unit(unit)
+    block = SampleBlock(rate, tuple(logic_names), pack_logic(bits) if bits else np.zeros(0, np.uint8),
+                        analog)
+    start_s = 0.0
+    if has_time and table.shape[0]:
+        start_s = float(table[0, 0]) * _time_unit_of_label(labels[0] if has_label_row else "", rate)
+    return Capture(name, block, unit_of, start_s, "sigrok CSV")
+
+
+def _sigrok_unit(label: str) -> str:
+    # sigrok's unit labels: "V DC", "V AC", "A", ...: the unit is the first word
+    return label.split()[0] if label.split() else "V"
+
+
+def _time_unit_of_label(label: str, rate: float) -> float:
+    if label.lower() in _TIME_UNITS:
+        return _TIME_UNITS[label.lower()]
+    # sigrok picks the time unit from the rate (ms at 20 Hz, us at 1 MHz): the time of one sample
+    for unit in (1.0, 1e-3, 1e-6, 1e-9, 1e-12):
+        if 1.0 / rate >= unit:
+            return unit
+    return 1e-15
+
+
+def _is_bits(col: np.ndarray) -> bool:
+    return bool(col.size) and bool(np.all((col == 0) | (col == 1)))
+
+
+def _numbers_like(text: str) -> bool:
+    return bool(re.fullmatch(r"[+-]?(?:[0-9]+(?:[.,][0-9]*)?|[.,][0-9]+)(?:[eE][+-]?[0-9]+)?", text.strip()))
+
+
+def parse_csv(data: bytes, name: str) -> Capture:
+    """A generic CSV: header row, a time column, one analog channel per other column."""
+    lines = data.split(b"\n")
+    index = _first_content_line(lines, 0, None)
+    if index is None:
+        raise CaptureError(f"{name}: line 1: empty: expected a header row naming the columns "
+                           "(one of them the time)")
+    try:
+        header_text = lines[index].decode("utf-8").strip().lstrip("\ufeff")
+    except UnicodeDecodeError:
+        raise CaptureError(f"{name}: line {index + 1}: not UTF-8 text: is it a capture file?") from None
+    delimiter = ";" if ";" in header_text else ("\t" if "\t" in header_text else ",")
+    header = [c.strip().strip('"') for c in header_text.split(delimiter)]
+    if all(_numbers_like(c) for c in header if c):
+        raise CaptureError(f"{name}: line {index + 1}: numbers where the header row was expected "
+                           "(names of the columns, one of them the time, like 'time [s],CH1 [V]')")
+    comment = "#" if delimiter == ";" else "#;"
+    after = _first_content_line(lines, index + 1, comment)
+    units: list[str] = [""] * len(header)
+    data_start = index + 1
+    if after is not None:
+        row = [c.strip().strip('"') for c in lines[after].decode("utf-8", "replace").split(delimiter)]
+        if row and not any(_numbers_like(c) for c in row if c) and len(row) == len(header):
+            units = row  # a units row under the header ("s,V,V")
+            data_start = after + 1
+    names: list[str] = []
+    column_units: list[str] = []
+    for raw, unit_row in zip(header, units, strict=True):
+        label, unit = _split_unit(raw)
+        names.append(label)
+        column_units.append(unit or unit_row)
+    # trailing empty columns (a separator at the end of each row) are not channels
+    while names and not names[-1]:
+        names.pop()
+        column_units.pop()
+    time_column = next((i for i, n in enumerate(names) if _is_time_name(n)), None)
+    if time_column is None:
+        raise CaptureError(f"{name}: line {index + 1}: no time column (named time, t or x-axis, in s or "
+                           f"ms); the header has {', '.join(n or '(empty)' for n in names)}")
+    seen: set[str] = set()
+    for label in names:
+        if not label:
+            raise CaptureError(f"{name}: line {index + 1}: a column without a name")
+        if label in seen:
+            raise CaptureError(f"{name}: line {index + 1}: column '{label}' given twice")
+        seen.add(label)
+    width = len(header)
+    decimal_comma = delimiter == ";" and _has_decimal_comma(lines, data_start)
+    table = _table(lines, data_start, width, name, delimiter.encode(), decimal_comma, comment)
+    table = table[:, : len(names)]
+    if table.shape[0] < 2:
+        raise CaptureError(f"{name}: line {data_start + 1}: fewer than 2 rows of samples")
+    time_unit = _time_unit(names[time_column], column_units[time_column])
+    if time_unit is None:
+        raise CaptureError(f"{name}: line {index + 1}: the time column's unit '{column_units[time_column]}' "
+                           "is not s, ms, us or ns")
+    t = table[:, time_column] * time_unit
+    rate = _steady_rate(t, name, lines, data_start, comment)
+    analog: dict[str, np.ndarray] = {}
+    unit_of: dict[str, str] = {}
+    for column, label in enumerate(names):
+        if column == time_column:
+            continue
+        col = table[:, column]
+        if np.any(np.isnan(col)):
+            bad_row = int(np.flatnonzero(np.isnan(col))[0])
+            raise CaptureError(f"{name}: line {_data_line(lines, data_start, bad_row, comment)}: column "
+                               f"'{label}' is empty, expected a number")
+        analog[label] = col.astype(np.float32)
+        unit_of[label] = column_units[column] or "V"
+    block = SampleBlock(rate, (), np.zeros(0, np.uint8), analog)
+    return Capture(name, block, unit_of, float(t[0]), "CSV")
+
+
+def _is_time_name(label: str) -> bool:
+    low = label.lower()
+    if low in _TIME_NAMES or low in _TIME_UNITS:
+        return True
+    base, _, suffix = low.rpartition("_")
+    return base in _TIME_NAMES and suffix in _TIME_UNITS
+
+
+def _time_unit(label: str, unit: str) -> float | None:
+    low = label.lower()
+    if unit:
+        return _TIME_UNITS.get(unit.strip().lower())
+    if low in _TIME_UNITS:
+        return _TIME_UNITS[low]
+    base, _, suffix = low.rpartition("_")
+    if base in _TIME_NAMES and suffix in _TIME_UNITS:
+        return _TIME_UNITS[suffix]
+    return 1.0  # a time without a unit is in seconds
+
+
+_UNIT_RE = re.compile(r"^(.*?)\s*(?:\[([^\]]*)\]|\(([^)]*)\))\s*$")
+
+
+def _split_unit(text: str) -> tuple[str, str]:
+    """``Time [ms]`` / ``CH1 (V)`` -> (name, unit); a bare name has no unit."""
+    match = _UNIT_RE.match(text)
+    if match:
+        return match.group(1).strip(), (match.group(2) or match.group(3) or "").strip()
+    return text.strip(), ""
+
+
+def _first_content_line(lines: Sequence[bytes], start: int, comment: str | None) -> int | None:
+    marks = tuple(c.encode() for c in (comment if comment is not None else "#"))
+    for i in range(start, len(lines)):
+        line = lines[i].strip()
+        if line and not line.startswith(marks) and not line.startswith(b"//"):
+            return i
+    return None
+
+
+def _has_decimal_comma(lines: Sequence[bytes], start: int) -> bool:
+    for i in range(start, min(len(lines), start + 50)):
+        line = lines[i].strip()
+        if line and not line.startswith(b"#"):
+            return b"," in line
+    return False
+
+
+def _table(lines: Sequence[bytes], start: int, width: int, name: str, delimiter: bytes,
+           decimal_comma: bool = False, comment: str = ";") -> np.ndarray:
+    """The numeric rows from line index ``start`` on, as ``(rows, width)`` float64."""
+    marks = tuple(c.encode() for c in comment)
+    body_lines = lines[start:]
+    data = b"\n".join(body_lines)
+    # comment and empty lines inside the rows are taken out (rarely there: the fast path is whole)
+    if any(m in data for m in marks) or b"\n\n" in data or data.startswith(b"\n"):
+        data = b"\n".join(ln for ln in body_lines if ln.strip() and not ln.lstrip().startswith(marks))
+    if delimiter == b";":
+        data = data.translate(_numbers.SEMICOLON_DECIMAL_COMMA if decimal_comma else _numbers.SEMICOLON)
+    elif delimiter == b"\t":
+        data = data.translate(_numbers.TAB)
+    data = data.strip(b"\n") + b"\n" if data.strip() else b""
+    table = _numbers.parse_rows(data, width)
+    if table is None:
+        _find_bad_row(lines, start, width, name, delimiter, decimal_comma, marks)
+        raise CaptureError(f"{name}: line {start + 1}: the rows are not numbers in {width} columns")
+    return table
+
+
+def _find_bad_row(lines: Sequence[bytes], start: int, width: int, name: str, delimiter: bytes,
+                  decimal_comma: bool, marks: tuple[bytes, ...]) -> None:
+    """Raises the CaptureError naming the first row that is not ``width`` numbers."""
+    for i in range(start, len(lines)):
+        raw = lines[i].strip()
+        if not raw or raw.startswith(marks):
+            continue
+        text = raw.decode("utf-8", "replace")
+        fields = text.split(delimiter.decode())
+        if len(fields) != width:
+            raise CaptureError(f"{name}: line {i + 1}: {len(fields)} fields, expected {width} (as the "
+                               "header has)")
+        for k, field in enumerate(fields, 1):
+            cell = field.strip().replace(",", ".") if decimal_comma else field.strip()
+            if cell and _numbers.parse_rows(cell.encode() + b"\n", 1) is None:
+                shown = field if len(field) <= 30 else field[:29] + "…"
+                raise CaptureError(f"{name}: line {i + 1}: field {k} '{shown}' is not a number "
+                                   "(a plain decimal like 12, -0.5 or 1.5e-3)")
+
+
+def _data_line(lines: Sequence[bytes], start: int, row: int, comment: str = ";") -> int:
+    marks = tuple(c.encode() for c in comment)
+    seen = -1
+    for i in range(start, len(lines)):
+        line = lines[i].strip()
+        if line and not line.startswith(marks):
+            seen += 1
+            if seen == row:
+                return i + 1
+    return len(lines)
+
+
+def _steady_rate(t: np.ndarray, name: str, lines: Sequence[bytes], start: int, comment: str) -> float:
+    n = t.size
+    steps = np.diff(t)
+    step = float(np.median(steps))
+    if not (step > 0 and math.isfinite(step)):
+        raise CaptureError(f"{name}: line {_data_line(lines, start, 1, comment)}: the time does not "
+                           "increase")
+    off = np.abs(steps - step) > TIME_JITTER * step
+    if np.any(off):
+        i = int(np.flatnonzero(off)[0]) + 1
+        raise CaptureError(
+            f"{name}: line {_data_line(lines, start, i, comment)}: time {t[i]:.9g} s after "
+            f"{t[i - 1]:.9g} s: off the steady rate of {_rate_text(1.0 / step)} (a sample every "
+            f"{step:.6g} s): a capture at one sample rate is expected")
+    return float(f"{(n - 1) / (t[-1] - t[0]):.9g}")
