@@ -39,6 +39,34 @@ def pytest_unconfigure(config):
         _travel = None
 
 
+@pytest.hookimpl(tryfirst=True)
+def pytest_timeout_set_timer(item, settings):
+    """pytest-timeout's thread method, with the hanging test's id in one line before the stacks
+    (the plugin's own dump names only the functions on them)."""
+    if settings.method != "thread":
+        return None
+    import pytest_timeout
+
+    def expire() -> None:
+        capture = item.config.pluginmanager.getplugin("capturemanager")
+        if capture is not None:
+            capture.suspend_global_capture(item)  # the line goes to the terminal, not the capture
+        terminal = item.config.get_terminal_writer()
+        terminal.line(f"\nTIMEOUT: {item.nodeid} ran longer than {settings.timeout:g} s", red=True)
+        pytest_timeout.timeout_timer(item, settings)  # the captured output, every stack, exit 1
+
+    timer = threading.Timer(settings.timeout, expire)
+    timer.name = f"pytest_timeout {item.nodeid}"
+
+    def cancel() -> None:
+        timer.cancel()
+        timer.join()
+
+    item.cancel_timeout = cancel
+    timer.start()
+    return True
+
+
 def pytest_report_header(config):
     if _travel is not None:
         days = os.environ["FHA_TEST_TRAVEL_DAYS"]
