@@ -28,6 +28,11 @@ driver's current monitor] are required; ``cmd_pos`` [deg], ``load_pos`` [deg, ex
 the output] and ``vel`` [r/min, output] are optional; further columns are extra channels (the
 writer's own signals) and are kept by name in :attr:`Recording.channels`.
 
+**fha-recording/2** is the same file with ``# format: fha-recording/2``, in which ``current`` and
+``load_inertia_kgm2`` are optional (a bench capture through CN2: the HA-655 has no current monitor
+output). It also knows the column ``in_pos`` (the drive's IN-POS output, 1 = on). A writer writes
+/2 only when one of the two is missing; ``fha-recording/1`` files read as before.
+
 The file loads in plain numpy, e.g. ``np.genfromtxt(path, delimiter=",", comments="#")[1:]``
 (the header row reads as NaN and is dropped) or ``np.loadtxt(path, delimiter=",", comments="#",
 skiprows=...)``.
@@ -56,12 +61,20 @@ from fha_studio.catalog import get_actuator
 from fha_studio.fileio import FileProblem
 
 FORMAT_ID = "fha-recording/1"
+#: The second version: ``current`` and ``load_inertia_kgm2`` are optional (a bench capture of a
+#: drive without a current monitor, of an axis whose load nobody declared). Written only when one
+#: of them is absent, so a recording that has both stays an ``fha-recording/1`` file.
+FORMAT_V2 = "fha-recording/2"
+FORMATS = (FORMAT_ID, FORMAT_V2)
 
 REQUIRED_COLUMNS = ("t", "pos", "current")
-OPTIONAL_COLUMNS = ("cmd_pos", "load_pos", "vel")
-CONTRACT_COLUMNS = REQUIRED_COLUMNS + OPTIONAL_COLUMNS
-#: unit of each contract column, as the format defines it
-COLUMN_UNITS = {"t": "s", "pos": "deg", "current": "A", "cmd_pos": "deg", "load_pos": "deg", "vel": "r/min"}
+#: what a ``fha-recording/2`` file must have
+REQUIRED_COLUMNS_V2 = ("t", "pos")
+OPTIONAL_COLUMNS = ("cmd_pos", "load_pos", "vel", "in_pos")
+CONTRACT_COLUMNS = ("t", "pos", "current", *OPTIONAL_COLUMNS)
+#: unit of each contract column, as the format defines it (in_pos: 1 = the drive's IN-POS output on)
+COLUMN_UNITS = {"t": "s", "pos": "deg", "current": "A", "cmd_pos": "deg", "load_pos": "deg", "vel": "r/min",
+                "in_pos": "1 = on, 0 = off"}
 
 # Numeric metadata keys (unit in the name) and the unit text a writer may append to the value.
 _NUMERIC_KEYS = {
@@ -130,7 +143,7 @@ class RecordingMetadata:
     """The ``# key: value`` lines of a recording, typed. Units are in the names."""
 
     actuator: str
-    load_inertia_kgm2: float
+    load_inertia_kgm2: float | None  # None: not declared (fha-recording/2 only)
     supply_voltage: int = 200
     sample_rate_hz: float | None = None
     torque_constant_nm_per_a: float | None = None
@@ -143,10 +156,19 @@ class RecordingMetadata:
         """True for ``actuator: custom`` (constants given in the file, not from the catalogue)."""
         return self.actuator == "custom"
 
-    def lines(self) -> list[str]:
-        """The metadata as ``# key: value`` lines (without newline), in the format's order."""
-        out = [f"# format: {FORMAT_ID}", f"# actuator: {self.actuator}"]
-        out.append(f"# load_inertia_kgm2: {_num(self.load_inertia_kgm2)}")
+    def format_for(self, columns: Sequence[str] = REQUIRED_COLUMNS) -> str:
+        """The version a file of these columns is written in: ``fha-recording/1`` unless the
+        current or the load inertia is missing."""
+        if self.load_inertia_kgm2 is None or "current" not in columns:
+            return FORMAT_V2
+        return FORMAT_ID
+
+    def lines(self, columns: Sequence[str] = REQUIRED_COLUMNS) -> list[str]:
+        """The metadata as ``# key: value`` lines (without newline), in the format's order, for a
+        file of ``columns``."""
+        out = [f"# format: {self.format_for(columns)}", f"# actuator: {self.actuator}"]
+        if self.load_inertia_kgm2 is not None:
+            out.append(f"# load_inertia_kgm2: {_num(self.load_inertia_kgm2)}")
         out.append(f"# supply_voltage: {int(self.supply_voltage)}")
         for key in ("sample_rate_hz", "torque_constant_nm_per_a", "actuator_inertia_kgm2",
                     "motor_turns_per_output_rev"):
@@ -177,9 +199,23 @@ class Recording:
         return self.channels["pos"]
 
     @property
+    def has_current(self) -> bool:
+        """True when the recording measured the motor current (always in fha-recording/1)."""
+        return "current" in self.channels
+
+    @property
     def current_a(self) -> np.ndarray:
-        """Motor current as the driver's monitor reports it [A]."""
+        """Motor current as the driver's monitor reports it [A]; RecordingError when the
+        recording has none (see :attr:`has_current`)."""
+        if "current" not in self.channels:
+            raise RecordingError("no current column: this recording did not measure the motor current",
+                                 source=self.source, field="current")
         return self.channels["current"]
+
+    @property
+    def in_pos(self) -> np.ndarray | None:
+        """The drive's IN-POS output (1 = on), or None when not recorded."""
+        return self.channels.get("in_pos")
 
     @property
     def cmd_pos_deg(self) -> np.ndarray | None:
@@ -261,14 +297,14 @@ def parse_recording(text: str, *, source: str = "", check_actuator: bool = True)
         raise RecordingError(f"missing metadata line '# format: {FORMAT_ID}'", source=source,
                              line=1, field="format")
     fmt, fmt_line = meta_raw["format"]
-    if fmt != FORMAT_ID:
-        raise RecordingError(f"format is '{fmt}', expected '{FORMAT_ID}'", source=source,
+    if fmt not in FORMATS:
+        raise RecordingError(f"format is '{fmt}', expected '{FORMAT_ID}' or '{FORMAT_V2}'", source=source,
                              line=fmt_line, field="format")
     metadata = _parse_metadata(meta_raw, source, check_actuator)
     if header_index is None:
         raise RecordingError("no header row (column names) after the metadata", source=source,
                              line=len(lines) + 1, field="header")
-    columns = _parse_header(lines[header_index], header_index + 1, source)
+    columns = _parse_header(lines[header_index], header_index + 1, source, fmt)
     data = _parse_rows(lines, header_index + 1, columns, source)
     channels = {name: data[:, i].copy() for i, name in enumerate(columns)}
     data_lines = _data_line_numbers(lines, header_index + 1)
@@ -279,6 +315,7 @@ def parse_recording(text: str, *, source: str = "", check_actuator: bool = True)
 
 
 def _parse_metadata(raw: dict[str, tuple[str, int]], source: str, check_actuator: bool) -> RecordingMetadata:
+    version = raw.get("format", (FORMAT_ID, 0))[0]
     for alias, proper in _UNITLESS_ALIASES.items():
         if alias in raw:
             raise RecordingError(f"metadata key has no unit: write '{proper}' ({_unit_of(proper)})",
@@ -288,7 +325,7 @@ def _parse_metadata(raw: dict[str, tuple[str, int]], source: str, check_actuator
         raise RecordingError("missing metadata '# actuator: <model code>' (or 'custom')", source=source,
                              line=missing_line, field="actuator")
     actuator, actuator_line = raw["actuator"]
-    if "load_inertia_kgm2" not in raw:
+    if "load_inertia_kgm2" not in raw and version != FORMAT_V2:
         raise RecordingError("missing metadata '# load_inertia_kgm2: <declared load inertia>'",
                              source=source, line=missing_line, field="load_inertia_kgm2")
     values: dict[str, float] = {}
@@ -315,7 +352,7 @@ def _parse_metadata(raw: dict[str, tuple[str, int]], source: str, check_actuator
     extra = {k: v for k, (v, _) in raw.items() if k not in known}
     return RecordingMetadata(
         actuator=actuator,
-        load_inertia_kgm2=values["load_inertia_kgm2"],
+        load_inertia_kgm2=values.get("load_inertia_kgm2"),
         supply_voltage=int(supply),
         sample_rate_hz=values.get("sample_rate_hz"),
         torque_constant_nm_per_a=values.get("torque_constant_nm_per_a"),
@@ -370,7 +407,7 @@ def _clip(text: str, width: int = 40) -> str:
     return text if len(text) <= width else text[: width - 1] + "…"
 
 
-def _parse_header(line: str, line_no: int, source: str) -> list[str]:
+def _parse_header(line: str, line_no: int, source: str, version: str = FORMAT_ID) -> list[str]:
     names = [name.strip() for name in line.split(",")]
     seen: set[str] = set()
     for name in names:
@@ -381,7 +418,7 @@ def _parse_header(line: str, line_no: int, source: str) -> list[str]:
         if name in seen:
             raise RecordingError("column given twice", source=source, line=line_no, field=name)
         seen.add(name)
-    for name in REQUIRED_COLUMNS:
+    for name in REQUIRED_COLUMNS_V2 if version == FORMAT_V2 else REQUIRED_COLUMNS:
         if name not in seen:
             raise RecordingError(
                 f"required column '{name}' ({COLUMN_UNITS[name]}) is missing; "
@@ -480,8 +517,8 @@ class RecordingWriter:
     def __init__(self, path: str | os.PathLike, metadata: RecordingMetadata,
                  columns: Sequence[str] = REQUIRED_COLUMNS, *, digits: int = 12):
         columns = list(columns)
-        _parse_header(",".join(columns), 0, "new recording")  # same rules as the reader
-        lines = metadata.lines()
+        lines = metadata.lines(columns)
+        _parse_header(",".join(columns), 0, "new recording", metadata.format_for(columns))  # as the reader
         for line in lines:
             if "\n" in line or "\r" in line:
                 raise ValueError(f"metadata line contains a line break: {line!r}")
@@ -636,8 +673,9 @@ def write_recording(path: str | os.PathLike, recording: Recording, *, digits: in
 
 
 def make_recording(metadata: RecordingMetadata, **channels: np.ndarray) -> Recording:
-    """Build a recording in memory from arrays (t, pos, current required), checked like a read file."""
-    for name in REQUIRED_COLUMNS:
+    """Build a recording in memory from arrays (t, pos required; current too unless the recording
+    is an fha-recording/2 one), checked like a read file."""
+    for name in REQUIRED_COLUMNS_V2:
         if name not in channels:
             raise RecordingError(f"required column '{name}' is missing", field=name)
     arrays = {k: np.asarray(v, dtype=np.float64).ravel() for k, v in channels.items()}

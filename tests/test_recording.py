@@ -84,7 +84,7 @@ def _replace(old: str, new: str) -> str:
     ("text", "line", "field", "words"),
     [
         (_replace("# format: fha-recording/1\n", ""), 1, "format", "format"),
-        (_replace("fha-recording/1", "fha-recording/2"), 1, "format", "expected"),
+        (_replace("fha-recording/1", "fha-recording/9"), 1, "format", "expected"),
         (_replace("# actuator: FHA-25C-50-US250\n", ""), None, "actuator", "missing"),
         (_replace("FHA-25C-50-US250", "FHA-99C-50-US250"), 2, "actuator", "model code"),
         (_replace("# load_inertia_kgm2: 1.5\n", ""), None, "load_inertia_kgm2", "missing"),
@@ -297,9 +297,10 @@ def test_writer_refuses_what_the_reader_would_refuse(tmp_path):
             w.append([1.0, 1.0, float("nan")])
         with pytest.raises(ValueError, match="3 values"):
             w.append([1.0, 1.0])
-    with pytest.raises(RecordingError, match="required column 'current'"):
-        RecordingWriter(tmp_path / "x.csv", _meta(), ["t", "pos"])
+    with pytest.raises(RecordingError, match="required column 'pos'"):
+        RecordingWriter(tmp_path / "x.csv", _meta(), ["t", "current"])
     assert not (tmp_path / "x.csv").exists()
+    # without current the file is an fha-recording/2 one (tests below), not refused
 
 
 def test_make_recording_checks_arrays():
@@ -307,3 +308,54 @@ def test_make_recording_checks_arrays():
         make_recording(_meta(), t=[0, 0], pos=[0, 0], current=[0, 0])
     with pytest.raises(RecordingError, match="'current'"):
         make_recording(_meta(), t=[0, 1], pos=[0, 0], current=[0, np.nan])
+
+
+# ----------------------------------------------------------------------- fha-recording/2 (bench)
+
+V2 = """\
+# format: fha-recording/2
+# actuator: FHA-25C-50-US250
+# sample_rate_hz: 1000
+t,pos,cmd_pos,vel,in_pos
+0,0,0,0,1
+0.001,0.01,0.02,1.5,0
+0.002,0.03,0.04,2.5,0
+"""
+
+
+def test_a_version_2_recording_may_lack_current_and_load_inertia():
+    r = parse_recording(V2)
+    assert not r.has_current and r.metadata.load_inertia_kgm2 is None
+    assert list(r.in_pos) == [1, 0, 0] and r.vel_rpm is not None
+    with pytest.raises(RecordingError, match="no current column"):
+        _ = r.current_a
+
+
+def test_a_version_1_recording_still_needs_current_and_load_inertia():
+    with pytest.raises(RecordingError, match="required column 'current'"):
+        parse_recording(V2.replace("fha-recording/2", "fha-recording/1").replace(
+            "# sample_rate_hz", "# load_inertia_kgm2: 1\n# sample_rate_hz"))
+    with pytest.raises(RecordingError, match="missing metadata '# load_inertia_kgm2"):
+        parse_recording(GOOD.replace("# load_inertia_kgm2: 1.5\n", ""))
+    assert parse_recording(GOOD).metadata.load_inertia_kgm2 == 1.5
+
+
+def test_the_writer_writes_version_1_when_it_can_and_version_2_without_current(tmp_path):
+    t = np.array([0.0, 0.001, 0.002])
+    with_current = make_recording(_meta(), t=t, pos=t, current=t)
+    write_recording(tmp_path / "a.csv", with_current)
+    assert (tmp_path / "a.csv").read_text().startswith("# format: fha-recording/1\n")
+    bench = make_recording(_meta(load_inertia_kgm2=None), t=t, pos=t, in_pos=[1, 1, 0])
+    write_recording(tmp_path / "b.csv", bench)
+    text = (tmp_path / "b.csv").read_text()
+    assert text.startswith("# format: fha-recording/2\n") and "load_inertia" not in text
+    back = read_recording(tmp_path / "b.csv")
+    assert not back.has_current and list(back.in_pos) == [1, 1, 0]
+
+
+def test_the_model_check_refuses_a_recording_without_current():
+    from fha_studio.logic.modelcheck import ModelCheckError
+    from fha_studio.logic.modelcheck.axis import declared_axis
+
+    with pytest.raises(ModelCheckError, match="no current column"):
+        declared_axis(parse_recording(V2))

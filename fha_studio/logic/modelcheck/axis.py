@@ -43,6 +43,13 @@ class DeclaredAxis:
 def declared_axis(rec: Recording) -> DeclaredAxis:
     """The nominal model of a recording; ModelCheckError when the declaration is inconsistent."""
     meta = rec.metadata
+    if not rec.has_current:
+        raise ModelCheckError("the recording has no current column (a bench capture without a current "
+                              "probe): the model check needs the motor current")
+    if meta.load_inertia_kgm2 is None:
+        raise ModelCheckError("the recording declares no load inertia (load_inertia_kgm2): the model "
+                              "check needs the declared load")
+    load_inertia_kgm2 = float(meta.load_inertia_kgm2)
     if meta.is_custom:
         peak = float(np.max(np.abs(rec.current_a)))
         ppr = _guess_ppr(rec.pos_deg)
@@ -53,7 +60,7 @@ def declared_axis(rec: Recording) -> DeclaredAxis:
             torque_constant_nm_per_a=float(kt),
             max_current_a=max(1.5 * peak, 1e-3),
             actuator_inertia_kgm2=float(inertia),
-            load_inertia_kgm2=float(meta.load_inertia_kgm2),
+            load_inertia_kgm2=load_inertia_kgm2,
             ratio=meta.motor_turns_per_output_rev,
             output_resolution_ppr=ppr,
         )
@@ -69,7 +76,7 @@ def declared_axis(rec: Recording) -> DeclaredAxis:
             f"the recording says supply_voltage {meta.supply_voltage} V but {meta.actuator} is a "
             f"{actuator.supply_voltage} V actuator (100 V models carry option A): wrong actuator declared?"
         )
-    model = AxisModel.from_actuator(actuator, load_inertia_kgm2=meta.load_inertia_kgm2)
+    model = AxisModel.from_actuator(actuator, load_inertia_kgm2=load_inertia_kgm2)
     return DeclaredAxis(meta.actuator, model, actuator)
 
 

@@ -297,8 +297,10 @@ class ModelCheckPage(BasePage):
                                                         or (c == "vel" and recording.vel_rpm is not None)])
         self.source_label.setText(
             f"Recording: {label} — {m.actuator}, {len(recording)} samples over {recording.duration_s:.2f} s, "
-            f"columns {columns}. Declared load inertia {m.load_inertia_kgm2:g} kg·m²."
-            + ("" if abs(declared - m.load_inertia_kgm2) <= 1e-12 else
+            f"columns {columns}. "
+            + ("No load inertia declared in it." if m.load_inertia_kgm2 is None
+               else f"Declared load inertia {m.load_inertia_kgm2:g} kg·m².")
+            + ("" if m.load_inertia_kgm2 is not None and abs(declared - m.load_inertia_kgm2) <= 1e-12 else
                f" The model check uses the axis's declared load inertia, {declared:g} kg·m².")
         )
 
@@ -357,7 +359,8 @@ class ModelCheckPage(BasePage):
         if recording is None:
             return None
         declared = self.state.load_inertia_kgm2
-        if abs(declared - recording.metadata.load_inertia_kgm2) > 1e-12:
+        recorded = recording.metadata.load_inertia_kgm2
+        if recorded is None or abs(declared - recorded) > 1e-12:
             recording = dataclasses.replace(
                 recording, metadata=dataclasses.replace(recording.metadata, load_inertia_kgm2=declared)
             )

@@ -1,0 +1,307 @@
+"""The simulated drive's CN2 outputs as a bench instrument samples them, and that instrument.
+
+:class:`Cn2Signals` turns the servo's trace (position, command and speed per servo period) into
+the levels and volts on CN2, at an instrument's sample rate (the positions are interpolated
+between servo periods):
+
+- encoder A/B line-driver outputs at the actuator's resolution (the drive's feedback pulses,
+  x4: A leads B going forward) and Z once per motor turn (high for one count);
+- the command pulses of the drive's own moves in the form of parameter 1 (two-pulse: FWD pulses
+  on CMD_A, REV on CMD_B; pulse + sign: pulses on CMD_A, CMD_B high = REV; two-phase: CMD_A
+  leading CMD_B = FWD, an edge per pulse at x4, a cycle per pulse at x1), before the electronic
+  gear 3/4 (the pulses the controller sends);
+- SPD-MON (CN2-23): +10 V at the motor speed of parameter 9, through the monitor's bandwidth,
+  with its offset and noise (assumptions of this simulation, :class:`MonitorModel`);
+- IN-POS (|command - feedback| within the in-position range) and ALARM.
+
+:class:`VirtualBenchInstrument` runs a servo axis and samples those outputs like a logic analyzer
+with one analog input: whole captures (:meth:`~VirtualBenchInstrument.record`), a stream of
+:class:`~fha_studio.hardware.bench.capture.SampleBlock` (:meth:`~VirtualBenchInstrument.stream`),
+written as ``.sr``, VCD or CSV (:meth:`~VirtualBenchInstrument.write`). What the drive itself
+counted at each sample is kept in :attr:`~VirtualBenchInstrument.truth`, for tests and training.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy import signal as _signal
+
+from fha_studio.hardware.bench import writers
+from fha_studio.hardware.bench.capture import SampleBlock, join_blocks, pack_logic
+from fha_studio.physics import ServoAxis
+
+LOGIC_CHANNELS = ("ENC_A", "ENC_B", "ENC_Z", "CMD_A", "CMD_B", "IN_POS", "ALARM")
+ANALOG_CHANNELS = ("SPD_MON",)
+RAD_S_PER_RPM = 2.0 * math.pi / 60.0
+#: One sample per edge at least: the instrument refuses a rate at which its own edges would merge.
+MIN_SAMPLES_PER_EDGE = 2.0
+FORMS = ("sr", "vcd", "sigrok-csv", "csv", "csv-semicolon")
+
+
+@dataclass(frozen=True)
+class MonitorModel:
+    """SPD-MON's imperfections (assumptions: the public manual states none of them)."""
+
+    offset_v: float = 0.015
+    noise_v: float = 0.004  # rms
+    bandwidth_hz: float = 2000.0  # first-order
+    seed: int | None = 0
+
+
+@dataclass(frozen=True)
+class Cn2Settings:
+    """The drive's parameters that shape its CN2 outputs (wire values); the electronic gear
+    (parameters 3/4) is the servo's own (``ServoSettings``)."""
+
+    counts_per_motor_turn: int = 10000
+    pulse_form: int = 0  # parameter 1
+    multiplication: int = 4  # parameter 2
+    speed_conversion_rpm: float = 3000.0  # parameter 9
+    monitor: MonitorModel = field(default_factory=MonitorModel)
+
+
+@dataclass
+class Truth:
+    """What the drive counted at each instrument sample (to check a decoding against)."""
+
+    encoder_counts: list[np.ndarray] = field(default_factory=list)
+    command_pulses: list[np.ndarray] = field(default_factory=list)
+    command_counts: list[np.ndarray] = field(default_factory=list)
+    motor_rpm: list[np.ndarray] = field(default_factory=list)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {
+            name: np.concatenate(getattr(self, name)) if getattr(self, name) else np.zeros(0)
+            for name in ("encoder_counts", "command_pulses", "command_counts", "motor_rpm")
+        }
+
+
+class Cn2Signals:
+    """Servo trace chunks in, instrument samples out (state carried from chunk to chunk)."""
+
+    def __init__(
+        self,
+        sample_rate_hz: float,
+        settings: Cn2Settings,
+        *,
+        output_pulse_rad: float,
+        ratio: float,
+        in_position_range_counts: int,
+        direction: float = 1.0,
+        gear: tuple[int, int] = (1, 1),
+    ):
+        self.rate = float(sample_rate_hz)
+        self.s = settings
+        self.pulse_rad = output_pulse_rad
+        self.ratio = ratio
+        self.in_position_range = in_position_range_counts
+        self.direction = direction
+        self.gear_numerator, self.gear_denominator = gear
+        self.next_sample = 0
+        self._last: tuple[float, float, float, float] | None = None  # t, pos, cmd, vel
+        self._sign = 0
+        self._last_pulses: int | None = None
+        wc = 2.0 * math.pi * settings.monitor.bandwidth_hz
+        alpha = 1.0 - math.exp(-wc / self.rate)
+        self._filter = (np.array([alpha]), np.array([1.0, alpha - 1.0]))
+        self._zi: np.ndarray | None = None
+        self._rng = np.random.default_rng(settings.monitor.seed)
+
+    def feed(
+        self, trace: dict[str, np.ndarray], alarm: bool = False
+    ) -> tuple[SampleBlock, dict[str, np.ndarray]]:
+        """The samples up to the trace's last time, and the drive's own counts at them."""
+        t = trace["t"]
+        pos = trace["pos"] * self.direction
+        cmd = trace["cmd_pos"] * self.direction
+        vel = trace["vel"] * self.direction
+        if self._last is not None:
+            t = np.concatenate(([self._last[0]], t))
+            pos = np.concatenate(([self._last[1]], pos))
+            cmd = np.concatenate(([self._last[2]], cmd))
+            vel = np.concatenate(([self._last[3]], vel))
+        if t.size == 0:
+            return self._empty(), {}
+        last_index = math.floor(t[-1] * self.rate + 1e-9)
+        k = np.arange(self.next_sample, last_index + 1)
+        ts = k / self.rate
+        first = self.next_sample
+        self.next_sample = last_index + 1
+        self._last = (float(t[-1]), float(pos[-1]), float(cmd[-1]), float(vel[-1]))
+        if k.size == 0:
+            return self._empty(), {}
+        p = np.interp(ts, t, pos)
+        c = np.interp(ts, t, cmd)
+        v = np.interp(ts, t, vel)
+        counts = np.floor(p / self.pulse_rad + 0.5).astype(np.int64)
+        # command input pulses (before the electronic gear); two-phase at x2 / x1 takes 2 / 4 edges
+        # per pulse, so its lines follow the command edge by edge
+        per = 4 // self.s.multiplication if self.s.pulse_form == 2 else 1
+        edges = np.floor(c / self.pulse_rad * self.gear_denominator / self.gear_numerator * per + 0.5).astype(
+            np.int64
+        )
+        pulses = np.floor_divide(edges, per)
+        cmd_counts = np.floor(c / self.pulse_rad + 0.5).astype(np.int64)
+        self._check_steps(counts, "encoder edges")
+        enc_a, enc_b = _quadrature_levels(counts)
+        enc_z = np.mod(counts, self.s.counts_per_motor_turn) == 0
+        cmd_a, cmd_b = self._command_levels(edges if self.s.pulse_form == 2 else pulses)
+        in_pos = np.abs(cmd_counts - counts) <= self.in_position_range
+        motor_rpm = v / RAD_S_PER_RPM * self.ratio
+        volts = motor_rpm / self.s.speed_conversion_rpm * 10.0
+        b, a = self._filter
+        if self._zi is None:
+            self._zi = _signal.lfilter_zi(b, a) * volts[0]
+        volts, self._zi = _signal.lfilter(b, a, volts, zi=self._zi)
+        m = self.s.monitor
+        volts = volts + m.offset_v + self._rng.normal(0.0, m.noise_v, volts.size)
+        logic = pack_logic([enc_a, enc_b, enc_z, cmd_a, cmd_b, in_pos, np.full(k.size, alarm)])
+        block = SampleBlock(self.rate, LOGIC_CHANNELS, logic, {"SPD_MON": volts.astype(np.float32)}, first)
+        truth = {
+            "encoder_counts": counts,
+            "command_pulses": pulses,
+            "command_counts": pulses * self.gear_numerator / self.gear_denominator,
+            "motor_rpm": motor_rpm,
+        }
+        return block, truth
+
+    def _empty(self) -> SampleBlock:
+        return SampleBlock(
+            self.rate,
+            LOGIC_CHANNELS,
+            np.zeros(0, np.uint8),
+            {"SPD_MON": np.zeros(0, np.float32)},
+            self.next_sample,
+        )
+
+    def _check_steps(self, values: np.ndarray, what: str) -> None:
+        if values.size > 1 and np.any(np.abs(np.diff(values)) > 1):
+            raise ValueError(
+                f"the instrument's {self.rate:g} Hz is too slow for the {what}: more than one "
+                "per sample; sample faster"
+            )
+
+    def _command_levels(self, pulses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        prev = self._last_pulses if self._last_pulses is not None else int(pulses[0])
+        self._last_pulses = int(pulses[-1])
+        steps = np.diff(np.concatenate(([prev], pulses)))
+        form = self.s.pulse_form
+        if form == 2:  # ``pulses`` are the edges here
+            self._check_steps(np.concatenate(([prev], pulses)), "command edges")
+            return _quadrature_levels(pulses)
+        if np.any(np.abs(steps) > 1):
+            raise ValueError(f"the instrument's {self.rate:g} Hz is too slow for the command pulses")
+        up = steps > 0
+        down = steps < 0
+        moved = np.flatnonzero(steps)
+        if moved.size > 1 and np.any(np.diff(moved) < 2):
+            raise ValueError(
+                f"the instrument's {self.rate:g} Hz is too slow for the command pulses: "
+                "two in consecutive samples"
+            )
+        if form == 0:
+            return up, down
+        # pulse + sign: the sign holds the direction of the last pulse (high = REV)
+        sign = np.full(pulses.size, -1, np.int8)
+        sign[moved] = down[moved].astype(np.int8)
+        last = np.maximum.accumulate(np.where(sign >= 0, np.arange(sign.size), -1))
+        held = np.where(last >= 0, sign[np.maximum(last, 0)], self._sign).astype(bool)
+        self._sign = int(held[-1])
+        return up | down, held
+
+
+def _quadrature_levels(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A/B levels of a x4 count: phase 0..3 = 00, 10, 11, 01 (A leads B going forward)."""
+    phase = np.mod(counts, 4)
+    return (phase == 1) | (phase == 2), phase >= 2
+
+
+class VirtualBenchInstrument:
+    """A logic analyzer with one analog input on the simulated drive's CN2.
+
+    It advances ``axis`` itself (the caller commands moves between calls, e.g. through
+    ``actions``), tracing every servo period.
+    """
+
+    def __init__(
+        self,
+        axis: ServoAxis,
+        sample_rate_hz: float,
+        settings: Cn2Settings | None = None,
+        *,
+        alarm: Callable[[], bool] | None = None,
+    ):
+        self.axis = axis
+        self.settings = settings or Cn2Settings()
+        model = axis.model
+        self.signals = Cn2Signals(
+            sample_rate_hz,
+            self.settings,
+            output_pulse_rad=model.output_pulse_rad,
+            ratio=float(model.ratio or 1),
+            in_position_range_counts=axis.settings.in_position_range_pulses,
+            direction=axis.settings.direction_sign,
+            gear=(axis.settings.electronic_gear_numerator, axis.settings.electronic_gear_denominator),
+        )
+        self.alarm = alarm or (lambda: False)
+        self.truth = Truth()
+        self._blocks: list[SampleBlock] = []
+
+    @property
+    def sample_rate_hz(self) -> float:
+        return self.signals.rate
+
+    def stream(self, seconds: float, block_s: float = 0.01) -> Iterator[SampleBlock]:
+        """Blocks of about ``block_s`` while the axis runs for ``seconds`` (drive time)."""
+        periods = max(1, round(block_s / self.axis.servo_period_s))
+        total = max(1, round(seconds / self.axis.servo_period_s))
+        if self.signals._last is None:
+            self.axis.start_trace(1)
+            self.axis.step(1)  # the first trace point: where the axis is now
+        done = 0
+        while done < total:
+            n = min(periods, total - done)
+            self.axis.step(n)
+            done += n
+            block, truth = self.signals.feed(self.axis.read_trace(clear=True), self.alarm())
+            if block.samples:
+                for name, values in truth.items():
+                    getattr(self.truth, name).append(values)
+                yield block
+
+    def record(self, seconds: float) -> SampleBlock:
+        """Run for ``seconds`` and keep what was sampled; returns everything kept so far."""
+        self._blocks.extend(self.stream(seconds))
+        return self.capture()
+
+    def capture(self) -> SampleBlock:
+        """Everything recorded so far, as one block."""
+        if not self._blocks:
+            raise ValueError("nothing recorded yet")
+        return join_blocks(self._blocks)
+
+    def write(self, path: str | os.PathLike[str], form: str) -> Path:
+        """The capture so far in one of :data:`FORMS` (VCD: the logic channels only)."""
+        block = self.capture()
+        if form == "sr":
+            return writers.write_sr(path, block)
+        if form == "vcd":
+            return writers.write_vcd(
+                path, SampleBlock(block.sample_rate_hz, block.logic_channels, block.logic)
+            )
+        if form == "sigrok-csv":
+            return writers.write_sigrok_csv(path, block)
+        if form in ("csv", "csv-semicolon"):
+            return writers.write_csv(path, block, semicolon=form == "csv-semicolon")
+        raise ValueError(f"form '{form}': one of {', '.join(FORMS)}")
+
+    @staticmethod
+    def fastest_edges_hz(motor_rpm: float, counts_per_motor_turn: int) -> float:
+        """The encoder's edge rate at a motor speed (to choose the sample rate)."""
+        return abs(motor_rpm) / 60.0 * counts_per_motor_turn

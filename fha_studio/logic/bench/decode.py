@@ -1,0 +1,231 @@
+"""Decoding the drive's CN2 signals from sampled levels and volts (numpy, vectorised).
+
+- :func:`quadrature`: encoder A/B counted x4 (A leading B = forward, + counts); an edge where
+  both phases changed at once is an *illegal transition* (counted, not counted as motion); a
+  state that returns within :data:`GLITCH_SAMPLES` samples is a *glitch* (counted; its counts
+  cancel).
+- :func:`z_check`: every Z pulse must come at the same count modulo the counts per motor turn
+  (within :data:`Z_TOLERANCE_COUNTS`).
+- :func:`command_pulses`: the command pulse lines by parameter 1 (0 two-pulse: FWD pulses on
+  line A, REV pulses on line B; 1 pulse + sign: pulses on A, B low = FWD; 2 two-phase: A leading
+  B = FWD, counted x1/x2/x4 by parameter 2), then through the electronic gear (parameter 3 /
+  parameter 4) to commanded encoder counts.
+- :func:`speed_from_monitor`: SPD-MON volts to motor r/min by parameter 9 (+10 V = parameter 9),
+  the offset taken where the axis stands.
+- :func:`check_edge_rate`: the capture's sample rate against the encoder's edge rate at the
+  speed reached (two samples per edge at least), refused with both figures.
+
+Counts are per sample: ``counts[i]`` is the position after sample ``i``, 0 at the first sample.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: A state that reverts within this many samples is a glitch (a spike on one phase).
+GLITCH_SAMPLES = 2
+#: Z pulses may come this many counts off the counts-per-turn grid (a Z edge is not tied to one
+#: A/B edge on every encoder) before they count as an error.
+Z_TOLERANCE_COUNTS = 1
+#: The sample rate must be at least this many times the encoder's edge rate.
+SAMPLES_PER_EDGE = 2.0
+#: SPD-MON: volts at the speed in parameter 9.
+MONITOR_FULL_SCALE_V = 10.0
+
+PULSE_FORMS = {0: "two-pulse", 1: "pulse + sign", 2: "two-phase"}
+
+# Gray phase of (A, B): 00 -> 0, A=1 B=0 -> 1, 11 -> 2, A=0 B=1 -> 3 (A leads B going forward)
+_PHASE = np.array([0, 1, 3, 2], np.int8)  # index: A + 2 B
+# phase step (mod 4) -> count step; 2 is illegal (both phases changed)
+_STEP = np.array([0, 1, 0, -1], np.int8)
+
+
+class DecodeError(ValueError):
+    """The signals cannot be decoded as asked (one line: what, and the figures)."""
+
+
+@dataclass(frozen=True)
+class QuadratureResult:
+    """Encoder counts per sample and what was wrong with the edges."""
+
+    counts: np.ndarray  # int64, per sample
+    edges: int
+    glitches: int
+    illegal_transitions: int
+    edge_samples: np.ndarray  # sample index of each counted edge
+
+    @property
+    def total_counts(self) -> int:
+        return int(self.counts[-1]) if self.counts.size else 0
+
+
+def _changes(state: np.ndarray) -> np.ndarray:
+    """Indices i >= 1 where state[i] != state[i-1]."""
+    return np.flatnonzero(state[1:] != state[:-1]) + 1
+
+
+def quadrature(a: np.ndarray, b: np.ndarray) -> QuadratureResult:
+    """Count A/B x4; see the module docstring."""
+    n = a.shape[0]
+    code = a.astype(np.int8) + 2 * b.astype(np.int8)
+    phase = _PHASE[code]
+    at = _changes(phase)
+    delta = (phase[at] - phase[at - 1]) % 4
+    illegal = int(np.count_nonzero(delta == 2))
+    steps = _STEP[delta].astype(np.int64)
+    counts = np.zeros(n, np.int64)
+    if at.size:
+        counts[at] = steps
+        np.cumsum(counts, out=counts)
+    # a glitch: a step undone by the next one within GLITCH_SAMPLES samples
+    glitches = 0
+    if at.size > 1:
+        undone = (steps[1:] == -steps[:-1]) & (steps[1:] != 0) & (np.diff(at) <= GLITCH_SAMPLES)
+        glitches = int(np.count_nonzero(undone))
+    return QuadratureResult(counts, int(at.size), glitches, illegal, at[steps != 0])
+
+
+def rising_edges(level: np.ndarray) -> np.ndarray:
+    """Sample indices where a line goes from low to high."""
+    lv = level.astype(bool)
+    return np.flatnonzero(lv[1:] & ~lv[:-1]) + 1
+
+
+@dataclass(frozen=True)
+class ZCheck:
+    pulses: int
+    count_errors: int
+    counts_per_turn: int
+
+
+def z_check(z: np.ndarray, counts: np.ndarray, counts_per_turn: int) -> ZCheck:
+    """Z pulses against the counts per motor turn: each one at the first one's count modulo it."""
+    at = rising_edges(z)
+    if at.size == 0:
+        return ZCheck(0, 0, counts_per_turn)
+    where = counts[at]
+    off = (where - where[0]) % counts_per_turn
+    off = np.minimum(off, counts_per_turn - off)
+    return ZCheck(int(at.size), int(np.count_nonzero(off > Z_TOLERANCE_COUNTS)), counts_per_turn)
+
+
+@dataclass(frozen=True)
+class CommandPulseResult:
+    pulses: np.ndarray  # int64 per sample: input pulses after the x1/x2/x4 multiplication
+    counts: np.ndarray  # float64 per sample: commanded encoder counts (through the electronic gear)
+    illegal_transitions: int
+
+
+def command_pulses(
+    a: np.ndarray,
+    b: np.ndarray | None,
+    pulse_form: int,
+    multiplication: int,
+    gear_numerator: int,
+    gear_denominator: int,
+) -> CommandPulseResult:
+    """Commanded counts from the command pulse lines; see the module docstring."""
+    if pulse_form not in PULSE_FORMS:
+        raise DecodeError(f"parameter 1 (command pulse form) is {pulse_form}; 0, 1 or 2 expected")
+    if gear_numerator <= 0 or gear_denominator <= 0:
+        raise DecodeError(f"electronic gear {gear_numerator}/{gear_denominator}: both must be at least 1")
+    n = a.shape[0]
+    illegal = 0
+    if pulse_form == 2:
+        if b is None:
+            raise DecodeError(
+                "two-phase command pulses (parameter 1 = 2) need both lines, command_a and command_b"
+            )
+        if multiplication not in (1, 2, 4):
+            raise DecodeError(f"parameter 2 (multiplication) is {multiplication}; 1, 2 or 4 expected")
+        q = quadrature(a, b)
+        illegal = q.illegal_transitions
+        pulses = np.floor_divide(q.counts, 4 // multiplication)
+    else:
+        steps = np.zeros(n, np.int64)
+        up = rising_edges(a)
+        if pulse_form == 0:
+            steps[up] += 1
+            if b is not None:
+                steps[rising_edges(b)] -= 1
+        else:
+            sign = np.ones(up.size, np.int64)
+            if b is not None:
+                sign[b.astype(bool)[up]] = -1  # the sign line high (ON) = REV
+            steps[up] = sign
+        pulses = np.cumsum(steps)
+    counts = pulses * (gear_numerator / gear_denominator)
+    return CommandPulseResult(pulses, counts, illegal)
+
+
+def standstill_mask(counts: np.ndarray, rate_hz: float, window_s: float = 0.01) -> np.ndarray:
+    """Samples inside a stretch of at least ``window_s`` in which the encoder did not move."""
+    n = counts.shape[0]
+    at = _changes(counts)
+    bounds = np.concatenate(([0], at, [n]))
+    lengths = np.diff(bounds)
+    still = lengths >= max(1, int(window_s * rate_hz))
+    return np.repeat(still, lengths)
+
+
+@dataclass(frozen=True)
+class SpeedResult:
+    motor_rpm: np.ndarray  # float32 per sample
+    offset_v: float
+    offset_from: str  # where the offset was taken, in words
+
+
+def speed_from_monitor(
+    volts: np.ndarray, speed_conversion_rpm: float, still: np.ndarray | None
+) -> SpeedResult:
+    """SPD-MON volts to motor r/min (+10 V = parameter 9), less the offset at standstill.
+
+    ``still``: samples where the axis stands (from the encoder); without it, or when it marks
+    none, the first 20 ms are taken as standing."""
+    v = volts.astype(np.float64)
+    if still is not None and np.count_nonzero(still) >= 16:
+        offset = float(np.median(v[still]))
+        where = "the median where the encoder stood still"
+    else:
+        head = v[: max(16, v.size // 50)]
+        offset = float(np.median(head))
+        where = "the median of the capture's first samples (no encoder to show standstill)"
+    rpm = ((v - offset) * (speed_conversion_rpm / MONITOR_FULL_SCALE_V)).astype(np.float32)
+    return SpeedResult(rpm, offset, where)
+
+
+def edge_rate_hz(motor_rpm: float, counts_per_turn: int) -> float:
+    """Encoder edges per second (x4 counts) at a motor speed."""
+    return abs(motor_rpm) / 60.0 * counts_per_turn
+
+
+def check_edge_rate(sample_rate_hz: float, peak_motor_rpm: float, counts_per_turn: int) -> None:
+    """Refuses a capture whose rate cannot resolve the encoder's edges at the speed reached."""
+    edges = edge_rate_hz(peak_motor_rpm, counts_per_turn)
+    needed = SAMPLES_PER_EDGE * edges
+    if sample_rate_hz < needed:
+        raise DecodeError(
+            f"the capture's sample rate of {_hz(sample_rate_hz)} cannot resolve the encoder at the "
+            f"{peak_motor_rpm:.0f} r/min (motor) reached: {counts_per_turn} counts per motor turn give "
+            f"{_hz(edges)} of edges, which needs at least {_hz(needed)}; capture faster or move slower"
+        )
+
+
+def peak_rpm_from_counts(
+    counts: np.ndarray, rate_hz: float, counts_per_turn: int, window_s: float = 1e-3
+) -> float:
+    """The highest motor speed the encoder shows, over windows of ``window_s``."""
+    step = max(1, int(window_s * rate_hz))
+    if counts.size <= step:
+        return 0.0
+    moved = np.abs(counts[step:] - counts[:-step])
+    return float(moved.max()) / (step / rate_hz) / counts_per_turn * 60.0
+
+
+def _hz(value: float) -> str:
+    for factor, unit in ((1e9, "GHz"), (1e6, "MHz"), (1e3, "kHz")):
+        if abs(value) >= factor:
+            return f"{value / factor:.3g} {unit}"
+    return f"{value:.3g} Hz"

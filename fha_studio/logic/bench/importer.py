@@ -1,0 +1,448 @@
+"""A bench capture of the drive's CN2 signals made into a recording (``fha-studio bench import``).
+
+The technician maps channels of capture files to the drive's signals (*roles*, :data:`ROLES`);
+the signals are decoded (:mod:`.decode`) at the capture's rate and the recording is taken from
+them at :data:`OUTPUT_RATE_HZ` (or the capture's rate if lower):
+
+- ``pos`` [deg, output]: the encoder counts (x4) / (counts per motor turn x ratio) x 360; without
+  an encoder, SPD-MON integrated (the metadata says so);
+- ``cmd_pos`` [deg]: the command pulses through parameters 1, 2, 3, 4, in the same counts;
+- ``vel`` [r/min, output]: SPD-MON by parameter 9, less its offset at standstill, / ratio, the
+  mean over each output interval;
+- ``in_pos`` (1 = on), ``alarm`` (1 = on) and ``current`` [A] = probe volts x A per V, the mean
+  over each interval, only where a probe measured it.
+
+Each column's source (file, channel, scale) is named in the recording's metadata
+(``source_<column>``). The recording is an ``fha-recording/2`` file when it has no current.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from fha_studio.hardware.bench.capture import Capture
+from fha_studio.hardware.bench.readers import read_capture
+from fha_studio.logic.bench import decode
+from fha_studio.recording import Recording, RecordingMetadata, make_recording
+
+ROLES = (
+    "speed_monitor",
+    "encoder_a",
+    "encoder_b",
+    "encoder_z",
+    "command_a",
+    "command_b",
+    "in_position",
+    "alarm",
+    "current_probe",
+)
+#: The recording's rate, when the capture is faster (the scope's and the model check's 1 kHz).
+OUTPUT_RATE_HZ = 1000.0
+#: (mode, number) of the parameter items the decoding reads, and what each is
+PARAMETERS = {
+    ("system", 1): "parameter 1 (command pulse form)",
+    ("system", 2): "parameter 2 (multiplication of the two-phase pulse input)",
+    ("system", 3): "parameter 3 (electronic gear numerator)",
+    ("system", 4): "parameter 4 (electronic gear denominator)",
+    ("system", 9): "parameter 9 (speed conversion factor, r/min at +10 V)",
+}
+
+
+class BenchImportError(ValueError):
+    """Bad input for an import: one line naming what and where."""
+
+
+@dataclass(frozen=True)
+class SignalSpec:
+    """``ROLE=FILE[#CHANNEL]``."""
+
+    role: str
+    path: str
+    channel: str | None = None
+
+    @property
+    def text(self) -> str:
+        return f"{self.path}#{self.channel}" if self.channel else self.path
+
+
+def parse_signal(text: str) -> SignalSpec:
+    """``ROLE=FILE[#CHANNEL]`` -> SignalSpec; BenchImportError naming what is wrong."""
+    role, sep, rest = text.partition("=")
+    role = role.strip()
+    if not sep or not rest:
+        raise BenchImportError(f"--signal '{text}': expected ROLE=FILE or ROLE=FILE#CHANNEL")
+    if role not in ROLES:
+        raise BenchImportError(f"--signal '{text}': unknown role '{role}' (roles: {', '.join(ROLES)})")
+    path, hash_, channel = rest.rpartition("#") if "#" in rest else (rest, "", "")
+    if hash_ and not channel:
+        raise BenchImportError(f"--signal '{text}': no channel after '#'")
+    if not path:
+        raise BenchImportError(f"--signal '{text}': no file before '#'")
+    return SignalSpec(role, path, channel or None)
+
+
+@dataclass(frozen=True)
+class DriveSettings:
+    """The drive's parameters the decoding needs (wire values of the HA-655's items)."""
+
+    pulse_form: int
+    multiplication: int
+    gear_numerator: int
+    gear_denominator: int
+    speed_conversion_rpm: float
+
+    @classmethod
+    def from_values(
+        cls, values: Mapping[tuple[str, int], int], where: str = "the parameters"
+    ) -> DriveSettings:
+        missing = [text for key, text in PARAMETERS.items() if key not in values]
+        if missing:
+            raise BenchImportError(
+                f"{where}: {', '.join(missing)} not given; they are needed to decode the capture"
+            )
+        return cls(
+            int(values[("system", 1)]),
+            int(values[("system", 2)]),
+            int(values[("system", 3)]),
+            int(values[("system", 4)]),
+            float(values[("system", 9)]),
+        )
+
+
+@dataclass(frozen=True)
+class AxisFacts:
+    """What the actuator's catalogue entry says about the counts."""
+
+    actuator: str
+    ratio: int
+    counts_per_motor_turn: int
+    supply_voltage: int
+
+    @property
+    def counts_per_output_turn(self) -> int:
+        return self.counts_per_motor_turn * self.ratio
+
+    @classmethod
+    def for_actuator(cls, code: str) -> AxisFacts:
+        from fha_studio.catalog import get_actuator
+        from fha_studio.catalog.tables import encoder_resolution_table
+
+        try:
+            actuator = get_actuator(code)
+        except (ValueError, KeyError, LookupError) as exc:
+            raise BenchImportError(f"--actuator {code}: {exc}") from None
+        counts = encoder_resolution_table(actuator.encoder).counts_per_motor_rev
+        return cls(actuator.model_code, int(actuator.ratio), int(counts), int(actuator.supply_voltage))
+
+
+@dataclass(frozen=True)
+class Decoded:
+    """The signals decoded per capture sample (what the recording is taken from)."""
+
+    sample_rate_hz: float
+    samples: int
+    encoder: decode.QuadratureResult | None = None
+    z: decode.ZCheck | None = None
+    command: decode.CommandPulseResult | None = None
+    speed: decode.SpeedResult | None = None
+
+
+@dataclass(frozen=True)
+class BenchImport:
+    recording: Recording
+    summary: dict[str, Any]
+    decoded: Decoded
+    notes: list[str] = field(default_factory=list)
+
+
+Loader = Callable[[str], Capture]
+
+
+def import_bench(
+    signals: Sequence[SignalSpec],
+    axis: AxisFacts,
+    settings: DriveSettings,
+    *,
+    current_scale_a_per_v: float | None = None,
+    output_rate_hz: float = OUTPUT_RATE_HZ,
+    loader: Loader | None = None,
+) -> BenchImport:
+    """Decode the mapped signals and make the recording; BenchImportError for bad input."""
+    load = loader or _read
+    roles: dict[str, SignalSpec] = {}
+    for spec in signals:
+        if spec.role in roles:
+            raise BenchImportError(
+                f"--signal {spec.role}: given twice ({roles[spec.role].text} and {spec.text})"
+            )
+        roles[spec.role] = spec
+    if not roles:
+        raise BenchImportError("no --signal given: map at least the encoder or the speed monitor")
+    if "current_probe" in roles and current_scale_a_per_v is None:
+        raise BenchImportError(
+            "--signal current_probe needs --current-scale A_PER_V (the probe's amperes per volt)"
+        )
+    for need, other in (("encoder_a", "encoder_b"), ("encoder_b", "encoder_a")):
+        if need in roles and other not in roles:
+            raise BenchImportError(
+                f"--signal {need} without {other}: the encoder is counted from both phases"
+            )
+    if "encoder_z" in roles and "encoder_a" not in roles:
+        raise BenchImportError(
+            "--signal encoder_z needs encoder_a and encoder_b (Z is checked against counts)"
+        )
+    if "command_b" in roles and "command_a" not in roles:
+        raise BenchImportError("--signal command_b without command_a")
+    if "encoder_a" not in roles and "speed_monitor" not in roles:
+        raise BenchImportError(
+            "neither the encoder (encoder_a, encoder_b) nor the speed monitor "
+            "(speed_monitor) is mapped: the recording needs one of them for its position"
+        )
+    captures: dict[str, Capture] = {}
+    for spec in roles.values():
+        if spec.path not in captures:
+            captures[spec.path] = load(spec.path)
+    rates = {path: c.sample_rate_hz for path, c in captures.items()}
+    first_path, rate = next(iter(rates.items()))
+    for path, r in rates.items():
+        if abs(r / rate - 1.0) > 1e-9:
+            raise BenchImportError(
+                f"{path}: sampled at {decode._hz(r)} but {first_path} at {decode._hz(rate)}: "
+                "the signals of one import must come at one rate"
+            )
+    n = min(c.samples for c in captures.values())
+    if n < 2:
+        raise BenchImportError(f"{first_path}: fewer than 2 samples")
+    channel_of = {role: _channel(captures[spec.path], spec) for role, spec in roles.items()}
+
+    def logic(role: str) -> np.ndarray:
+        return captures[roles[role].path].logic(channel_of[role])[:n]
+
+    def analog(role: str) -> np.ndarray:
+        return captures[roles[role].path].analog(channel_of[role])[:n]
+
+    encoder = z = command = speed = None
+    if "encoder_a" in roles:
+        encoder = decode.quadrature(logic("encoder_a"), logic("encoder_b"))
+        if "encoder_z" in roles:
+            z = decode.z_check(logic("encoder_z"), encoder.counts, axis.counts_per_motor_turn)
+    if "speed_monitor" in roles:
+        still = decode.standstill_mask(encoder.counts, rate) if encoder is not None else None
+        speed = decode.speed_from_monitor(analog("speed_monitor"), settings.speed_conversion_rpm, still)
+    # the edge rate at the speed reached: refused before anything is trusted
+    if encoder is not None:
+        if speed is not None:
+            window = max(1, int(rate * 1e-3))
+            peak = _peak_mean(speed.motor_rpm, window)
+        else:
+            peak = decode.peak_rpm_from_counts(encoder.counts, rate, axis.counts_per_motor_turn)
+        try:
+            decode.check_edge_rate(rate, peak, axis.counts_per_motor_turn)
+        except decode.DecodeError as exc:
+            raise BenchImportError(f"{roles['encoder_a'].path}: {exc}") from None
+    if "command_a" in roles:
+        try:
+            command = decode.command_pulses(
+                logic("command_a"),
+                logic("command_b") if "command_b" in roles else None,
+                settings.pulse_form,
+                settings.multiplication,
+                settings.gear_numerator,
+                settings.gear_denominator,
+            )
+        except decode.DecodeError as exc:
+            raise BenchImportError(str(exc)) from None
+    decoded = Decoded(rate, n, encoder, z, command, speed)
+    return _make(
+        decoded,
+        roles,
+        channel_of,
+        axis,
+        settings,
+        current_scale_a_per_v,
+        output_rate_hz,
+        {role: analog(role) for role in ("current_probe",) if role in roles},
+        {role: logic(role) for role in ("in_position", "alarm") if role in roles},
+    )
+
+
+def _read(path: str) -> Capture:
+    try:
+        return read_capture(path)
+    except ValueError as exc:  # FileProblem, CaptureError: one line naming the file already
+        raise BenchImportError(str(exc)) from None
+
+
+def _channel(capture: Capture, spec: SignalSpec) -> str:
+    if spec.channel is not None:
+        if not capture.has(spec.channel):
+            raise BenchImportError(
+                f"--signal {spec.role}={spec.text}: {spec.path} has no channel "
+                f"'{spec.channel}' (it has {', '.join(capture.channels)})"
+            )
+        return spec.channel
+    if len(capture.channels) == 1:
+        return capture.channels[0]
+    raise BenchImportError(
+        f"--signal {spec.role}={spec.path}: the file has {len(capture.channels)} channels "
+        f"({', '.join(capture.channels)}); name one as {spec.role}={spec.path}#CHANNEL"
+    )
+
+
+def _peak_mean(values: np.ndarray, window: int) -> float:
+    """The largest |mean| over consecutive windows (noise averaged out)."""
+    m = values.shape[0] // window
+    if m == 0:
+        return float(np.max(np.abs(values))) if values.size else 0.0
+    means = values[: m * window].astype(np.float64).reshape(m, window).mean(axis=1)
+    return float(np.max(np.abs(means)))
+
+
+def _window_means(values: np.ndarray, idx: np.ndarray, n: int) -> np.ndarray:
+    """Mean of ``values`` over [idx[k], idx[k+1]) (the last window runs to the end)."""
+    csum = np.concatenate(([0.0], np.cumsum(values, dtype=np.float64)))
+    ends = np.append(idx[1:], n)
+    means: np.ndarray = (csum[ends] - csum[idx]) / np.maximum(ends - idx, 1)
+    return means
+
+
+def _make(
+    decoded: Decoded,
+    roles: Mapping[str, SignalSpec],
+    channel_of: Mapping[str, str],
+    axis: AxisFacts,
+    settings: DriveSettings,
+    current_scale: float | None,
+    output_rate_hz: float,
+    analog: Mapping[str, np.ndarray],
+    logic: Mapping[str, np.ndarray],
+) -> BenchImport:
+    rate, n = decoded.sample_rate_hz, decoded.samples
+    out_rate = min(output_rate_hz, rate)
+    step = rate / out_rate
+    idx = np.unique(np.floor(np.arange(0, n, step)).astype(np.int64))
+    idx = idx[idx < n]
+    deg_per_count = 360.0 / axis.counts_per_output_turn
+    columns: dict[str, np.ndarray] = {"t": idx / rate}
+    sources: dict[str, str] = {}
+    notes: list[str] = []
+
+    def src(role: str) -> str:
+        return f"{roles[role].path}#{channel_of[role]}"
+
+    if decoded.encoder is not None:
+        columns["pos"] = decoded.encoder.counts[idx] * deg_per_count
+        sources["pos"] = (
+            f"{src('encoder_a')} and {src('encoder_b')}, x4, {axis.counts_per_output_turn} counts "
+            f"per output turn ({axis.counts_per_motor_turn} per motor turn x {axis.ratio})"
+        )
+    elif decoded.speed is not None:
+        out_rpm = decoded.speed.motor_rpm.astype(np.float64) / axis.ratio
+        turns = np.concatenate(([0.0], np.cumsum(out_rpm[:-1]))) / 60.0 / rate
+        columns["pos"] = turns[idx] * 360.0
+        sources["pos"] = f"{src('speed_monitor')} integrated (no encoder mapped)"
+        notes.append("pos is the speed monitor integrated: no encoder was mapped")
+    if decoded.command is not None:
+        columns["cmd_pos"] = decoded.command.counts[idx] * deg_per_count
+        line_b = f" and {src('command_b')}" if "command_b" in roles else ""
+        sources["cmd_pos"] = (
+            f"{src('command_a')}{line_b}, {decode.PULSE_FORMS[settings.pulse_form]}"
+            + (f" x{settings.multiplication}" if settings.pulse_form == 2 else "")
+            + f", electronic gear {settings.gear_numerator}/{settings.gear_denominator}"
+        )
+    if decoded.speed is not None:
+        columns["vel"] = _window_means(decoded.speed.motor_rpm, idx, n) / axis.ratio
+        sources["vel"] = (
+            f"{src('speed_monitor')}, +10 V = {settings.speed_conversion_rpm:g} r/min motor "
+            f"(parameter 9) / {axis.ratio}, offset {decoded.speed.offset_v * 1000:.1f} mV"
+        )
+    if "in_position" in logic:
+        columns["in_pos"] = logic["in_position"][idx].astype(np.float64)
+        sources["in_pos"] = f"{src('in_position')}, high = on"
+    if "alarm" in logic:
+        columns["alarm"] = logic["alarm"][idx].astype(np.float64)
+        sources["alarm"] = f"{src('alarm')}, high = on"
+    if "current_probe" in analog and current_scale is not None:
+        columns["current"] = _window_means(analog["current_probe"], idx, n) * current_scale
+        sources["current"] = f"{src('current_probe')}, {current_scale:g} A/V"
+    extra = {f"source_{name}": text for name, text in sources.items()}
+    extra["recorded_by"] = "fha-studio bench import"
+    metadata = RecordingMetadata(
+        actuator=axis.actuator,
+        load_inertia_kgm2=None,
+        supply_voltage=axis.supply_voltage,
+        sample_rate_hz=out_rate,
+        extra=extra,
+    )
+    recording = make_recording(metadata, **columns)
+    summary = _summary(decoded, roles, channel_of, axis, settings, current_scale, sources, len(idx))
+    return BenchImport(recording, summary, decoded, notes)
+
+
+def _summary(
+    decoded: Decoded,
+    roles: Mapping[str, SignalSpec],
+    channel_of: Mapping[str, str],
+    axis: AxisFacts,
+    settings: DriveSettings,
+    current_scale: float | None,
+    sources: Mapping[str, str],
+    rows: int,
+) -> dict[str, Any]:
+    per_role: dict[str, dict[str, Any]] = {}
+    for role, spec in roles.items():
+        scale: float | None
+        unit: str
+        if role in ("encoder_a", "encoder_b", "encoder_z"):
+            scale, unit = float(axis.counts_per_output_turn), "counts per output turn (x4)"
+        elif role in ("command_a", "command_b"):
+            scale = settings.gear_numerator / settings.gear_denominator
+            unit = (
+                f"counts per command pulse ({decode.PULSE_FORMS[settings.pulse_form]}, "
+                f"x{settings.multiplication}, electronic gear)"
+            )
+        elif role == "speed_monitor":
+            scale = settings.speed_conversion_rpm / decode.MONITOR_FULL_SCALE_V
+            unit = "motor r/min per V"
+        elif role == "current_probe":
+            scale, unit = current_scale, "A per V"
+        else:
+            scale, unit = None, "logic, high = on"
+        per_role[role] = {
+            "source": f"{spec.path}#{channel_of[role]}",
+            "file": os.fspath(spec.path),
+            "channel": channel_of[role],
+            "scale": scale,
+            "scale_unit": unit,
+        }
+    summary: dict[str, Any] = {
+        "samples": decoded.samples,
+        "duration_s": decoded.samples / decoded.sample_rate_hz,
+        "sample_rate_hz": decoded.sample_rate_hz,
+        "roles": per_role,
+        "encoder": None,
+        "command_counts": None,
+        "speed_offset_v": None,
+        "recording": {"rows": rows, "sources": dict(sources)},
+    }
+    if decoded.encoder is not None:
+        summary["encoder"] = {
+            "counts": decoded.encoder.total_counts,
+            "glitches": decoded.encoder.glitches,
+            "illegal_transitions": decoded.encoder.illegal_transitions,
+            "z_pulses": decoded.z.pulses if decoded.z else None,
+            "z_count_errors": decoded.z.count_errors if decoded.z else None,
+            "counts_per_motor_turn": axis.counts_per_motor_turn,
+        }
+    if decoded.command is not None:
+        final = float(decoded.command.counts[-1])
+        summary["command_counts"] = int(final) if math.isclose(final, round(final)) else final
+    if decoded.speed is not None:
+        summary["speed_offset_v"] = decoded.speed.offset_v
+    return summary

@@ -1,0 +1,144 @@
+"""The simulated drive's CN2 outputs recorded through the virtual bench instrument in each file
+form, imported, give the drive's own positions back: encoder counts and command counts exact,
+speed within 1 % of the drive's."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fha_studio.catalog import get_actuator
+from fha_studio.hardware.sim.cn2 import FORMS, Cn2Settings, VirtualBenchInstrument
+from fha_studio.logic.bench.importer import (
+    AxisFacts,
+    BenchImportError,
+    DriveSettings,
+    SignalSpec,
+    import_bench,
+)
+from fha_studio.physics import AxisModel, ServoAxis
+from fha_studio.recording import read_recording, write_recording
+
+CODE = "FHA-25C-50-US250"
+CHANNELS = {
+    "encoder_a": "ENC_A",
+    "encoder_b": "ENC_B",
+    "encoder_z": "ENC_Z",
+    "command_a": "CMD_A",
+    "command_b": "CMD_B",
+    "in_position": "IN_POS",
+    "alarm": "ALARM",
+    "speed_monitor": "SPD_MON",
+}
+RPM = 2 * math.pi / 60
+
+
+def _drive(pulse_form=0, multiplication=4, gear=(1, 1), rate=200e3):
+    actuator = get_actuator(CODE)
+    model = AxisModel.from_actuator(actuator, load_inertia_kgm2=0.3)
+    axis = ServoAxis(model)
+    axis.set_settings(
+        axis.settings.replace(electronic_gear_numerator=gear[0], electronic_gear_denominator=gear[1])
+    )
+    axis.servo_on()
+    instrument = VirtualBenchInstrument(
+        axis, rate, Cn2Settings(pulse_form=pulse_form, multiplication=multiplication)
+    )
+    instrument.record(0.03)  # standing: where the monitor's offset is taken
+    axis.move_by_pulses(9000, speed_rad_s=8 * RPM)
+    instrument.record(0.45)
+    axis.move_by_pulses(-4000, speed_rad_s=5 * RPM)
+    instrument.record(0.3)
+    return axis, instrument
+
+
+@pytest.fixture(scope="module")
+def drive():
+    return _drive(pulse_form=1, gear=(2, 1))
+
+
+def _settings(pulse_form=1, multiplication=4, gear=(2, 1)):
+    return DriveSettings(pulse_form, multiplication, gear[0], gear[1], 3000.0)
+
+
+@pytest.mark.parametrize("form", FORMS)
+def test_each_file_form_gives_the_drives_positions_back(drive, form, tmp_path):
+    axis, instrument = drive
+    path = tmp_path / ("capture.sr" if form == "sr" else "capture.vcd" if form == "vcd" else "capture.csv")
+    instrument.write(path, form)
+    signals = [
+        SignalSpec(role, str(path), channel)
+        for role, channel in CHANNELS.items()
+        if not (form == "vcd" and role == "speed_monitor")
+    ]  # a VCD holds logic only
+    result = import_bench(signals, AxisFacts.for_actuator(CODE), _settings())
+    truth = instrument.truth.arrays()
+    decoded = result.decoded
+    assert decoded.samples == truth["encoder_counts"].size
+    # encoder counts exact, sample by sample, and the drive's own feedback count at the end
+    assert np.array_equal(decoded.encoder.counts, truth["encoder_counts"] - truth["encoder_counts"][0])
+    assert result.summary["encoder"]["counts"] == truth["encoder_counts"][-1] - truth["encoder_counts"][0]
+    assert truth["encoder_counts"][-1] == axis.feedback_pulses
+    assert result.summary["encoder"]["illegal_transitions"] == 0
+    assert result.summary["encoder"]["z_pulses"] >= 1 and result.summary["encoder"]["z_count_errors"] == 0
+    # command counts exact: 9000 - 4000 command pulses through the 2/1 gear
+    assert np.array_equal(decoded.command.counts, truth["command_counts"] - truth["command_counts"][0])
+    assert result.summary["command_counts"] == 10000 == axis.command_pulses
+    recording = result.recording
+    assert recording.metadata.extra["source_pos"].startswith(f"{path}#ENC_A and {path}#ENC_B")
+    assert not recording.has_current
+    if form == "vcd":
+        assert recording.vel_rpm is None and result.summary["speed_offset_v"] is None
+        return
+    # speed: the drive's output r/min over each recording interval, within 1 % of the peak
+    idx = np.rint(recording.t_s * instrument.sample_rate_hz).astype(int)
+    drive_rpm = truth["motor_rpm"] / 50.0
+    sums = np.concatenate(([0.0], np.cumsum(drive_rpm)))
+    ends = np.append(idx[1:], drive_rpm.size)
+    expected = (sums[ends] - sums[idx]) / (ends - idx)
+    peak = float(np.max(np.abs(expected)))
+    assert peak > 7.5
+    assert float(np.max(np.abs(recording.vel_rpm - expected))) < 0.01 * peak
+    assert result.summary["speed_offset_v"] == pytest.approx(instrument.settings.monitor.offset_v, abs=0.002)
+    # the recording as a file: fha-recording/2, read back the same
+    write_recording(tmp_path / "rec.csv", recording)
+    back = read_recording(tmp_path / "rec.csv")
+    assert back.metadata.extra["source_vel"].startswith(f"{path}#SPD_MON")
+    assert np.allclose(back.pos_deg, recording.pos_deg)
+
+
+@pytest.mark.parametrize(("pulse_form", "multiplication"), [(0, 4), (2, 4), (2, 1)])
+def test_every_command_pulse_form_round_trips(pulse_form, multiplication, tmp_path):
+    gear = (2, 1) if multiplication == 1 else (1, 1)  # x1: four command edges per pulse, two counts
+    axis, instrument = _drive(
+        pulse_form, multiplication, gear=gear, rate=400e3 if multiplication == 1 else 200e3
+    )
+    instrument.write(tmp_path / "c.sr", "sr")
+    signals = [SignalSpec(r, str(tmp_path / "c.sr"), c) for r, c in CHANNELS.items()]
+    result = import_bench(signals, AxisFacts.for_actuator(CODE), _settings(pulse_form, multiplication, gear))
+    truth = instrument.truth.arrays()
+    assert np.array_equal(result.decoded.command.counts, truth["command_counts"] - truth["command_counts"][0])
+    assert result.summary["command_counts"] == axis.command_pulses == 5000 * gear[0] // gear[1]
+
+
+def test_a_capture_too_slow_for_the_encoder_is_refused_with_both_figures(drive, tmp_path):
+    from fha_studio.hardware.bench import writers
+    from fha_studio.hardware.bench.capture import SampleBlock
+
+    _, instrument = drive
+    block = instrument.capture()
+    every = 8  # 25 kHz: the encoder's edges at 400 r/min (motor) are 66.7 kHz
+    slow = SampleBlock(
+        block.sample_rate_hz / every,
+        block.logic_channels,
+        block.logic[::every].copy(),
+        {k: v[::every].copy() for k, v in block.analog.items()},
+    )
+    writers.write_sr(tmp_path / "slow.sr", slow)
+    signals = [SignalSpec(r, str(tmp_path / "slow.sr"), c) for r, c in CHANNELS.items()]
+    with pytest.raises(BenchImportError) as err:
+        import_bench(signals, AxisFacts.for_actuator(CODE), _settings())
+    text = str(err.value)
+    assert "25 kHz" in text and "r/min" in text and "kHz of edges" in text and "\n" not in text
