@@ -150,3 +150,6 @@ EFFECT_PARAMETER_RANGES: dict[str, Range] = {
     "k2_nm_per_rad": EFFECT_STIFFNESS_NM_PER_RAD,
     "k3_nm_per_rad": EFFECT_STIFFNESS_NM_PER_RAD,
 }
+
+CURRENT_PROBE_A_PER_V = Range("current probe scale", 1e-6, 1000.0, "A/V",
+                              "current probes and shunt amplifiers give 1 mA/V ... 1000 A/V")

@@ -1,0 +1,171 @@
+"""``fha-studio bench``: the drive's CN2 signals from bench instruments.
+
+``bench import`` decodes capture files (sigrok ``.sr``, VCD, sigrok-cli's CSV, a generic CSV)
+into a recording (:mod:`fha_studio.logic.bench.importer`); a further sub-command is added here
+with :func:`add_command`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from typing import Any
+
+from fha_studio import fileio
+from fha_studio.cli import CliError
+from fha_studio.cli._values import in_range, output_path
+from fha_studio.plausible import CURRENT_PROBE_A_PER_V
+
+ORDER = 45
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "bench",
+        help="decode the drive's CN2 signals captured by a logic analyzer, oscilloscope or DAQ",
+        description="The drive's CN2 monitor outputs (SPD-MON, encoder A/B/Z, IN-POS, ALARM) and the "
+        "command pulses, captured by bench instruments: what a drive whose CN3 is silent while the servo "
+        "is on does in motion.",
+    )
+    commands = p.add_subparsers(dest="bench_command", metavar="COMMAND", parser_class=type(p))
+    p.set_defaults(func=lambda args: _no_command(p))
+    add_import(commands)
+
+
+def _no_command(parser: argparse.ArgumentParser) -> int:
+    parser.print_help()
+    return 2
+
+
+def add_import(commands: argparse._SubParsersAction) -> None:
+    from fha_studio.logic.bench.importer import ROLES
+
+    p = commands.add_parser(
+        "import",
+        help="decode capture files into a recording (t, cmd_pos, pos, vel, in_pos, current)",
+        description="Decode capture files (sigrok .sr, VCD, sigrok-cli CSV, CSV with a time column) of "
+        "the drive's CN2 signals into an fha-recording file: the encoder counted x4 (glitches, illegal "
+        "transitions and Z pulses checked), the command pulses by parameters 1, 2, 3 and 4, SPD-MON by "
+        "parameter 9 with its offset at standstill. Each column's source is named in the recording.",
+    )
+    p.add_argument(
+        "--actuator",
+        required=True,
+        metavar="CODE",
+        help="the actuator's model code, e.g. FHA-25C-50-US250 (its encoder's counts per turn)",
+    )
+    p.add_argument(
+        "--parameters",
+        required=True,
+        metavar="PARAMS.toml",
+        help="the drive's parameter file (fha-parameters/1, as the Parameters page saves it): "
+        "parameters 1, 2, 3, 4 and 9 are read from it",
+    )
+    p.add_argument(
+        "--signal",
+        action="append",
+        default=[],
+        metavar="ROLE=FILE[#CHANNEL]",
+        help=f"a signal and where it was captured; ROLE is one of {', '.join(ROLES)}; CHANNEL is "
+        "the channel's name in the file (needed when the file has more than one)",
+    )
+    p.add_argument(
+        "--current-scale",
+        type=in_range(CURRENT_PROBE_A_PER_V),
+        metavar="A_PER_V",
+        help="the current probe's amperes per volt (with --signal current_probe=...)",
+    )
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        type=output_path,
+        metavar="RECORDING.csv",
+        help="the recording to write",
+    )
+    p.add_argument("--json", type=output_path, metavar="SUMMARY.json", help="write the summary as JSON")
+    p.set_defaults(func=run_import)
+
+
+def run_import(args: argparse.Namespace) -> int:
+    from fha_studio.logic.bench.importer import (
+        AxisFacts,
+        BenchImportError,
+        DriveSettings,
+        import_bench,
+        parse_signal,
+    )
+    from fha_studio.recording import write_recording
+
+    if args.current_scale is not None and not any(t.startswith("current_probe=") for t in args.signal):
+        raise CliError("--current-scale without --signal current_probe=FILE[#CHANNEL]")
+    try:
+        signals = [parse_signal(text) for text in args.signal]
+        axis = AxisFacts.for_actuator(args.actuator)
+        settings = DriveSettings.from_values(_parameter_values(args.parameters), args.parameters)
+        result = import_bench(signals, axis, settings, current_scale_a_per_v=args.current_scale)
+    except BenchImportError as exc:
+        raise CliError(str(exc)) from None
+    summary = result.summary
+    write_recording(args.output, result.recording)
+    if args.json:
+        fileio.write_text(args.json, json.dumps(_finite(summary), indent=2) + "\n")
+    rate = summary["sample_rate_hz"]
+    print(
+        f"{summary['samples']} samples at {_hz(rate)} ({summary['duration_s']:.4g} s) decoded into "
+        f"{args.output}: {summary['recording']['rows']} rows, columns "
+        f"{', '.join(result.recording.channels)}"
+    )
+    encoder = summary["encoder"]
+    if encoder is not None:
+        z = (
+            ""
+            if encoder["z_pulses"] is None
+            else f", {encoder['z_pulses']} Z pulses ({encoder['z_count_errors']} off the "
+            f"{encoder['counts_per_motor_turn']} counts per motor turn)"
+        )
+        print(
+            f"encoder: {encoder['counts']} counts, {encoder['glitches']} glitches, "
+            f"{encoder['illegal_transitions']} illegal transitions{z}"
+        )
+    if summary["command_counts"] is not None:
+        print(f"command: {summary['command_counts']} counts")
+    if summary["speed_offset_v"] is not None:
+        print(f"speed monitor: offset {1000 * summary['speed_offset_v']:.1f} mV taken at standstill")
+    for note in result.notes:
+        print(note)
+    if args.json:
+        print(f"summary written to {args.json}")
+    return 0
+
+
+def _parameter_values(path: str) -> dict[tuple[str, int], int]:
+    from fha_studio.hardware.parameters import load_parameter_model
+    from fha_studio.logic.bench.importer import BenchImportError
+    from fha_studio.logic.paramfile import ParameterFileError, load_parameter_file
+
+    try:
+        loaded = load_parameter_file(path, load_parameter_model("HA-655"))
+        if loaded.driver == "HA-675":
+            loaded = load_parameter_file(path, load_parameter_model("HA-675"))
+    except ParameterFileError as exc:
+        raise BenchImportError(str(exc)) from None
+    return dict(loaded.values)
+
+
+def _hz(value: float) -> str:
+    for factor, unit in ((1e6, "MHz"), (1e3, "kHz")):
+        if value >= factor:
+            return f"{value / factor:g} {unit}"
+    return f"{value:g} Hz"
+
+
+def _finite(obj: Any) -> Any:
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_finite(v) for v in obj]
+    return obj
