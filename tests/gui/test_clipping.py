@@ -76,3 +76,33 @@ def test_every_page_fits_a_1024_by_600_screen(window, qtbot):
         assert hint.width() <= 1024 and hint.height() <= 600, f"{page_id}: {hint.width()} x {hint.height()}"
         window.resize(1024, 600)
         qtbot.waitUntil(lambda: window.width() <= 1024 and window.height() <= 600, timeout=10000)
+
+
+@pytest.mark.parametrize("size", [(1280, 720), (1024, 600)], ids=["1280x720", "1024x600"])
+def test_every_page_shows_its_controls_and_its_text_whole(window, qtbot, size):
+    """At 1280 x 720 (the window on a 1366 x 768 screen) and 1024 x 600 every page's controls
+    are in view without a toolbar's chevron or a tab bar's arrows, and no text is cut: not the
+    scope's file buttons, not its read-out progress."""
+    from PySide6.QtWidgets import QTabWidget
+
+    from fha_studio.gui.pages.base import PageId
+    from tests.gui.fit import cut_texts, hidden_actions
+
+    window.resize(*size)
+    qtbot.waitUntil(lambda: (window.width(), window.height()) == size, timeout=10000)
+    problems: set[str] = set()
+    for page_id in PageId:
+        page = window.show_page(page_id)
+        if page_id is PageId.SCOPE:  # a trace being read out: its progress bar says so
+            page.view._on_readout_progress(1200, 40000, 12.0)
+        # every tab of the page's own tab widgets (the scope's Trigger and Tests, the model
+        # check's steps), each as it is shown
+        for tabs in [None, *page.findChildren(QTabWidget)]:
+            for index in range(tabs.count() if tabs is not None else 1):
+                if tabs is not None:
+                    if not tabs.isVisible():
+                        break
+                    tabs.setCurrentIndex(index)
+                qtbot.wait(20)  # let the page lay out
+                problems |= {f"{page_id}: {p}" for p in hidden_actions(window) + cut_texts(window)}
+    assert not problems, "\n".join(sorted(problems))

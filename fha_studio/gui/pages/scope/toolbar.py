@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtGui import QFont, QFontMetrics
-from PySide6.QtWidgets import QCheckBox, QComboBox, QLabel, QPushButton, QToolBar
+from PySide6.QtWidgets import QCheckBox, QComboBox, QGridLayout, QLabel, QToolBar, QToolButton, QWidget
 
 TIME_BASES_S = (0.5, 1.0, 2.0, 5.0, 10.0, 30.0, 60.0)
 DEFAULT_TIME_BASE_S = 10.0
@@ -22,8 +22,23 @@ INDICATOR_WIDTH_PX = 270
 _INDICATOR_PADDING_PX = 20
 
 
-class ScopeToolbar(QToolBar):
-    """Says what the plot shows and carries the user's view-wide actions out as signals."""
+def _button(text: str, checkable: bool = False) -> QToolButton:
+    """A toolbar button as wide as its text (a push button is at least 80 px): the whole row
+    fits a 1280 px window, as the main window's toolbar buttons do."""
+    button = QToolButton()
+    button.setText(text)
+    button.setCheckable(checkable)
+    button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+    button.setAutoRaise(True)
+    return button
+
+
+class ScopeToolbar(QWidget):
+    """Says what the plot shows and carries the user's view-wide actions out as signals.
+
+    Two toolbars: the view's (indicator, live, pause, time base, scale, cursors) and the files'
+    (record, save, PNG, CSV, open). They share a row when it holds both (1280 px and wider) and
+    the files' goes under the view's when it does not: no button is ever behind a chevron."""
 
     sigLiveToggled = Signal(bool)
     sigBackToLive = Signal()
@@ -35,52 +50,76 @@ class ScopeToolbar(QToolBar):
     sigFile = Signal(str)  # "save", "png", "csv" or "open": ask for a path
 
     def __init__(self, parent=None):
-        super().__init__("Scope", parent)
+        super().__init__(parent)
+        self.view_bar = QToolBar("Scope")
+        self.file_bar = QToolBar("Scope files")
+        self._grid = QGridLayout(self)
+        self._grid.setContentsMargins(0, 0, 0, 0)
+        self._grid.setSpacing(0)
+        self._grid.addWidget(self.view_bar, 0, 0)
+        self._grid.addWidget(self.file_bar, 0, 1)
+        self._grid.setColumnStretch(1, 1)
+        self._one_row = True
+        view = self.view_bar
         self.indicator = QLabel()
         self.indicator.setObjectName("scopeIndicator")
         # a fixed width: the buttons do not shift when LIVE becomes NOT LIVE: ... (long texts are
         # elided, the whole text is in the tooltip)
         self.indicator.setFixedWidth(INDICATOR_WIDTH_PX)
-        self.addWidget(self.indicator)
-        self.addSeparator()
-        self.live_button = QPushButton("Start live")
-        self.live_button.setCheckable(True)
+        view.addWidget(self.indicator)
+        view.addSeparator()
+        self.live_button = _button("Start live", checkable=True)
         self.live_button.toggled.connect(self.sigLiveToggled)
-        self.addWidget(self.live_button)
-        self.back_button = QPushButton("Back to live")
+        view.addWidget(self.live_button)
+        self.back_button = _button("Back to live")
         self.back_button.setToolTip("Leave the capture or file on show and return to the live view")
         self.back_button.clicked.connect(self.sigBackToLive)
-        self.addWidget(self.back_button)
-        self.pause_button = QPushButton("Pause")
-        self.pause_button.setCheckable(True)
+        view.addWidget(self.back_button)
+        self.pause_button = _button("Pause", checkable=True)
         self.pause_button.toggled.connect(self.sigPaused)
-        self.addWidget(self.pause_button)
-        self.addWidget(QLabel(" Time base "))
+        view.addWidget(self.pause_button)
+        view.addWidget(QLabel(" Time base "))
         self.time_base = QComboBox()
         for tb in TIME_BASES_S:
             self.time_base.addItem(f"{tb:g} s", tb)
         self.time_base.setCurrentIndex(TIME_BASES_S.index(DEFAULT_TIME_BASE_S))
-        self.addWidget(self.time_base)
+        view.addWidget(self.time_base)
         self.autoscale = QCheckBox("Autoscale Y")
         self.autoscale.setChecked(True)
         self.autoscale.toggled.connect(self.sigAutoscale)
-        self.addWidget(self.autoscale)
-        fit = QPushButton("Fit")
+        view.addWidget(self.autoscale)
+        fit = _button("Fit")
         fit.clicked.connect(self.sigFit)
-        self.addWidget(fit)
+        view.addWidget(fit)
         self.cursors_box = QCheckBox("Cursors")
         self.cursors_box.toggled.connect(self.sigCursors)
-        self.addWidget(self.cursors_box)
-        self.addSeparator()
-        self.record_button = QPushButton("Record…")
-        self.record_button.setCheckable(True)
+        view.addWidget(self.cursors_box)
+        files = self.file_bar
+        files.setContentsMargins(8, 0, 0, 0)  # apart from the view's buttons, in one row or two
+        self.record_button = _button("Record…", checkable=True)
         self.record_button.clicked.connect(self.sigRecord)
-        self.addWidget(self.record_button)
+        files.addWidget(self.record_button)
         for text, what in (("Save capture…", "save"), ("PNG…", "png"), ("CSV…", "csv"), ("Open…", "open")):
-            button = QPushButton(text)
+            button = _button(text)
             button.clicked.connect(lambda _=False, w=what: self.sigFile.emit(w))
-            self.addWidget(button)
+            files.addWidget(button)
         self._indicator_text = ""
+
+    def resizeEvent(self, event) -> None:
+        """The files' toolbar beside the view's when the row holds both, else under it."""
+        super().resizeEvent(event)
+        one_row = self.view_bar.sizeHint().width() + self.file_bar.sizeHint().width() <= event.size().width()
+        if one_row != self._one_row:
+            self._one_row = one_row
+            self._grid.removeWidget(self.file_bar)
+            if one_row:
+                self._grid.addWidget(self.file_bar, 0, 1)
+            else:
+                self._grid.addWidget(self.file_bar, 1, 0, 1, 2)
+
+    def one_row(self) -> bool:
+        """True when both toolbars share one row."""
+        return self._one_row
 
     def time_base_s(self) -> float:
         return float(self.time_base.currentData())

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtGui import QFontMetrics
 from PySide6.QtWidgets import (
     QFileDialog,
     QHBoxLayout,
@@ -227,7 +228,6 @@ class ScopeView(QWidget):
         bottom.addWidget(self.info_label, 1)
         self.readout_progress = QProgressBar()
         self.readout_progress.setObjectName("scopeReadoutProgress")
-        self.readout_progress.setMaximumWidth(360)
         self.readout_progress.setVisible(False)
         bottom.addWidget(self.readout_progress)
         outer.addLayout(bottom)
@@ -682,6 +682,10 @@ class ScopeView(QWidget):
         bar.setValue(done)
         left = "" if seconds_left < 0 else f", about {seconds_left:.0f} s left"
         bar.setFormat(f"Reading out the capture: {done} of {total} samples{left}")
+        # as wide as its longest text for this capture (its own size hint is about 90 px): the
+        # text is never cut, and the bar does not change its width while it counts
+        widest = f"Reading out the capture: {total} of {total} samples, about 999 s left"
+        bar.setMinimumWidth(QFontMetrics(bar.font()).horizontalAdvance(widest) + 24)
         bar.setVisible(done < total)
 
     def _on_trace_done(self, result: TraceResult) -> None:
