@@ -19,6 +19,8 @@ find_python() {
 }
 
 # Debian package names of the shared libraries Qt needs; see shared/reference/qt-stack-notes.md.
+# sigrok-cli (a command) streams the bench instruments: logic analyzers, oscilloscopes, DAQs.
+BENCH_PACKAGES="sigrok-cli"
 QT_OFFSCREEN_PACKAGES="libglib2.0-0 libegl1 libgl1 libdbus-1-3 libfontconfig1 libxkbcommon0"
 QT_XCB_PACKAGES="libxcb-cursor0 libxcb-icccm4 libxcb-keysyms1 libxcb-shape0 libxcb-xkb1 libxkbcommon-x11-0"
 
@@ -42,6 +44,9 @@ missing_libraries() {
             libxkbcommon-x11-0) lib=libxkbcommon-x11.so.0 ;;
             poppler-utils)  # a command, not a library: pdftotext checks the report PDFs' text
                 command -v pdftotext >/dev/null || echo -n "$pkg "
+                continue ;;
+            sigrok-cli)  # a command: the acquisition engine of the bench instruments
+                command -v sigrok-cli >/dev/null || echo -n "$pkg "
                 continue ;;
             *) lib="$pkg" ;;
         esac
