@@ -1,4 +1,4 @@
-"""``fha-studio register [--db FILE] ACTION ...``: the questions a plant asks of the register.
+"""``fha-studio register [--register FILE] ACTION ...``: the questions a plant asks of the register.
 
 - ``machines``: the machines, their sites, how many axes and open items.
 - ``axes [MACHINE]``: every axis with actuator, driver, port, checks passed/failed, report.
@@ -12,8 +12,9 @@
 - ``check``: SQLite's integrity check, and what a damaged register still holds.
 - ``add-machine NAME``, ``add-axis MACHINE/AXIS``, ``import FILE... --machine M``: fill it.
 
-Every action takes ``--json``. The register is ``--db FILE``, else ``$FHA_STUDIO_REGISTER``, else
-``register.sqlite`` in the user data directory.
+Every action takes ``--json``. The register is ``--register FILE``, else ``$FHA_STUDIO_REGISTER``,
+else ``register.sqlite`` in the user data directory: the GUI's rule and option
+(``default_register_path``). ``--db FILE`` is the old name of ``--register``, still taken.
 """
 
 from __future__ import annotations
@@ -42,6 +43,14 @@ from fha_studio.logic.register.words import (
 ORDER = 70
 
 
+class _OldName(argparse.Action):
+    """``--db FILE``: the old name of ``--register FILE``, taken with a note on stderr."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        print(f"{parser.prog}: note: --db is now called --register", file=sys.stderr)
+        setattr(namespace, self.dest, values)
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "register",
@@ -50,16 +59,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "verified writes, checks, alarms, reports, recordings, model checks) in one SQLite file.",
     )
     p.add_argument(
-        "--db",
+        "--register",
         type=Path,
         metavar="FILE",
         help="the register file (default: $FHA_STUDIO_REGISTER, "
-        "else register.sqlite in the user data directory)",
+        "else register.sqlite in the user data directory), as for the GUI",
     )
+    p.add_argument("--db", type=Path, dest="register", action=_OldName, help=argparse.SUPPRESS)
     p.add_argument("--json", action="store_true", help="print JSON")
     common = argparse.ArgumentParser(add_help=False, allow_abbrev=False)
     # also accepted after the action; SUPPRESS keeps the action from resetting what came before it
-    common.add_argument("--db", type=Path, metavar="FILE", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    hidden = argparse.SUPPRESS
+    common.add_argument("--register", type=Path, metavar="FILE", default=hidden, help=hidden)
+    common.add_argument("--db", type=Path, dest="register", action=_OldName, default=hidden, help=hidden)
     common.add_argument("--json", action="store_true", default=argparse.SUPPRESS, help="print JSON")
     sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
 
@@ -159,7 +171,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 @contextmanager
 def _open_register(args):
-    from fha_studio.logic.register import Register, RegisterError
+    from fha_studio.logic.register import Register, RegisterError, default_register_path
 
     # a question asked of a register that is not there is a mistake (a typed path), not an empty
     # answer; adding or importing creates it
@@ -167,7 +179,7 @@ def _open_register(args):
     # a question changes nothing in the file (the report records itself: it writes)
     question = not create and args.action != "report"
     try:
-        reg = Register(args.db, create=create, read_only=question)
+        reg = Register(default_register_path(args.register), create=create, read_only=question)
     except RegisterError as exc:
         none = "there is no register" in str(exc)
         hint = " (start one: fha-studio register add-machine NAME)" if none else ""
@@ -473,7 +485,7 @@ def _check(args) -> int:
     from fha_studio.logic.register.check import check_register
     from fha_studio.names import quoted
 
-    path = args.db if args.db is not None else default_register_path()
+    path = default_register_path(args.register)
     try:
         result = check_register(path)
     except RegisterError as exc:

@@ -93,7 +93,7 @@ def _parser() -> argparse.ArgumentParser:
         "--register",
         metavar="FILE",
         help="the register file (default: $FHA_STUDIO_REGISTER, else register.sqlite in the user data "
-        "directory)",
+        "directory), as for fha-studio register",
     )
     parser.add_argument(
         "--training",
@@ -109,17 +109,13 @@ def _machine_window(args):
     when the machine or the register cannot be opened."""
     if not (args.machine or args.machine_file):
         return None
-    from pathlib import Path
-
-    from fha_studio.gui.machine_window import MachineWindow, register_path
+    from fha_studio.gui.machine_window import MachineWindow
     from fha_studio.logic.machine import MachineError, MachineProject
-    from fha_studio.logic.register import Register, RegisterError
+    from fha_studio.logic.register import Register, RegisterError, default_register_path
 
     try:
         # a machine file is put into the register (made when missing); a machine by name must be there
-        register = Register(
-            Path(args.register) if args.register else register_path(), create=bool(args.machine_file)
-        )
+        register = Register(default_register_path(args.register), create=bool(args.machine_file))
         try:
             if args.machine_file:
                 project = MachineProject.load(args.machine_file)

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import getpass
 import logging
-import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -48,11 +47,10 @@ from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.register_dialog import RegisterDialog
-from fha_studio.gui.session import data_dir
 from fha_studio.gui.widgets import StopButton
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures import ProcedureSession
-from fha_studio.logic.register import ENV_REGISTER, Register, RegisterError, record_session
+from fha_studio.logic.register import Register, RegisterError, record_session
 
 log = logging.getLogger(__name__)
 
@@ -65,13 +63,6 @@ def _login_name() -> str:
         return getpass.getuser()
     except (KeyError, OSError):  # no login name in the environment or the password database
         return ""
-
-
-def register_path() -> Path:
-    """The register the GUI uses: the site's choice (setting ``register/path`` or
-    ``$FHA_STUDIO_REGISTER``), else ``register.sqlite`` in the user data directory."""
-    chosen = str(QSettings().value("register/path", "") or os.environ.get(ENV_REGISTER, "")).strip()
-    return Path(chosen).expanduser() if chosen else data_dir() / "register.sqlite"
 
 
 @dataclass(frozen=True)

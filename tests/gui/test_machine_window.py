@@ -8,6 +8,7 @@ from __future__ import annotations
 import gc
 import shutil
 import subprocess
+from pathlib import Path
 
 import pytest
 from PySide6.QtCore import QCoreApplication
@@ -273,6 +274,41 @@ def test_the_gui_opens_a_machine_of_the_register_or_says_why_not(qtbot, tmp_path
     assert (
         run(["--machine", "Press 7", "--register", str(path), "--no-connect", "--quit-after-ms", "200"]) == 0
     )
+
+
+def test_the_gui_and_the_command_line_open_the_same_register(qtbot, tmp_path, monkeypatch, capsys):
+    """One rule: --register FILE (the same option for both), else $FHA_STUDIO_REGISTER, else the user
+    data directory's register.sqlite; a GUI setting of old (register/path) does not make it differ."""
+    from PySide6.QtCore import QSettings
+
+    from fha_studio.cli import main as cli_main
+    from fha_studio.gui.app import run
+    from fha_studio.logic.register.guard import shown_path
+    from fha_studio.paths import user_data_dir
+
+    QSettings().setValue("register/path", str(tmp_path / "setting.sqlite"))
+    monkeypatch.chdir(tmp_path)  # short relative paths: the refusals show them whole
+    monkeypatch.setenv("XDG_DATA_HOME", "data")
+
+    def opened(option: list[str]) -> tuple[str, str]:
+        """The file each one looked for (none is there, so each says which)."""
+        assert cli_main(["register", *option, "machines"]) == 2
+        said_by_cli = capsys.readouterr().err
+        with pytest.raises(SystemExit):
+            run(["--machine", "Press 7", *option, "--no-connect"])
+        said_by_gui = capsys.readouterr().err
+        return (said_by_cli.split("there is no register at ")[1].split(" (start one")[0],
+                said_by_gui.removeprefix("fha-studio: there is no register at ").rstrip("\n"))
+
+    default = user_data_dir() / "register.sqlite"
+    assert default == Path("data/FHA Studio/fha-studio/register.sqlite")
+    assert opened([]) == (shown_path(default),) * 2
+    monkeypatch.setenv("FHA_STUDIO_REGISTER", "site.sqlite")
+    assert opened([]) == (shown_path(Path("site.sqlite")),) * 2
+    assert opened(["--register", "chosen.sqlite"]) == (shown_path(Path("chosen.sqlite")),) * 2
+    # the register command's old name of the option still works, and says its new name
+    assert cli_main(["register", "--db", "chosen.sqlite", "machines"]) == 2
+    assert capsys.readouterr().err.startswith("fha-studio register: note: --db is now called --register\n")
 
 
 @pytest.mark.slow

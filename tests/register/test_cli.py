@@ -16,9 +16,10 @@ from fha_studio.logic.register import Register
 @pytest.fixture
 def db(tmp_path, capsys):
     path = tmp_path / "plant.sqlite"
-    assert main(["register", "--db", str(path), "add-machine", "Line 3", "--site", "Plant A"]) == 0
+    assert main(["register", "--register", str(path), "add-machine", "Line 3", "--site", "Plant A"]) == 0
     for axis, port in (("table", "/dev/ttyUSB0"), ("table twin", "/dev/ttyUSB1")):
-        args = ["register", "--db", str(path), "add-axis", f"Line 3/{axis}", "--actuator", "FHA-25C-50-US250"]
+        args = ["register", "--register", str(path), "add-axis", f"Line 3/{axis}",
+                "--actuator", "FHA-25C-50-US250"]
         assert main([*args, "--driver", "HA-655-2-200", "--port", port, "--load-inertia", "1.5"]) == 0
     with Register(path) as reg:
         delivery = [("system", 8, "rotary_direction", 0), ("tune", 4, "in_position_range", 10)]
@@ -41,7 +42,7 @@ def db(tmp_path, capsys):
 
 
 def run(capsys, db, *args):
-    code = main(["register", "--db", str(db), *args])
+    code = main(["register", "--register", str(db), *args])
     out, err = capsys.readouterr()
     return code, out, err
 
@@ -126,7 +127,7 @@ def test_a_load_inertia_that_is_no_number_is_refused_in_one_line(capsys, db):
                 ("-1", "-1 is outside 0 ... 1500 kg m^2"))
     for value, words in refusals:
         with pytest.raises(SystemExit) as stop:
-            main(["register", "--db", str(db), "add-axis", "Line 3/roll", "--load-inertia", value])
+            main(["register", "--register", str(db), "add-axis", "Line 3/roll", "--load-inertia", value])
         err = capsys.readouterr().err
         assert stop.value.code == 2 and err.count("\n") == 1 and f"--load-inertia: {words}" in err
     with Register(db) as reg:
@@ -190,14 +191,14 @@ def test_machine_report_from_the_register(capsys, db, tmp_path):
 
 def test_a_question_to_a_register_that_is_not_there_is_refused(capsys, tmp_path):
     missing = tmp_path / "tpyo.sqlite"
-    assert main(["register", "--db", str(missing), "machines"]) == 2
+    assert main(["register", "--register", str(missing), "machines"]) == 2
     err = capsys.readouterr().err
     assert err == (
         f"fha-studio register: error: there is no register at {missing} "
         "(start one: fha-studio register add-machine NAME)\n"
     )
     assert not missing.exists()
-    assert main(["register", "--db", str(missing), "add-machine", "Press 7"]) == 0
+    assert main(["register", "--register", str(missing), "add-machine", "Press 7"]) == 0
     assert missing.exists()
 
 

@@ -147,11 +147,11 @@ def test_a_locked_register_says_who_holds_it(tmp_path):
 
 def test_register_check_on_the_command_line(tmp_path, capsys):
     path = _filled(tmp_path / "r.sqlite")
-    assert main(["register", "--db", str(path), "check"]) == 0
+    assert main(["register", "--register", str(path), "check"]) == 0
     assert capsys.readouterr().out.startswith(f"{path}: sound (SQLite's integrity check: ok); 1 machine(s)")
     _damage_table(path, "axis")
     before = path.read_bytes()
-    assert main(["register", "--db", str(path), "check"]) == 1
+    assert main(["register", "--register", str(path), "check"]) == 1
     out = capsys.readouterr().out
     assert out.startswith(f"{path}: DAMAGED. SQLite's integrity check: ")
     assert "  machines               1 (all)\n" in out and "  axes                   none: damaged\n" in out
@@ -163,7 +163,7 @@ def test_a_machine_report_is_not_written_when_the_register_cannot_record_it(tmp_
     path = _filled(tmp_path / "r.sqlite")
     monkeypatch.setattr(guard, "writable", lambda p: False)
     out = tmp_path / "report.html"
-    assert main(["register", "--db", str(path), "report", "Press 7", "-o", str(out)]) == 2
+    assert main(["register", "--register", str(path), "report", "Press 7", "-o", str(out)]) == 2
     assert capsys.readouterr().err == (
         f"fha-studio register: error: the register {path} is read-only: "
         "nothing was changed (it needs write access to the file and its folder)\n")

@@ -49,10 +49,12 @@ _ORIGIN_PREFIX = "origin: "
 _NOT_APPLICABLE = "not applicable"
 
 
-def default_register_path() -> Path:
-    """``$FHA_STUDIO_REGISTER`` when set, else ``register.sqlite`` in the user data directory."""
-    chosen = os.environ.get(ENV_REGISTER, "").strip()
-    return Path(chosen).expanduser() if chosen else user_data_dir() / REGISTER_FILE_NAME
+def default_register_path(chosen: str | Path | None = None) -> Path:
+    """The register file, by one rule for the GUI and the command line: ``chosen`` (their
+    ``--register FILE``) when given, else ``$FHA_STUDIO_REGISTER`` when set, else
+    ``register.sqlite`` in the user data directory."""
+    text = str(chosen or "").strip() or os.environ.get(ENV_REGISTER, "").strip()
+    return Path(text).expanduser() if text else user_data_dir() / REGISTER_FILE_NAME
 
 
 def utc_stamp(when: str | _dt.datetime | None = None) -> str:
