@@ -1,19 +1,18 @@
 """``fha-studio bench``: the drive's CN2 signals from bench instruments.
 
 ``bench import`` decodes capture files (sigrok ``.sr``, VCD, sigrok-cli's CSV, a generic CSV)
-into a recording (:mod:`fha_studio.logic.bench.importer`); a further sub-command is added here
-with :func:`add_command`.
+into a recording (:mod:`fha_studio.logic.bench.importer`); ``bench devices`` and ``bench record``
+(live instruments through sigrok-cli) are in :mod:`fha_studio.cli._bench_live`.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import math
-from typing import Any
 
 from fha_studio import fileio
 from fha_studio.cli import CliError
+from fha_studio.cli._bench_common import finite, parameter_values
 from fha_studio.cli._values import in_range, output_path
 from fha_studio.plausible import CURRENT_PROBE_A_PER_V
 
@@ -31,6 +30,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     commands = p.add_subparsers(dest="bench_command", metavar="COMMAND", parser_class=type(p))
     p.set_defaults(func=lambda args: _no_command(p))
     add_import(commands)
+    from fha_studio.cli._bench_live import add_devices, add_record
+
+    add_devices(commands)
+    add_record(commands)
 
 
 def _no_command(parser: argparse.ArgumentParser) -> int:
@@ -103,14 +106,14 @@ def run_import(args: argparse.Namespace) -> int:
     try:
         signals = [parse_signal(text) for text in args.signal]
         axis = AxisFacts.for_actuator(args.actuator)
-        settings = DriveSettings.from_values(_parameter_values(args.parameters), args.parameters)
+        settings = DriveSettings.from_values(parameter_values(args.parameters), args.parameters)
         result = import_bench(signals, axis, settings, current_scale_a_per_v=args.current_scale)
     except BenchImportError as exc:
         raise CliError(str(exc)) from None
     summary = result.summary
     write_recording(args.output, result.recording)
     if args.json:
-        fileio.write_text(args.json, json.dumps(_finite(summary), indent=2) + "\n")
+        fileio.write_text(args.json, json.dumps(finite(summary), indent=2) + "\n")
     rate = summary["sample_rate_hz"]
     print(
         f"{summary['samples']} samples at {_hz(rate)} ({summary['duration_s']:.4g} s) decoded into "
@@ -140,32 +143,8 @@ def run_import(args: argparse.Namespace) -> int:
     return 0
 
 
-def _parameter_values(path: str) -> dict[tuple[str, int], int]:
-    from fha_studio.hardware.parameters import load_parameter_model
-    from fha_studio.logic.bench.importer import BenchImportError
-    from fha_studio.logic.paramfile import ParameterFileError, load_parameter_file
-
-    try:
-        loaded = load_parameter_file(path, load_parameter_model("HA-655"))
-        if loaded.driver == "HA-675":
-            loaded = load_parameter_file(path, load_parameter_model("HA-675"))
-    except ParameterFileError as exc:
-        raise BenchImportError(str(exc)) from None
-    return dict(loaded.values)
-
-
 def _hz(value: float) -> str:
     for factor, unit in ((1e6, "MHz"), (1e3, "kHz")):
         if value >= factor:
             return f"{value / factor:g} {unit}"
     return f"{value:g} Hz"
-
-
-def _finite(obj: Any) -> Any:
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_finite(v) for v in obj]
-    return obj
