@@ -16,6 +16,7 @@ go through in chunks of whole rows so the intermediate arrays stay small.
 from __future__ import annotations
 
 import re
+from typing import Any
 
 import numpy as np
 
@@ -23,7 +24,7 @@ CHUNK_BYTES = 1 << 22
 
 _DIGIT, _DOT, _COMMA, _NEWLINE, _MINUS, _PLUS, _EXP, _OTHER = range(8)
 _CLASS = np.full(256, _OTHER, np.uint8)
-_CLASS[ord("0"): ord("9") + 1] = _DIGIT
+_CLASS[ord("0") : ord("9") + 1] = _DIGIT
 _CLASS[ord(".")] = _DOT
 _CLASS[ord(",")] = _COMMA
 _CLASS[ord("\n")] = _NEWLINE
@@ -41,9 +42,10 @@ SEMICOLON = bytes.maketrans(b";", b",")
 TAB = bytes.maketrans(b"\t", b",")
 
 
-def parse_rows(data: bytes, columns: int) -> np.ndarray | None:
+def parse_rows(data: bytes, columns: int, *, digits: bool = False) -> np.ndarray | None:
     """The rows of ``data`` (each ending in ``\\n``) as a ``(rows, columns)`` float64 array, or
-    None when a field is not a number or a row has another number of fields."""
+    None when a field is not a number or a row has another number of fields. ``digits``: rows of
+    single digits (a logic analyzer's) come as uint8 instead."""
     if not data:
         return np.zeros((0, columns))
     if not data.endswith(b"\n"):
@@ -53,6 +55,10 @@ def parse_rows(data: bytes, columns: int) -> np.ndarray | None:
             return None
         data = data.translate(None, _SPACES)
     fixed = _fixed_width_digits(data, columns)
+    if fixed is not None and not digits:
+        fixed = fixed.astype(np.float64)
+    if fixed is None:
+        fixed = _fixed_width_fields(data, columns)
     if fixed is not None:
         return fixed
     parts: list[np.ndarray] = []
@@ -72,7 +78,7 @@ def parse_rows(data: bytes, columns: int) -> np.ndarray | None:
 def _fixed_width_digits(data: bytes, columns: int) -> np.ndarray | None:
     """Rows of single digits (a logic analyzer's ``1,0,1``): the bytes as a 2-D array."""
     width = 2 * columns
-    if len(data) % width or data[width - 1: width] != b"\n":
+    if len(data) % width or data[width - 1 : width] != b"\n":
         return None
     grid = np.frombuffer(data, np.uint8).reshape(-1, width)
     values = grid[:, 0::2]
@@ -82,7 +88,134 @@ def _fixed_width_digits(data: bytes, columns: int) -> np.ndarray | None:
     digits = values - np.uint8(ord("0"))
     if np.any(digits > 9):
         return None
-    return digits.astype(np.float64)
+    return digits
+
+
+def _fixed_width_fields(data: bytes, columns: int) -> np.ndarray | None:
+    """Rows of one length whose fields keep their places (most instruments' exports): the
+    character kinds of the first row hold in every row, so every digit of every field is checked
+    in one pass and weighted by its place in one matrix product per field."""
+    width = data.find(b"\n") + 1
+    if width <= 1 or len(data) % width:
+        return None
+    first = np.frombuffer(data, np.uint8, width)
+    seps = np.flatnonzero(first == ord(","))
+    if seps.size != columns - 1:
+        return None
+    grid = np.frombuffer(data, np.uint8).reshape(-1, width)
+    rows = grid.shape[0]
+    marks = np.concatenate((seps, [width - 1]))
+    expected = first[marks]
+    if np.any(np.bitwise_or.reduce(np.take(grid, marks, axis=1) ^ expected, axis=0)):
+        return None
+    bounds = np.concatenate(([-1], seps, [width - 1]))
+    plans = []
+    for k in range(columns):
+        plan = _field_plan(first, int(bounds[k]) + 1, int(bounds[k + 1]))
+        if plan is None:
+            return None
+        plans.append(plan)
+    # every place that must hold a digit, in every row, checked at once
+    digit_at = np.array([j for plan in plans for j in plan["mantissa"] + plan["exponent"]], np.int64)
+    digits = np.take(grid, digit_at, axis=1)
+    digits -= np.uint8(ord("0"))
+    if digits.size and int(digits.max()) > 9:
+        return None
+    # the other places: the same character as in the first row (points, exponent marks)
+    fixed_at = np.array([j for plan in plans for j in plan["same"]], np.int64)
+    if fixed_at.size and np.any(
+        np.bitwise_or.reduce(np.take(grid, fixed_at, axis=1) ^ first[fixed_at], axis=0)
+    ):
+        return None
+    out = np.empty((rows, columns))
+    used = 0
+    for k, plan in enumerate(plans):
+        m, e = len(plan["mantissa"]), len(plan["exponent"])
+        block = digits[:, used : used + m + e]
+        used += m + e
+        values = block[:, :m] @ (10.0 ** np.arange(m - 1, -1, -1)) if m else np.zeros(rows)
+        head = grid[:, plan["head"]] if plan["head"] is not None else None
+        negative = None
+        if head is not None:  # a sign in some rows, a digit in others
+            head_digit = head - np.uint8(ord("0"))
+            is_digit = head_digit <= 9
+            if not np.all(is_digit | (head == ord("-")) | (head == ord("+"))):
+                return None
+            if m == 0 and not np.all(is_digit):
+                return None  # a sign without digits
+            values += np.where(is_digit, head_digit, 0) * 10.0**m
+            negative = head == ord("-")
+        scale = np.full(rows, -plan["frac"], np.int64)
+        if plan["exp_sign"] is not None or e:
+            exponent = (block[:, m:] @ (10 ** np.arange(e - 1, -1, -1))).astype(np.int64)
+            if plan["exp_sign"] is not None:
+                sign = grid[:, plan["exp_sign"]]
+                if not np.all((sign == ord("-")) | (sign == ord("+"))):
+                    return None
+                exponent[sign == ord("-")] *= -1
+            scale += exponent
+            if np.any(np.abs(scale) > 300):
+                return None
+            up = scale > 0
+            values[up] *= np.power(10.0, scale[up])
+            values[~up] /= np.power(10.0, -scale[~up])
+        elif plan["frac"]:
+            values /= 10.0 ** plan["frac"]
+        if negative is not None:
+            values[negative] *= -1.0
+        elif plan["negative"]:
+            values *= -1.0
+        out[:, k] = values
+    return out
+
+
+def _field_plan(first: np.ndarray, start: int, stop: int) -> dict[str, Any] | None:
+    """Where a fixed-width field's digits, point, exponent and sign are, from the first row."""
+    kinds = _CLASS[first[start:stop]].tolist()
+    width = len(kinds)
+    if width == 0 or width > 24:
+        return None
+    exp_at = kinds.index(_EXP) if _EXP in kinds else width
+    plan: dict[str, Any] = {
+        "mantissa": [],
+        "exponent": [],
+        "same": [],
+        "head": None,
+        "exp_sign": None,
+        "frac": 0,
+        "negative": False,
+    }
+    seen_dot = False
+    for j in range(exp_at):
+        kind = kinds[j]
+        if kind == _DIGIT:
+            if j == 0:
+                plan["head"] = start  # a digit here, a sign in other rows maybe
+            else:
+                plan["mantissa"].append(start + j)
+                plan["frac"] += seen_dot
+        elif kind == _DOT and not seen_dot:
+            seen_dot = True
+            plan["same"].append(start + j)
+        elif kind in (_MINUS, _PLUS) and j == 0:
+            plan["head"] = start
+        else:
+            return None
+    if exp_at < width:
+        plan["same"].append(start + exp_at)
+        j = exp_at + 1
+        if j < width and kinds[j] in (_MINUS, _PLUS):
+            plan["exp_sign"] = start + j
+            j += 1
+        rest = list(range(j, width))
+        if not 0 < len(rest) <= 3 or any(kinds[r] != _DIGIT for r in rest):
+            return None
+        plan["exponent"] = [start + r for r in rest]
+    if not plan["mantissa"] and plan["head"] is None:
+        return None
+    if len(plan["mantissa"]) > 16:
+        return None
+    return plan
 
 
 def _parse_chunk(a: np.ndarray, columns: int) -> np.ndarray | None:
@@ -94,7 +227,7 @@ def _parse_chunk(a: np.ndarray, columns: int) -> np.ndarray | None:
     fields = seps.size
     newlines = cls[seps] == _NEWLINE
     rows = int(np.count_nonzero(newlines))
-    if fields != rows * columns or not np.all(newlines[columns - 1:: columns]):
+    if fields != rows * columns or not np.all(newlines[columns - 1 :: columns]):
         return None
     field_of = np.cumsum(is_sep, dtype=np.int64)  # the field a byte belongs to (a separator ends it)
     starts = np.empty(fields, np.int64)

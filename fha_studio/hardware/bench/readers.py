@@ -329,14 +329,23 @@ def _rate_text(rate: float) -> str:
 
 def parse_sigrok_csv(data: bytes, name: str) -> Capture:
     """``sigrok-cli -O csv`` output (with or without the time column and the label row)."""
-    if b": " in data:  # libsigrok 0.5.2 prints analog samples as 'A0: 10.00 V DC' lines as well
+    # libsigrok 0.5.2 prints analog samples as 'A0: 10.00 V DC' lines as well (rows never hold ': ')
+    comments_end = 0
+    while data.startswith(b";", comments_end):
+        comments_end = data.find(b"\n", comments_end) + 1 or len(data)
+    if data.find(b": ", comments_end) >= 0:
         data = _SIGROK_ANALOG_LINE.sub(b"", data)
-    lines = data.split(b"\n")
+    lines = _head_lines(data)
     names: list[str] = []
     rate: float | None = None
-    index = 0
-    for index, raw in enumerate(lines):  # noqa: B007 - the index of the first data line is used
-        line = raw.strip()
+    index = -1
+    while True:
+        index += 1
+        if index == HEAD_LINES and len(lines) > HEAD_LINES:  # a long preamble: the file in lines after all
+            lines = data.split(b"\n")
+        if index >= len(lines):
+            break
+        line = lines[index].strip()
         if not line:
             continue
         if line.startswith(b";"):
@@ -352,13 +361,11 @@ def parse_sigrok_csv(data: bytes, name: str) -> Capture:
         if _SIGROK_ANALOG_LINE.match(line):
             continue  # libsigrok 0.5.2 prints live analog samples as 'A0: 1.0 V DC' lines too
         break
-    else:
-        index = len(lines)
     if not names:
         raise CaptureError(f"{name}: line 1: no '; Channels (n/m): ...' comment naming the channels")
     if rate is None:
         raise CaptureError(f"{name}: line 1: no '; Samplerate: ...' comment (like '1 MHz')")
-    first = lines[index].decode("utf-8", "replace").strip() if index < len(lines) else ""
+    first = _line(lines, index).decode("utf-8", "replace").strip() if index < len(lines) else ""
     labels = [c.strip() for c in first.split(",")]
     has_label_row = bool(first) and not all(_numbers_like(c) for c in labels)
     width = len(labels)
@@ -367,7 +374,7 @@ def parse_sigrok_csv(data: bytes, name: str) -> Capture:
         raise CaptureError(f"{name}: line {index + 1}: {width} columns, expected {len(names)} (the "
                            f"channels {', '.join(names)}) or one more for the time")
     start = index + 1 if has_label_row else index
-    table = _table(lines, start, width, name, b",")
+    table = _table(lines, start, width, name, b",", digits=True)
     values = table[:, 1:] if has_time else table
     units = labels[1:] if has_time and has_label_row else (labels if has_label_row else [""] * len(names))
     logic_names: list[str] = []
@@ -395,6 +402,29 @@ def parse_sigrok_csv(data: bytes, name: str) -> Capture:
     return Capture(name, block, unit_of, start_s, "sigrok CSV")
 
 
+#: The lines split off a CSV's start to find its header; the rest stays one piece (the rows).
+HEAD_LINES = 200
+
+
+def _head_lines(data: bytes) -> list[bytes]:
+    """The first HEAD_LINES lines, then the rest of the file as one element (joined back with
+    ``\n`` it is the file again); :func:`_all_lines` splits it when a line must be named."""
+    return data.split(b"\n", HEAD_LINES)
+
+
+def _line(lines: Sequence[bytes], i: int) -> bytes:
+    """Line ``i`` (of the rest of the file, its first line)."""
+    text = lines[i]
+    if i < HEAD_LINES:
+        return text
+    end = text.find(b"\n")
+    return text if end < 0 else text[:end]
+
+
+def _all_lines(lines: Sequence[bytes]) -> list[bytes]:
+    return b"\n".join(lines).split(b"\n") if len(lines) > HEAD_LINES else list(lines)
+
+
 def _sigrok_unit(label: str) -> str:
     # sigrok's unit labels: "V DC", "V AC", "A", ...: the unit is the first word
     return label.split()[0] if label.split() else "V"
@@ -411,6 +441,8 @@ def _time_unit_of_label(label: str, rate: float) -> float:
 
 
 def _is_bits(col: np.ndarray) -> bool:
+    if col.dtype == np.uint8:
+        return bool(col.size) and int(col.max()) <= 1
     return bool(col.size) and bool(np.all((col == 0) | (col == 1)))
 
 
@@ -420,13 +452,13 @@ def _numbers_like(text: str) -> bool:
 
 def parse_csv(data: bytes, name: str) -> Capture:
     """A generic CSV: header row, a time column, one analog channel per other column."""
-    lines = data.split(b"\n")
+    lines = _head_lines(data)
     index = _first_content_line(lines, 0, None)
     if index is None:
         raise CaptureError(f"{name}: line 1: empty: expected a header row naming the columns "
                            "(one of them the time)")
     try:
-        header_text = lines[index].decode("utf-8").strip().lstrip("\ufeff")
+        header_text = _line(lines, index).decode("utf-8").strip().lstrip("\ufeff")
     except UnicodeDecodeError:
         raise CaptureError(f"{name}: line {index + 1}: not UTF-8 text: is it a capture file?") from None
     delimiter = ";" if ";" in header_text else ("\t" if "\t" in header_text else ",")
@@ -439,7 +471,7 @@ def parse_csv(data: bytes, name: str) -> Capture:
     units: list[str] = [""] * len(header)
     data_start = index + 1
     if after is not None:
-        row = [c.strip().strip('"') for c in lines[after].decode("utf-8", "replace").split(delimiter)]
+        row = [c.strip().strip('"') for c in _line(lines, after).decode("utf-8", "replace").split(delimiter)]
         if row and not any(_numbers_like(c) for c in row if c) and len(row) == len(header):
             units = row  # a units row under the header ("s,V,V")
             data_start = after + 1
@@ -526,7 +558,7 @@ def _split_unit(text: str) -> tuple[str, str]:
 def _first_content_line(lines: Sequence[bytes], start: int, comment: str | None) -> int | None:
     marks = tuple(c.encode() for c in (comment if comment is not None else "#"))
     for i in range(start, len(lines)):
-        line = lines[i].strip()
+        line = _line(lines, i).strip()
         if line and not line.startswith(marks) and not line.startswith(b"//"):
             return i
     return None
@@ -534,29 +566,35 @@ def _first_content_line(lines: Sequence[bytes], start: int, comment: str | None)
 
 def _has_decimal_comma(lines: Sequence[bytes], start: int) -> bool:
     for i in range(start, min(len(lines), start + 50)):
-        line = lines[i].strip()
+        line = _line(lines, i).strip()
         if line and not line.startswith(b"#"):
             return b"," in line
     return False
 
 
 def _table(lines: Sequence[bytes], start: int, width: int, name: str, delimiter: bytes,
-           decimal_comma: bool = False, comment: str = ";") -> np.ndarray:
+           decimal_comma: bool = False, comment: str = ";", digits: bool = False) -> np.ndarray:
     """The numeric rows from line index ``start`` on, as ``(rows, width)`` float64."""
     marks = tuple(c.encode() for c in comment)
     body_lines = lines[start:]
     data = b"\n".join(body_lines)
     # comment and empty lines inside the rows are taken out (rarely there: the fast path is whole)
     if any(m in data for m in marks) or b"\n\n" in data or data.startswith(b"\n"):
-        data = b"\n".join(ln for ln in body_lines if ln.strip() and not ln.lstrip().startswith(marks))
+        data = b"\n".join(ln for ln in _all_lines(body_lines)
+                          if ln.strip() and not ln.lstrip().startswith(marks))
     if delimiter == b";":
         data = data.translate(_numbers.SEMICOLON_DECIMAL_COMMA if decimal_comma else _numbers.SEMICOLON)
     elif delimiter == b"\t":
         data = data.translate(_numbers.TAB)
-    data = data.strip(b"\n") + b"\n" if data.strip() else b""
-    table = _numbers.parse_rows(data, width)
+    if data.startswith(b"\n"):
+        data = data.lstrip(b"\n")
+    if data and not data.endswith(b"\n"):
+        data += b"\n"
+    if data.endswith(b"\n\n"):
+        data = data.rstrip(b"\n") + b"\n"
+    table = _numbers.parse_rows(data, width, digits=digits)
     if table is None:
-        _find_bad_row(lines, start, width, name, delimiter, decimal_comma, marks)
+        _find_bad_row(_all_lines(lines), start, width, name, delimiter, decimal_comma, marks)
         raise CaptureError(f"{name}: line {start + 1}: the rows are not numbers in {width} columns")
     return table
 
@@ -583,6 +621,7 @@ def _find_bad_row(lines: Sequence[bytes], start: int, width: int, name: str, del
 
 def _data_line(lines: Sequence[bytes], start: int, row: int, comment: str = ";") -> int:
     marks = tuple(c.encode() for c in comment)
+    lines = _all_lines(lines)
     seen = -1
     for i in range(start, len(lines)):
         line = lines[i].strip()

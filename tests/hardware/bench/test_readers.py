@@ -151,6 +151,13 @@ def test_the_vectorised_number_parser_reads_as_float_does():
     for bad in ("1,a\n", "1.2.3,4\n", "-,1\n", "1e,2\n", "1 2,3\n", "1-2,3\n", "1,2,3\n", "1e+,2\n"):
         assert parse_rows(bad.encode(), 2) is None, bad
     assert np.array_equal(parse_rows(b" 1 ,\t-2.5e+1\r\n", 2), [[1.0, -25.0]])
+    # rows of one length (fields in fixed places) take the column-wise path: the same numbers
+    fixed = "".join(f"{a:+09.3f},{b:.4e},{c:08d}\n" for a, b, c in
+                    zip(values[:1000], values[1000:2000], range(1000), strict=True))
+    expected = [[float(x) for x in line.split(",")] for line in fixed.splitlines()]
+    assert np.array_equal(parse_rows(fixed.encode(), 3), expected)
+    for bad in ("1,-\n2,3\n", "1.2.,3\n4.5.,6\n", "1e5,1\n1x5,1\n"):
+        assert parse_rows(bad.encode(), 2) is None, bad
 
 
 def test_sigrok_rates_and_blocks():
