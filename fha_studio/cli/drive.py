@@ -24,6 +24,7 @@ from typing import Any
 
 from fha_studio import fileio
 from fha_studio.cli import CliError
+from fha_studio.hardware.protocol import BAUD_RATES, BAUDRATE
 
 ORDER = 35
 
@@ -63,7 +64,9 @@ def register(subparsers: Any) -> None:
 
     def common(p: argparse.ArgumentParser, actuator_required: bool = False) -> None:
         p.add_argument("--url", required=True, help="the drive: /dev/ttyUSB0, a pty path, socket://host:port")
-        p.add_argument("--baud", type=int, default=19200, help="baud rate (default %(default)s, CN3's)")
+        p.add_argument("--baud", type=int, default=BAUDRATE, choices=BAUD_RATES, metavar="RATE",
+                       help="baud rate (default %(default)s, CN3's; one of "
+                       f"{', '.join(map(str, BAUD_RATES))})")
         p.add_argument("--actuator", required=actuator_required, metavar="CODE",
                        help="actuator model code (its ratio scales the position), e.g. FHA-25C-50-S248")
 
@@ -164,7 +167,7 @@ def _no_answer(url: str, exc: Exception, bounded: Any) -> str:
                 "power)")
     if isinstance(exc, DeadlinePassed) or "no drive answers" in str(exc) or "no reply" in str(exc):
         return (f"no drive answers on {url}: {heard} bytes arrived but no usable reply (check the baud "
-                "rate, 19200 8N1, and that this is the drive's CN3 port)")
+                f"rate, {BAUDRATE} 8N1, and that this is the drive's CN3 port)")
     return f"the link to {url} failed: {exc}"
 
 

@@ -1,5 +1,7 @@
 """``fha-studio gui``: listed here so that ``--help`` shows it; the entry point (fha_studio.main)
-starts the GUI itself, because the CLI never imports Qt."""
+starts the GUI itself, because the CLI never imports Qt. Its options are the GUI's own parser's
+(fha_studio.gui.app), which ``fha-studio gui --help`` shows: none are repeated here, where nothing
+would read them."""
 
 from __future__ import annotations
 
@@ -14,13 +16,9 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "gui",
         help="the commissioning GUI (also without a command, e.g. fha-studio --url /dev/ttyUSB0)",
-        description="Start the GUI. Without --url it connects to the embedded simulated drive.",
+        description="Start the GUI. Its options (--url, --baud, --page, --machine, ...): "
+        "fha-studio gui --help.",
     )
-    p.add_argument("--url", help="drive to connect to at start: a serial device, a pty path, "
-                   "socket://host:port or sim://ACTUATOR-CODE?...")
-    p.add_argument("--baud", type=int, help="baud rate of a serial link (default 19200; 1200 ... 115200)")
-    p.add_argument("--no-connect", action="store_true", help="start without connecting")
-    p.add_argument("--page", help="page to show first")
     p.set_defaults(func=run)
 
 

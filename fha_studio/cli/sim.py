@@ -20,6 +20,7 @@ from fha_studio import plausible
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.cli import CliError
 from fha_studio.cli._values import in_range, output_path, tcp_port, text
+from fha_studio.hardware.protocol import BAUDRATE
 
 if TYPE_CHECKING:
     from fha_studio.hardware.api import SimPanel
@@ -54,7 +55,7 @@ def register(subparsers: Any) -> None:
                    help="fit or leave out the option-L sensor set (default: option L of the code)")
     p.add_argument("--eeprom", metavar="PATH",
                    help="EEPROM file (default: the user data directory, one file per driver and actuator)")
-    p.add_argument("--unpaced", action="store_true", help="reply at memory speed instead of 19200 baud")
+    p.add_argument("--unpaced", action="store_true", help=f"reply at memory speed instead of {BAUDRATE} baud")
     p.add_argument("--oww-seconds", type=in_range(plausible.OWW_CLEAR_S), metavar="S",
                    help=f"how long OWW takes (default 5 s; {plausible.OWW_CLEAR_S.allowed()})")
     p.add_argument("--profile", choices=("full", "documented"), default="full",

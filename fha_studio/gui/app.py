@@ -11,6 +11,7 @@ from typing import Any, NoReturn
 
 from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.session import DEFAULT_SIM_URL
+from fha_studio.hardware.protocol import BAUD_RATES, BAUDRATE
 
 ORGANISATION = "FHA Studio"
 APPLICATION = "fha-studio"
@@ -20,10 +21,6 @@ APPLICATION = "fha-studio"
 #: every polled sample (a 1-item sample takes 7 ms on the line). 0.5 ms bounds that wait; the
 #: extra switches cost nothing measurable (benchmarks/scope_throughput.py).
 GIL_SWITCH_INTERVAL_S = 0.0005
-
-
-#: Baud rates a serial port may be opened at (CN3 runs at 19200; pyserial's standard rates).
-BAUD_RATES = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
 
 
 class _OneLineParser(argparse.ArgumentParser):
@@ -68,8 +65,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--baud",
         type=_baud,
-        default=19200,
-        help=f"baud rate of a serial link (default 19200; {', '.join(map(str, BAUD_RATES))})",
+        default=BAUDRATE,
+        help=f"baud rate of a serial link (default {BAUDRATE}, CN3's; one of "
+        f"{', '.join(map(str, BAUD_RATES))})",
     )
     parser.add_argument("--no-connect", action="store_true", help="start without connecting")
     parser.add_argument(

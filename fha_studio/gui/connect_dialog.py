@@ -18,9 +18,7 @@ from PySide6.QtWidgets import (
 
 from fha_studio.catalog import DEFAULT_ACTUATOR, all_model_codes
 from fha_studio.gui.forms import child, load_form
-
-BAUD_RATES = (9600, 19200, 38400, 57600, 115200)
-DEFAULT_BAUD = 19200
+from fha_studio.hardware.protocol import BAUD_RATES, BAUDRATE
 
 
 def list_serial_ports() -> list[tuple[str, str]]:
@@ -80,6 +78,9 @@ class ConnectDialog(QDialog):
         self.sim_actuator.addItems(catalogue_codes())
         for rate in BAUD_RATES:
             self.baud_combo.addItem(str(rate), rate)
+        if len(BAUD_RATES) == 1:  # nothing to choose: say why
+            self.baud_combo.setEnabled(False)
+            self.baud_combo.setToolTip(f"CN3 runs at {BAUDRATE} bit/s and at no other rate")
         self.refresh_button.clicked.connect(lambda: self.refresh_ports())
         self.port_combo.activated.connect(lambda: self.serial_radio.setChecked(True))
         self.address_edit.textEdited.connect(lambda: self.address_radio.setChecked(True))
@@ -111,7 +112,7 @@ class ConnectDialog(QDialog):
         if index >= 0:
             self.port_combo.setCurrentIndex(index)
         self.address_edit.setText(str(settings.value("connect/address", "")))
-        baud = int(str(settings.value("connect/baud", DEFAULT_BAUD)))
+        baud = int(str(settings.value("connect/baud", BAUDRATE)))
         self.baud_combo.setCurrentIndex(max(0, self.baud_combo.findData(baud)))
         {"serial": self.serial_radio, "address": self.address_radio}.get(kind, self.sim_radio).setChecked(
             True
@@ -151,7 +152,7 @@ class ConnectDialog(QDialog):
         return sim_url(self.sim_actuator.currentText(), self.load_inertia_kgm2)
 
     def baud_rate(self) -> int:
-        return int(self.baud_combo.currentData() or DEFAULT_BAUD)
+        return int(self.baud_combo.currentData() or BAUDRATE)
 
     @Slot()
     def _accept(self) -> None:

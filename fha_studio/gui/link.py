@@ -37,7 +37,7 @@ from fha_studio.hardware.api import (
 )
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import Mode, MonitorItem
-from fha_studio.hardware.protocol import EXTENSION_COMMANDS, Command, IoBit
+from fha_studio.hardware.protocol import BAUDRATE, EXTENSION_COMMANDS, Command, IoBit
 from fha_studio.hardware.sim.options import public_url
 from fha_studio.hardware.transaction import LinkSettings
 from fha_studio.logic.absolute import SERVO_ON_TEXT, refusal_text
@@ -211,7 +211,7 @@ class DriveStatus:
 OpenClient = Callable[[str, int], DriveApi]
 
 
-def link_settings(baud_rate: int = 19200) -> LinkSettings:
+def link_settings(baud_rate: int = BAUDRATE) -> LinkSettings:
     """The link worker's settings: short timeouts, so a dead link shows within a second or two
     (one retry of 0.25 s); every call ends within ``transaction_limit_s`` whatever the line does."""
     return LinkSettings(baudrate=baud_rate, response_timeout_s=0.25, retries=1)
@@ -382,7 +382,7 @@ class LinkWorker(QObject):
         return DriveClient.open(url, link_settings(baud_rate), should_abort=self._abandon)
 
     # -- commands -----------------------------------------------------------------------------
-    def _do_open(self, url: str, baud_rate: int = 19200) -> LinkInfo:
+    def _do_open(self, url: str, baud_rate: int = BAUDRATE) -> LinkInfo:
         if self._client is not None:
             self._shut(stop_axis=True)
             self.sigDisconnected.emit("switched to another drive", False)
@@ -759,7 +759,7 @@ class LinkController(QObject):
         self.sigCommand.emit(LinkCommand(cmd, tuple(args), token))
         return token
 
-    def open(self, url: str, baud_rate: int = 19200) -> int:
+    def open(self, url: str, baud_rate: int = BAUDRATE) -> int:
         return self.send(Cmd.OPEN, url, baud_rate)
 
     def close_link(self) -> int:

@@ -33,6 +33,7 @@ from fha_studio.gui.pages.registry import PAGES, PageEntry
 from fha_studio.gui.session import Session, new_axis_state
 from fha_studio.gui.state import AxisState
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton
+from fha_studio.hardware.protocol import BAUDRATE
 from fha_studio.logic.commissioning import CommissioningState
 
 log = logging.getLogger(__name__)
@@ -312,7 +313,7 @@ class MainWindow(QMainWindow):
         # the session says "Nothing written: ..." when a write it was asked for did not happen
         self.show_message(text, Level.WARNING if text.startswith("Nothing written") else Level.INFO)
 
-    def connect_to(self, url: str | None = None, baud_rate: int = 19200) -> bool:
+    def connect_to(self, url: str | None = None, baud_rate: int = BAUDRATE) -> bool:
         """Connects (after asking, when the axis is live); False when the user said no. Without a
         URL: the embedded simulated drive, carrying the axis's declared load inertia."""
         if url is None:

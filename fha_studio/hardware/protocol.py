@@ -42,6 +42,10 @@ MAX_LINE_CHARS = 200
 
 #: Line settings of CN3 (HA-655 manual p.20): 19200 bit/s, 8N1 = 10 bits per character.
 BAUDRATE = 19200
+#: The baud rates FHA Studio opens a serial link at (the GUI's --baud and connect dialog, the
+#: drive command's --baud): CN3 runs at BAUDRATE and at no other rate (HA-655 manual p.20), so
+#: this is the one; a drive documented to run at others adds them here, in one place.
+BAUD_RATES: tuple[int, ...] = (BAUDRATE,)
 BITS_PER_CHARACTER = 10
 
 

@@ -53,3 +53,18 @@ def test_abbreviated_options_are_unknown(args, capsys):
     assert exit_.value.code == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
+
+
+def test_the_cli_lists_gui_without_options_of_its_own_and_gui_help_is_the_guis(capsys):
+    """The entry point hands ``fha-studio gui ...`` to the GUI's parser: an option on the CLI's
+    ``gui`` entry would be shown by no help and read by nothing."""
+    from fha_studio.gui.app import _parser as gui_parser
+
+    (gui,) = [sub for name, sub in _every_parser(build_parser()) if name == "fha-studio gui"]
+    assert [a.option_strings for a in gui._actions] == [["-h", "--help"]]
+    with pytest.raises(SystemExit):
+        main(["gui", "--help"])
+    shown = capsys.readouterr().out
+    for action in gui_parser()._actions:
+        if action.help != argparse.SUPPRESS:
+            assert all(option in shown for option in action.option_strings)

@@ -677,7 +677,7 @@ class MoveTest:
         status = self.trace.status()
         if status.state is p.TraceState.DONE and self.state_text.startswith("moving"):
             self.state_text = (f"reading out {status.count} samples (about "
-                               f"{self.trace.readout_estimate_s(status.count):.0f} s at 19200 bit/s)")
+                               f"{self.trace.readout_estimate_s(status.count):.0f} s at {p.BAUDRATE} bit/s)")
         elif status.state is p.TraceState.DONE:
             self._analyse(self.trace.read(self.should_abort, self.progress))
         elif self.clock() > self._deadline:

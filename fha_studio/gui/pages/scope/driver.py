@@ -24,7 +24,7 @@ from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
 from fha_studio.hardware.api import DriveApi
 from fha_studio.hardware.errors import LinkError, ReadAborted
-from fha_studio.hardware.protocol import TraceState
+from fha_studio.hardware.protocol import BAUDRATE, TraceState
 from fha_studio.logic.scope.acquisition import (
     LiveMode,
     LiveStatus,
@@ -278,7 +278,7 @@ class ScopeDriver(QObject):
         if status.state is TraceState.DONE:
             seconds = trace.readout_estimate_s(status.count)
             self.sigTraceState.emit(f"reading out {status.count} samples (about {seconds:.0f} s at "
-                                    "19200 bit/s)")
+                                    f"{BAUDRATE} bit/s)")
             self._trace = None
             try:
                 result = trace.read(self._should_abort, self._report_progress)
