@@ -28,6 +28,7 @@ import os
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy import signal as _signal
@@ -35,6 +36,9 @@ from scipy import signal as _signal
 from fha_studio.hardware.bench import writers
 from fha_studio.hardware.bench.capture import SampleBlock, join_blocks, pack_logic
 from fha_studio.physics import ServoAxis
+
+if TYPE_CHECKING:
+    from fha_studio.hardware.sim.drive import SimDrive
 
 LOGIC_CHANNELS = ("ENC_A", "ENC_B", "ENC_Z", "CMD_A", "CMD_B", "IN_POS", "ALARM")
 ANALOG_CHANNELS = ("SPD_MON",)
@@ -225,8 +229,9 @@ def _quadrature_levels(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class VirtualBenchInstrument:
     """A logic analyzer with one analog input on the simulated drive's CN2.
 
-    It advances ``axis`` itself (the caller commands moves between calls, e.g. through
-    ``actions``), tracing every servo period.
+    It advances ``axis`` itself, or the drive through ``advance`` (a stepped
+    :class:`~fha_studio.hardware.sim.drive.SimDrive`'s, :meth:`on_drive`), tracing every servo
+    period; the caller commands moves between calls.
     """
 
     def __init__(
@@ -236,8 +241,10 @@ class VirtualBenchInstrument:
         settings: Cn2Settings | None = None,
         *,
         alarm: Callable[[], bool] | None = None,
+        advance: Callable[[float], None] | None = None,
     ):
         self.axis = axis
+        self._advance = advance
         self.settings = settings or Cn2Settings()
         model = axis.model
         self.signals = Cn2Signals(
@@ -263,17 +270,41 @@ class VirtualBenchInstrument:
         total = max(1, round(seconds / self.axis.servo_period_s))
         if self.signals._last is None:
             self.axis.start_trace(1)
-            self.axis.step(1)  # the first trace point: where the axis is now
+            self._step(1)  # the first trace point: where the axis is now
         done = 0
         while done < total:
             n = min(periods, total - done)
-            self.axis.step(n)
+            self._step(n)
             done += n
             block, truth = self.signals.feed(self.axis.read_trace(clear=True), self.alarm())
             if block.samples:
                 for name, values in truth.items():
                     getattr(self.truth, name).append(values)
                 yield block
+
+    def _step(self, periods: int) -> None:
+        if self._advance is None:
+            self.axis.step(periods)
+        else:
+            self._advance(periods * self.axis.servo_period_s)
+
+    @classmethod
+    def on_drive(
+        cls, drive: SimDrive, sample_rate_hz: float, monitor: MonitorModel | None = None
+    ) -> VirtualBenchInstrument:
+        """The instrument on a stepped simulated drive's CN2: its parameters 1, 2 and 9, its
+        resolution, its alarm; the drive's time advances as the instrument records."""
+        model = drive.axis.model
+        settings = Cn2Settings(
+            counts_per_motor_turn=round(model.output_resolution_ppr / (model.ratio or 1)),
+            pulse_form=drive.memory.value("command_pulse_configuration"),
+            multiplication=drive.memory.value("two_phase_pulse_multiplication"),
+            speed_conversion_rpm=float(drive.memory.value("speed_conversion_factor")),
+            monitor=monitor or MonitorModel(),
+        )
+        return cls(
+            drive.axis, sample_rate_hz, settings, alarm=lambda: bool(drive.alarm), advance=drive.advance
+        )
 
     def record(self, seconds: float) -> SampleBlock:
         """Run for ``seconds`` and keep what was sampled; returns everything kept so far."""

@@ -142,3 +142,50 @@ def test_a_capture_too_slow_for_the_encoder_is_refused_with_both_figures(drive, 
         import_bench(signals, AxisFacts.for_actuator(CODE), _settings())
     text = str(err.value)
     assert "25 kHz" in text and "r/min" in text and "kHz of edges" in text and "\n" not in text
+
+
+def test_the_simulated_drive_on_the_documented_profile_through_the_instrument(tmp_path):
+    """A stepped SimDrive whose CN3 is silent in motion (documented profile): the controller's
+    pulse train moves it, the instrument samples CN2, and the import gives its counts back."""
+    from fha_studio.hardware.sim.drive import SimDrive
+
+    drive = SimDrive(CODE, profile="documented", stepped=True, eeprom=str(tmp_path / "eeprom.json"))
+    try:
+        instrument = VirtualBenchInstrument.on_drive(drive, 400e3)
+        drive.set_servo(True)
+        instrument.record(0.03)
+        drive.set_move_speed(10.0)
+        drive.controller_command(12.0)
+        blocks = list(instrument.stream(0.6, block_s=0.02))  # as a live stream delivers it
+        assert [b.first_sample for b in blocks[1:]] == [a.first_sample + a.samples for a in blocks[:-1]]
+        instrument._blocks.extend(blocks)
+        instrument.write(tmp_path / "cn2.sr", "sr")
+        signals = [SignalSpec(role, str(tmp_path / "cn2.sr"), channel) for role, channel in CHANNELS.items()]
+        values = {
+            ("system", n): drive.memory.value(key)
+            for n, key in (
+                (1, "command_pulse_configuration"),
+                (2, "two_phase_pulse_multiplication"),
+                (3, "electronic_gear_numerator"),
+                (4, "electronic_gear_denominator"),
+                (9, "speed_conversion_factor"),
+            )
+        }
+        result = import_bench(signals, AxisFacts.for_actuator(CODE), DriveSettings.from_values(values))
+        truth = instrument.truth.arrays()
+        assert truth["encoder_counts"][-1] == drive.axis.feedback_pulses
+        assert np.array_equal(
+            result.decoded.encoder.counts, truth["encoder_counts"] - truth["encoder_counts"][0]
+        )
+        assert result.summary["command_counts"] == drive.axis.command_pulses == round(12.0 / 360 * 500000)
+        assert abs(result.recording.pos_deg[-1] - 12.0) < 0.01
+        recording = result.recording
+        idx = np.rint(recording.t_s * instrument.sample_rate_hz).astype(int)
+        sums = np.concatenate(([0.0], np.cumsum(truth["motor_rpm"] / 50.0)))
+        ends = np.append(idx[1:], truth["motor_rpm"].size)
+        expected = (sums[ends] - sums[idx]) / (ends - idx)
+        peak = float(np.max(np.abs(expected)))
+        assert peak > 9.0
+        assert float(np.max(np.abs(recording.vel_rpm - expected))) < 0.01 * peak
+    finally:
+        drive.close()
