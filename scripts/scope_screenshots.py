@@ -1,15 +1,24 @@
 """Screenshots of the scope page in the real main window against the embedded simulated drive.
 
 Run: xvfb-run -a -s "-screen 0 1366x768x24" python scripts/scope_screenshots.py [OUTDIR]
-(the images in docs/screenshots/scope-*.png come from it; OUTDIR defaults to docs/screenshots)."""
+(the images in docs/screenshots/scope-*.png come from it; OUTDIR defaults to docs/screenshots).
+Settings and data go to a temporary directory, never the user's (as the tests' and the other
+screenshot scripts')."""
+import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
-from PySide6.QtCore import QCoreApplication, QEventLoop, QTimer
-from PySide6.QtWidgets import QApplication
+TMP = tempfile.mkdtemp(prefix="fha-scope-shots-")
+os.environ["XDG_CONFIG_HOME"] = f"{TMP}/config"
+os.environ["XDG_DATA_HOME"] = f"{TMP}/data"
+os.environ.pop("FHA_STUDIO_REGISTER", None)
 
-from fha_studio.hardware import protocol as p
+from PySide6.QtCore import QCoreApplication, QEventLoop, QTimer  # noqa: E402
+from PySide6.QtWidgets import QApplication  # noqa: E402
+
+from fha_studio.hardware import protocol as p  # noqa: E402
 
 OUT = sys.argv[1] if len(sys.argv) > 1 else str(Path(__file__).resolve().parents[1] / "docs" / "screenshots")
 app = QApplication([])
