@@ -133,20 +133,27 @@ def _fixed_width_fields(data: bytes, columns: int) -> np.ndarray | None:
         m, e = len(plan["mantissa"]), len(plan["exponent"])
         block = digits[:, used : used + m + e]
         used += m + e
-        values = block[:, :m] @ (10.0 ** np.arange(m - 1, -1, -1)) if m else np.zeros(rows)
-        head = grid[:, plan["head"]] if plan["head"] is not None else None
+        values = np.zeros(rows)
+        for j in range(m):  # Horner over the places, one column at a time
+            if j:
+                values *= 10.0
+            values += block[:, j]
+        head_at = plan["head"]
         negative = None
-        if head is not None:  # a sign in some rows, a digit in others
+        if head_at is not None:  # a digit here, or a sign in some rows
+            head = grid[:, head_at]
             head_digit = head - np.uint8(ord("0"))
-            is_digit = head_digit <= 9
-            if not np.all(is_digit | (head == ord("-")) | (head == ord("+"))):
-                return None
-            if m == 0 and not np.all(is_digit):
-                return None  # a sign without digits
-            values += np.where(is_digit, head_digit, 0) * 10.0**m
-            negative = head == ord("-")
-        scale = np.full(rows, -plan["frac"], np.int64)
+            if int(head_digit.max()) > 9:
+                if m == 0:
+                    return None  # a sign without digits
+                negative = head == ord("-")
+                signed = negative | (head == ord("+"))
+                if not np.all(signed | (head_digit <= 9)):
+                    return None
+                head_digit[signed] = 0
+            values += head_digit * 10.0**m
         if plan["exp_sign"] is not None or e:
+            scale = np.full(rows, -plan["frac"], np.int64)
             exponent = (block[:, m:] @ (10 ** np.arange(e - 1, -1, -1))).astype(np.int64)
             if plan["exp_sign"] is not None:
                 sign = grid[:, plan["exp_sign"]]
@@ -162,7 +169,7 @@ def _fixed_width_fields(data: bytes, columns: int) -> np.ndarray | None:
         elif plan["frac"]:
             values /= 10.0 ** plan["frac"]
         if negative is not None:
-            values[negative] *= -1.0
+            np.negative(values, out=values, where=negative)
         elif plan["negative"]:
             values *= -1.0
         out[:, k] = values
