@@ -1,0 +1,66 @@
+"""The bench source of the scope on sigrok-cli's demo driver: rows through the ring, drained by
+the GUI timer, labelled with their source; stop, an instrument that vanishes, a refusal."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+
+import numpy as np
+import pytest
+
+from fha_studio.gui.pages.scope.bench_source import BenchSettings, BenchSource, rows_as_columns
+
+pytestmark = pytest.mark.skipif(shutil.which("sigrok-cli") is None, reason="sigrok-cli is not installed")
+
+
+@pytest.fixture
+def source(qtbot):
+    made = BenchSource()
+    yield made
+    made.shutdown()
+
+
+def _rows_until(qtbot, source, count):
+    got = []
+    source.sigRows.connect(got.append)
+    qtbot.waitUntil(lambda: sum(len(r) for r in got) >= count, timeout=10000)
+    return got
+
+
+def test_a_stream_comes_through_the_ring_at_the_display_rate_and_stops_cleanly(qtbot, source):
+    with qtbot.waitSignal(source.sigStarted, timeout=10000) as started:
+        source.start(BenchSettings("demo", ("D1", "D4"), 2e6))
+    info = source.started
+    assert info is not None and started.args[0] is info
+    assert info.labels == ("demo:D1", "demo:D4") and info.sample_rate_hz == 2e6 and info.row_rate_hz == 1e4
+    got = _rows_until(qtbot, source, 2000)
+    with qtbot.waitSignal(source.sigStopped, timeout=10000) as stopped:
+        source.stop()
+    assert stopped.args == [""] and not source.running
+    rows = np.concatenate(got)
+    assert np.allclose(np.diff(rows[:, 0]), 1e-4)  # no row lost or doubled between drains
+    columns = rows_as_columns(info, rows)
+    assert set(np.unique(columns["demo:D1"])) <= {0.0, 1.0}  # high if high anywhere in a window
+    assert source.status is not None and source.status.dropped == 0
+
+
+def test_an_instrument_that_vanishes_is_said_and_what_came_stays(qtbot, source):
+    with qtbot.waitSignal(source.sigStarted, timeout=10000):
+        source.start(BenchSettings("demo", ("D0",), 1e6))
+    got = _rows_until(qtbot, source, 1000)
+    acquisition = source.worker._acquisition
+    assert acquisition is not None and acquisition._process is not None
+    with qtbot.waitSignal(source.sigStopped, timeout=10000) as stopped:
+        os.kill(acquisition._process.pid, signal.SIGKILL)
+    assert "demo: the instrument stopped sending" in stopped.args[0]
+    assert sum(len(r) for r in got) >= 1000 and source.started is not None
+    assert len(source.started.ring) >= 1000  # the ring still holds what came
+
+
+def test_a_channel_the_instrument_lacks_is_refused_in_one_line(qtbot, source):
+    with qtbot.waitSignal(source.sigStopped, timeout=10000) as stopped:
+        source.start(BenchSettings("demo", ("D9",), 1e6))
+    assert stopped.args[0].startswith("demo: no channel D9") and "\n" not in stopped.args[0]
+    assert source.started is None and not source.running
