@@ -3,7 +3,8 @@
 - :func:`quadrature`: encoder A/B counted x4 (A leading B = forward, + counts); an edge where
   both phases changed at once is an *illegal transition* (counted, not counted as motion); a
   state that returns within :data:`GLITCH_SAMPLES` samples is a *glitch* (counted; its counts
-  cancel).
+  cancel). An encoder resting on an edge can dither as fast (the simulated one does, having no
+  comparator hysteresis): such glitches at standstill are not lost counts.
 - :func:`z_check`: every Z pulse must come at the same count modulo the counts per motor turn
   (within :data:`Z_TOLERANCE_COUNTS`).
 - :func:`command_pulses`: the command pulse lines by parameter 1 (0 two-pulse: FWD pulses on
