@@ -19,10 +19,14 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import json
+import math
 import os
 import stat
 import tempfile
+import tomllib
 from pathlib import Path
+from typing import Any
 
 #: Default bound on what a reader reads: far above any file FHA Studio writes or reads as input
 #: (parameter, session, model and EEPROM files are kilobytes), so a larger file is not one of ours.
@@ -286,3 +290,62 @@ class PartialFile:
             fd, self._fd = self._fd, None
             with contextlib.suppress(OSError):
                 os.close(fd)
+
+
+# ------------------------------------------------------------------------------------------- parsing
+
+#: The deepest nesting of tables and lists an input file may have: FHA Studio's own files go
+#: four levels deep (a session's runs.ID.records[N].value); far deeper is not one of ours, and
+#: Python's parsers (and whatever walks the result) would exhaust the stack on it.
+MAX_DEPTH = 32
+
+
+class NestedTooDeep(tomllib.TOMLDecodeError):
+    """A TOML or JSON text nested deeper than :data:`MAX_DEPTH` (a ``TOMLDecodeError``, so that
+    the readers' own refusals of a broken file take it too)."""
+
+
+def _too_deep() -> NestedTooDeep:
+    return NestedTooDeep(f"nested more than {MAX_DEPTH} levels deep")
+
+
+def _check_depth(data: object) -> None:
+    stack: list[tuple[object, int]] = [(data, 0)]
+    while stack:
+        item, depth = stack.pop()
+        if isinstance(item, dict | list):
+            if depth >= MAX_DEPTH:
+                raise _too_deep()
+            children = item.values() if isinstance(item, dict) else item
+            stack.extend((child, depth + 1) for child in children)
+
+
+def parse_toml(text: str) -> dict[str, Any]:
+    """``tomllib.loads`` bounded in depth: :class:`NestedTooDeep` (a TOMLDecodeError) for a text
+    nested deeper than :data:`MAX_DEPTH`, instead of a RecursionError."""
+    try:
+        data = tomllib.loads(text)
+    except RecursionError:
+        raise _too_deep() from None
+    _check_depth(data)
+    return data
+
+
+def parse_json(text: str) -> Any:
+    """``json.loads`` bounded in depth (:class:`NestedTooDeep`, a ValueError), and strict about
+    numbers: ``NaN``, ``Infinity`` and a number too large for a float (``1e999``) are refused."""
+    def constant(name: str) -> float:
+        raise ValueError(f"{name} is not a number in a file")
+
+    def number(text: str) -> float:
+        value = float(text)
+        if not math.isfinite(value):
+            raise ValueError(f"the number {text[:40]} is too large")
+        return value
+
+    try:
+        data = json.loads(text, parse_constant=constant, parse_float=number)
+    except RecursionError:
+        raise _too_deep() from None
+    _check_depth(data)
+    return data

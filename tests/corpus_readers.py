@@ -56,6 +56,19 @@ def read_capture(path: Path) -> None:
     read_capture(path)
 
 
+def read_import(path: Path) -> None:
+    """Imports the file into a fresh register (session or parameter file, as `register import`)."""
+    import tempfile
+
+    from fha_studio.logic.register import Register, import_parameter_file, import_session_file
+
+    with tempfile.TemporaryDirectory() as folder, Register(Path(folder) / "r.sqlite") as register:
+        if path.suffix == ".json":
+            import_session_file(register, path, "Press 7", "feed")
+        else:
+            import_parameter_file(register, path, "Press 7", "feed")
+
+
 READERS = {
     "capture": read_capture,
     "recording": read_recording,
@@ -65,4 +78,5 @@ READERS = {
     "model": read_model,
     "machine": read_machine,
     "register": read_register,
+    "import": read_import,
 }

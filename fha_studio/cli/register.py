@@ -560,7 +560,9 @@ def _import(args) -> int:
     from fha_studio.logic.register import import_parameter_file, import_session_file
 
     results = []
-    with _open_register(args) as reg:
+    lines: list[str] = []
+    # every file into one transaction: a refused file leaves nothing of the others either
+    with _open_register(args) as reg, reg.batch():
         for path in args.files:
             if not path.is_file():
                 raise CliError(f"import: {path}: no such file")
@@ -583,17 +585,15 @@ def _import(args) -> int:
                     "not_taken": list(result.not_taken),
                 }
             )
-            if not args.json:
-                print(f"{path} -> {result.axis.ref}: {what}")
-                for line in result.not_taken:
-                    print(f"  not taken: {line}")
+            lines.append(f"{path} -> {result.axis.ref}: {what}")
+            lines.extend(f"  not taken: {line}" for line in result.not_taken)
+    if not args.json:
+        print("\n".join(lines))
     if args.json:
         _print_json(results)
     return 0
 
 
 def _is_session(path: Path) -> bool:
-    """A session file is JSON (starts with '{'); a parameter file is TOML."""
-    with path.open("rb") as fh:
-        head = fh.read(256).lstrip()
-    return head.startswith(b"{")
+    """A session file is JSON (starts with '{', after a byte-order mark); a parameter file is TOML."""
+    return fileio.read_text(path).lstrip().startswith("{")  # a regular file, bounded

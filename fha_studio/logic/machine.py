@@ -19,10 +19,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fha_studio import fileio
+from fha_studio import fileio, names, plausible
 from fha_studio.logic.commissioning import CommissioningState
+from fha_studio.names import quoted
 
 FORMAT = "fha-machine/1"
+
+
+#: The text fields of a machine file, and of each of its axes (load_inertia_kgm2 is a number).
+MACHINE_FIELDS = ("name", "site", "notes")
+AXIS_FIELDS = ("name", "actuator_code", "driver_model", "port_url", "notes", "serial_number", "session_file")
+#: The longest text field a machine file may hold (notes); names are shorter (fha_studio.names).
+MAX_FIELD_TEXT = 10_000
 
 
 class MachineError(ValueError):
@@ -70,9 +78,13 @@ class MachineProject:
     """A machine and its axes, in the order they were added."""
 
     def __init__(self, name: str, site: str = "", notes: str = ""):
-        name = name.strip()
-        if not name:
+        if not name.strip():
             raise MachineError("a machine needs a name")
+        try:  # one line of printable text, of a length a list shows (fha_studio.names)
+            name = names.check_name(name, "machine name")
+            site = names.check_name(site, "site", names.TEXT_MAX, empty_ok=True)
+        except names.NameProblem as exc:
+            raise MachineError(str(exc)) from None
         if "/" in name:
             raise MachineError(f"machine name '{name}': '/' separates machine and axis, use another sign")
         self.name = name
@@ -105,9 +117,14 @@ class MachineProject:
         """A new axis with its own commissioning state. Raises MachineError for an empty or taken
         name, and the catalogue's ModelCodeError (a ValueError) for a wrong model code; nothing is
         added then."""
-        name = name.strip()
-        if not name:
+        if not name.strip():
             raise MachineError(f"an axis of '{self.name}' needs a name")
+        try:
+            name = names.check_name(name, "axis name")
+            port_url = names.check_name(port_url, "port", names.PORT_MAX, empty_ok=True)
+            serial_number = names.check_name(serial_number, "serial number", names.TEXT_MAX, empty_ok=True)
+        except names.NameProblem as exc:
+            raise MachineError(str(exc)) from None
         if any(a.name == name for a in self._axes):
             raise MachineError(f"'{self.name}' already has an axis called '{name}'")
         port = port_url.strip()
@@ -163,26 +180,51 @@ class MachineProject:
 
     @classmethod
     def from_json(cls, data: Any, where: str = "machine file") -> MachineProject:
+        """A machine from a machine file's data, every field checked against its shape first
+        (MACHINE_FIELDS, AXIS_FIELDS): MachineError names the file and the field."""
         if not isinstance(data, dict) or data.get("format") != FORMAT:
             raise MachineError(f"{where}: not an {FORMAT} machine file")
+        _known(data, ("format", *MACHINE_FIELDS, "axes"), where)
+        if "name" not in data:
+            raise MachineError(f"{where}: no name")
+        texts = {k: _field_text(data.get(k, ""), f"{where}: field {k}") for k in MACHINE_FIELDS}
+        axes = data.get("axes", [])
+        if not isinstance(axes, list):
+            raise MachineError(f"{where}: field axes: must be a list of axes, got {_kind(axes)}")
         try:
-            project = cls(str(data["name"]), str(data.get("site", "")), str(data.get("notes", "")))
-            for number, axis in enumerate(data.get("axes", []), start=1):
-                try:
-                    project.add_axis(
-                        str(axis["name"]),
-                        str(axis.get("actuator_code", "")),
-                        str(axis.get("driver_model", "")),
-                        str(axis.get("port_url", "")),
-                        float(axis.get("load_inertia_kgm2") or 0.0),
-                        str(axis.get("notes", "")),
-                        str(axis.get("serial_number", "")),
-                        axis.get("session_file") or None,
-                    )
-                except (KeyError, TypeError, ValueError) as exc:
-                    raise MachineError(f"{where}: axis {number}: {_reason(exc)}") from None
-        except KeyError as exc:
-            raise MachineError(f"{where}: no {exc.args[0]}") from None
+            project = cls(texts["name"], texts["site"], texts["notes"])
+        except ValueError as exc:
+            raise MachineError(f"{where}: {_reason(exc)}") from None
+        for number, axis in enumerate(axes, start=1):
+            at = f"{where}: axis {number}"
+            if not isinstance(axis, dict):
+                raise MachineError(f"{at}: must be a table of fields, got {_kind(axis)}")
+            _known(axis, (*AXIS_FIELDS, "load_inertia_kgm2"), at)
+            if "name" not in axis:
+                raise MachineError(f"{at}: no name")
+            fields = {k: _field_text(axis.get(k, ""), f"{at}: field {k}") for k in AXIS_FIELDS}
+            inertia = axis.get("load_inertia_kgm2", 0.0)
+            if inertia is None:
+                inertia = 0.0
+            if isinstance(inertia, bool) or not isinstance(inertia, int | float):
+                raise MachineError(f"{at}: field load_inertia_kgm2: must be a number of kg m^2, "
+                                   f"got {_kind(inertia)}")
+            if not plausible.LOAD_INERTIA_KGM2.contains(float(inertia)):
+                raise MachineError(f"{at}: field load_inertia_kgm2: {inertia:g} is outside "
+                                   f"{plausible.LOAD_INERTIA_KGM2.allowed()}")
+            try:
+                project.add_axis(
+                    fields["name"],
+                    fields["actuator_code"],
+                    fields["driver_model"],
+                    fields["port_url"],
+                    float(inertia),
+                    fields["notes"],
+                    fields["serial_number"],
+                    fields["session_file"] or None,
+                )
+            except (KeyError, TypeError, ValueError) as exc:
+                raise MachineError(f"{at}: {_reason(exc)}") from None
         return project
 
     @classmethod
@@ -196,8 +238,8 @@ class MachineProject:
                 raise MachineError(f"{path}: no such machine file") from None
             raise MachineError(str(exc)) from None
         try:
-            data = json.loads(text)
-        except (json.JSONDecodeError, RecursionError) as exc:
+            data = fileio.parse_json(text)  # bounded in depth, finite numbers
+        except ValueError as exc:
             raise MachineError(f"{path}: not a readable machine file: {exc}") from None
         return cls.from_json(data, str(path))
 
@@ -247,3 +289,29 @@ def _reason(exc: BaseException) -> str:
     if isinstance(exc, KeyError):
         return f"no {exc.args[0]}"
     return str(exc)
+
+
+def _kind(value: Any) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return f"the number {value:g}"
+    if isinstance(value, str):
+        return f"the text {quoted(value, 30)}"
+    return "a list" if isinstance(value, list) else "a table"
+
+
+def _field_text(value: Any, where: str) -> str:
+    if not isinstance(value, str):
+        raise MachineError(f"{where}: must be text, got {_kind(value)}")
+    if len(value) > MAX_FIELD_TEXT:
+        raise MachineError(f"{where}: is {len(value)} characters long; at most {MAX_FIELD_TEXT}")
+    return value
+
+
+def _known(table: dict[str, Any], allowed: tuple[str, ...], where: str) -> None:
+    unknown = sorted(str(k) for k in table if k not in allowed)
+    if unknown:
+        raise MachineError(f"{where}: field {quoted(unknown[0], 40)}: unknown; allowed: {', '.join(allowed)}")

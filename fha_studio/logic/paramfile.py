@@ -26,7 +26,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from fha_studio import clock
+from fha_studio import clock, fileio
 from fha_studio.hardware.parameters import ParameterItem, ParameterModel
 
 FORMAT = "fha-parameters/1"
@@ -129,7 +129,7 @@ def read_parameter_file(
     if text.startswith("\ufeff"):  # a byte-order mark some editors put first
         text = text[1:]
     try:
-        data = tomllib.loads(text)
+        data = fileio.parse_toml(text)  # bounded in depth
     except tomllib.TOMLDecodeError as exc:
         line = _line_from_message(str(exc))
         where = f"line {line}" if line else "somewhere"

@@ -317,7 +317,9 @@ class AxisModel:
     def from_toml(cls, text: str, where: str = "model file") -> AxisModel:
         """Parse a model file's text; errors name the file (where) and the field."""
         try:
-            data = tomllib.loads(text)
+            from fha_studio import fileio
+
+            data = fileio.parse_toml(text)  # bounded in depth
         except tomllib.TOMLDecodeError as exc:
             raise ValueError(f"{where}: not valid TOML: {exc}") from None
         return cls.from_dict(data, where=where)

@@ -134,12 +134,14 @@ class ProcedureSession:
                 raise SessionError(f"{path}: no such session file") from None
             raise SessionError(str(exc)) from None
         try:
-            data = json.loads(text)
+            data = fileio.parse_json(text)  # bounded in depth, finite numbers
         except json.JSONDecodeError as exc:
             raise SessionError(
                 f"{path}: line {exc.lineno}: not a session file (not JSON: {exc.msg})") from None
-        except RecursionError:
-            raise SessionError(f"{path}: not a session file (nested too deep)") from None
+        except fileio.NestedTooDeep as exc:
+            raise SessionError(f"{path}: not a session file (nested too deep: {exc})") from None
+        except ValueError as exc:
+            raise SessionError(f"{path}: not a session file ({exc})") from None
         if not isinstance(data, dict) or data.get("format") != FORMAT:
             raise SessionError(f"{path}: not an {FORMAT} session file (no \"format\": \"{FORMAT}\")")
         try:
@@ -250,11 +252,31 @@ def _session_from_json(data: dict[str, Any]) -> ProcedureSession:
             angles[name] = float(value)
         values["sensor_angles_deg"] = angles
     if "parameters" in data:
-        values["parameters"] = _table(data["parameters"], "parameters", "parameter values")
+        values["parameters"] = _parameters(data["parameters"])
     if "runs" in data:
         runs = _table(data["runs"], "runs", "procedure runs by procedure id")
         values["runs"] = {pid: _run_from_json(run, f"runs.{pid}") for pid, run in runs.items()}
     return ProcedureSession(**values)
+
+
+def _parameters(data: Any) -> dict[str, Any]:
+    """``{"file": text, "read_utc": text, "values": {key: wire integer}}``."""
+    table = _table(data, "parameters", "fields (file, read_utc, values)")
+    allowed = ("file", "read_utc", "values")
+    unknown = sorted(set(table) - set(allowed))
+    if unknown:
+        raise _ShapeError(f"parameters.{unknown[0]}", f"unknown; allowed: {', '.join(allowed)}")
+    out: dict[str, Any] = {k: _text(table[k], f"parameters.{k}") for k in ("file", "read_utc") if k in table}
+    if "values" in table:
+        found = _table(table["values"], "parameters.values", "wire integers by parameter key")
+        for key, wire in found.items():
+            if isinstance(wire, bool) or not isinstance(wire, int):
+                raise _ShapeError(f"parameters.values.{key}", f"must be a whole number (the drive's value), "
+                                  f"got {_kind(wire)}")
+            if not -(2**31) <= wire < 2**31:
+                raise _ShapeError(f"parameters.values.{key}", f"{wire:g} is no value a drive holds")
+        out["values"] = dict(found)
+    return out
 
 
 def _run_from_json(data: Any, where: str) -> RunState:

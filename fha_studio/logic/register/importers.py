@@ -72,6 +72,7 @@ def _record_session(register: Register, axis: Axis, session: Any) -> ImportResul
 
 
 def _session_parameters(register: Register, axis: Axis, session: Any) -> tuple[int | None, list[str]]:
+    source = str(session.path or "")
     params = session.parameters or {}
     values = params.get("values") or {}
     if not values:
@@ -88,9 +89,10 @@ def _session_parameters(register: Register, axis: Axis, session: Any) -> tuple[i
             not_taken.append(f"parameter {key}: {exc.args[0]}")
             continue
         try:
-            rows.append((item.mode.value, item.number, item.key, int(wire)))
-        except (TypeError, ValueError):
-            not_taken.append(f"parameter {key}: {wire!r} is not a wire integer")
+            item.check(wire)  # 77 for the rotary direction, 12 for an item of 0 ... 10: refused
+        except ValueError as exc:
+            raise RegisterError(f"{source or 'session'}: field parameters.values.{key}: {exc}") from None
+        rows.append((item.mode.value, item.number, item.key, int(wire)))
     if not rows:
         return None, not_taken
     at = params.get("read_utc") or session.created_utc
@@ -157,6 +159,13 @@ def import_parameter_file(
         loaded = read_parameter_file(text, model, name=str(path))
     except ParameterFileError as exc:
         raise RegisterError(str(exc)) from None
+    if loaded.actuator:
+        from fha_studio.catalog import ModelCodeError, parse_model_code
+
+        try:
+            parse_model_code(loaded.actuator)
+        except ModelCodeError as exc:
+            raise RegisterError(f"{path}: actuator: {exc}") from None
     with register.batch():  # all of it or nothing: no machine or axis left behind by a refusal
         target = register.ensure_axis(
             machine, axis, actuator_code=loaded.actuator, driver_model=loaded.driver_model, who=who
@@ -188,7 +197,7 @@ def _peek_driver(text: str) -> str:
     import tomllib
 
     try:
-        data = tomllib.loads(text)
+        data = fileio.parse_toml(text)
     except tomllib.TOMLDecodeError:
         return ""  # read_parameter_file says where it is broken
     return str(data.get("driver_model") or data.get("driver") or "")

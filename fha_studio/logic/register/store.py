@@ -28,7 +28,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
-from fha_studio import clock, fileio
+from fha_studio import clock, fileio, names
 from fha_studio.logic.register import guard, words
 from fha_studio.logic.register.guard import RegisterError as RegisterError
 from fha_studio.logic.register.schema import MIGRATIONS, SCHEMA_VERSION
@@ -71,11 +71,16 @@ def utc_stamp(when: str | _dt.datetime | None = None) -> str:
             moment = _dt.datetime.fromisoformat(text.replace("Z", "+00:00"))
         except ValueError:
             raise RegisterError(
-                f"'{when}' is not a time (ISO 8601 expected, e.g. 2026-11-30T04:05:06Z)"
+                f"{names.quoted(str(when))} is not a time (ISO 8601 expected, e.g. 2026-11-30T04:05:06Z)"
             ) from None
     if moment.tzinfo is None:
         moment = moment.replace(tzinfo=_dt.UTC)
-    return moment.astimezone(_dt.UTC).isoformat(timespec="microseconds")
+    try:
+        return moment.astimezone(_dt.UTC).isoformat(timespec="microseconds")
+    except OverflowError:  # 9999-12-31T23:59:59-05:00 is in the year 10000 in UTC
+        raise RegisterError(
+            f"{names.quoted(str(when))} is past the last time the register holds (9999-12-31 UTC)"
+        ) from None
 
 
 def file_sha256(path: str | Path) -> str:
@@ -331,14 +336,16 @@ class Register:
     # -- machines and axes ----------------------------------------------------------------------------
     def add_machine(self, name: str, site: str = "", notes: str = "") -> Machine:
         """A new machine; RegisterError when the name is empty, has '/' or is taken."""
-        name = name.strip()
-        if not name:
+        if not name.strip():
             raise RegisterError("a machine needs a name")
+        name = _checked(name, "machine name")
+        site = _checked(site, "site", names.TEXT_MAX)
         if "/" in name:
-            raise RegisterError(f"machine name '{name}': '/' separates machine and axis, use another sign")
+            raise RegisterError(
+                f"machine name {names.quoted(name)}: '/' separates machine and axis, use another sign")
         with self._transaction() as db:
             if db.execute("SELECT 1 FROM machine WHERE name = ?", (name,)).fetchone():
-                raise RegisterError(f"there is already a machine called '{name}'")
+                raise RegisterError(f"there is already a machine called {names.quoted(name)}")
             db.execute(
                 "INSERT INTO machine (name, site, notes, created_utc) VALUES (?, ?, ?, ?)",
                 (name, site.strip(), notes, utc_stamp()),
@@ -348,8 +355,8 @@ class Register:
     def machine(self, name: str) -> Machine:
         row = self._db.execute("SELECT * FROM machine WHERE name = ?", (name.strip(),)).fetchone()
         if row is None:
-            known = ", ".join(m.name for m in self.machines()) or "none yet"
-            raise RegisterError(f"no machine called '{name}' in the register (machines: {known})")
+            known = _listed(m.name for m in self.machines()) or "none yet"
+            raise RegisterError(f"no machine called {names.quoted(name)} in the register (machines: {known})")
         return Machine(**dict(row))
 
     def ensure_machine(self, name: str, site: str = "") -> Machine:
@@ -401,16 +408,21 @@ class Register:
         who: str = "",
     ) -> Axis:
         """A new axis on ``machine``; RegisterError when the name is empty or taken there."""
-        name = name.strip()
-        if not name:
-            raise RegisterError(f"an axis of machine '{machine}' needs a name")
+        if not name.strip():
+            raise RegisterError(f"an axis of machine {names.quoted(machine)} needs a name")
+        name = _checked(name, "axis name")
+        port_url = _checked(port_url, "port", names.PORT_MAX)
+        for label, text in (("actuator", actuator_code), ("driver", driver_model),
+                            ("serial number", serial_number), ("operator", who)):
+            _checked(text, label, names.TEXT_MAX)
         _check_inertia(load_inertia_kgm2)
         machine_row = self.machine(machine)
         with self._transaction() as db:
             if db.execute(
                 "SELECT 1 FROM axis WHERE machine_id = ? AND name = ?", (machine_row.id, name)
             ).fetchone():
-                raise RegisterError(f"machine '{machine_row.name}' already has an axis called '{name}'")
+                raise RegisterError(f"machine {names.quoted(machine_row.name)} already has an axis "
+                                    f"called {names.quoted(name)}")
             self._check_port_free(machine_row.id, port_url.strip(), name)
             now = utc_stamp()
             cursor = db.execute(
@@ -478,6 +490,10 @@ class Register:
         unknown = set(fields) - set(self._AXIS_FIELDS)
         if unknown:
             raise RegisterError(f"an axis has no field {', '.join(sorted(unknown))}")
+        limits = {"name": names.NAME_MAX, "port_url": names.PORT_MAX}
+        for key in ("name", "port_url", "actuator_code", "driver_model", "serial_number"):
+            if key in fields:
+                _checked(str(fields[key]), self._AXIS_FIELDS[key], limits.get(key, names.TEXT_MAX))
         if "actuator_code" in fields:
             fields["actuator_code"] = str(fields["actuator_code"]).strip().upper()
         if "load_inertia_kgm2" in fields:
@@ -568,19 +584,22 @@ class Register:
                 f"{self._AXIS_SELECT} WHERE machine.name = ? AND axis.name = ?", (machine, name)
             ).fetchone()
             if row is None:
-                known = ", ".join(a.name for a in self.axes(machine)) if self._has_machine(machine) else ""
-                where = f"machine '{machine}' has no axis '{name}'" + (f" (axes: {known})" if known else "")
+                known = _listed(a.name for a in self.axes(machine)) if self._has_machine(machine) else ""
+                where = (f"machine {names.quoted(machine)} has no axis {names.quoted(name)}"
+                         + (f" (axes: {known})" if known else ""))
                 if not self._has_machine(machine):
-                    where = f"no machine called '{machine}' in the register"
+                    where = f"no machine called {names.quoted(machine)} in the register"
                 raise RegisterError(where)
             return self._axis(row)
         rows = self._db.execute(f"{self._AXIS_SELECT} WHERE axis.name = ?", (text,)).fetchall()
         if len(rows) == 1:
             return self._axis(rows[0])
         if not rows:
-            raise RegisterError(f"no axis called '{text}' in the register (name one as MACHINE/AXIS)")
-        machines = ", ".join(r["machine"] for r in rows)
-        raise RegisterError(f"several machines have an axis called '{text}' ({machines}): say MACHINE/AXIS")
+            raise RegisterError(
+                f"no axis called {names.quoted(text)} in the register (name one as MACHINE/AXIS)")
+        machines = _listed(r["machine"] for r in rows)
+        raise RegisterError(f"several machines have an axis called {names.quoted(text)} ({machines}): "
+                            "say MACHINE/AXIS")
 
     def _has_machine(self, name: str) -> bool:
         return self._db.execute("SELECT 1 FROM machine WHERE name = ?", (name,)).fetchone() is not None
@@ -1180,6 +1199,21 @@ def _upgrade_if_older(path: Path, busy_timeout_s: float) -> None:
         return  # opening it read-only says what is wrong
     if older:
         Register(path, busy_timeout_s=busy_timeout_s, create=False).close()
+
+
+def _listed(items: Iterable[str], most: int = 8) -> str:
+    """Names for a refusal: each at most 40 characters and escaped, the first ``most`` of them."""
+    every = list(items)
+    shown = ", ".join(names.quoted(n, 40, always=False) for n in every[:most])
+    return shown + (f" and {len(every) - most} more" if len(every) > most else "")
+
+
+def _checked(text: str, what: str, limit: int = names.NAME_MAX) -> str:
+    """``text`` stripped, or RegisterError: longer than ``limit`` or not printable text."""
+    try:
+        return names.check_name(text, what, limit, empty_ok=True)
+    except names.NameProblem as exc:
+        raise RegisterError(str(exc)) from None
 
 
 def _check_inertia(value: float | None) -> None:

@@ -345,7 +345,7 @@ def load_scenario(source: str | Path) -> Scenario:
         raise ScenarioError(str(exc)) from None
     r = _Reader(path, text)
     try:
-        data = tomllib.loads(text)
+        data = fileio.parse_toml(text)  # bounded in depth
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path}: not a TOML file: {exc}") from None
     _unknown(r, data, ("scenario", "drive", "fault", "step"), "top level", 0)
