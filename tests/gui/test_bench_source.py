@@ -64,3 +64,32 @@ def test_a_channel_the_instrument_lacks_is_refused_in_one_line(qtbot, source):
         source.start(BenchSettings("demo", ("D9",), 1e6))
     assert stopped.args[0].startswith("demo: no channel D9") and "\n" not in stopped.args[0]
     assert source.started is None and not source.running
+
+
+def test_the_scope_page_bench_tab_finds_the_demo_and_plots_it_beside_cn3(qtbot):
+    from fha_studio.gui.pages.scope.bench_panel import BenchPanel
+
+    panel = BenchPanel()
+    qtbot.addWidget(panel)
+    try:
+        with qtbot.waitSignal(panel.sigDevicesListed, timeout=10000):
+            panel.scan()
+        assert panel.device_box.itemText(0).startswith("demo  (Demo device)")
+        with qtbot.waitSignal(panel.source.sigStarted, timeout=10000):
+            panel.start(panel.device_box.itemText(0), "D0, D2", "1m")
+        def plotted() -> int:
+            x, _y = panel._curves[0].getData()
+            return 0 if x is None else len(x)
+
+        qtbot.waitUntil(lambda: plotted() > 100, timeout=10000)
+        names = [item.text for _, item in panel.plot.plotItem.legend.items]
+        assert names == ["bench demo:D0", "bench demo:D2"]
+        assert panel.status_label.text().startswith("LIVE from the bench: demo at 1 MHz")
+        with qtbot.waitSignal(panel.source.sigStopped, timeout=10000):
+            panel.start_button.click()
+        assert not panel.start_button.isChecked() and panel.status_label.text().startswith("Stopped after")
+        panel.rate_edit.setText("fast")
+        panel.start_button.click()
+        assert panel.status_label.text() == "Sample rate 'fast': a number of Hz, e.g. 200k or 1m."
+    finally:
+        panel.shutdown()

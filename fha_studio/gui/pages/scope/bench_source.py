@@ -73,6 +73,7 @@ class BenchWorker(QObject):
     sigError = Signal(str)  # refused before any sample (one line)
     sigVanished = Signal(str, int)  # the instrument went away: one line, samples kept
     sigFinished = Signal(int)  # stopped as asked: samples
+    sigDevices = Signal(object, str)  # the instruments sigrok-cli finds (list of Device), or why none
 
     def __init__(self) -> None:
         super().__init__()
@@ -86,6 +87,14 @@ class BenchWorker(QObject):
             self._stop = True
             if self._acquisition is not None:
                 self._acquisition.stop()
+
+    @Slot(str)
+    def scan(self, driver: str) -> None:
+        """List the instruments (every driver when ``driver`` is empty)."""
+        try:
+            self.sigDevices.emit(sigrok.scan(driver or None), "")
+        except sigrok.SigrokError as exc:
+            self.sigDevices.emit([], str(exc))
 
     @Slot(object)
     def run(self, settings: BenchSettings) -> None:
@@ -136,6 +145,7 @@ class BenchSource(QObject):
     ``[t_s, values...]`` each timer tick drained (none when nothing came)."""
 
     sigStart = Signal(object)  # BenchSettings, queued to the worker
+    sigScan = Signal(str)  # a driver or "", queued to the worker
     sigRows = Signal(object)  # np.ndarray, in the GUI thread
     sigStarted = Signal(object)  # BenchStarted
     sigStopped = Signal(str)  # "" when stopped as asked, else the one line why
@@ -150,6 +160,7 @@ class BenchSource(QObject):
         self.worker = BenchWorker()
         self.worker.moveToThread(self._thread)
         self.sigStart.connect(self.worker.run)
+        self.sigScan.connect(self.worker.scan)
         self.worker.sigStarted.connect(self._on_started)
         self.worker.sigStatus.connect(self._on_status)
         self.worker.sigError.connect(self._on_ended)

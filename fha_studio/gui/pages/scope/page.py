@@ -17,6 +17,7 @@ from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.pages.scope.jog_panel import JogPanel
 from fha_studio.gui.widgets import space_jogs_only
 
+from .bench_panel import BenchPanel
 from .driver import ScopeCmd, ScopeController, ScopeRequest
 from .view import ScopeContext, ScopeView
 
@@ -31,7 +32,7 @@ def _attach_in_link_thread(controller: ScopeController, ratio: int | None, clien
 
 
 class ScopePage(BasePage):
-    """Page "Scope": live view, trace, built-in tests, recording."""
+    """Page "Scope": live view, trace, built-in tests, recording, a bench instrument."""
 
     def __init__(self, session, main_window=None):
         super().__init__(main_window)
@@ -47,6 +48,9 @@ class ScopePage(BasePage):
         self.jog_panel = JogPanel(link, main_window.stop_button if main_window is not None else None)
         self.view.dock_under_channels(self.jog_panel)
         space_jogs_only(self, (self.jog_panel.fwd_button, self.jog_panel.rev_button))
+        # a bench instrument on CN2 beside CN3 polling (a real drive's CN3 is silent in motion)
+        self.bench = BenchPanel()
+        self.view.plots.addTab(self.bench, "Bench")
         # the axis's actuator, driver and load decide the scaling and what is recorded, at every moment
         state = self.state
         for signal in (state.sigActuatorChanged, state.sigDriverChanged, state.sigLoadInertiaChanged):
@@ -93,5 +97,6 @@ class ScopePage(BasePage):
 
     def shutdown(self) -> None:
         self.jog_panel.release_jog()
+        self.bench.shutdown()
         self.view.shutdown()
         self.controller.shutdown()

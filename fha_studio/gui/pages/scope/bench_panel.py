@@ -1,0 +1,194 @@
+"""The scope's "Bench" tab: a bench instrument streamed through sigrok-cli beside CN3 polling.
+
+A real HA-655 answers CN3 with ``s`` while its servo is on; its CN2 monitor outputs (SPD-MON,
+encoder A/B/Z, IN-POS, ALARM) still show on a logic analyzer or an oscilloscope. This tab lists
+the instruments sigrok-cli finds, streams the channels asked for (``BenchSource``) and plots the
+newest seconds, every trace named with its source (``bench demo:D0``) so nobody takes it for a
+CN3 channel. Where sigrok-cli is missing the tab says how to install it.
+"""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6.QtCore import Signal, Slot
+from PySide6.QtWidgets import (
+    QComboBox,
+    QGridLayout,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from fha_studio.hardware.bench import sigrok
+
+from .bench_source import BenchSettings, BenchSource, BenchStarted
+
+#: Seconds of the newest rows on show.
+WINDOW_S = 2.0
+_COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#e07000", "#9467bd", "#8c564b", "#e377c2", "#008b8b")
+
+
+def _rate(text: str) -> float | None:
+    """``1m``, ``200k``, ``24 MHz``, ``500000`` -> Hz; empty: None (the instrument's own)."""
+    t = text.strip().lower().replace(" ", "").removesuffix("hz")
+    if not t:
+        return None
+    factor = {"k": 1e3, "m": 1e6, "g": 1e9}.get(t[-1], 1.0)
+    number = t[:-1] if factor != 1.0 else t
+    value = float(number)
+    if not value > 0:
+        raise ValueError
+    return value * factor
+
+
+class BenchPanel(QWidget):
+    """Instrument, channels and rate; Start/Stop; a plot of the stream."""
+
+    sigDevicesListed = Signal(int)  # in the GUI thread: how many instruments the scan found
+
+    def __init__(self, parent: QWidget | None = None):
+        super().__init__(parent)
+        self.setObjectName("scopeBench")
+        self.source = BenchSource(self)
+        self.source.worker.sigDevices.connect(self._on_devices)
+        self.source.sigStarted.connect(self._on_started)
+        self.source.sigRows.connect(self._on_rows)
+        self.source.sigStopped.connect(self._on_stopped)
+        self._curves: list[pg.PlotDataItem] = []
+        self._started: BenchStarted | None = None
+
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(4, 4, 4, 4)
+        grid = QGridLayout()
+        grid.addWidget(QLabel("Instrument"), 0, 0)
+        self.device_box = QComboBox()
+        self.device_box.setEditable(True)  # a driver with options may be typed: demo:analog_channels=2
+        self.device_box.setToolTip("the sigrok driver (and its options) of the instrument")
+        grid.addWidget(self.device_box, 0, 1, 1, 2)
+        self.scan_button = QPushButton("Find")
+        self.scan_button.setToolTip("list the instruments sigrok-cli finds")
+        self.scan_button.clicked.connect(self.scan)
+        grid.addWidget(self.scan_button, 0, 3)
+        grid.addWidget(QLabel("Channels"), 1, 0)
+        self.channels_edit = QLineEdit("D0,D1,D2")
+        self.channels_edit.setToolTip("the instrument's channels, e.g. D0,D1,D2 (logic) or A0 (analog)")
+        grid.addWidget(self.channels_edit, 1, 1)
+        self.rate_edit = QLineEdit("1m")
+        self.rate_edit.setToolTip("sample rate, e.g. 200k, 1m, 24m (empty: the instrument's own)")
+        self.rate_edit.setMaximumWidth(70)
+        grid.addWidget(self.rate_edit, 1, 2)
+        self.start_button = QPushButton("Start")
+        self.start_button.setCheckable(True)
+        self.start_button.clicked.connect(self._start_clicked)
+        grid.addWidget(self.start_button, 1, 3)
+        grid.setColumnStretch(1, 1)
+        layout.addLayout(grid)
+        self.plot = pg.PlotWidget(background="w")
+        self.plot.setLabel("bottom", "time", units="s")
+        self.plot.addLegend(offset=(5, 5))
+        layout.addWidget(self.plot, 1)
+        self.status_label = QLabel("")
+        self.status_label.setObjectName("scopeBenchStatus")
+        self.status_label.setWordWrap(True)
+        layout.addWidget(self.status_label)
+        if shutil.which(sigrok.SIGROK_CLI) is None:
+            self.status_label.setText(sigrok.INSTALL_HINT)
+            for widget in (self.scan_button, self.start_button):
+                widget.setEnabled(False)
+        else:
+            self.status_label.setText("Bench instruments through sigrok-cli: Find lists them.")
+
+    # -- actions --
+
+    def scan(self) -> None:
+        self.scan_button.setEnabled(False)
+        self.status_label.setText("Looking for instruments …")
+        self.source.sigScan.emit("")
+
+    def start(self, device: str, channels: str, rate: str = "") -> None:
+        """Stream (what the Start button does with the fields' text)."""
+        self.device_box.setEditText(device)
+        self.channels_edit.setText(channels)
+        self.rate_edit.setText(rate)
+        self.start_button.setChecked(True)
+        self._start_clicked(True)
+
+    def stop(self) -> None:
+        self.source.stop()
+
+    def shutdown(self) -> None:
+        self.source.shutdown()
+
+    # -- slots --
+
+    def _start_clicked(self, checked: bool) -> None:
+        if not checked:
+            self.stop()
+            return
+        device = self.device_box.currentText().split(" ", 1)[0].strip()
+        names = tuple(c.strip() for c in self.channels_edit.text().split(",") if c.strip())
+        try:
+            rate = _rate(self.rate_edit.text())
+        except ValueError:
+            self._refuse(f"Sample rate '{self.rate_edit.text()}': a number of Hz, e.g. 200k or 1m.")
+            return
+        if not device or not names:
+            self._refuse("Give the instrument (Find lists them) and its channels.")
+            return
+        self.status_label.setText(f"Starting {device} …")
+        self.source.start(BenchSettings(device, names, rate))
+
+    def _refuse(self, text: str) -> None:
+        self.start_button.setChecked(False)
+        self.status_label.setText(text)
+
+    @Slot(object, str)
+    def _on_devices(self, devices: list, why: str) -> None:
+        self.scan_button.setEnabled(True)
+        current = self.device_box.currentText()
+        self.device_box.clear()
+        for device in devices:
+            self.device_box.addItem(f"{device.spec}  ({device.description})")
+        if current and not devices:
+            self.device_box.setEditText(current)
+        if why:
+            self.status_label.setText(why)
+        else:
+            self.status_label.setText(f"{len(devices)} instrument(s) found." if devices
+                                      else "sigrok-cli finds no instrument (is it plugged in?)")
+        self.sigDevicesListed.emit(len(devices))
+
+    def _on_started(self, started: BenchStarted) -> None:
+        self._started = started
+        self.plot.clear()
+        self._curves = []
+        for i, label in enumerate(started.labels):
+            pen = pg.mkPen(_COLORS[i % len(_COLORS)], width=1)
+            self._curves.append(self.plot.plot([], [], pen=pen, name=f"bench {label}"))
+        self.status_label.setText(f"LIVE from the bench: {started.device} at "
+                                  f"{sigrok.rate_text(started.sample_rate_hz)}, "
+                                  f"{', '.join(started.labels)}")
+
+    def _on_rows(self, _rows: np.ndarray) -> None:
+        started = self._started
+        if started is None:
+            return
+        rows = started.ring.window(int(WINDOW_S * started.row_rate_hz))
+        for i, (curve, name) in enumerate(zip(self._curves, started.channels, strict=True)):
+            values = rows[:, 1 + i]
+            if sigrok.is_logic_channel(name):  # a logic analyzer's look: one lane per channel
+                values = values * 0.8 + 1.2 * (len(self._curves) - 1 - i)
+            curve.setData(rows[:, 0], values)
+
+    def _on_stopped(self, why: str) -> None:
+        self.start_button.setChecked(False)
+        samples = self.source.status.samples if self.source.status is not None else 0
+        if why:
+            self.status_label.setText(f"NOT LIVE: {why}")
+        else:
+            self.status_label.setText(f"Stopped after {samples} samples.")
