@@ -123,6 +123,9 @@ MOVE_ANGLE_DEG = Range("move angle", 0.0, 360.0 * 1000, "deg", "a thousand outpu
                        open_minimum=True)
 CYCLE_TIME_S = Range("cycle time", 0.001, 24 * 3600.0, "s",
                      "a move takes longer than a millisecond, and comes at least once a day")
+ACCEL_TIME_S = Range("acceleration time", 0.0, 3600.0, "s",
+                     "an hour to reach the speed; a longer time is a unit mistake (ms for s)",
+                     open_minimum=True)
 LOAD_TORQUE_NM = Range("load torque", -8200.0, 8200.0, "N m",
                        "ten times the largest FHA-C maximum torque, 820 N m")
 DUTY_FACTOR = Range("duty factor", 0.0, 100.0, "", "the manual's graphs (2-4-5) stay far below")

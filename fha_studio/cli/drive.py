@@ -24,6 +24,7 @@ from typing import Any
 
 from fha_studio import fileio
 from fha_studio.cli import CliError
+from fha_studio.cli._values import whole
 from fha_studio.hardware.protocol import BAUD_RATES, BAUDRATE
 
 ORDER = 35
@@ -64,7 +65,8 @@ def register(subparsers: Any) -> None:
 
     def common(p: argparse.ArgumentParser, actuator_required: bool = False) -> None:
         p.add_argument("--url", required=True, help="the drive: /dev/ttyUSB0, a pty path, socket://host:port")
-        p.add_argument("--baud", type=int, default=BAUDRATE, choices=BAUD_RATES, metavar="RATE",
+        p.add_argument("--baud", type=whole(1, 10_000_000), default=BAUDRATE, choices=BAUD_RATES,
+                       metavar="RATE",
                        help="baud rate (default %(default)s, CN3's; one of "
                        f"{', '.join(map(str, BAUD_RATES))})")
         p.add_argument("--actuator", required=actuator_required, metavar="CODE",

@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 from contextlib import contextmanager
 from dataclasses import asdict
@@ -39,6 +40,7 @@ from fha_studio.logic.register.words import (
     value_text,
     when_text,
 )
+from fha_studio.names import quoted
 
 ORDER = 70
 
@@ -356,6 +358,10 @@ def _parse_query(reg, query: str) -> tuple[str, int | None, Any]:
     if not value_part.strip():
         return key, None, item
     try:
+        # the drive's whole-number value: ASCII digits only (1_5 and Arabic-Indic digits are
+        # not numbers here, as nowhere on the command line)
+        if not re.fullmatch(r"[+-]?[0-9]{1,11}", value_part.strip()):
+            raise ValueError(value_part)
         value = int(value_part.strip())
     except ValueError:
         allowed = (
@@ -364,7 +370,7 @@ def _parse_query(reg, query: str) -> tuple[str, int | None, Any]:
             else ""
         )
         raise CliError(
-            f"find: '{value_part.strip()}' for {item.name if item else key} is not the drive's"
+            f"find: {quoted(value_part.strip())} for {item.name if item else key} is not the drive's"
             " whole-number value" + (f" ({allowed})" if allowed else "")
         ) from None
     if item is not None:
@@ -483,7 +489,6 @@ def _report(args) -> int:
 def _check(args) -> int:
     from fha_studio.logic.register import RegisterError, default_register_path
     from fha_studio.logic.register.check import check_register
-    from fha_studio.names import quoted
 
     path = default_register_path(args.register)
     try:

@@ -28,6 +28,7 @@ _RANGES = {
     "angle": plausible.MOVE_ANGLE_DEG,
     "cycle": plausible.CYCLE_TIME_S,
     "load_torque": plausible.LOAD_TORQUE_NM,
+    "accel_time": plausible.ACCEL_TIME_S,
     "radial_load_n": plausible.BEARING_LOAD_N,
     "axial_load_n": plausible.BEARING_LOAD_N,
     "radial_offset_mm": plausible.LOAD_OFFSET_MM,

@@ -161,4 +161,5 @@ def test_accel_time_sizes_for_the_machines_move(capsys):
     assert any(c["name"] == "acceleration torque" for c in data["checks"])
     rc, out, err = run(capsys, *EXAMPLE, "--accel-time", "0")
     assert rc == 2 and out == ""
-    assert err.strip() == "fha-studio size: error: --accel-time must be a number > 0 (s), got 0.0"
+    assert err.strip() == ("fha-studio size: error: --accel-time: 0 is outside more than 0 and at most "
+                           "3600 s (an hour to reach the speed; a longer time is a unit mistake (ms for s))")

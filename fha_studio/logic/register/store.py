@@ -910,7 +910,10 @@ class Register:
     def parameter_set(self, ref: str | int) -> ParameterSet:
         """A snapshot by its number, or an axis's latest known values by ``MACHINE/AXIS``."""
         text = str(ref).strip().lstrip("#")
-        if text.isdigit():
+        if text.isdigit() or text.isdecimal():  # ² and ٣ are digits to Python, not to a person
+            if not text.isascii() or len(text) > 18:
+                raise RegisterError(f"{names.quoted(text, 40)} is not a snapshot number "
+                                    "(a whole number, see history) nor MACHINE/AXIS")
             return self.snapshot(int(text))
         return self.current_values(str(ref))
 
