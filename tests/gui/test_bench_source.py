@@ -59,6 +59,21 @@ def test_an_instrument_that_vanishes_is_said_and_what_came_stays(qtbot, source):
     assert len(source.started.ring) >= 1000  # the ring still holds what came
 
 
+def test_encoder_counts_come_as_a_last_column_equal_to_decoding_the_whole_stream(qtbot, source):
+    from fha_studio.logic.bench.decode import quadrature
+
+    with qtbot.waitSignal(source.sigStarted, timeout=10000):
+        source.start(BenchSettings("demo", ("D0", "D1"), 10e3, encoder=("D0", "D1")))
+    info = source.started
+    assert info is not None and info.labels[-1] == "demo:D0/D1 counts"
+    got = _rows_until(qtbot, source, 3000)
+    with qtbot.waitSignal(source.sigStopped, timeout=10000):
+        source.stop()
+    rows = np.concatenate(got)  # 10 kHz: one row a sample, so the levels are the stream's own
+    expected = quadrature(rows[:, 1] > 0.5, rows[:, 2] > 0.5).counts
+    assert np.array_equal(rows[:, 3] - rows[0, 3], expected) and np.count_nonzero(np.diff(expected))
+
+
 def test_a_channel_the_instrument_lacks_is_refused_in_one_line(qtbot, source):
     with qtbot.waitSignal(source.sigStopped, timeout=10000) as stopped:
         source.start(BenchSettings("demo", ("D9",), 1e6))
@@ -76,7 +91,7 @@ def test_the_scope_page_bench_tab_finds_the_demo_and_plots_it_beside_cn3(qtbot):
             panel.scan()
         assert panel.device_box.itemText(0).startswith("demo  (Demo device)")
         with qtbot.waitSignal(panel.source.sigStarted, timeout=10000):
-            panel.start(panel.device_box.itemText(0), "D0, D2", "1m")
+            panel.start(panel.device_box.itemText(0), "D0, D2", "1m", "D0,D2")
         def plotted() -> int:
             x, _y = panel._curves[0].getData()
             return 0 if x is None else len(x)
@@ -84,6 +99,8 @@ def test_the_scope_page_bench_tab_finds_the_demo_and_plots_it_beside_cn3(qtbot):
         qtbot.waitUntil(lambda: plotted() > 100, timeout=10000)
         names = [item.text for _, item in panel.plot.plotItem.legend.items]
         assert names == ["bench demo:D0", "bench demo:D2"]
+        assert panel.counts_plot.isVisibleTo(panel)  # the demo's D0/D2 counted as an encoder
+        assert panel.counts_plot.plotItem.getAxis("left").labelText == "bench demo:D0/D2 counts"
         assert panel.status_label.text().startswith("LIVE from the bench: demo at 1 MHz")
         with qtbot.waitSignal(panel.source.sigStopped, timeout=10000):
             panel.start_button.click()

@@ -49,3 +49,23 @@ def test_analog_windows_are_averaged_and_slow_instruments_are_not_decimated():
     assert np.array_equal(rows[:, 1], [1.5, 5.5, 9.5])
     assert display_factor(24e6) == 2400 and display_factor(10e3) == 1 and display_factor(1e3) == 1
     assert display_factor(15e3) == 2
+
+
+def test_encoder_counts_carry_on_across_blocks_as_on_the_whole_stream():
+    from fha_studio.logic.bench.decode import quadrature
+    from fha_studio.logic.bench.display import LiveQuadrature
+
+    # an encoder forward 3 turns' worth of edges, then back: phase 0..3 as A/B levels
+    rng = np.random.default_rng(7)
+    steps = np.concatenate([np.ones(4000, int), -np.ones(1500, int)])
+    phase = np.repeat(np.cumsum(steps) % 4, rng.integers(1, 6, steps.size))
+    a = np.isin(phase, (1, 2))
+    b = np.isin(phase, (2, 3))
+    whole = quadrature(a, b).counts
+    live = LiveQuadrature()
+    cuts = np.sort(rng.choice(np.arange(1, a.size), 40, replace=False))
+    pieces = zip(np.split(a, cuts), np.split(b, cuts), strict=True)
+    counts = np.concatenate([live.feed(x, y) for x, y in pieces])
+    # 4000 steps forward, 1500 back; the first sample is already one step on (the reference)
+    assert np.array_equal(counts, whole) and live.counts == whole[-1] == 2499
+    assert live.illegal_transitions == 0

@@ -86,12 +86,23 @@ class BenchPanel(QWidget):
         self.start_button.setCheckable(True)
         self.start_button.clicked.connect(self._start_clicked)
         grid.addWidget(self.start_button, 1, 3)
+        grid.addWidget(QLabel("Encoder"), 2, 0)
+        self.encoder_edit = QLineEdit("")
+        self.encoder_edit.setPlaceholderText("A,B e.g. D0,D1")
+        self.encoder_edit.setToolTip("encoder A and B among the channels: counted x4 as they come")
+        grid.addWidget(self.encoder_edit, 2, 1)
         grid.setColumnStretch(1, 1)
         layout.addLayout(grid)
         self.plot = pg.PlotWidget(background="w")
         self.plot.setLabel("bottom", "time", units="s")
         self.plot.addLegend(offset=(5, 5))
         layout.addWidget(self.plot, 1)
+        self.counts_plot = pg.PlotWidget(background="w")
+        self.counts_plot.setLabel("left", "counts")
+        self.counts_plot.setXLink(self.plot)
+        self.counts_plot.setVisible(False)
+        self._counts_curve = self.counts_plot.plot([], [], pen=pg.mkPen("#333333", width=1))
+        layout.addWidget(self.counts_plot, 1)
         self.status_label = QLabel("")
         self.status_label.setObjectName("scopeBenchStatus")
         self.status_label.setWordWrap(True)
@@ -110,8 +121,9 @@ class BenchPanel(QWidget):
         self.status_label.setText("Looking for instruments …")
         self.source.sigScan.emit("")
 
-    def start(self, device: str, channels: str, rate: str = "") -> None:
+    def start(self, device: str, channels: str, rate: str = "", encoder: str = "") -> None:
         """Stream (what the Start button does with the fields' text)."""
+        self.encoder_edit.setText(encoder)
         self.device_box.setEditText(device)
         self.channels_edit.setText(channels)
         self.rate_edit.setText(rate)
@@ -140,8 +152,13 @@ class BenchPanel(QWidget):
         if not device or not names:
             self._refuse("Give the instrument (Find lists them) and its channels.")
             return
+        phases = tuple(c.strip() for c in self.encoder_edit.text().split(",") if c.strip())
+        if phases and len(phases) != 2:
+            self._refuse("Encoder: its A and B channels, e.g. D0,D1.")
+            return
+        encoder = (phases[0], phases[1]) if phases else None
         self.status_label.setText(f"Starting {device} …")
-        self.source.start(BenchSettings(device, names, rate))
+        self.source.start(BenchSettings(device, names, rate, encoder))
 
     def _refuse(self, text: str) -> None:
         self.start_button.setChecked(False)
@@ -167,9 +184,14 @@ class BenchPanel(QWidget):
         self._started = started
         self.plot.clear()
         self._curves = []
-        for i, label in enumerate(started.labels):
+        for i, label in enumerate(started.labels[: len(started.channels)]):
             pen = pg.mkPen(_COLORS[i % len(_COLORS)], width=1)
             self._curves.append(self.plot.plot([], [], pen=pen, name=f"bench {label}"))
+        counting = len(started.labels) > len(started.channels)
+        self.counts_plot.setVisible(counting)
+        self._counts_curve.setData([], [])
+        if counting:
+            self.counts_plot.setLabel("left", f"bench {started.labels[-1]}")
         self.status_label.setText(f"LIVE from the bench: {started.device} at "
                                   f"{sigrok.rate_text(started.sample_rate_hz)}, "
                                   f"{', '.join(started.labels)}")
@@ -184,6 +206,8 @@ class BenchPanel(QWidget):
             if sigrok.is_logic_channel(name):  # a logic analyzer's look: one lane per channel
                 values = values * 0.8 + 1.2 * (len(self._curves) - 1 - i)
             curve.setData(rows[:, 0], values)
+        if len(started.labels) > len(started.channels):
+            self._counts_curve.setData(rows[:, 0], rows[:, -1])
 
     def _on_stopped(self, why: str) -> None:
         self.start_button.setChecked(False)

@@ -19,7 +19,7 @@ import numpy as np
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
 from fha_studio.hardware.bench import sigrok
-from fha_studio.logic.bench.display import DISPLAY_RATE_HZ, Decimator, display_factor
+from fha_studio.logic.bench.display import DISPLAY_RATE_HZ, Decimator, LiveQuadrature, display_factor
 from fha_studio.logic.scope.ring import RingBuffer
 
 #: Display rows the ring holds (10 s at the display rate).
@@ -38,6 +38,7 @@ class BenchSettings:
     device: str
     channels: tuple[str, ...]
     sample_rate_hz: float | None = None
+    encoder: tuple[str, str] | None = None  # encoder A and B among the channels: counted x4 live
 
 
 @dataclass(frozen=True)
@@ -46,7 +47,7 @@ class BenchStarted:
 
     device: str
     channels: tuple[str, ...]  # as the instrument names them
-    labels: tuple[str, ...]  # with the source: "demo:D0"
+    labels: tuple[str, ...]  # with the source: "demo:D0"; encoder counts last ("demo:D0/D1 counts")
     sample_rate_hz: float
     row_rate_hz: float
     ring: RingBuffer
@@ -98,6 +99,10 @@ class BenchWorker(QObject):
 
     @Slot(object)
     def run(self, settings: BenchSettings) -> None:
+        if settings.encoder is not None and not set(settings.encoder) <= set(settings.channels):
+            self.sigError.emit(f"encoder {'/'.join(settings.encoder)}: both must be among the channels "
+                               f"({', '.join(settings.channels)})")
+            return
         acquisition = sigrok.Acquisition(settings.device, settings.channels, settings.sample_rate_hz)
         try:
             acquisition.start()
@@ -109,16 +114,24 @@ class BenchWorker(QObject):
             if self._stop:
                 acquisition.stop()
         factor = display_factor(acquisition.sample_rate_hz)
-        decimator = Decimator(acquisition.sample_rate_hz, settings.channels, factor)
-        ring = RingBuffer(1 + len(settings.channels), RING_ROWS)
-        self.sigStarted.emit(BenchStarted(
-            settings.device, settings.channels,
-            tuple(source_label(settings.device, c) for c in settings.channels),
-            acquisition.sample_rate_hz, decimator.row_rate_hz, ring, time.monotonic()))
+        encoder = settings.encoder
+        quadrature = LiveQuadrature() if encoder is not None else None
+        extra = ("counts",) if encoder is not None else ()
+        decimator = Decimator(acquisition.sample_rate_hz, settings.channels, factor, extra)
+        ring = RingBuffer(1 + len(settings.channels) + len(extra), RING_ROWS)
+        labels = tuple(source_label(settings.device, c) for c in settings.channels)
+        if encoder is not None:
+            labels += (source_label(settings.device, f"{encoder[0]}/{encoder[1]} counts"),)
+        self.sigStarted.emit(BenchStarted(settings.device, settings.channels, labels,
+                                          acquisition.sample_rate_hz, decimator.row_rate_hz, ring,
+                                          time.monotonic()))
         last_status = 0.0
         try:
             for block in acquisition.blocks():
-                rows = decimator.feed(block)
+                counts = {}
+                if quadrature is not None and encoder is not None:
+                    counts["counts"] = quadrature.feed(block.bit(encoder[0]), block.bit(encoder[1]))
+                rows = decimator.feed(block, counts)
                 if len(rows):
                     ring.write(rows)
                 now = time.monotonic()
