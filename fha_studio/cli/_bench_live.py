@@ -135,6 +135,7 @@ def run_record(args: argparse.Namespace) -> int:
     except sigrok.SigrokError as exc:
         raise _sigrok_error(exc) from None
     capture = live.capture
+    origin = f"{args.device} through sigrok-cli (fha-studio bench record)"
     summary: dict[str, Any] = {"device": args.device, "complete": live.complete,
                                "seconds_asked": args.seconds}
     decoded_note = ""
@@ -156,10 +157,10 @@ def run_record(args: argparse.Namespace) -> int:
             summary.update(result.summary)
             what = f"decoded into {args.output}: columns {', '.join(result.recording.channels)}"
         else:
-            write_sigrok_csv(args.output, capture.block)
+            write_sigrok_csv(args.output, capture.block, source=origin)
             what = f"written raw to {args.output}{decoded_note}"
     else:
-        write_sigrok_csv(args.output, capture.block)
+        write_sigrok_csv(args.output, capture.block, source=origin)
         what = (f"written raw to {args.output} (channels {', '.join(capture.channels)}; decode with "
                 "fha-studio bench import, or record with --actuator and --parameters)")
     summary.update({"samples": capture.samples, "duration_s": capture.samples / capture.sample_rate_hz,

@@ -45,6 +45,7 @@ def test_record_without_decoding_writes_the_raw_channels_as_a_capture_file(tmp_p
     capture = read_capture(out)
     assert (capture.samples, capture.sample_rate_hz, capture.channels) == (100_000, 400e3, ("D3", "D1"))
     assert "100000 samples at 400 kHz (0.25 s) from demo written raw" in capsys.readouterr().out
+    assert out.read_text().splitlines()[1] == "; from demo through sigrok-cli (fha-studio bench record)"
 
 
 def test_record_with_the_actuator_and_parameters_decodes_into_a_recording(tmp_path: Path, capsys):
