@@ -185,6 +185,7 @@ def write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
         mode = 0o666 & ~_umask()
     except OSError as exc:
         raise FileProblem(target, os_reason(exc)) from None
+    remove_stale_temporaries(target)
     tmp = None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
@@ -202,6 +203,37 @@ def write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
     return target
+
+
+#: A temporary file of a write (``.NAME.XXXXXXXX.tmp``) untouched for this long is left over from
+#: a process killed while writing: no write of FHA Studio's outputs takes a minute.
+STALE_TEMPORARY_S = 60.0
+
+
+def remove_stale_temporaries(target: Path) -> list[Path]:
+    """Removes the temporary files a killed write of ``target`` left beside it (``.NAME.XXXX.tmp``
+    not changed for :data:`STALE_TEMPORARY_S`); returns them. A write going on now is left alone."""
+    import time
+
+    prefix = f".{target.name}."
+    removed = []
+    try:
+        entries = list(os.scandir(target.parent))
+    except OSError:
+        return []
+    now = time.time()
+    for entry in entries:
+        name = entry.name
+        if not (name.startswith(prefix) and name.endswith(".tmp") and len(name) == len(prefix) + 12):
+            continue
+        try:
+            info = entry.stat(follow_symlinks=False)
+            if stat.S_ISREG(info.st_mode) and now - info.st_mtime > STALE_TEMPORARY_S:
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+        except OSError:
+            continue
+    return removed
 
 
 def write_text(path: str | os.PathLike[str], text: str) -> Path:
