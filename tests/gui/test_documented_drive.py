@@ -172,8 +172,11 @@ def test_dgr_checks_encoder_direction_dogs_and_origin(make_window, qtbot, tmp_pa
     assert SERVO_ON_NOTE in page.reason_label.text()
     panel(window, qtbot, "command", 5.0)
     # the controller's 5 deg take their time; over CN3 a documented drive tells nothing of it, so
-    # the test looks at the simulated drive: done when the output stands still
-    qtbot.waitUntil(lambda: not sim_drive(window).moving, timeout=15000)
+    # the test gives them 1.5 s of the simulated drive's own time (its moving bit clears while the
+    # output still creeps at up to 0.5 r/min, and switched off then, it would coast on)
+    commanded_at = sim_drive(window).clock_s
+    qtbot.waitUntil(lambda: sim_drive(window).clock_s >= commanded_at + 1.5, timeout=30000)
+    assert not sim_drive(window).moving
     switch_servo(window, qtbot, False)
     qtbot.waitUntil(lambda: page.direction_end_button.isEnabled(), timeout=10000)
     record = click_and_record(page, qtbot, page.direction_end_button)
