@@ -17,6 +17,7 @@ from collections.abc import Sequence
 from typing import Any, NoReturn
 
 from fha_studio.fileio import FileProblem, os_reason
+from fha_studio.names import printable
 
 
 class CliError(Exception):
@@ -35,7 +36,14 @@ class OneLineParser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        self.exit(2, f"{self.prog}: error: {one_line(message)} (see {self.prog} --help)\n")
+
+
+def one_line(message: str, limit: int = 1000) -> str:
+    """A refusal as one readable line: what the user typed may hold line breaks or terminal
+    escape sequences (escaped here), and may be long (cut)."""
+    text = "".join(c if printable(c) else c.encode("unicode_escape").decode("ascii") for c in message)
+    return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -67,10 +75,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stdout.flush()  # a closed pipe shows here, inside the handler below
         return code
     except CliError as exc:
-        print(f"fha-studio {args.command}: error: {exc}", file=sys.stderr)
+        print(f"fha-studio {args.command}: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
     except FileProblem as exc:
-        print(f"fha-studio {args.command}: error: {exc}", file=sys.stderr)
+        print(f"fha-studio {args.command}: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130
