@@ -156,10 +156,15 @@ def _run(args) -> int:
         _context(args.actuator)
         session = ProcedureSession(actuator_code=args.actuator.strip().upper(), operator=args.operator)
         fileio.check_output_path(args.session)
-        session.save(args.session)
     context = _context(session.actuator_code)
+    try:  # an unknown procedure is refused before a new session file is made
+        procedure = load_procedure(args.procedure, context)
+    except ProcedureError as exc:
+        raise CliError(str(exc)) from None
+    if session.path is None:
+        session.save(args.session)
     try:
-        run = ProcedureRun(session, load_procedure(args.procedure, context))
+        run = ProcedureRun(session, procedure)
     except ProcedureError as exc:
         raise CliError(str(exc)) from None
     client = None
