@@ -69,6 +69,12 @@ def read_import(path: Path) -> None:
             import_parameter_file(register, path, "Press 7", "feed")
 
 
+def read_scenario(path: Path) -> None:
+    from fha_studio.logic.training.scenario import load_scenario
+
+    load_scenario(path)
+
+
 READERS = {
     "capture": read_capture,
     "recording": read_recording,
@@ -79,4 +85,5 @@ READERS = {
     "machine": read_machine,
     "register": read_register,
     "import": read_import,
+    "scenario": read_scenario,
 }

@@ -322,11 +322,18 @@ def _evidence_list(r: _Reader, data: Any, where: str, line: int, key: str) -> tu
     return tuple(_evidence(r, e, f"{where}, {key} {i + 1}", line) for i, e in enumerate(data))
 
 
+#: Simulated-drive options that name a file the drive would write: not taken from a scenario.
+FILE_OPTIONS = ("eeprom",)
+
+
 def _sim_values(r: _Reader, data: Any, where: str, line: int) -> dict[str, str]:
     if not isinstance(data, dict):
         raise r.fail(where, line, "must be a table of simulated-drive options (docs/sim.md)")
     out: dict[str, str] = {}
     for key, value in data.items():
+        if key in FILE_OPTIONS:  # checking or walking a scenario must write no file
+            raise r.fail(where, line, f"{key}: a scenario names no file for the simulated drive "
+                         "(the training drive keeps its EEPROM in memory)")
         if isinstance(value, bool):
             out[key] = "1" if value else "0"
         elif isinstance(value, int | float | str):
