@@ -182,3 +182,12 @@ def test_score_counts_recorded_procedure_checks():
     sheet = score(first, TraineeRecord(started_s=t - 60, ended_s=t + 1, session=session))
     assert sheet.faults[0].found
     assert "CCW" in sheet.faults[0].evidence[0].text
+
+
+def test_a_scenario_name_too_long_for_a_file_is_no_scenario():
+    from fha_studio.logic.training.scenario import ScenarioError, find_scenario
+
+    with pytest.raises(ScenarioError) as err:
+        find_scenario("n" * 10_000)
+    assert str(err.value).startswith("no training scenario 'nnnn")
+    assert "(10000 characters)" in str(err.value) and "\n" not in str(err.value)

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import quote
 
-from fha_studio import fileio
+from fha_studio import fileio, names
 from fha_studio.catalog import ModelCodeError, parse_model_code
 from fha_studio.hardware.sim import EepromError, SimDrive
 from fha_studio.hardware.sim.options import SimConfigError, config_from_url
@@ -201,15 +201,20 @@ def list_scenarios(directory: Path | None = None) -> list[Scenario]:
 
 def find_scenario(name: str, directory: Path | None = None) -> Scenario:
     """A scenario by its id or by a file path; ScenarioError listing the ids otherwise."""
+    folder = directory or scenarios_dir()
+    ids = ", ".join(p.stem for p in sorted(folder.glob("*.toml")))
+    if len(name) > names.TEXT_MAX or not names.printable(name):  # before it is used as a path
+        raise ScenarioError(f"no training scenario {names.quoted(name)}; scenarios: {ids}")
     path = Path(name)
     if path.suffix == ".toml" and path.exists():
         return load_scenario(path)
-    folder = directory or scenarios_dir()
     candidate = folder / f"{name}.toml"
-    if candidate.exists():
-        return load_scenario(candidate)
-    ids = ", ".join(p.stem for p in sorted(folder.glob("*.toml")))
-    raise ScenarioError(f"no training scenario {name!r}; scenarios: {ids}")
+    try:
+        if candidate.exists():
+            return load_scenario(candidate)
+    except OSError:  # a name the file system cannot take is no scenario's
+        pass
+    raise ScenarioError(f"no training scenario {names.quoted(name)}; scenarios: {ids}")
 
 
 class _Reader:
