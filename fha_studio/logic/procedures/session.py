@@ -260,9 +260,11 @@ def _session_from_json(data: dict[str, Any]) -> ProcedureSession:
 
 
 def _parameters(data: Any) -> dict[str, Any]:
-    """``{"file": text, "read_utc": text, "values": {key: wire integer}}``."""
-    table = _table(data, "parameters", "fields (file, read_utc, values)")
-    allowed = ("file", "read_utc", "values")
+    """``{"file": text, "read_utc": text, "values": {key: wire integer}, "front_panel": {key:
+    {"who": text, "time": text}}}`` (front_panel: the values entered from the drive's front panel,
+    as the Procedures page writes them)."""
+    table = _table(data, "parameters", "fields (file, read_utc, values, front_panel)")
+    allowed = ("file", "read_utc", "values", "front_panel")
     unknown = sorted(set(table) - set(allowed))
     if unknown:
         raise _ShapeError(f"parameters.{unknown[0]}", f"unknown; allowed: {', '.join(allowed)}")
@@ -276,6 +278,18 @@ def _parameters(data: Any) -> dict[str, Any]:
             if not -(2**31) <= wire < 2**31:
                 raise _ShapeError(f"parameters.values.{key}", f"{wire:g} is no value a drive holds")
         out["values"] = dict(found)
+    if "front_panel" in table:
+        entries = _table(table["front_panel"], "parameters.front_panel",
+                         "front-panel entries by parameter key")
+        panel: dict[str, dict[str, str]] = {}
+        for key, entry in entries.items():
+            where = f"parameters.front_panel.{key}"
+            fields = _table(entry, where, "fields (who, time)")
+            unknown = sorted(set(fields) - {"who", "time"})
+            if unknown:
+                raise _ShapeError(f"{where}.{unknown[0]}", "unknown; allowed: who, time")
+            panel[key] = {k: _text(fields[k], f"{where}.{k}") for k in ("who", "time") if k in fields}
+        out["front_panel"] = panel
     return out
 
 
