@@ -221,7 +221,7 @@ def remove_stale_temporaries(target: Path) -> list[Path]:
         entries = list(os.scandir(target.parent))
     except OSError:
         return []
-    now = time.time()
+    now = time.time()  # a file's age: the filesystem's clock, never a stamped fact's
     for entry in entries:
         name = entry.name
         if not (name.startswith(prefix) and name.endswith(".tmp") and len(name) == len(prefix) + 12):
