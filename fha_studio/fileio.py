@@ -47,7 +47,8 @@ def _shown(path: str) -> str:
     return path if len(path) <= 120 else path[:60] + "…" + path[-40:]
 
 
-_KIND = (
+#: what a path is when it is not a regular file, as a refusal names it
+FILE_KINDS = (
     (stat.S_ISDIR, "a directory"),
     (stat.S_ISFIFO, "a FIFO (named pipe)"),
     (stat.S_ISCHR, "a character device"),
@@ -57,7 +58,7 @@ _KIND = (
 
 
 def _kind(mode: int) -> str:
-    for test, name in _KIND:
+    for test, name in FILE_KINDS:
         if test(mode):
             return name
     return "not a regular file"

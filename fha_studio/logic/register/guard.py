@@ -21,6 +21,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
+from fha_studio import fileio
 from fha_studio.names import quoted
 
 #: The first 16 bytes of every SQLite 3 database file.
@@ -31,15 +32,6 @@ DEVICE_FOLDERS = ("/dev/",)
 
 class RegisterError(ValueError):
     """The register cannot be used or a request does not fit it; the message says what and where."""
-
-
-_KIND = (
-    (stat.S_ISDIR, "a directory"),
-    (stat.S_ISFIFO, "a FIFO (named pipe)"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISSOCK, "a socket"),
-)
 
 
 def shown_path(path: str | os.PathLike[str]) -> str:
@@ -65,7 +57,7 @@ def check_before_opening(path: Path, create: bool) -> bool:
 
         raise RegisterError(f"register {where}: {os_reason(exc)}") from None
     if not stat.S_ISREG(info.st_mode):
-        kind = next((name for test, name in _KIND if test(info.st_mode)), "not a regular file")
+        kind = next((name for test, name in fileio.FILE_KINDS if test(info.st_mode)), "not a regular file")
         raise RegisterError(f"register {where}: is {kind}, not a register file: nothing was opened")
     if info.st_size == 0:
         if not create:
