@@ -325,8 +325,8 @@ def _page_facts(window, page_id: str, page, servo_on: bool) -> None:
         assert not page.check_button.isEnabled() and "DGR checks" in page.check_button.toolTip()
         assert "front panel" in page.drive_label.text()
     elif page_id == "jog":
-        assert "CN2" in page.message.text()
-        assert not page.servo_on_button.isEnabled()
+        assert "CN2" in page.motion.message.text()
+        assert not page.motion.servo_on_button.isEnabled()
     elif page_id == "absolute":
         if servo_on:
             assert not page.read_button.isEnabled() and SERVO_ON_NOTE in page.reason_label.text()

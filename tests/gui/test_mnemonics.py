@@ -69,17 +69,19 @@ def test_space_jogs_on_the_jog_buttons_only(make_window, qtbot):
 
     window = make_window(connect="sim://FHA-25C-50-US250?paced=0")
     page = window.show_page("jog")
-    qtbot.waitUntil(lambda: page.move_button.isEnabled() or page.servo_on_button.isEnabled(), timeout=10000)
+    motion = page.motion
+    qtbot.waitUntil(lambda: motion.move_button.isEnabled() or motion.servo_on_button.isEnabled(),
+                    timeout=10000)
     sent = []
     window.link.sigCommand.connect(lambda command: sent.append(command.cmd))
-    for button in (page.move_button, page.servo_on_button):
+    for button in (page.motion.move_button, page.motion.servo_on_button):
         button.setFocus()
         qtbot.keyPress(button, Qt.Key.Key_Space)
         qtbot.keyRelease(button, Qt.Key.Key_Space)
     qtbot.wait(50)
     assert Cmd.MOVE_BY not in sent and Cmd.SERVO not in sent
-    page.fwd_button.setEnabled(True)
-    page.fwd_button.setFocus()
-    qtbot.keyPress(page.fwd_button, Qt.Key.Key_Space)
+    page.motion.fwd_button.setEnabled(True)
+    page.motion.fwd_button.setFocus()
+    qtbot.keyPress(page.motion.fwd_button, Qt.Key.Key_Space)
     qtbot.waitUntil(lambda: Cmd.JOG in sent, timeout=10000)
-    qtbot.keyRelease(page.fwd_button, Qt.Key.Key_Space)
+    qtbot.keyRelease(page.motion.fwd_button, Qt.Key.Key_Space)

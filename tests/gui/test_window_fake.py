@@ -74,11 +74,11 @@ def test_rotary_direction_written_read_back_and_power_cycle_offered(window, fake
 def test_jog_hold_runs_release_stops_and_stop_key(window, fake, qtbot):
     page = window.show_page("jog")
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO):
-        page.servo_on_button.click()
-    qtbot.waitUntil(lambda: page.fwd_button.isEnabled(), timeout=10000)
-    qtbot.mousePress(page.fwd_button, Qt.MouseButton.LeftButton)
+        page.motion.servo_on_button.click()
+    qtbot.waitUntil(lambda: page.motion.fwd_button.isEnabled(), timeout=10000)
+    qtbot.mousePress(page.motion.fwd_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: sum(1 for c in fake.calls if c[0] == "jog") >= 3, timeout=10000)  # keep-alive
-    qtbot.mouseRelease(page.fwd_button, Qt.MouseButton.LeftButton)
+    qtbot.mouseRelease(page.motion.fwd_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: fake.calls[-1] == ("stop",), timeout=10000)
     n = len(fake.calls)
     qtbot.keyClick(window, Qt.Key.Key_Escape)
@@ -113,7 +113,7 @@ def test_closing_with_the_servo_on_asks_and_cancel_keeps_the_window(window, fake
     from PySide6.QtWidgets import QMessageBox
 
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO):
-        window.jog_page.servo_on_button.click()
+        window.jog_page.motion.servo_on_button.click()
     qtbot.waitUntil(lambda: window.link.servo_on, timeout=10000)
     asked = []
 

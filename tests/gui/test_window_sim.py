@@ -25,7 +25,7 @@ def window(make_window, qtbot):
 
 def servo_on(window, qtbot):
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO, timeout=10000):
-        window.jog_page.servo_on_button.click()
+        window.jog_page.motion.servo_on_button.click()
     qtbot.waitUntil(lambda: window.link.servo_on, timeout=10000)
 
 
@@ -111,10 +111,10 @@ def test_jog_moves_the_axis_and_release_stops_it(window, qtbot):
     page = window.show_page("jog")
     servo_on(window, qtbot)
     start = window.link.status.position_pulse
-    page.speed_spin.setValue(10.0)
-    qtbot.mousePress(page.fwd_button, Qt.MouseButton.LeftButton)
+    page.motion.speed_spin.setValue(10.0)
+    qtbot.mousePress(page.motion.fwd_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: (window.link.status.speed_rpm or 0) > 5.0, timeout=10000)
-    qtbot.mouseRelease(page.fwd_button, Qt.MouseButton.LeftButton)
+    qtbot.mouseRelease(page.motion.fwd_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: abs(window.link.status.speed_rpm or 0) < 0.01, timeout=10000)
     assert window.link.status.position_pulse > start  # FWD counts up
     assert window.link.servo_on  # release stops and holds; the servo stays on
@@ -123,9 +123,9 @@ def test_jog_moves_the_axis_and_release_stops_it(window, qtbot):
 def test_stop_key_stops_a_move(window, qtbot):
     page = window.show_page("jog")
     servo_on(window, qtbot)
-    page.angle_spin.setValue(900.0)
-    page.move_speed_spin.setValue(20.0)
-    page.move_button.click()
+    page.motion.angle_spin.setValue(900.0)
+    page.motion.move_speed_spin.setValue(20.0)
+    page.motion.move_button.click()
     qtbot.waitUntil(lambda: (window.link.status.speed_rpm or 0) > 1.0, timeout=10000)
     qtbot.keyClick(window, Qt.Key.Key_Escape)
     qtbot.waitUntil(lambda: abs(window.link.status.speed_rpm or 0) < 0.01, timeout=10000)
@@ -178,7 +178,7 @@ def test_lost_link_shown_within_a_second(window, qtbot):
     assert lost.args[1] is True
     assert "LINK LOST" in window.caps_label.text()
     assert window.link_lamp.state is True  # red lamp: lost, not merely disconnected
-    assert not window.jog_page.fwd_button.isEnabled()
+    assert not window.jog_page.motion.fwd_button.isEnabled()
 
 
 def test_stop_and_failures_are_seen_in_the_message_area_and_kept_in_its_log(window, qtbot):
@@ -217,7 +217,7 @@ def test_parameter_mode_writes_are_prevented_up_front_while_the_servo_is_on(wind
     page.write_changed()  # e.g. a keyboard shortcut: still refused, nothing sent
     assert Cmd.WRITE_PARAMETERS not in sent and "Nothing written" in page.message.text()
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO, timeout=10000):
-        window.jog_page.servo_off_button.click()
+        window.jog_page.motion.servo_off_button.click()
     qtbot.waitUntil(page.write_changed_button.isEnabled, timeout=10000)
     assert not page.servo_note.isVisible()
 

@@ -13,8 +13,8 @@ from PySide6.QtWidgets import QVBoxLayout
 
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.gui.link import POLL_INTERVAL_MS, Cmd, LinkInfo
+from fha_studio.gui.motion_controls import MotionControls, MotionLayout
 from fha_studio.gui.pages.base import BasePage
-from fha_studio.gui.pages.scope.jog_panel import JogPanel
 from fha_studio.gui.widgets import space_jogs_only
 
 from .bench_panel import BenchPanel
@@ -45,7 +45,8 @@ class ScopePage(BasePage):
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.view)
         # move and watch at once: the jog panel beside the plot, STOP as the window's
-        self.jog_panel = JogPanel(link, main_window.stop_button if main_window is not None else None)
+        self.jog_panel = MotionControls(link, main_window.stop_button if main_window is not None else None,
+                                        MotionLayout.PANEL)
         self.view.dock_under_channels(self.jog_panel)
         space_jogs_only(self, (self.jog_panel.fwd_button, self.jog_panel.rev_button))
         # a bench instrument on CN2 beside CN3 polling (a real drive's CN3 is silent in motion)
