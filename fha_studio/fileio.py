@@ -122,6 +122,34 @@ def read_bytes(path: str | os.PathLike[str], *, limit_bytes: int = DEFAULT_READ_
         os.close(fd)
 
 
+def read_head(path: str | os.PathLike[str], max_bytes: int) -> bytes:
+    """The first ``max_bytes`` (or fewer) of a regular file; :class:`FileProblem` otherwise."""
+    name = os.fspath(path)
+    if not name:
+        raise FileProblem("''", "no file name given")
+    try:
+        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+    except OSError as exc:
+        raise FileProblem(name, os_reason(exc)) from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise FileProblem(name, f"is {_kind(info.st_mode)}, not a regular file: only files are read")
+        chunks: list[bytes] = []
+        total = 0
+        while total < max_bytes:
+            chunk = os.read(fd, min(1 << 20, max_bytes - total))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+        return b"".join(chunks)
+    except OSError as exc:
+        raise FileProblem(name, f"cannot be read: {os_reason(exc)}") from None
+    finally:
+        os.close(fd)
+
+
 def read_text(path: str | os.PathLike[str], *, limit_bytes: int = DEFAULT_READ_LIMIT_BYTES) -> str:
     """A regular file as UTF-8 text (a leading byte-order mark is dropped); :class:`FileProblem`
     for anything else, including bytes that are not UTF-8 (the message gives the line)."""

@@ -32,6 +32,7 @@ import os
 import re
 import zipfile
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -450,9 +451,29 @@ def _numbers_like(text: str) -> bool:
     return bool(re.fullmatch(r"[+-]?(?:[0-9]+(?:[.,][0-9]*)?|[.,][0-9]+)(?:[eE][+-]?[0-9]+)?", text.strip()))
 
 
-def parse_csv(data: bytes, name: str) -> Capture:
-    """A generic CSV: header row, a time column, one analog channel per other column."""
-    lines = _head_lines(data)
+@dataclass(frozen=True)
+class CsvLayout:
+    """Where a generic CSV's parts are, from its first lines: what sigrok-cli's CSV input is told
+    (``fha_studio.hardware.bench.sigrok_input``) and what :func:`parse_csv` reads by."""
+
+    delimiter: str  # ",", ";" or "\t"
+    decimal_comma: bool
+    comment: str  # the characters a comment line starts with
+    header_line: int  # index of the header row
+    data_start: int  # index of the first line after the header (and its units row)
+    names: tuple[str, ...]  # the columns' names, units taken off ("time", "CH1")
+    units: tuple[str, ...]  # each column's unit as the header or a units row says ("" if none)
+    time_column: int
+    width: int  # fields per row (trailing empty columns included)
+
+
+def csv_layout(data: bytes, name: str) -> CsvLayout:
+    """The layout of a generic CSV from its start (the whole file or its first lines);
+    :class:`CaptureError` naming the line for a file of another shape."""
+    return _csv_layout(_head_lines(data), name)
+
+
+def _csv_layout(lines: Sequence[bytes], name: str) -> CsvLayout:
     index = _first_content_line(lines, 0, None)
     if index is None:
         raise CaptureError(f"{name}: line 1: empty: expected a header row naming the columns "
@@ -496,17 +517,33 @@ def parse_csv(data: bytes, name: str) -> Capture:
         if label in seen:
             raise CaptureError(f"{name}: line {index + 1}: column '{label}' given twice")
         seen.add(label)
-    width = len(header)
+    if _time_unit(names[time_column], column_units[time_column]) is None:
+        raise CaptureError(f"{name}: line {index + 1}: the time column's unit '{column_units[time_column]}' "
+                           "is not s, ms, us or ns")
     decimal_comma = delimiter == ";" and _has_decimal_comma(lines, data_start)
+    return CsvLayout(delimiter, decimal_comma, comment, index, data_start, tuple(names),
+                     tuple(column_units), time_column, len(header))
+
+
+def time_unit_s(layout: CsvLayout) -> float:
+    """Seconds per unit of the layout's time column."""
+    unit = _time_unit(layout.names[layout.time_column], layout.units[layout.time_column])
+    assert unit is not None  # checked by csv_layout
+    return unit
+
+
+def parse_csv(data: bytes, name: str) -> Capture:
+    """A generic CSV: header row, a time column, one analog channel per other column."""
+    lines = _head_lines(data)
+    layout = _csv_layout(lines, name)
+    names, column_units, time_column = list(layout.names), list(layout.units), layout.time_column
+    data_start, delimiter, comment = layout.data_start, layout.delimiter, layout.comment
+    decimal_comma, width = layout.decimal_comma, layout.width
     table = _table(lines, data_start, width, name, delimiter.encode(), decimal_comma, comment)
     table = table[:, : len(names)]
     if table.shape[0] < 2:
         raise CaptureError(f"{name}: line {data_start + 1}: fewer than 2 rows of samples")
-    time_unit = _time_unit(names[time_column], column_units[time_column])
-    if time_unit is None:
-        raise CaptureError(f"{name}: line {index + 1}: the time column's unit '{column_units[time_column]}' "
-                           "is not s, ms, us or ns")
-    t = table[:, time_column] * time_unit
+    t = table[:, time_column] * time_unit_s(layout)
     rate = _steady_rate(t, name, lines, data_start, comment)
     analog: dict[str, np.ndarray] = {}
     unit_of: dict[str, str] = {}
