@@ -364,6 +364,7 @@ class FileAcquisition:
         self.analog: tuple[str, ...] = ()
         self.sample_rate_hz = 0.0
         self.samples = 0
+        self.max_samples: int | None = None
         self.units: dict[str, str] = {}
         self._processes: list[subprocess.Popen[bytes]] = []
         self._stop = False
@@ -466,6 +467,8 @@ class FileAcquisition:
             block = self._take(logic_parts, analog_parts)
             if block is not None:
                 yield block
+                if self.max_samples is not None and self.samples >= self.max_samples:
+                    self.stop()
         if self._stop:
             return
         for kind, _reader, process in readers_of.values():
@@ -483,6 +486,8 @@ class FileAcquisition:
         have_logic = sum(len(p) for p in logic_parts) if self.logic else None
         have_analog = sum(len(p) for p in analog_parts) if self.analog else None
         n = min(x for x in (have_logic, have_analog) if x is not None)
+        if self.max_samples is not None:
+            n = max(0, min(n, self.max_samples - self.samples))
         if n == 0:
             return None
         logic = np.zeros(0, np.uint8)

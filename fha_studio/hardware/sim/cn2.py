@@ -132,6 +132,8 @@ class Cn2Signals:
             vel = np.concatenate(([self._last[3]], vel))
         if t.size == 0:
             return self._empty(), {}
+        if self._last is None and self.next_sample == 0:
+            self.next_sample = max(0, math.ceil(t[0] * self.rate - 1e-9))  # a drive that ran a while
         last_index = math.floor(t[-1] * self.rate + 1e-9)
         k = np.arange(self.next_sample, last_index + 1)
         ts = k / self.rate
@@ -220,6 +222,33 @@ class Cn2Signals:
         return up | down, held
 
 
+def signals_of_axis(axis: ServoAxis, sample_rate_hz: float, settings: Cn2Settings) -> Cn2Signals:
+    """The CN2 outputs of a servo axis (its resolution, ratio, in-position range, direction and
+    electronic gear) at an instrument's rate."""
+    model = axis.model
+    return Cn2Signals(
+        sample_rate_hz,
+        settings,
+        output_pulse_rad=model.output_pulse_rad,
+        ratio=float(model.ratio or 1),
+        in_position_range_counts=axis.settings.in_position_range_pulses,
+        direction=axis.settings.direction_sign,
+        gear=(axis.settings.electronic_gear_numerator, axis.settings.electronic_gear_denominator),
+    )
+
+
+def settings_of_drive(drive: SimDrive, monitor: MonitorModel | None = None) -> Cn2Settings:
+    """The simulated drive's parameters 1, 2 and 9 and its resolution, as CN2 shows them."""
+    model = drive.axis.model
+    return Cn2Settings(
+        counts_per_motor_turn=round(model.output_resolution_ppr / (model.ratio or 1)),
+        pulse_form=drive.memory.value("command_pulse_configuration"),
+        multiplication=drive.memory.value("two_phase_pulse_multiplication"),
+        speed_conversion_rpm=float(drive.memory.value("speed_conversion_factor")),
+        monitor=monitor or MonitorModel(),
+    )
+
+
 def _quadrature_levels(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A/B levels of a x4 count: phase 0..3 = 00, 10, 11, 01 (A leads B going forward)."""
     phase = np.mod(counts, 4)
@@ -246,16 +275,7 @@ class VirtualBenchInstrument:
         self.axis = axis
         self._advance = advance
         self.settings = settings or Cn2Settings()
-        model = axis.model
-        self.signals = Cn2Signals(
-            sample_rate_hz,
-            self.settings,
-            output_pulse_rad=model.output_pulse_rad,
-            ratio=float(model.ratio or 1),
-            in_position_range_counts=axis.settings.in_position_range_pulses,
-            direction=axis.settings.direction_sign,
-            gear=(axis.settings.electronic_gear_numerator, axis.settings.electronic_gear_denominator),
-        )
+        self.signals = signals_of_axis(axis, sample_rate_hz, self.settings)
         self.alarm = alarm or (lambda: False)
         self.truth = Truth()
         self._blocks: list[SampleBlock] = []
@@ -294,14 +314,7 @@ class VirtualBenchInstrument:
     ) -> VirtualBenchInstrument:
         """The instrument on a stepped simulated drive's CN2: its parameters 1, 2 and 9, its
         resolution, its alarm; the drive's time advances as the instrument records."""
-        model = drive.axis.model
-        settings = Cn2Settings(
-            counts_per_motor_turn=round(model.output_resolution_ppr / (model.ratio or 1)),
-            pulse_form=drive.memory.value("command_pulse_configuration"),
-            multiplication=drive.memory.value("two_phase_pulse_multiplication"),
-            speed_conversion_rpm=float(drive.memory.value("speed_conversion_factor")),
-            monitor=monitor or MonitorModel(),
-        )
+        settings = settings_of_drive(drive, monitor)
         return cls(
             drive.axis, sample_rate_hz, settings, alarm=lambda: bool(drive.alarm), advance=drive.advance
         )

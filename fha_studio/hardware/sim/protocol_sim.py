@@ -19,6 +19,7 @@ from typing import Any
 
 from serial.serialutil import PortNotOpenError, SerialBase, SerialException, to_bytes
 
+from fha_studio.hardware.sim import cn2_live
 from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.eeprom import EepromError
 from fha_studio.hardware.sim.options import SimConfigError, config_from_url
@@ -53,12 +54,14 @@ class Serial(SerialBase):
         self.sim_server = SimProtocolServer(drive, paced=config.paced)
         if not config.stepped:
             drive.start()
+            cn2_live.plug(drive)  # its CN2 on offer as a bench instrument while the port is open
         self.is_open = True
 
     def close(self) -> None:
         drive, self.sim_drive = self.sim_drive, None
         self.is_open = False
         if drive is not None:
+            cn2_live.unplug(drive)
             drive.close()
         super().close()
 

@@ -96,3 +96,46 @@ class LiveQuadrature:
         self.illegal_transitions += result.illegal_transitions
         self._last = (bool(a[-1]), bool(b[-1]))
         return counts
+
+
+class LiveCommandPulses:
+    """The command pulse lines decoded as the blocks arrive (parameter 1's form, parameter 2's
+    multiplication, the electronic gear 3/4), carried across blocks as :class:`LiveQuadrature`
+    carries the encoder: the counts are those of :func:`decode.command_pulses` on the whole
+    stream."""
+
+    def __init__(self, pulse_form: int, multiplication: int, gear_numerator: int, gear_denominator: int):
+        # checked once, on an empty stream: a bad form or gear is refused before any block
+        decode.command_pulses(np.zeros(1, bool), np.zeros(1, bool), pulse_form, multiplication,
+                              gear_numerator, gear_denominator)
+        self.pulse_form = pulse_form
+        self.multiplication = multiplication
+        self.gear = (gear_numerator, gear_denominator)
+        self._last: tuple[bool, bool] | None = None
+        self._edges = LiveQuadrature() if pulse_form == 2 else None
+        self.pulses = 0  # after the last sample fed
+        self.illegal_transitions = 0
+
+    def feed(self, a: np.ndarray, b: np.ndarray | None) -> np.ndarray:
+        """The commanded encoder counts (float64) at each sample of the block."""
+        if a.size == 0:
+            return np.zeros(0)
+        numerator, denominator = self.gear
+        if self._edges is not None:
+            if b is None:
+                raise decode.DecodeError("two-phase command pulses (parameter 1 = 2) need both lines")
+            edges = self._edges.feed(a, b)
+            self.illegal_transitions = self._edges.illegal_transitions
+            pulses = np.floor_divide(edges, 4 // self.multiplication)
+        else:
+            b_line = b if b is not None else np.zeros(a.size, bool)
+            if self._last is None:
+                self._last = (bool(a[0]), bool(b_line[0]))
+            line_b = np.concatenate([[self._last[1]], b_line]) if b is not None else None
+            result = decode.command_pulses(np.concatenate([[self._last[0]], a]), line_b,
+                                           self.pulse_form, self.multiplication, 1, 1)
+            pulses = result.pulses[1:] + self.pulses
+            self._last = (bool(a[-1]), bool(b_line[-1]))
+        self.pulses = int(pulses[-1])
+        counts: np.ndarray = pulses * (numerator / denominator)
+        return counts

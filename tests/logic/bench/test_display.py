@@ -3,7 +3,10 @@ pulse still shows, analog windows are averaged."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
+import pytest
 
 from fha_studio.hardware.bench.capture import SampleBlock, pack_logic
 from fha_studio.logic.bench.display import Decimator, display_factor
@@ -69,3 +72,38 @@ def test_encoder_counts_carry_on_across_blocks_as_on_the_whole_stream():
     # 4000 steps forward, 1500 back; the first sample is already one step on (the reference)
     assert np.array_equal(counts, whole) and live.counts == whole[-1] == 2499
     assert live.illegal_transitions == 0
+
+
+@pytest.mark.parametrize(("pulse_form", "multiplication"), [(0, 4), (1, 4), (2, 4), (2, 1)])
+def test_live_command_pulses_across_blocks_equal_decoding_the_whole_stream(pulse_form, multiplication):
+    from fha_studio.logic.bench.decode import command_pulses
+    from fha_studio.logic.bench.display import LiveCommandPulses
+
+    rng = np.random.default_rng(pulse_form * 10 + multiplication)
+    a = rng.random(5000) < 0.3
+    b = rng.random(5000) < 0.5
+    if pulse_form == 2:  # a legal two-phase train that goes back and forth
+        steps = np.repeat(rng.choice([-1, 0, 1], 250, p=[0.3, 0.2, 0.5]), 20)
+        phase = np.cumsum(steps) % 4
+        a, b = (phase == 1) | (phase == 2), phase >= 2
+    whole = command_pulses(a, b, pulse_form, multiplication, 3, 2).counts
+    live = LiveCommandPulses(pulse_form, multiplication, 3, 2)
+    cuts = [0, 1, 2, 700, 701, 2500, 5000]
+    parts = [live.feed(a[i:j], b[i:j]) for i, j in itertools.pairwise(cuts)]
+    got = np.concatenate(parts)
+    assert np.array_equal(got - got[0], whole - whole[0]) and np.count_nonzero(np.diff(whole))
+
+
+def test_bench_move_figures_take_in_position_from_in_pos_and_following_error_in_counts():
+    from fha_studio.logic.bench.move import bench_move_figures
+
+    t = np.arange(0, 1.0, 1e-4)
+    cmd = np.clip((t - 0.1) / 0.2, 0, 1) * 1000.0  # 1000 counts from 0.1 s to 0.3 s
+    enc = np.clip((t - 0.12) / 0.2, 0, 1) * 1000.0  # 20 ms behind: following error 100 counts
+    in_pos = (np.abs(cmd - enc) <= 10) & (t > 0.4)  # the drive says in-position at 0.4 s
+    figures = bench_move_figures(t, cmd, enc, in_pos, counts_per_deg=100.0)
+    assert figures.metrics.target - figures.metrics.start == pytest.approx(10.0)
+    assert figures.in_position_time_s == pytest.approx(0.1, abs=2e-4)
+    assert figures.following_error_peak_counts == pytest.approx(100.0, abs=1.0)
+    assert figures.following_error_end_counts == 0.0
+    assert bench_move_figures(t, cmd, enc, np.zeros(t.size), 100.0).in_position_time_s is None

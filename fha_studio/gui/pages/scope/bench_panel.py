@@ -13,7 +13,7 @@ import shutil
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import Signal, Slot
+from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import (
     QComboBox,
     QGridLayout,
@@ -25,11 +25,17 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.hardware.bench import sigrok
+from fha_studio.logic.bench.importer import DriveSettings
+from fha_studio.logic.bench.move import BenchMoveFigures, bench_move_figures
 
 from .bench_source import BenchSettings, BenchSource, BenchStarted
 
 #: Seconds of the newest rows on show.
 WINDOW_S = 2.0
+#: A move's figures are taken once its command has stood this long [s] (the axis settles first).
+MOVE_SETTLED_S = 0.5
+#: A command standing still this long before a change marks where a move began [s].
+MOVE_GAP_S = 0.2
 _COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#e07000", "#9467bd", "#8c564b", "#e377c2", "#008b8b")
 
 
@@ -91,6 +97,19 @@ class BenchPanel(QWidget):
         self.encoder_edit.setPlaceholderText("A,B e.g. D0,D1")
         self.encoder_edit.setToolTip("encoder A and B among the channels: counted x4 as they come")
         grid.addWidget(self.encoder_edit, 2, 1)
+        grid.addWidget(QLabel("Command"), 3, 0)
+        self.command_edit = QLineEdit("")
+        self.command_edit.setPlaceholderText("A,B e.g. D2,D3")
+        self.command_edit.setToolTip("the command pulse lines into CN2 among the channels (A, and B for "
+                                     "two-pulse, the sign or two-phase), decoded by parameters 1, 2, 3 "
+                                     "and 4")
+        grid.addWidget(self.command_edit, 3, 1)
+        grid.addWidget(QLabel("IN-POS"), 4, 0)
+        self.in_position_edit = QLineEdit("")
+        self.in_position_edit.setPlaceholderText("e.g. D5 (CN2-33)")
+        self.in_position_edit.setToolTip("the drive's in-position output (CN2-33) among the channels: "
+                                         "the move's in-position time is taken from it")
+        grid.addWidget(self.in_position_edit, 4, 1)
         grid.setColumnStretch(1, 1)
         layout.addLayout(grid)
         self.plot = pg.PlotWidget(background="w")
@@ -103,6 +122,16 @@ class BenchPanel(QWidget):
         self.counts_plot.setVisible(False)
         self._counts_curve = self.counts_plot.plot([], [], pen=pg.mkPen("#333333", width=1))
         layout.addWidget(self.counts_plot, 1)
+        self.move_label = QLabel("")
+        self.move_label.setObjectName("scopeBenchMove")
+        self.move_label.setWordWrap(True)
+        self.move_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        layout.addWidget(self.move_label)
+        self.move_figures: BenchMoveFigures | None = None
+        self._move_seen_at: float | None = None
+        self._last_command_change: float | None = None
+        self.drive = DriveSettings(0, 4, 1, 1, 3000.0)
+        self.counts_per_output_turn = 0
         self.status_label = QLabel("")
         self.status_label.setObjectName("scopeBenchStatus")
         self.status_label.setWordWrap(True)
@@ -121,9 +150,18 @@ class BenchPanel(QWidget):
         self.status_label.setText("Looking for instruments …")
         self.source.sigScan.emit("")
 
-    def start(self, device: str, channels: str, rate: str = "", encoder: str = "") -> None:
+    def set_axis(self, counts_per_output_turn: int, drive: DriveSettings) -> None:
+        """The axis's encoder counts per output turn and the parameters that decode its command
+        pulses (from the drive or the front panel)."""
+        self.counts_per_output_turn = counts_per_output_turn
+        self.drive = drive
+
+    def start(self, device: str, channels: str, rate: str = "", encoder: str = "", command: str = "",
+              in_position: str = "") -> None:
         """Stream (what the Start button does with the fields' text)."""
         self.encoder_edit.setText(encoder)
+        self.command_edit.setText(command)
+        self.in_position_edit.setText(in_position)
         self.device_box.setEditText(device)
         self.channels_edit.setText(channels)
         self.rate_edit.setText(rate)
@@ -157,8 +195,21 @@ class BenchPanel(QWidget):
             self._refuse("Encoder: its A and B channels, e.g. D0,D1.")
             return
         encoder = (phases[0], phases[1]) if phases else None
+        lines = tuple(c.strip() for c in self.command_edit.text().split(",") if c.strip())
+        if len(lines) > 2:
+            self._refuse("Command: its A line and, where there is one, its B line, e.g. D2,D3.")
+            return
+        command = (lines[0], lines[1] if len(lines) > 1 else None) if lines else None
+        in_position = self.in_position_edit.text().strip()
+        if in_position and in_position not in names:
+            self._refuse(f"IN-POS {in_position}: it must be among the channels ({', '.join(names)}).")
+            return
+        self.move_figures = None
+        self._move_seen_at = None
+        self._last_command_change = None
+        self.move_label.setText("")
         self.status_label.setText(f"Starting {device} …")
-        self.source.start(BenchSettings(device, names, rate, encoder))
+        self.source.start(BenchSettings(device, names, rate, encoder, command, self.drive))
 
     def _refuse(self, text: str) -> None:
         self.start_button.setChecked(False)
@@ -187,11 +238,12 @@ class BenchPanel(QWidget):
         for i, label in enumerate(started.labels[: len(started.channels)]):
             pen = pg.mkPen(_COLORS[i % len(_COLORS)], width=1)
             self._curves.append(self.plot.plot([], [], pen=pen, name=f"bench {label}"))
-        counting = len(started.labels) > len(started.channels)
+        counting = "counts" in started.extra
         self.counts_plot.setVisible(counting)
         self._counts_curve.setData([], [])
         if counting:
-            self.counts_plot.setLabel("left", f"bench {started.labels[-1]}")
+            label = started.labels[len(started.channels) + started.extra.index("counts")]
+            self.counts_plot.setLabel("left", f"bench {label}")
         self.status_label.setText(f"LIVE from the bench: {started.device} at "
                                   f"{sigrok.rate_text(started.sample_rate_hz)}, "
                                   f"{', '.join(started.labels)}")
@@ -203,11 +255,61 @@ class BenchPanel(QWidget):
         rows = started.ring.window(int(WINDOW_S * started.row_rate_hz))
         for i, (curve, name) in enumerate(zip(self._curves, started.channels, strict=True)):
             values = rows[:, 1 + i]
-            if sigrok.is_logic_channel(name):  # a logic analyzer's look: one lane per channel
+            if name in started.logic:  # a logic analyzer's look: one lane per channel
                 values = values * 0.8 + 1.2 * (len(self._curves) - 1 - i)
             curve.setData(rows[:, 0], values)
-        if len(started.labels) > len(started.channels):
-            self._counts_curve.setData(rows[:, 0], rows[:, -1])
+        if "counts" in started.extra:
+            self._counts_curve.setData(rows[:, 0], rows[:, 1 + len(started.channels)])
+        self._measure_move(started, _rows)
+
+    def _measure_move(self, started: BenchStarted, new_rows: np.ndarray) -> None:
+        """The move test's figures of the last move the command made, once it has settled."""
+        if not {"counts", "command"} <= set(started.extra) or self.counts_per_output_turn <= 0:
+            return
+        column = 1 + len(started.channels) + started.extra.index("command")
+        if len(new_rows) > 1:
+            moved = np.flatnonzero(np.diff(new_rows[:, column]) != 0)
+            if moved.size:
+                self._last_command_change = float(new_rows[moved[-1] + 1, 0])
+        last = self._last_command_change
+        if (last is None or last == self._move_seen_at or not len(new_rows)
+                or new_rows[-1, 0] - last < MOVE_SETTLED_S):
+            return
+        rows = started.ring.window(len(started.ring))
+        if len(rows) < 3:
+            return
+        t = rows[:, 0]
+        first = 1 + len(started.channels)
+        enc = rows[:, first + started.extra.index("counts")]
+        cmd = rows[:, first + started.extra.index("command")]
+        changes = np.flatnonzero(np.diff(cmd) != 0)
+        if changes.size == 0:
+            return
+        self._move_seen_at = last
+        gaps = np.flatnonzero(np.diff(t[changes + 1]) >= MOVE_GAP_S)
+        begun = int(changes[gaps[-1] + 1]) if gaps.size else int(changes[0])
+        start = max(0, int(np.searchsorted(t, t[begun] - 0.05)))
+        in_position = self.in_position_edit.text().strip()
+        in_pos = (rows[start:, 1 + started.channels.index(in_position)]
+                  if in_position in started.channels else None)
+        try:
+            figures = bench_move_figures(t[start:], cmd[start:], enc[start:], in_pos,
+                                         self.counts_per_output_turn / 360.0)
+        except ValueError:
+            return
+        self.move_figures = figures
+        m = figures.metrics
+
+        def ms(value: float | None) -> str:
+            return "not reached" if value is None else f"{value * 1000:.1f} ms"
+
+        inpos = ms(figures.in_position_time_s) if in_pos is not None else "no IN-POS channel"
+        self.move_label.setText(
+            f"Move from the bench: {m.target - m.start:+.3f} deg; overshoot {m.overshoot_percent:.2f} % "
+            f"({m.overshoot:.4f} deg); settling time {ms(m.settling_time_s)} "
+            f"(band ±{m.settling_band:.3g} deg); in-position (IN-POS) {inpos} after the command ended; "
+            f"following error (command − encoder) at most {figures.following_error_peak_counts:.0f} "
+            f"counts, {figures.following_error_end_counts:.0f} counts at the end")
 
     def _on_stopped(self, why: str) -> None:
         self.start_button.setChecked(False)

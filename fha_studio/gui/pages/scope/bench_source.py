@@ -19,7 +19,16 @@ import numpy as np
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
 from fha_studio.hardware.bench import sigrok
-from fha_studio.logic.bench.display import DISPLAY_RATE_HZ, Decimator, LiveQuadrature, display_factor
+from fha_studio.logic.bench import instruments
+from fha_studio.logic.bench.decode import DecodeError
+from fha_studio.logic.bench.display import (
+    DISPLAY_RATE_HZ,
+    Decimator,
+    LiveCommandPulses,
+    LiveQuadrature,
+    display_factor,
+)
+from fha_studio.logic.bench.importer import DriveSettings
 from fha_studio.logic.scope.ring import RingBuffer
 
 #: Display rows the ring holds (10 s at the display rate).
@@ -39,6 +48,9 @@ class BenchSettings:
     channels: tuple[str, ...]
     sample_rate_hz: float | None = None
     encoder: tuple[str, str] | None = None  # encoder A and B among the channels: counted x4 live
+    # the command pulse lines (A, and B or None) among the channels, decoded live by ``drive``
+    command: tuple[str, str | None] | None = None
+    drive: DriveSettings | None = None  # parameters 1, 2, 3, 4 and 9 (the command's decoding)
 
 
 @dataclass(frozen=True)
@@ -47,11 +59,13 @@ class BenchStarted:
 
     device: str
     channels: tuple[str, ...]  # as the instrument names them
-    labels: tuple[str, ...]  # with the source: "demo:D0"; encoder counts last ("demo:D0/D1 counts")
+    labels: tuple[str, ...]  # with the source: "demo:D0"; then "demo:D0/D1 counts", "... command counts"
     sample_rate_hz: float
     row_rate_hz: float
     ring: RingBuffer
     t0: float  # time.monotonic() of t_s = 0
+    logic: tuple[str, ...] = ()  # the channels that are logic levels (the rest analog)
+    extra: tuple[str, ...] = ()  # the decoded columns after the channels: "counts", "command"
 
 
 @dataclass(frozen=True)
@@ -79,7 +93,7 @@ class BenchWorker(QObject):
     def __init__(self) -> None:
         super().__init__()
         self._lock = threading.Lock()
-        self._acquisition: sigrok.Acquisition | None = None
+        self._acquisition: instruments.Instrument | None = None
         self._stop = False
 
     def request_stop(self) -> None:
@@ -93,9 +107,10 @@ class BenchWorker(QObject):
     def scan(self, driver: str) -> None:
         """List the instruments (every driver when ``driver`` is empty)."""
         try:
-            self.sigDevices.emit(sigrok.scan(driver or None), "")
+            found, why = instruments.scan(driver or None)
         except sigrok.SigrokError as exc:
-            self.sigDevices.emit([], str(exc))
+            found, why = [], str(exc)
+        self.sigDevices.emit(found, why if not found else "")
 
     @Slot(object)
     def run(self, settings: BenchSettings) -> None:
@@ -103,7 +118,20 @@ class BenchWorker(QObject):
             self.sigError.emit(f"encoder {'/'.join(settings.encoder)}: both must be among the channels "
                                f"({', '.join(settings.channels)})")
             return
-        acquisition = sigrok.Acquisition(settings.device, settings.channels, settings.sample_rate_hz)
+        if settings.command is not None and not {c for c in settings.command if c} <= set(settings.channels):
+            self.sigError.emit(f"command pulses {'/'.join(c for c in settings.command if c)}: the lines "
+                               f"must be among the channels ({', '.join(settings.channels)})")
+            return
+        commands = None
+        if settings.command is not None:
+            drive = settings.drive or DriveSettings(0, 4, 1, 1, 3000.0)
+            try:
+                commands = LiveCommandPulses(drive.pulse_form, drive.multiplication, drive.gear_numerator,
+                                             drive.gear_denominator)
+            except DecodeError as exc:
+                self.sigError.emit(str(exc))
+                return
+        acquisition = instruments.open_instrument(settings.device, settings.channels, settings.sample_rate_hz)
         try:
             acquisition.start()
         except sigrok.SigrokError as exc:
@@ -116,21 +144,29 @@ class BenchWorker(QObject):
         factor = display_factor(acquisition.sample_rate_hz)
         encoder = settings.encoder
         quadrature = LiveQuadrature() if encoder is not None else None
-        extra = ("counts",) if encoder is not None else ()
+        extra = (("counts",) if encoder is not None else ()) + (("command",) if commands is not None else ())
         decimator = Decimator(acquisition.sample_rate_hz, settings.channels, factor, extra)
         ring = RingBuffer(1 + len(settings.channels) + len(extra), RING_ROWS)
         labels = tuple(source_label(settings.device, c) for c in settings.channels)
         if encoder is not None:
             labels += (source_label(settings.device, f"{encoder[0]}/{encoder[1]} counts"),)
+        if settings.command is not None:
+            lines = "/".join(c for c in settings.command if c)
+            labels += (source_label(settings.device, f"{lines} command counts"),)
         self.sigStarted.emit(BenchStarted(settings.device, settings.channels, labels,
                                           acquisition.sample_rate_hz, decimator.row_rate_hz, ring,
-                                          time.monotonic()))
+                                          time.monotonic(),
+                                          instruments.logic_channels(acquisition, settings.channels), extra))
         last_status = 0.0
         try:
             for block in acquisition.blocks():
                 counts = {}
                 if quadrature is not None and encoder is not None:
                     counts["counts"] = quadrature.feed(block.bit(encoder[0]), block.bit(encoder[1]))
+                if commands is not None and settings.command is not None:
+                    line_a, line_b = settings.command
+                    counts["command"] = commands.feed(block.bit(line_a),
+                                                      block.bit(line_b) if line_b else None)
                 rows = decimator.feed(block, counts)
                 if len(rows):
                     ring.write(rows)

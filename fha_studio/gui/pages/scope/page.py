@@ -52,10 +52,14 @@ class ScopePage(BasePage):
         # a bench instrument on CN2 beside CN3 polling (a real drive's CN3 is silent in motion)
         self.bench = BenchPanel()
         self.view.plots.addTab(self.bench, "Bench")
+        self._bench_axis()
         # the axis's actuator, driver and load decide the scaling and what is recorded, at every moment
         state = self.state
         for signal in (state.sigActuatorChanged, state.sigDriverChanged, state.sigLoadInertiaChanged):
             signal.connect(self._axis_changed)
+        for signal in (state.sigActuatorChanged, state.sigDriverChanged, state.sigParametersChanged,
+                       state.sigFrontPanelChanged):
+            signal.connect(self._bench_axis)
         self.view.sigLoadInertiaEdited.connect(self._load_inertia_edited)
         self.view.sigLiveChanged.connect(self._on_live_changed)
 
@@ -66,6 +70,27 @@ class ScopePage(BasePage):
         self.view.set_context(self._context())  # another actuator stops live (and a recording)
         if was_live and not self.view.live_button.isChecked() and self.controller.connected:
             self.view.start_live()  # the technician watching goes on watching, at the new scale
+
+    def _bench_axis(self, *_args) -> None:
+        """The bench decodes with the axis's counts per output turn and the parameters known
+        (read from the drive or entered from its front panel), else the parameters' defaults."""
+        from fha_studio.hardware.parameters import load_parameter_model
+        from fha_studio.logic.bench.importer import PARAMETERS, DriveSettings
+
+        state = self.state
+        try:
+            model = load_parameter_model(state.driver or "HA-655")
+        except (KeyError, ValueError):
+            model = load_parameter_model()
+        fallback = {1: 0, 2: 4, 3: 1, 4: 1, 9: 3000}  # where the table gives no default
+        values = {}
+        for mode, number in PARAMETERS:
+            value = state.value_of(mode, number)
+            if value is None:
+                value = model.item(mode, number).default
+            values[(mode, number)] = value if value is not None else fallback[number]
+        counts = state.output_resolution_ppr if state.actuator_code else 0
+        self.bench.set_axis(int(counts or 0), DriveSettings.from_values(values))
 
     def _load_inertia_edited(self, value_kgm2: float) -> None:
         self.state.set_load_inertia(value_kgm2)

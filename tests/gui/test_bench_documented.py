@@ -1,0 +1,92 @@
+"""The scope's bench source on the documented profile, where CN3 answers only DGR and is silent
+(``s``) while the servo is on: the simulated controller (the sim panel: servo-ON and a command
+pulse train on CN2) moves the axis, the running drive's CN2 streams live as the ``sim-cn2``
+instrument, and the move test's figures come from that capture (overshoot, settling, the
+in-position time from IN-POS, following error = command counts - encoder counts)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fha_studio.gui.link import Cmd
+from fha_studio.hardware.sim import cn2_live
+
+CODE = "FHA-25C-50-US250"
+URL = f"sim://{CODE}?paced=0&profile=documented"
+COUNTS_PER_OUTPUT_TURN = 500000  # 10000 counts per motor turn (x4) x 50
+
+
+def _panel_done(window, qtbot, action) -> None:
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SIM_PANEL,
+                          timeout=10000) as done:
+        action()
+    assert done.args[0].ok, done.args[0].error
+
+
+@pytest.fixture
+def window(make_window, qtbot):
+    w = make_window(connect=URL)
+    w.state.set_actuator(CODE, acknowledged=True)
+    return w
+
+
+def test_a_controller_move_is_shown_live_from_cn2_with_the_move_tests_figures(window, qtbot):
+    drive = window.link._worker._client.transaction.transport.inner.sim_drive
+    assert window.link.info.documented_only and window.sim_panel.isVisible()
+    bench = window.show_page("scope").bench
+    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
+        bench.scan()
+    assert bench.device_box.itemText(0) == f"sim-cn2  (FHA Studio simulated drive {CODE} (CN2))"
+    assert bench.counts_per_output_turn == COUNTS_PER_OUTPUT_TURN
+    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
+        bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,SPD_MON", "250k",
+                    "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS")
+    started = bench.source.started
+    assert started.labels[:2] == ("sim-cn2:ENC_A", "sim-cn2:ENC_B")
+    assert started.labels[-2:] == ("sim-cn2:ENC_A/ENC_B counts", "sim-cn2:CMD_A/CMD_B command counts")
+    assert started.logic == ("ENC_A", "ENC_B", "CMD_A", "CMD_B", "IN_POS")
+    assert bench.status_label.text().startswith("LIVE from the bench: sim-cn2 at 250 kHz")
+
+    _panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
+    qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
+    qtbot.wait(300)  # standing under servo: what the move starts from
+    with drive.lock:
+        before = drive.axis.feedback_pulses
+    window.sim_panel.command_spin.setValue(10.0)
+    _panel_done(window, qtbot, window.sim_panel.fwd_button.click)
+    qtbot.waitUntil(lambda: bench.move_figures is not None, timeout=30000)
+    with drive.lock:
+        after = drive.axis.feedback_pulses
+        commanded = drive.axis.command_pulses
+
+    figures = bench.move_figures
+    m = figures.metrics
+    step_counts = round(10.0 / 360.0 * COUNTS_PER_OUTPUT_TURN)
+    assert m.target - m.start == pytest.approx(step_counts * 360.0 / COUNTS_PER_OUTPUT_TURN, abs=1e-9)
+    # the bench's encoder counts are the drive's own feedback over the move
+    assert abs((m.target - m.start - m.final_error) * COUNTS_PER_OUTPUT_TURN / 360.0
+               - (after - before)) <= 1.5
+    assert commanded == step_counts  # the controller's pulses, as the drive counted them
+    assert figures.in_position_time_s is not None and figures.in_position_time_s < 0.5
+    assert m.settling_time_s is not None and m.overshoot_percent >= 0.0
+    assert figures.following_error_peak_counts > 10  # the error counter fills while the axis runs
+    assert abs(figures.following_error_end_counts) <= 10  # within the in-position range (tune 4)
+    text = bench.move_label.text()
+    for words in ("Move from the bench: +10.000 deg", "overshoot", "settling time", "in-position (IN-POS)",
+                  "following error (command − encoder)", "counts at the end"):
+        assert words in text, text
+    x, y = bench._curves[0].getData()
+    assert x is not None and len(x) > 1000 and set(np.unique(np.round(y % 1.2, 3))) <= {0.0, 0.8}
+    names = [item.text for _, item in bench.plot.plotItem.legend.items]
+    assert names[0] == "bench sim-cn2:ENC_A" and names[-1] == "bench sim-cn2:SPD_MON"
+    with qtbot.waitSignal(bench.source.sigStopped, timeout=10000):
+        bench.start_button.click()
+
+
+def test_the_instrument_goes_when_its_drive_does(make_window, qtbot):
+    window = make_window(connect=URL)
+    assert [d.spec for d in cn2_live.devices()] == ["sim-cn2"]
+    with qtbot.waitSignal(window.link.sigDisconnected, timeout=10000):
+        window.disconnect_drive()
+    assert cn2_live.devices() == []
