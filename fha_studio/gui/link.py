@@ -61,8 +61,10 @@ PROBE_INTERVAL_MS = 700
 SERVO_ON_PROBE_MS = 1000
 #: What the technician is told while a drive answers s (the words of the DGR checks and the CLI).
 SERVO_ON_NOTE = SERVO_ON_TEXT
-#: Consecutive timeouts after which the link is declared lost (the client has retried already).
-TIMEOUTS_TO_LOST = 1
+#: Failed transactions in a row after which the transaction layer marks the link lost (its one
+#: rule, ``LinkSettings.max_consecutive_failures``): one exchange left unanswered after its retry
+#: shows the technician a dead link at once. Set once the drive is open (``lose_link_after``).
+LINK_LOST_AFTER_FAILURES = 1
 #: The monitor items of the status poll: output position, output speed, motor current.
 STATUS_MONITORS = (MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.MOTOR_CURRENT)
 
@@ -263,7 +265,6 @@ class LinkWorker(QObject):
         self._jog_timer: QTimer | None = None
         self._jog_speed_rpm = 0.0
         self._jog_lease_s = 0.0
-        self._timeouts = 0
         self._monitor_ok = True
         #: What each command runs (every Cmd has one; a test checks it).
         self.handlers: dict[Cmd, Callable[..., Any]] = {
@@ -321,12 +322,9 @@ class LinkWorker(QObject):
             value = handler(*command.args)
         except Exception as exc:
             self._emit(command, error=exc)
-            if self._client is not None and (
-                isinstance(exc, LinkLost) or (isinstance(exc, LinkTimeout) and self._count_timeout())
-            ):
+            if self._client is not None and isinstance(exc, LinkLost):
                 self._lose(exc)
             return
-        self._timeouts = 0
         self._emit(command, value=value)
 
     def _emit(self, command: LinkCommand, value: Any = None, error: Exception | None = None) -> None:
@@ -334,10 +332,6 @@ class LinkWorker(QObject):
             self.sigResult.emit(CommandResult(command.token, command.cmd, value))
         else:
             self.sigResult.emit(CommandResult(command.token, command.cmd, None, _message(error), type(error)))
-
-    def _count_timeout(self) -> bool:
-        self._timeouts += 1
-        return self._timeouts >= TIMEOUTS_TO_LOST
 
     def _lose(self, exc: Exception) -> None:
         reason = f"link lost: {_message(exc)}"
@@ -387,8 +381,9 @@ class LinkWorker(QObject):
             self._shut(stop_axis=True)
             self.sigDisconnected.emit("switched to another drive", False)
         self._client = self._open_client(url, baud_rate)
+        if isinstance(self._client, DriveClient):  # the transaction layer's verdict, made prompt
+            self._client.lose_link_after(LINK_LOST_AFTER_FAILURES)
         self._url = url
-        self._timeouts = 0
         self._monitor_ok = True
         info = self._describe(url)
         self.sigConnected.emit(info)
@@ -530,7 +525,7 @@ class LinkWorker(QObject):
             self._jog_speed_rpm = 0.0
             self._jog_timer.stop()
             self._emit(LinkCommand(Cmd.JOG), error=exc)
-            if isinstance(exc, LinkLost) or (isinstance(exc, LinkTimeout) and self._count_timeout()):
+            if isinstance(exc, LinkLost):
                 self._lose(exc)
 
     def _do_set_move_speed(self, speed_rpm: float) -> float:
@@ -622,15 +617,11 @@ class LinkWorker(QObject):
                     status["servo_on"] = True  # a drive refuses CN3 commands while the servo is on
                     status["note"] = SERVO_ON_NOTE
                     interval_ms = max(interval_ms, SERVO_ON_PROBE_MS)
-        except (LinkLost, LinkTimeout) as exc:
-            if isinstance(exc, LinkLost) or self._count_timeout():
-                self._lose(exc)
-                return
-            log.info("poll failed: %s", exc)
+        except LinkLost as exc:
+            self._lose(exc)
+            return
         except LinkError as exc:
             log.info("poll failed: %s", exc)
-        else:
-            self._timeouts = 0
         self.sigStatus.emit(DriveStatus(**status))
         if self._client is not None and self._poll_timer is not None:
             self._poll_timer.start(interval_ms)

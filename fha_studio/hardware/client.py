@@ -188,6 +188,12 @@ class DriveClient:
     def port(self) -> str:
         return self.transaction.port
 
+    def lose_link_after(self, failures: int) -> None:
+        """The link is marked lost (``LinkLost``) after ``failures`` failed transactions in a row
+        from now on (the transaction layer's one rule; ``Transaction.lose_link_after``)."""
+        self.transaction.lose_link_after(failures)
+        self.settings = self.transaction.settings
+
     @property
     def is_open(self) -> bool:
         return self.transaction.is_open

@@ -15,7 +15,9 @@ Commands whose repetition could act twice (``protocol.NOT_RETRIED``: MOV, OWW, P
 in ``protocol.COMMAND_FACTS``) are never retried. ``s`` and ``x`` are
 answers, not failures: raised at once as ``ServoOnRefused`` / ``CommandRejected``, never retried.
 After ``settings.max_consecutive_failures`` failed transactions in a row the link is marked lost
-(``LinkLost``); one success resets the count.
+(``LinkLost``); one success resets the count. This is the one rule of when a link counts as lost:
+whoever supervises the link (the GUI's link worker) takes ``LinkLost`` as the verdict and sets
+how many failures it takes with ``lose_link_after``; nobody counts timeouts a second time.
 
 Wall time: an attempt ends at the latest ``reply_time_limit_s`` after its first-byte timeout,
 however the line behaves (silent, trickling, flooding, garbage, NUL), and so does each wait for a
@@ -32,7 +34,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TypeVar
 
 from fha_studio.hardware import protocol as p
@@ -210,6 +212,14 @@ class Transaction:
                 self._closed = True
                 self.transport.close()
 
+    def lose_link_after(self, failures: int) -> None:
+        """From now on the link is marked lost after ``failures`` failed transactions in a row
+        (``settings.max_consecutive_failures``). A supervisor that must show a dead link at once
+        (the GUI's link worker: 1) sets it once the drive is open, so that opening keeps its
+        fallbacks (a drive that ignores CAP)."""
+        with self.lock:
+            self.settings = replace(self.settings, max_consecutive_failures=failures)
+
     @property
     def port(self) -> str:
         return self.transport.name
@@ -296,10 +306,12 @@ class Transaction:
             if quiet:
                 self._drain_quietly(command)
             failure = self._failure(command, why, made, attempts == 1, time.monotonic() - started)
-            if self._health.consecutive_failures >= self.settings.max_consecutive_failures:
+            failures = self._health.consecutive_failures
+            if failures >= self.settings.max_consecutive_failures:
+                in_a_row = f"; {failures} failed transactions in a row" if failures > 1 else ""
                 lost = LinkLost(
-                    f"{failure}; {self._health.consecutive_failures} failed transactions in a row: "
-                    "link marked lost (check the cable and the drive's power, then reconnect)",
+                    f"{failure}{in_a_row}: link marked lost (check the cable and the drive's power, "
+                    "then reconnect)",
                     port=self.port,
                 )
                 self._health.lost = lost

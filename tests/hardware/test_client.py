@@ -296,6 +296,20 @@ def test_consecutive_failures_mark_the_link_lost_and_one_success_resets(client_f
     assert client.link_lost
 
 
+def test_a_supervisor_sets_how_many_failures_lose_the_link(client_for, mini):
+    """The GUI's link worker asks for a dead link at the first unanswered exchange: the same
+    rule, one failure (not a second count of its own)."""
+    silent = {"on": False}
+    mini.override["ALM"] = lambda r: None if silent["on"] else Reply(("0",))
+    client, _ = client_for(mini, LinkSettings(response_timeout_s=0.03, retries=0, max_consecutive_failures=3))
+    client.lose_link_after(1)
+    assert client.settings.max_consecutive_failures == 1 and client.alarm() == 0
+    silent["on"] = True
+    with pytest.raises(LinkLost, match="link marked lost") as lost:
+        client.alarm()
+    assert "in a row" not in str(lost.value) and client.link_lost
+
+
 def test_noise_before_a_reply_is_skipped_without_a_retry(client_for, mini):
     mini.override["ALM"] = lambda r: [b"\x00\xff\r\n", Reply(("20",))]
     client, drive = client_for(mini)
