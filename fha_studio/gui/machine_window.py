@@ -14,8 +14,7 @@ from __future__ import annotations
 
 import getpass
 import logging
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -48,9 +47,23 @@ from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.register_dialog import RegisterDialog
 from fha_studio.gui.widgets import StopButton
+from fha_studio.logic.absolute import DgrCheckRecord
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures import ProcedureSession
 from fha_studio.logic.register import Register, RegisterError, record_session
+from fha_studio.logic.register.facts_from_session import (
+    DriverFact,
+    Fact,
+    RecordingFact,
+    alarm_facts,
+    facts_from_dgr_check,
+    front_panel_facts,
+    model_check_facts,
+    read_facts,
+    record_fact,
+    report_facts,
+    write_fact,
+)
 
 log = logging.getLogger(__name__)
 
@@ -63,24 +76,6 @@ def _login_name() -> str:
         return getpass.getuser()
     except (KeyError, OSError):  # no login name in the environment or the password database
         return ""
-
-
-@dataclass(frozen=True)
-class _DgrCheck:
-    """A check of the DGR checks page in the fields the register takes for a procedure check."""
-
-    step_id: str
-    text: str
-    value: object
-    passed: bool
-    who: str
-    at_utc: str
-    detail: str
-    procedure_id: str = "dgr-checks"
-    kind: str = "dgr"
-    section: str = ""
-    expected: str = ""
-    unit: str = ""
 
 
 class AxisRecorder(QObject):
@@ -141,7 +136,11 @@ class AxisRecorder(QObject):
         page.sigRecorded.connect(self._on_dgr_check)
 
     # -- writing, never failing the GUI ---------------------------------------------------------------
-    def _record(self, what: str, action: Callable[[], object]) -> None:
+    def _record(self, facts: Iterable[Fact]) -> None:
+        for fact in facts:
+            self._record_action(fact.what, partial(record_fact, self.register, self.axis_ref, fact))
+
+    def _record_action(self, what: str, action: Callable[[], object]) -> None:
         try:
             action()
         except (RegisterError, OSError, ValueError) as exc:
@@ -160,55 +159,25 @@ class AxisRecorder(QObject):
     def _on_connected(self, info: LinkInfo) -> None:
         self._alarm_code = 0
         if info.driver_model:
-            self._record(
-                "driver",
-                lambda: self.register.update_axis(
-                    self.axis_ref, who=self.who, driver_model=info.driver_model
-                ),
-            )
+            self._record([DriverFact(info.driver_model, self.who)])
 
     @Slot(object)
     def _on_result(self, result: CommandResult) -> None:
         if result.cmd is not Cmd.READ_PARAMETERS or not result.ok or not result.value["values"]:
             return
-        model = self.window.session.parameter_model
-        rows = []
-        for (mode, number), value in result.value["values"].items():
-            try:
-                key = model.item(mode, number).key
-            except KeyError:
-                key = f"{mode}_{number}"
-            rows.append((str(mode), int(number), key, int(value)))
         info = self.window.link.info
         self._record(
-            "parameter read",
-            lambda: self.register.record_snapshot(
-                self.axis_ref, rows, "link", who=self.who, driver_model=info.driver_model if info else ""
-            ),
+            read_facts(
+                self.window.session.parameter_model,
+                result.value["values"],
+                self.who,
+                driver_model=info.driver_model if info else "",
+            )
         )
 
     @Slot(object)
     def _on_write(self, entry: dict) -> None:
-        mode, number = str(entry["mode"]), int(entry["number"])
-        try:
-            key = self.window.session.parameter_model.item(mode, number).key
-        except KeyError:
-            key = f"{mode}_{number}"
-        self._record(
-            "parameter write",
-            lambda: self.register.record_write(
-                self.axis_ref,
-                mode,
-                number,
-                key,
-                int(entry["new"]),
-                entry.get("old"),
-                entry.get("read_back"),
-                bool(entry.get("verified")),
-                error=entry.get("error") or "",
-                who=self.who,
-            ),
-        )
+        self._record([write_fact(self.window.session.parameter_model, entry, self.who)])
 
     @Slot(object)
     def _on_status(self, status: DriveStatus) -> None:
@@ -216,39 +185,19 @@ class AxisRecorder(QObject):
         if code is None or code == self._alarm_code:
             return
         self._alarm_code = code
-        if code == 0:
-            return
-        from fha_studio.hardware.parameters import load_alarm_table
-
-        alarm = load_alarm_table(self.window.session.driver).get(code)
-        name = alarm.name if alarm is not None else "unknown code"
-        self._record("alarm", lambda: self.register.record_alarm(self.axis_ref, code, name, who=self.who))
+        self._record(alarm_facts(code, self.window.session.driver, self.who))
 
     @Slot()
     def _on_front_panel(self) -> None:
         """Values read off the drive's front panel by a person: a front-panel snapshot per
         entry time and person (an entry already recorded is not recorded again)."""
-        groups: dict[tuple[str, str], list[tuple[str, int, str, int]]] = {}
-        model = self.window.session.parameter_model
-        for entry in self.window.state.front_panel.values():
-            seen = (entry.mode, entry.number, entry.value, entry.time)
-            if seen in self._front_panel_seen:
-                continue
-            self._front_panel_seen.add(seen)
-            try:
-                key = model.item(entry.mode, entry.number).key
-            except KeyError:
-                key = f"{entry.mode}_{entry.number}"
-            groups.setdefault((entry.who, entry.time), []).append(
-                (entry.mode, entry.number, key, entry.value)
+        self._record(
+            front_panel_facts(
+                self.window.session.parameter_model,
+                self.window.state.front_panel.values(),
+                self._front_panel_seen,
             )
-        for (who, at), rows in groups.items():
-            self._record(
-                "front-panel value",
-                partial(
-                    self.register.record_snapshot, self.axis_ref, rows, "front_panel", who=who, at_utc=at
-                ),
-            )
+        )
 
     # -- from the pages -------------------------------------------------------------------------------
     def _on_procedures(self, page) -> None:
@@ -261,104 +210,24 @@ class AxisRecorder(QObject):
             session.axis = axis_name
             session.site = session.site or self.site
             if session.path is not None:
-                self._record("session file", session.save)
-        self._record("procedure check", lambda: record_session(self.register, self.axis_ref, session))
+                self._record_action("session file", session.save)
+        self._record_action("procedure check", lambda: record_session(self.register, self.axis_ref, session))
 
     def _on_report(self, page, html: Path, pdf: Path | None) -> None:
-        session = page.session
-        signature = session.signature if session is not None else {}
-        warnings = 0
-        if session is not None:
-            from fha_studio.logic.procedures.report import build_report
-
-            warnings = len(build_report(session, page.context).warnings)
-        for path in (pdf, html):
-            if path is None:
-                continue
-            self._record(
-                "report",
-                lambda path=path: self.register.record_report(  # type: ignore[misc]  # default binds path
-                    path,
-                    axis=self.axis_ref,
-                    signed_by=signature.get("who", ""),
-                    signed_utc=signature.get("at_utc", ""),
-                    open_warnings=warnings,
-                    who=self.who,
-                ),
-            )
-            break  # the PDF when there is one: the file that is handed over
+        self._record(report_facts(page.session, page.context, html, pdf, self.who))
 
     @Slot(object, str)
     def _on_recording(self, path: Path, what: str) -> None:
-        self._record(
-            "recording", lambda: self.register.record_recording(self.axis_ref, path, what, who=self.who)
-        )
+        self._record([RecordingFact(path, what, self.who)])
 
     @Slot(object)
-    def _on_dgr_check(self, record) -> None:
-        """A check of the DGR checks page: a check with its verdict (or a note when it has none);
-        the absolute origin as the axis's origin; parameter 8 as entered from the front panel."""
-        from fha_studio.logic.absolute import CHECK_TITLES
-
-        title = CHECK_TITLES.get(record.check, record.check)
-        by_hand = " (given by hand)" if record.by_hand else ""
-        if record.passed is None:
-            self._record(
-                "check",
-                lambda: self.register.add_axis_note(
-                    self.axis_ref, f"{title}{by_hand}: {record.detail}", who=record.who, at_utc=record.at
-                ),
-            )
-        else:
-            check = _DgrCheck(
-                step_id=record.check,
-                text=title + by_hand,
-                value=dict(record.values),
-                passed=bool(record.passed),
-                who=record.who,
-                at_utc=record.at,
-                detail=record.detail,
-            )
-            self._record("check", lambda: self.register.record_checks(self.axis_ref, [check]))
-        if record.check == "absolute_origin" and record.passed:
-            where = record.values.get("position_deg")
-            read_back = f", read back at {where:+.2f}°" if isinstance(where, float) else ""
-            text = f"absolute origin set (OWW){read_back}"
-            self._record(
-                "origin",
-                lambda: self.register.record_origin(self.axis_ref, text, who=record.who, at_utc=record.at),
-            )
-        if record.check == "sensor_dog" and record.passed and record.values.get("sensor") == "origin_sensor":
-            angle = float(record.values["angle_deg"])
-            self._record(
-                "origin",
-                lambda: self.register.record_origin(
-                    self.axis_ref, f"origin sensor at {angle:+.2f}° (4-7-2)", who=record.who, at_utc=record.at
-                ),
-            )
-        entered = record.values.get("rotary_direction") if record.check == "rotary_direction" else None
-        if isinstance(entered, int):
-            self._record(
-                "front-panel value",
-                lambda: self.register.record_snapshot(
-                    self.axis_ref,
-                    [("system", 8, "rotary_direction", entered)],
-                    "front_panel",
-                    who=record.who,
-                    at_utc=record.at,
-                    note="parameter 8 as read on the drive's front panel",
-                ),
-            )
+    def _on_dgr_check(self, record: DgrCheckRecord) -> None:
+        """A check of the DGR checks page (what it becomes: ``facts_from_dgr_check``)."""
+        self._record(facts_from_dgr_check(record))
 
     def _on_model_check(self, page, result) -> None:
-        lines = result.summary_lines(manual_units=True)
-        summary = "; ".join(lines[:3]) if lines else "model check run"
-        source = page.recording_path or ""
         self._record(
-            "model check",
-            lambda: self.register.record_model_check(
-                self.axis_ref, summary, recording_file=source, who=self.who
-            ),
+            model_check_facts(result.summary_lines(manual_units=True), page.recording_path or "", self.who)
         )
 
 
