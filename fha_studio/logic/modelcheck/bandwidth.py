@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import fftconvolve
 
-from fha_studio.logic.modelcheck.selection import gram
+from fha_studio.logic.modelcheck.linalg import gram
 from fha_studio.logic.modelcheck.signals import make_filter
 
 GROWTH_LIMIT = 1.5  # unexplained torque may grow this much over the best of the longer windows
