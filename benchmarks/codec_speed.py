@@ -11,8 +11,8 @@ import time
 
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.client import DriveClient, LinkSettings
-from fha_studio.hardware.scripted import ScriptedDrive
 from fha_studio.hardware.transport import pipe_pair
+from tests.support.scripted import ScriptedDrive
 
 
 def rate(fn, n: int) -> float:

@@ -10,9 +10,9 @@ from fha_studio.gui.connect_dialog import ConnectDialog
 from fha_studio.gui.link import Cmd
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.client import DriveClient
-from fha_studio.hardware.scripted import ScriptedDrive
 from fha_studio.hardware.transport import pipe_pair
 from fha_studio.recording import RecordingMetadata, make_recording, read_recording, write_recording
+from tests.support.scripted import ScriptedDrive
 
 DGR_COUNTS = -40000  # motor encoder counts, 8192 per motor turn
 

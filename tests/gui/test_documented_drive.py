@@ -12,8 +12,8 @@ from PySide6.QtCore import Qt
 
 from fha_studio.gui.link import PROBE_INTERVAL_MS, SERVO_ON_NOTE, SERVO_ON_PROBE_MS, Cmd
 from fha_studio.hardware import protocol as p
-from fha_studio.hardware.scripted import ScriptedDrive, documented_only
 from fha_studio.hardware.transport import pipe_pair
+from tests.support.scripted import ScriptedDrive, documented_only
 
 URL = "sim://FHA-25C-50-S248?paced=0&profile=documented&oww_clear_s=1"
 

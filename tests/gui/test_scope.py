@@ -18,9 +18,9 @@ from fha_studio.gui.pages.scope.driver import ScopeCmd, ScopeController
 from fha_studio.gui.pages.scope.view import ScopeContext, ScopeView
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.client import DriveClient
-from fha_studio.hardware.scripted import ScriptedDrive
 from fha_studio.hardware.transport import pipe_pair
 from fha_studio.recording import read_recording
+from tests.support.scripted import ScriptedDrive
 
 ACTUATOR = "FHA-25C-50-US250"
 SIM_URL = f"sim://{ACTUATOR}?paced=0"

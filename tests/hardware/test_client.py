@@ -24,8 +24,8 @@ from fha_studio.hardware.client import (
 )
 from fha_studio.hardware.parameters import ParameterValueError
 from fha_studio.hardware.protocol import Command, Reply
-from fha_studio.hardware.scripted import documented_only
 from fha_studio.hardware.transport import corrupt_at, split_every
+from tests.support.scripted import documented_only
 
 # --- settings ---------------------------------------------------------------------------------
 

@@ -27,8 +27,8 @@ from fha_studio.hardware.api import (
 )
 from fha_studio.hardware.client import DriveClient, LinkSettings
 from fha_studio.hardware.protocol import Command
-from fha_studio.hardware.scripted import ScriptedDrive, documented_only
 from fha_studio.hardware.transport import PipeEnd, pipe_pair
+from tests.support.scripted import ScriptedDrive, documented_only
 
 #: The link worker's settings (gui/link.py): a dead line must show within a few seconds.
 GUI = LinkSettings(response_timeout_s=0.25, retries=1)

@@ -7,8 +7,8 @@ import pytest
 
 from fha_studio.hardware.api import SimPanel
 from fha_studio.hardware.client import DriveClient
-from fha_studio.hardware.scripted import documented_only
 from fha_studio.hardware.sim import SimRefused
+from tests.support.scripted import documented_only
 
 
 def test_a_sim_port_has_the_panel_of_its_drive():

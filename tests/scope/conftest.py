@@ -6,8 +6,8 @@ import pytest
 from scope_fakes import FAST
 
 from fha_studio.hardware.client import DriveClient
-from fha_studio.hardware.scripted import ScriptedDrive
 from fha_studio.hardware.transport import pipe_pair
+from tests.support.scripted import ScriptedDrive
 
 
 @pytest.fixture

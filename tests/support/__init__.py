@@ -1,0 +1,7 @@
+"""What more than one test module needs, in one place (imported as ``tests.support.*``).
+
+- ``scripted``: ``ScriptedDrive``, a stand-in drive on a pipe end answering from a handler.
+
+No module here imports Qt at import time unless its name says it is for the GUI tests: the core
+tests run without Qt.
+"""
