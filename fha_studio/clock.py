@@ -8,7 +8,9 @@ passing, so a test (or a replay) sets the time in one place: ``use(FixedClock(..
 from __future__ import annotations
 
 import datetime as _dt
+import os
 import threading
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Protocol
@@ -105,3 +107,27 @@ def utc_iso() -> str:
 def file_stamp() -> str:
     """Now as a file name's stamp, local time: 20261130-091500."""
     return now_local().strftime("%Y%m%d-%H%M%S")
+
+
+# --- how long this process has run (a command's wall-time promise counts from its start) ----------
+
+_IMPORTED_AT = time.monotonic()
+
+
+def process_started_monotonic() -> float:
+    """The moment this process started, on ``time.monotonic()``'s scale: a command that promises
+    an answer within N s of being run counts Python's own start-up too. From the kernel's start
+    time of the process (Linux ``/proc/self/stat``); elsewhere, or where that reads oddly, the
+    moment this module was imported (a little later than the start)."""
+    now = time.monotonic()
+    try:
+        with open("/proc/self/stat", "rb") as stat:
+            fields = stat.read().rsplit(b")", 1)[1].split()
+        started_s = int(fields[19]) / os.sysconf("SC_CLK_TCK")  # field 22, starttime in ticks
+        age_s = time.clock_gettime(time.CLOCK_BOOTTIME) - started_s
+    except (OSError, ValueError, IndexError, AttributeError):
+        return _IMPORTED_AT
+    # a kernel that counts the start time without a suspend gives an age too long: not ours
+    if not 0.0 <= age_s <= now - _IMPORTED_AT + 30.0:
+        return _IMPORTED_AT
+    return min(now - age_s, _IMPORTED_AT)

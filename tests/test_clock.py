@@ -61,3 +61,17 @@ def test_every_stamp_takes_the_one_clock(tmp_path, fixed_clock):
     model = load_parameter_model("HA-655")
     text = dump_parameter_file(model, {("system", 8): 1}, "FHA-17C-50-US250", "HA-655-2-200")
     assert read_parameter_file(text, model).saved.startswith("2031-02-03T04:05:06")
+
+
+def test_a_process_start_is_counted_from_before_python_imported_the_clock():
+    # a command's wall-time promise (drive probe: exit 3 within 5 s) counts Python's start-up: the
+    # clock module imported 0.5 s after the start still knows when the process began
+    import subprocess
+    import sys
+
+    code = ("import time; time.sleep(0.5); from fha_studio import clock; "
+            "print(time.monotonic() - clock.process_started_monotonic())")
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
+                          timeout=60, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    assert done.returncode == 0, done.stderr
+    assert float(done.stdout) >= 0.49

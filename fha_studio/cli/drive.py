@@ -6,7 +6,7 @@
     fha-studio drive params read|write|backup|restore --url URL ...
 
 Exit status: 0 done; 2 a mistake on the command line; 3 nothing usable answers (silent, garbage,
-flooding or slow line: within ``CONNECT_S`` of the start, whatever the line does); 4 the drive
+flooding or slow line: within ``PROBE_S`` of the start, whatever the line does); 4 the drive
 answered but cannot do it (servo on, incremental encoder, no parameter access). Every failure is
 one line on stderr.
 """
@@ -17,6 +17,7 @@ import argparse
 import contextlib
 import json
 import sys
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,9 +30,14 @@ from fha_studio.hardware.protocol import BAUD_RATES, BAUDRATE
 
 ORDER = 35
 
-#: Wall time for opening the port and asking the drive what it is (the probe's whole budget). The
-#: command promises exit 3 within 5 s; the rest is Python's start-up.
-CONNECT_S = 3.5
+#: The command promises exit 3 within 5 s of being run, whatever the line does. It is kept by
+#: construction: one deadline, fixed from the process's own start (Python's start-up counts),
+#: for opening the port (a TCP connect included) and asking the drive what it is, every attempt
+#: and retry inside it; what comes after it (closing the port, the one line, the interpreter's
+#: exit) has the rest of PROBE_S, and PROBE_S leaves half a second to the promise. (A sim:// drive
+#: is built in this process first, which waits on no line; its deadline counts from then.)
+PROBE_S = 4.5
+CONNECT_S = 4.0
 #: Extra wall time for parameter reads and writes on a drive that has them.
 PARAMETERS_S = 60.0
 
@@ -131,6 +137,7 @@ class _Link:
 
 @contextlib.contextmanager
 def _connect(args: argparse.Namespace) -> Iterator[_Link]:
+    from fha_studio.clock import process_started_monotonic
     from fha_studio.hardware.client import DriveClient, LinkSettings
     from fha_studio.hardware.deadline import DeadlineTransport
     from fha_studio.hardware.errors import LinkFailure
@@ -140,13 +147,19 @@ def _connect(args: argparse.Namespace) -> Iterator[_Link]:
         raise CliError(f"--baud {args.baud}: must be a positive number of bit/s")
     # one retry, and no reply longer than a second: a probe must finish inside CONNECT_S
     settings = LinkSettings(baudrate=args.baud, retries=1, max_reply_s=1.0)
+    deadline = process_started_monotonic() + CONNECT_S
+    simulated = args.url.lower().startswith("sim://")
     bounded = None
     try:
         try:
-            port = open_transport(args.url, baudrate=args.baud, timeout=settings.poll_s)
+            port = open_transport(args.url, baudrate=args.baud, timeout=settings.poll_s,
+                                  open_timeout_s=deadline - time.monotonic())
         except ValueError as exc:
             raise CliError(f"--url: {exc}") from None
-        bounded = DeadlineTransport(port, CONNECT_S)
+        if simulated:  # the drive was built in this process (seconds on a loaded machine): no line
+            deadline = time.monotonic() + CONNECT_S  # was waited on, its line starts now
+        bounded = DeadlineTransport(port)
+        bounded.allow_until(deadline, CONNECT_S)
         client = DriveClient.attach(bounded, settings)
     except LinkFailure as exc:
         raise _Stop(EXIT_NO_ANSWER, _no_answer(args.url, exc, bounded)) from None
@@ -159,17 +172,20 @@ def _connect(args: argparse.Namespace) -> Iterator[_Link]:
 
 
 def _no_answer(url: str, exc: Exception, bounded: Any) -> str:
+    from fha_studio.clock import process_started_monotonic
     from fha_studio.hardware.deadline import DeadlinePassed
 
     if bounded is None:  # the port did not open
         return str(exc)
+    # how long since the command was run: the time the promise counts, said where it gave up
+    taken = f"in {time.monotonic() - process_started_monotonic():.1f} s"
     heard = bounded.received_bytes
     if heard == 0:
-        return (f"no drive answers on {url}: nothing arrived (check the cable, the port and the drive's "
-                "power)")
+        return (f"no drive answers on {url}: nothing arrived {taken} (check the cable, the port and "
+                "the drive's power)")
     if isinstance(exc, DeadlinePassed) or "no drive answers" in str(exc) or "no reply" in str(exc):
-        return (f"no drive answers on {url}: {heard} bytes arrived but no usable reply (check the baud "
-                f"rate, {BAUDRATE} 8N1, and that this is the drive's CN3 port)")
+        return (f"no drive answers on {url}: {heard} bytes arrived {taken} but no usable reply (check "
+                f"the baud rate, {BAUDRATE} 8N1, and that this is the drive's CN3 port)")
     return f"the link to {url} failed: {exc}"
 
 

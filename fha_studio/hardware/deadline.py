@@ -40,6 +40,13 @@ class DeadlineTransport:
         self.allowed_s = seconds
         self.deadline = time.monotonic() + seconds
 
+    def allow_until(self, deadline: float, allowed_s: float) -> None:
+        """Everything until ``deadline`` (monotonic seconds), fixed before the port was opened: one
+        deadline for the whole exchange, opening included; ``allowed_s`` is what messages call the
+        budget."""
+        self.allowed_s = allowed_s
+        self.deadline = deadline
+
     def remaining_s(self) -> float | None:
         return None if self.deadline is None else self.deadline - time.monotonic()
 

@@ -15,12 +15,14 @@ through ``write_filter``, and ``unplug()`` makes both ends fail like a pulled ca
 from __future__ import annotations
 
 import contextlib
+import socket
 import threading
 import time
 from collections.abc import Callable, Iterable
 from typing import Any, Protocol
 
 import serial
+from serial.urlhandler import protocol_socket
 
 from fha_studio.hardware.errors import LinkLost
 from fha_studio.hardware.protocol import BAUDRATE
@@ -156,27 +158,70 @@ def check_url(url: str) -> None:
             raise ValueError(f"{url[:80]}: expected socket://HOST:PORT with a port 1 ... 65535")
 
 
+class _BoundedSocket(protocol_socket.Serial):
+    """pyserial's ``socket://`` port with the TCP connect bounded by ``connect_timeout_s`` (its
+    own is a fixed 5 s, longer than a caller with a deadline has) and no pause on closing (its
+    0.3 s "in case of quick reconnects" is for a caller that reconnects, not one that exits)."""
+
+    connect_timeout_s: float = protocol_socket.POLL_TIMEOUT
+
+    def open(self) -> None:
+        self.logger = None
+        if self._port is None or self._opened():
+            raise serial.SerialException("the socket port is not configured or already open")
+        try:
+            connected = socket.create_connection(self.from_url(self.portstr),
+                                                 timeout=max(0.001, self.connect_timeout_s))
+        except TimeoutError:
+            raise serial.SerialException(
+                f"nothing accepted the connection in {self.connect_timeout_s:.1f} s") from None
+        except OSError as exc:
+            raise serial.SerialException(str(exc.strerror or exc).lower()) from None
+        connected.setblocking(False)
+        self._socket = connected
+        self.is_open = True
+        self.reset_input_buffer()
+        self.reset_output_buffer()
+
+    def _opened(self) -> bool:
+        return bool(getattr(self, "is_open", False))
+
+    def close(self) -> None:
+        connected = getattr(self, "_socket", None)
+        if self._opened() and connected is not None:
+            with contextlib.suppress(OSError):
+                connected.shutdown(socket.SHUT_RDWR)
+            connected.close()
+        self._socket = None  # type: ignore[assignment]  # pyserial's own close does the same
+        self.is_open = False
+
+
 def open_transport(
-    url: str, baudrate: int = BAUDRATE, timeout: float | None = 0.05, **kwargs: Any
+    url: str, baudrate: int = BAUDRATE, timeout: float | None = 0.05, *,
+    open_timeout_s: float | None = None, **kwargs: Any
 ) -> GuardedTransport:
     """Open ``url`` at ``baudrate`` 8N1 (CN3's line) and return it guarded.
 
     ``timeout`` is the read timeout of the port in seconds (the client sets its own per read).
-    Raises ``LinkLost`` naming the port when it cannot be opened (absent, busy, no permission),
-    ``ValueError`` for a URL scheme nobody handles.
+    ``open_timeout_s`` bounds the opening itself where it can wait (a ``socket://`` connect to a
+    listener that never accepts; devices and ptys open at once): a caller with one deadline for
+    the whole exchange passes what is left of it.
+    Raises ``LinkLost`` naming the port when it cannot be opened (absent, busy, no permission,
+    no connection in time), ``ValueError`` for a URL scheme nobody handles.
     """
     check_url(url)
     register_url_handlers()
+    settings = dict(baudrate=baudrate, bytesize=serial.EIGHTBITS, parity=serial.PARITY_NONE,
+                    stopbits=serial.STOPBITS_ONE, timeout=timeout, **kwargs)
     try:
-        port = serial.serial_for_url(
-            url,
-            baudrate=baudrate,
-            bytesize=serial.EIGHTBITS,
-            parity=serial.PARITY_NONE,
-            stopbits=serial.STOPBITS_ONE,
-            timeout=timeout,
-            **kwargs,
-        )
+        if open_timeout_s is not None and url.lower().startswith("socket://"):
+            bounded = _BoundedSocket(None, **settings)
+            bounded.connect_timeout_s = open_timeout_s
+            bounded.port = url
+            bounded.open()
+            port = bounded
+        else:
+            port = serial.serial_for_url(url, **settings)
     except ValueError as exc:
         if "not known" in str(exc):
             scheme = url.split("://", 1)[0]

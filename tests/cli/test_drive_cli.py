@@ -11,6 +11,7 @@ import json
 import os
 import re
 import select
+import socket
 import subprocess
 import sys
 import time
@@ -18,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from fha_studio.cli import drive as drive_cli
 from fha_studio.main import main as entry
 
 pytestmark = pytest.mark.e2e
@@ -121,23 +123,81 @@ def test_probe_servo_on_and_incremental(line):
     assert (data["servo"], data["encoder"], data["position_counts"]) == ("off", "incremental", None)
 
 
+def taken_s(err: str) -> float:
+    """The time the command says it took, from its own start (Python's start-up counted) to where
+    it gave up: the figure the 5 s promise is about, which a loaded machine cannot stretch in the
+    test's own measurement (the test's wall time includes its own waiting for the child)."""
+    found = re.search(r" in (\d+\.\d) s\b", err)
+    assert found, err
+    return float(found.group(1))
+
+
 @pytest.mark.parametrize("mode", ["silent", "flood", "slow", "garbage"])
-def test_probe_exits_3_within_5_s_whatever_the_line_does(line, mode):
+def test_probe_exits_3_within_5_s_whatever_the_line_does(line, mode, time_ceiling):
     server = line(mode)
     code, out, err, elapsed = fha("drive", "probe", "--url", server.path, "--json")
     assert code == 3, (out, err)
     assert out == ""
     one_line(err)
-    assert elapsed < 5.0, f"{mode}: {elapsed:.2f} s"
+    # one deadline for the whole probe, from the process's start: 4.0 s, the rest of 4.5 s is
+    # closing and exiting; attempts and retries each with their own timeouts came to 5.2-5.4 s
+    assert taken_s(err) <= drive_cli.CONNECT_S + 0.1 <= drive_cli.PROBE_S, err
+    time_ceiling(f"drive probe on a {mode} line", elapsed, 30.0)
     if mode == "silent":
         assert "nothing arrived" in err
     else:
-        assert "bytes arrived but no usable reply" in err
+        assert "bytes arrived" in err and "but no usable reply" in err
 
 
-def test_probe_on_a_missing_port_is_exit_3(tmp_path):
+@pytest.fixture
+def listener():
+    """A TCP listener that never accepts: the kernel completes the first connection into the
+    backlog (then nothing is ever read or written); with ``full=True`` the backlog is taken by a
+    connection of the test's own, so a probe's connect is never answered (SYNs dropped)."""
+    opened: list[socket.socket] = []
+
+    def start(full: bool) -> str:
+        server = socket.socket()
+        server.bind(("127.0.0.1", 0))
+        server.listen(0)
+        opened.append(server)
+        port = server.getsockname()[1]
+        if full:
+            filler = socket.create_connection(("127.0.0.1", port), timeout=5)
+            opened.append(filler)
+            probe = socket.socket()
+            probe.settimeout(0.3)
+            opened.append(probe)
+            try:  # does the backlog refuse a second one? (it does on Linux with listen(0))
+                probe.connect(("127.0.0.1", port))
+                pytest.skip("this system's listen(0) backlog took a second connection")
+            except TimeoutError:
+                pass
+        return f"socket://127.0.0.1:{port}"
+
+    yield start
+    for one in opened:
+        one.close()
+
+
+@pytest.mark.parametrize("full", [False, True], ids=["connected-silent", "connect-unanswered"])
+def test_probe_on_a_listener_that_never_accepts_ends_within_4_5_s(listener, full, time_ceiling):
+    url = listener(full)
+    code, out, err, elapsed = fha("drive", "probe", "--url", url, "--json")
+    assert code == 3 and out == "", (out, err)
+    one_line(err)
+    assert taken_s(err) <= drive_cli.CONNECT_S + 0.1, err
+    time_ceiling("drive probe on a listener that never accepts", elapsed, 30.0)
+    if full:
+        assert "nothing accepted the connection" in err
+    else:
+        assert "nothing arrived" in err
+
+
+def test_probe_on_a_missing_port_is_exit_3(tmp_path, time_ceiling):
     code, _, err, elapsed = fha("drive", "probe", "--url", str(tmp_path / "ttyNOPE"))
-    assert code == 3 and "ttyNOPE" in one_line(err) and elapsed < 5.0
+    assert code == 3 and "ttyNOPE" in one_line(err)
+    time_ceiling("drive probe on a missing port", elapsed, 30.0)
 
 
 def test_position_servo_off_servo_on_incremental(line):

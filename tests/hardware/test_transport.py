@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import os
+import socket
 import threading
+import time
 
 import pytest
 import serial
@@ -59,6 +61,46 @@ def test_pty_whose_other_side_closes_is_link_lost():
     finally:
         port.close()
         os.close(slave)
+
+
+def test_socket_with_an_open_timeout_talks_and_closes_at_once(time_ceiling):
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(1)
+    try:
+        port = open_transport(f"socket://127.0.0.1:{server.getsockname()[1]}", timeout=0.5,
+                              open_timeout_s=2.0)
+        peer, _ = server.accept()
+        with peer:
+            port.write(b"DGR\r")
+            assert peer.recv(16) == b"DGR\r"
+            peer.sendall(b"DGR+00000\r")
+            assert port.read(10) == b"DGR+00000\r"
+            started = time.monotonic()
+            port.close()  # without pyserial's 0.3 s pause for a reconnect
+            time_ceiling("closing a bounded socket port", time.monotonic() - started, 0.25)
+            assert not port.is_open
+    finally:
+        server.close()
+
+
+def test_socket_connect_that_nothing_accepts_gives_up_at_the_open_timeout(time_ceiling):
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(0)
+    address = server.getsockname()
+    filler = socket.create_connection(address, timeout=5)  # the backlog's one place
+    try:
+        started = time.monotonic()
+        with pytest.raises(LinkLost, match=r"nothing accepted the connection in 0\.5 s") as caught:
+            open_transport(f"socket://127.0.0.1:{address[1]}", open_timeout_s=0.5)
+        assert "\n" not in str(caught.value)
+        taken = time.monotonic() - started
+        assert taken >= 0.45, "gave up before its time: the backlog took the connection?"
+        time_ceiling("a socket connect bounded at 0.5 s", taken, 5.0)
+    finally:
+        filler.close()
+        server.close()
 
 
 def test_pipe_carries_bytes_and_times_out():
