@@ -37,9 +37,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio import fileio
 from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
-from fha_studio.gui.pages.base import BasePage
+from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
 from fha_studio.hardware.protocol import IoBit
 from fha_studio.logic.procedures import (
@@ -54,6 +53,7 @@ from fha_studio.logic.procedures import (
     load_all,
 )
 from fha_studio.logic.procedures.report import SignError, build_report, sign, value_text
+from fha_studio.logic.procedures.report_inputs import ReportInputs, collect_for_report
 from fha_studio.logic.register.words import when_text
 
 log = logging.getLogger(__name__)
@@ -521,78 +521,29 @@ class ProceduresPage(BasePage):
 
     # -- report -------------------------------------------------------------------------------
     def _collect_for_report(self) -> None:
-        """Bring the drive's identity and parameter values into the session before a report."""
-        if self.session is None:
-            return
-        self._collect_direction_check()
-        identity = self._identity()
-        if identity:
-            self.session.driver = identity
-        values = self.gui_session.known_values()
-        if values:
-            model = self.gui_session.parameter_model
-            by_key = {}
-            for (mode, number), wire in values.items():
-                try:
-                    by_key[model.item(mode, number).key] = int(wire)
-                except (KeyError, ValueError, TypeError):
-                    continue
-            path = self.session.path.with_suffix(".params") if self.session.path else None
-            if path is not None:
-                try:
-                    fileio.write_text(path, self.gui_session.parameter_file_text())
-                except Exception as exc:  # the report still goes out, saying the file is missing
-                    log.warning("parameter file not written: %s", exc)
-                    path = None
-            panel = {}
-            for (mode, number), entry in self.state.front_panel.items():
-                if (mode, number) in self.state.drive_values:
-                    continue
-                try:
-                    panel[model.item(mode, number).key] = {"who": entry.who, "time": entry.time}
-                except (KeyError, ValueError):
-                    continue
-            self.session.parameters = {"file": str(path or ""), "values": by_key, "front_panel": panel}
-        self._collect_dgr_checks()
-        if self.session.path:
-            self.session.save()
-
-    def _collect_direction_check(self) -> None:
-        """A rotary-direction check confirmed on the Rotary direction page is the 1-10 procedure
-        done (unless it was walked here): the report shows it with its records, not "not started"."""
-        import dataclasses
-
-        from fha_studio.gui.pages.base import PageId
-        from fha_studio.logic.procedures.direction_check import record_direction_check
-
-        built = getattr(self.main_window, "built_page", None)
-        page = built(PageId.DIRECTION) if built is not None else None
-        check = getattr(page, "last_check", None)
-        if check is None or self.session is None:
-            return
-        if record_direction_check(self.session, dataclasses.replace(check, who=check.who or self.who)):
-            if self.session.path:
-                self.session.save()
+        """Bring what the other pages know into the session before a report (what goes where:
+        ``logic.procedures.report_inputs``)."""
+        if self.session is not None and collect_for_report(self.session, self._report_inputs()):
             self._refresh()
 
-    def _collect_dgr_checks(self) -> None:
-        """The DGR checks page's records (encoder, rotary direction, sensor dogs, absolute origin)
-        go into the report as notes with who and the verdict, each once."""
-        from fha_studio.gui.pages.base import PageId
-        from fha_studio.logic.absolute import CHECK_TITLES
-
+    def _report_inputs(self) -> ReportInputs:
+        """The drive's identity, the known parameter values, the Rotary direction page's check and
+        the DGR checks page's records, as plain data."""
+        values = self.gui_session.known_values()
         window = self.main_window
-        built = getattr(window, "built_page", None)
-        checks = built(PageId.ABSOLUTE) if built is not None else None
-        if checks is None or self.session is None:
-            return
-        noted = {n.get("text", "") for n in self.session.notes}
-        for record in getattr(checks, "records", []):
-            verdict = {True: "pass", False: "FAIL", None: "recorded"}[record.passed]
-            how = ", entered by hand" if record.by_hand else ", with DGR"
-            text = f"{CHECK_TITLES[record.check]} ({record.at}{how}): {verdict}: {record.detail}"
-            if text not in noted:
-                self.session.add_note(text, who=record.who)
+        direction = window.built_page(PageId.DIRECTION) if window is not None else None
+        checks = window.built_page(PageId.ABSOLUTE) if window is not None else None
+        return ReportInputs(
+            who=self.who,
+            parameter_model=self.gui_session.parameter_model,
+            driver=self._identity(),
+            values=values,
+            read=set(self.state.drive_values),
+            front_panel=dict(self.state.front_panel),
+            parameter_file_text=self.gui_session.parameter_file_text(values) if values else "",
+            direction_check=getattr(direction, "last_check", None),
+            dgr_checks=list(getattr(checks, "records", [])),
+        )
 
     def add_plot(self, title: str, png_path: str | Path) -> None:
         if self.session is not None:
