@@ -1,7 +1,8 @@
 """The register: every commissioning fact of every axis, in one SQLite file (no Qt).
 
 - :mod:`.store`: :class:`Register` (machines, axes, snapshots, writes, checks, alarms, reports,
-  recordings, model checks; history, diff, find, open items, export).
+  recordings, model checks; history, diff, find, open items, export), in layers: :mod:`.connection`,
+  :mod:`.axes`, :mod:`.facts`, :mod:`.queries`, :mod:`.history`; :mod:`.records` what they return.
 - :mod:`.schema`: the tables and their migrations (``PRAGMA user_version``).
 - :mod:`.importers`: procedure session files and parameter files into the register.
 """

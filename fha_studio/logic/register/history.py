@@ -1,0 +1,139 @@
+"""An axis's history: every fact recorded for it as one sentence for people (and its data),
+oldest first."""
+
+from __future__ import annotations
+
+import json
+
+from fha_studio.logic.register import guard, words
+from fha_studio.logic.register.queries import Queries
+from fha_studio.logic.register.records import SNAPSHOT_SOURCE_WORDS, Axis, Event, check_name, utc_stamp
+
+
+@guard.in_words
+class History(Queries):
+    """The history of an axis."""
+
+    def history(self, axis: Axis | str | int, since: str | None = None) -> list[Event]:
+        """Everything recorded for the axis, oldest first."""
+        current = self.axis(axis)
+        a = current.id
+        db = self._db
+        events: list[Event] = []
+        for r in db.execute("SELECT * FROM axis_event WHERE axis_id = ?", (a,)):
+            events.append(Event(r["at_utc"], "axis", r["who"], r["text"], r["id"]))
+        for r in self.snapshots(current):
+            where = f" ({r['file']})" if r["file"] else ""
+            events.append(
+                Event(
+                    r["at_utc"],
+                    "snapshot",
+                    r["who"],
+                    f"parameters {SNAPSHOT_SOURCE_WORDS[r['source']]}: {r['count']} values,"
+                    f" snapshot {r['id']}{where}",
+                    r["id"],
+                    {"source": r["source"], "file": r["file"], "count": r["count"]},
+                )
+            )
+        for r in db.execute("SELECT * FROM parameter_write WHERE axis_id = ?", (a,)):
+            outcome = "verified" if r["verified"] else f"NOT verified ({r['error'] or 'read-back differs'})"
+            name = words.parameter_name(r["key"], current.driver_model, (r["mode"], r["number"]))
+            change = words.change_text(r["key"], r["old"], r["new"], current.driver_model)
+            events.append(
+                Event(
+                    r["at_utc"],
+                    "write",
+                    r["who"],
+                    f"{name}: {change}, {outcome}",
+                    r["id"],
+                    {
+                        k: r[k]
+                        for k in ("mode", "number", "key", "old", "new", "read_back", "verified", "error")
+                    },
+                )
+            )
+        titles = self._procedure_titles(a)
+        for r in db.execute("SELECT * FROM check_result WHERE axis_id = ?", (a,)):
+            value = json.loads(r["value_json"])
+            shown = ("yes" if value else "no") if r["kind"] == "confirm" else f"{value} {r['unit']}".strip()
+            verdict = "pass" if r["passed"] else "FAIL"
+            if isinstance(value, dict):  # a check with several readings: its own sentence says them
+                shown = r["detail"] or words.readings_text(value)
+            events.append(
+                Event(
+                    r["at_utc"],
+                    "check",
+                    r["who"],
+                    f"{check_name(r, titles)}: {shown} — {verdict}",
+                    r["id"],
+                    {
+                        "procedure_id": r["procedure_id"],
+                        "step_id": r["step_id"],
+                        "value": value,
+                        "passed": bool(r["passed"]),
+                        "expected": r["expected"],
+                        "detail": r["detail"],
+                    },
+                )
+            )
+        for r in db.execute("SELECT * FROM alarm WHERE axis_id = ?", (a,)):
+            note = f" ({r['note']})" if r["note"] else ""
+            events.append(
+                Event(
+                    r["at_utc"],
+                    "alarm",
+                    r["who"],
+                    f"alarm {r['code']}: {r['name']}{note}",
+                    r["id"],
+                    {"code": r["code"]},
+                )
+            )
+        for r in db.execute("SELECT * FROM report WHERE axis_id = ?", (a,)):
+            signed = f"signed by {r['signed_by']}" if r["signed_by"] else "not signed"
+            events.append(
+                Event(
+                    r["at_utc"],
+                    "report",
+                    r["who"],
+                    f"report {r['file']} ({signed}, {r['open_warnings']} open warnings)",
+                    r["id"],
+                    {"file": r["file"], "sha256": r["sha256"], "signed_by": r["signed_by"]},
+                )
+            )
+        for r in db.execute("SELECT * FROM recording WHERE axis_id = ?", (a,)):
+            summary = f": {r['summary']}" if r["summary"] else ""
+            events.append(
+                Event(
+                    r["at_utc"],
+                    "recording",
+                    r["who"],
+                    f"recording {r['file']}{summary}",
+                    r["id"],
+                    {"file": r["file"]},
+                )
+            )
+        for r in db.execute("SELECT * FROM model_check WHERE axis_id = ?", (a,)):
+            events.append(
+                Event(
+                    r["at_utc"],
+                    "model_check",
+                    r["who"],
+                    f"model check: {r['summary']}",
+                    r["id"],
+                    {"file": r["file"], "recording_file": r["recording_file"]},
+                )
+            )
+        if since is not None:
+            cutoff = utc_stamp(since)
+            events = [e for e in events if e.at_utc >= cutoff]
+        order = {
+            "axis": 0,
+            "snapshot": 1,
+            "write": 2,
+            "check": 3,
+            "alarm": 4,
+            "recording": 5,
+            "model_check": 6,
+            "report": 7,
+        }
+        return sorted(events, key=lambda e: (e.at_utc, order[e.kind], e.ref or 0))
