@@ -18,34 +18,34 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, TypedDict
+from typing import Any
 
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
-from fha_studio import clock
-from fha_studio.hardware.api import (
-    AlarmRecord,
-    CommandNotSupported,
-    CommandRejected,
-    DriveApi,
-    DriveRefused,
-    LinkError,
-    LinkLost,
-    LinkTimeout,
-    ServoOnRefused,
-    SimPanel,
-)
+from fha_studio.hardware.api import AlarmRecord, DriveApi, DriveRefused, LinkError, LinkLost, SimPanel
 from fha_studio.hardware.client import DriveClient
-from fha_studio.hardware.parameters import Mode, MonitorItem
-from fha_studio.hardware.protocol import BAUDRATE, EXTENSION_COMMANDS, Command, IoBit
+from fha_studio.hardware.protocol import BAUDRATE, EXTENSION_COMMANDS
 from fha_studio.hardware.sim.options import public_url
 from fha_studio.hardware.transaction import LinkSettings
-from fha_studio.logic.absolute import SERVO_ON_TEXT, refusal_text
+from fha_studio.logic.drive_session import (
+    POLL_INTERVAL_MS,
+    PROBE_INTERVAL_MS,
+    SERVO_ON_NOTE,
+    SERVO_ON_PROBE_MS,
+    STATUS_MONITORS,
+    DriveStatus,
+    ParameterKey,
+    ParameterReadout,
+    ParameterWrite,
+    StatusPoller,
+    WriteEntry,
+    failure_text,
+    read_parameters,
+    write_parameters,
+)
 
 log = logging.getLogger(__name__)
 
-#: Poll period of status, alarm, I/O and monitors while connected, in ms.
-POLL_INTERVAL_MS = 100
 #: Jog keep-alive period, in ms: the drive's watchdog stops the axis 100 ms after the last JOG.
 JOG_KEEPALIVE_MS = 40
 #: A held jog button renews its lease this often (GUI side), in ms ...
@@ -53,20 +53,10 @@ JOG_LEASE_RENEW_MS = 150
 #: ... and the worker stops jogging if the lease is older than this (a frozen GUI must not
 #: leave the axis running), in s.
 JOG_LEASE_S = 0.5
-#: Idle probe period of a drive without status commands (a drive of the manual's DGR and OWW),
-#: in ms: one DGR about every 0.7 s, so a drive switched off or unplugged shows within 2 s
-#: (this period plus one failed exchange with its retry, about 1 s).
-PROBE_INTERVAL_MS = 700
-#: While the drive answers "servo on" (s), it is asked at most once a second.
-SERVO_ON_PROBE_MS = 1000
-#: What the technician is told while a drive answers s (the words of the DGR checks and the CLI).
-SERVO_ON_NOTE = SERVO_ON_TEXT
 #: Failed transactions in a row after which the transaction layer marks the link lost (its one
 #: rule, ``LinkSettings.max_consecutive_failures``): one exchange left unanswered after its retry
 #: shows the technician a dead link at once. Set once the drive is open (``lose_link_after``).
 LINK_LOST_AFTER_FAILURES = 1
-#: The monitor items of the status poll: output position, output speed, motor current.
-STATUS_MONITORS = (MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.MOTOR_CURRENT)
 
 
 class Cmd(enum.Enum):
@@ -162,53 +152,6 @@ class LinkInfo:
     embedded_sim: bool = False  # an embedded simulated drive: its panel (SIM_PANEL) can be used
 
 
-class ReadParametersResult(TypedDict):
-    """The value of READ_PARAMETERS: wire values, and a sentence per item that could not be read."""
-
-    values: dict[tuple[str, int], int]
-    errors: dict[tuple[str, int], str]
-
-
-class WriteEntry(TypedDict, total=False):
-    """One write of WRITE_PARAMETERS (and of ``sigWrite``), for the session log."""
-
-    time: float
-    mode: str
-    number: int
-    new: int
-    old: int | None
-    read_back: int | None
-    verified: bool
-    error: str | None
-    restart_required: bool
-    message: str
-
-
-@dataclass(frozen=True)
-class DriveStatus:
-    """One poll of the drive. Fields are None when the drive could not tell (servo-on refusal,
-    no monitor support)."""
-
-    time_s: float
-    servo_on: bool | None = None
-    alarm_code: int | None = None
-    io_bits: int | None = None
-    speed_rpm: float | None = None
-    position_pulse: int | None = None
-    current_a: float | None = None
-    jogging: bool = False
-    refused: bool = False  # the drive answered "servo on: not now"
-    absolute_counts: int | None = None  # DGR's position (servo off, absolute encoder)
-    note: str = ""  # one line for the technician about this poll (servo on, DGR refused)
-
-    def bit(self, bit: IoBit) -> bool | None:
-        return None if self.io_bits is None else bool(self.io_bits >> bit & 1)
-
-    @property
-    def moving(self) -> bool:
-        return bool(self.jogging or self.bit(IoBit.MOVING))
-
-
 #: Opens a drive: (url, baud rate) -> an open DriveApi. Raises LinkError when it cannot.
 OpenClient = Callable[[str, int], DriveApi]
 
@@ -219,21 +162,9 @@ def link_settings(baud_rate: int = BAUDRATE) -> LinkSettings:
     return LinkSettings(baudrate=baud_rate, response_timeout_s=0.25, retries=1)
 
 
-_PLAIN_FAILURES: tuple[tuple[type[Exception], str], ...] = (
-    (NotConnected, "not connected"),
-    (LinkLost, "the link is lost"),
-    (LinkTimeout, "the drive did not answer"),
-    (ServoOnRefused, "refused: the servo is on"),
-    (DriveRefused, "refused by the drive"),
-)
-
-
 def _message(exc: Exception) -> str:
     """One line for the user: the exception's text, or what its kind means when it has none."""
-    text = str(exc)
-    if text:
-        return text
-    return next((plain for kind, plain in _PLAIN_FAILURES if isinstance(exc, kind)), "failed")
+    return failure_text(exc, ((NotConnected, "not connected"),))
 
 
 class LinkWorker(QObject):
@@ -258,6 +189,7 @@ class LinkWorker(QObject):
         self._closing = closing or threading.Event()
         self._final = False
         self._poll_interval_ms = POLL_INTERVAL_MS
+        self._poller: StatusPoller | None = None
         self._open_client: OpenClient = open_client or self._open_drive
         self._client: DriveApi | None = None
         self._url = ""
@@ -265,7 +197,6 @@ class LinkWorker(QObject):
         self._jog_timer: QTimer | None = None
         self._jog_speed_rpm = 0.0
         self._jog_lease_s = 0.0
-        self._monitor_ok = True
         #: What each command runs (every Cmd has one; a test checks it).
         self.handlers: dict[Cmd, Callable[..., Any]] = {
             Cmd.OPEN: self._do_open,
@@ -345,6 +276,7 @@ class LinkWorker(QObject):
             self._poll_timer.stop()
         self._jog_speed_rpm = 0.0
         client, self._client = self._client, None
+        self._poller = None
         if client is None:
             return
         if stop_axis:
@@ -384,7 +316,7 @@ class LinkWorker(QObject):
         if isinstance(self._client, DriveClient):  # the transaction layer's verdict, made prompt
             self._client.lose_link_after(LINK_LOST_AFTER_FAILURES)
         self._url = url
-        self._monitor_ok = True
+        self._poller = StatusPoller(self._client, self._poll_interval_ms)
         info = self._describe(url)
         self.sigConnected.emit(info)
         assert self._poll_timer is not None
@@ -426,57 +358,12 @@ class LinkWorker(QObject):
     def _do_identify(self) -> LinkInfo:
         return self._describe(self._url)
 
-    def _do_read_parameters(self, items: list[tuple[str, int]]) -> ReadParametersResult:
-        values: dict[tuple[str, int], int] = {}
-        errors: dict[tuple[str, int], str] = {}
-        for mode, number in items:
-            if self._abort.is_set():
-                errors[(mode, number)] = "stopped"
-                continue
-            try:
-                values[(mode, number)] = self.client.read_parameter(mode, number)
-            except (DriveRefused, ValueError) as exc:  # this item; the link failures end the read
-                errors[(mode, number)] = _message(exc)
-        return {"values": values, "errors": errors}
+    def _do_read_parameters(self, items: list[ParameterKey]) -> ParameterReadout:
+        return read_parameters(self.client, items, self._abort.is_set)
 
-    def _do_write_parameters(self, writes: list[tuple[str, int, int]]) -> list[WriteEntry]:
+    def _do_write_parameters(self, writes: list[ParameterWrite]) -> list[WriteEntry]:
         """Writes one by one; each entry says old, new, verified (by read-back) or the error."""
-        done: list[WriteEntry] = []
-        for mode, number, value in writes:
-            entry: WriteEntry = {
-                "time": clock.now_s(),
-                "mode": mode,
-                "number": number,
-                "new": value,
-                "old": None,
-                "read_back": None,
-                "verified": False,
-                "error": None,
-            }
-            if self._abort.is_set():
-                entry["error"] = "not written: stopped"
-                done.append(entry)
-                self.sigWrite.emit(entry)
-                continue
-            try:
-                result = self.client.write_parameter(mode, number, value)
-            except (DriveRefused, ValueError) as exc:
-                entry["error"] = _message(exc)
-            except LinkError as exc:
-                entry["error"] = _message(exc)
-                self.sigWrite.emit(entry)
-                raise
-            else:
-                entry["old"] = result.previous
-                entry["read_back"] = result.value
-                entry["verified"] = result.verified
-                entry["restart_required"] = result.needs_restart
-                entry["message"] = result.message
-                if not result.verified:
-                    entry["error"] = result.message or "read-back differs"
-            done.append(entry)
-            self.sigWrite.emit(entry)
-        return done
+        return write_parameters(self.client, writes, self._abort.is_set, self.sigWrite.emit)
 
     def _do_servo(self, on: bool) -> bool:
         self.client.servo(bool(on))
@@ -559,6 +446,8 @@ class LinkWorker(QObject):
 
     def _do_set_poll_interval(self, interval_ms: int) -> int:
         self._poll_interval_ms = max(POLL_INTERVAL_MS, int(interval_ms))
+        if self._poller is not None:
+            self._poller.set_interval(self._poll_interval_ms)
         return self._poll_interval_ms
 
     def _do_call(self, function: Callable[[DriveApi], Any]) -> Any:
@@ -596,71 +485,17 @@ class LinkWorker(QObject):
     # -- polling ------------------------------------------------------------------------------
     @Slot()
     def _poll(self) -> None:
-        client = self._client
-        if client is None:
+        poller = self._poller
+        if self._client is None or poller is None:
             return
-        status: dict[str, Any] = {"time_s": time.monotonic(), "jogging": bool(self._jog_speed_rpm)}
-        interval_ms = self._poll_interval_ms
         try:
-            if not client.capabilities.supports(Command.IOS):
-                interval_ms = self._probe(client, status)
-            else:
-                try:
-                    status["alarm_code"] = client.alarm()
-                    io = client.io_state()
-                    status["io_bits"] = io.raw
-                    status["servo_on"] = io.servo_on
-                    if self._monitor_ok:
-                        self._poll_monitors(client, status)
-                except ServoOnRefused:
-                    status["refused"] = True
-                    status["servo_on"] = True  # a drive refuses CN3 commands while the servo is on
-                    status["note"] = SERVO_ON_NOTE
-                    interval_ms = max(interval_ms, SERVO_ON_PROBE_MS)
+            status, interval_ms = poller.poll(jogging=bool(self._jog_speed_rpm))
         except LinkLost as exc:
             self._lose(exc)
             return
-        except LinkError as exc:
-            log.info("poll failed: %s", exc)
-        self.sigStatus.emit(DriveStatus(**status))
+        self.sigStatus.emit(status)
         if self._client is not None and self._poll_timer is not None:
             self._poll_timer.start(interval_ms)
-
-    def _probe(self, client: DriveApi, status: dict[str, Any]) -> int:
-        """The idle probe of a drive without status commands: one DGR. Data, s and x all prove
-        the drive is there; silence ends the link (the caller). Returns the next poll's delay."""
-        try:
-            status["absolute_counts"] = client.absolute_position()
-            status["servo_on"] = False
-        except ServoOnRefused:
-            status["servo_on"] = True
-            status["refused"] = True
-            status["note"] = SERVO_ON_NOTE
-            return max(self._poll_interval_ms, SERVO_ON_PROBE_MS)
-        except CommandRejected as exc:
-            # s comes to everything while the servo is on, so x means: servo off, no DGR
-            status["servo_on"] = False
-            status["note"] = refusal_text(exc, Command.DGR)
-        return max(self._poll_interval_ms, PROBE_INTERVAL_MS)
-
-    def _poll_monitors(self, client: DriveApi, status: dict[str, Any]) -> None:
-        """Output position (pulse), output speed (r/min) and motor current (A), scaled by the
-        parameter model's monitor items."""
-        try:
-            values = client.read_monitors(STATUS_MONITORS)
-        except (CommandNotSupported, CommandRejected) as exc:
-            self._monitor_ok = False  # a drive without the monitor extension: stop asking
-            log.info("monitors not available: %s", exc)
-            return
-
-        def scaled(item: MonitorItem) -> float | None:
-            wire = values.get(item)
-            return None if wire is None else client.model.item(Mode.MONITOR, item).to_unit(wire)
-
-        position = values.get(MonitorItem.FEEDBACK_POSITION)
-        status["position_pulse"] = position
-        status["speed_rpm"] = scaled(MonitorItem.OUTPUT_SPEED)
-        status["current_a"] = scaled(MonitorItem.MOTOR_CURRENT)
 
 
 def _embedded_sim(client: DriveApi) -> SimPanel | None:
@@ -820,7 +655,11 @@ class LinkController(QObject):
         self.sigResult.emit(result)
 
 
-__all__ = [
+__all__ = [  # the poll's figures and types re-exported: the pages know them from here
+    "POLL_INTERVAL_MS",
+    "PROBE_INTERVAL_MS",
+    "SERVO_ON_NOTE",
+    "SERVO_ON_PROBE_MS",
     "STATUS_MONITORS",
     "Cmd",
     "CommandResult",
@@ -832,7 +671,7 @@ __all__ = [
     "NotConnected",
     "OpenClient",
     "PanelRefused",
-    "ReadParametersResult",
+    "ParameterReadout",
     "SimPanelAction",
     "WriteEntry",
 ]

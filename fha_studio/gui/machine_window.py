@@ -163,13 +163,13 @@ class AxisRecorder(QObject):
 
     @Slot(object)
     def _on_result(self, result: CommandResult) -> None:
-        if result.cmd is not Cmd.READ_PARAMETERS or not result.ok or not result.value["values"]:
+        if result.cmd is not Cmd.READ_PARAMETERS or not result.ok or not result.value.values:
             return
         info = self.window.link.info
         self._record(
             read_facts(
                 self.window.session.parameter_model,
-                result.value["values"],
+                result.value.values,
                 self.who,
                 driver_model=info.driver_model if info else "",
             )

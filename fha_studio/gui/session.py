@@ -146,13 +146,13 @@ class Session(QObject):
     @Slot(object)
     def _on_result(self, result: CommandResult) -> None:
         if result.cmd is Cmd.READ_PARAMETERS and result.ok:
-            self.state.record_read(result.value["values"])
+            self.state.record_read(result.value.values)
         if result.token == self._backup_read_token:
             self._backup_read_token = None
             writes, self._pending_writes = self._pending_writes, None
-            if not result.ok or result.value["errors"]:
+            if not result.ok or result.value.errors:
                 why = result.error or "; ".join(
-                    f"{m} {n}: {e}" for (m, n), e in result.value["errors"].items()
+                    f"{m} {n}: {e}" for (m, n), e in result.value.errors.items()
                 )
                 self.sigMessage.emit(f"Nothing written: the backup read failed ({why}).")
                 self.sigWritesDone.emit([])

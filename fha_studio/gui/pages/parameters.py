@@ -595,8 +595,8 @@ class ParametersPage(BasePage):
     def _on_result(self, result: CommandResult) -> None:
         if result.cmd is Cmd.READ_PARAMETERS:
             if result.ok:
-                errors = result.value["errors"]
-                n = len(result.value["values"])
+                errors = result.value.errors
+                n = len(result.value.values)
                 text = f"Read {n} item(s) from the drive."
                 if errors:
                     text += " Not read: " + "; ".join(f"{m} {k}: {e}" for (m, k), e in errors.items())
