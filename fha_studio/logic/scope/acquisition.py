@@ -12,6 +12,9 @@ Two paths through the same view (docs/protocol.md):
 - ``TraceAcquisition``: the drive samples up to 4 monitor items at the servo rate / divider,
   with a trigger (level, I/O bit edge, alarm) and pre-trigger; read out in 64-sample blocks.
 
+The trace capture is trace.py, the configuration and the line's budget budget.py; their names
+are taken from here too.
+
 ``MoveTest`` commands a move (or a step: a short move at the highest acceleration) and captures
 it with a trace when the drive has one, else by polling; then computes ``move_metrics``. It is
 stepped (``step()`` from a timer), so the link thread never blocks for the length of a move.
@@ -24,17 +27,16 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-import tomllib
 from collections import deque
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
 
 from fha_studio import clock
 from fha_studio.hardware import protocol as p
-from fha_studio.hardware.api import Capabilities, CapabilityLevel, DriveApi, TraceStatus
+from fha_studio.hardware.api import Capabilities, CapabilityLevel, DriveApi
 from fha_studio.hardware.errors import (
     CommandNotSupported,
     CommandRejected,
@@ -46,79 +48,25 @@ from fha_studio.hardware.errors import (
     ServoOnRefused,
 )
 from fha_studio.logic.scope.analysis import MoveMetrics, move_metrics
+from fha_studio.logic.scope.budget import (
+    READOUT_CHARS_PER_VALUE,
+    ScopeConfig,
+    dgr_line_time_s,
+    estimated_rate_hz,
+    load_scope_config,
+    mmr_reply_chars,
+    readout_time_s,
+    sample_line_time_s,
+    theoretical_rate_hz,
+)
 from fha_studio.logic.scope.channels import IO_STATE_ITEM, ScopeChannel, items_to_poll
 from fha_studio.logic.scope.ring import RingBuffer
-from fha_studio.paths import resource
+from fha_studio.logic.scope.trace import TraceAcquisition, TraceResult, TraceSettings, Trigger, convert_rows
 
 #: Monitor items of the channels the move test captures (feedback, command, speed, current).
 FEEDBACK_KEY = "feedback_position"
 COMMAND_KEY = "command_position"
 DGR_ITEM = -1  # the pseudo monitor item of the DGR position channel
-
-
-# --- configuration (resources/scope/scope.toml) ----------------------------------------------------
-
-
-@dataclass(frozen=True)
-class ScopeConfig:
-    """Numbers the scope needs that the protocol does not carry (see resources/scope/scope.toml)."""
-
-    servo_rate_hz: float = 5000.0
-    servo_rate_assumed: bool = True
-    stale_after_s: float = 0.5
-    stale_after_periods: float = 5.0
-
-
-def load_scope_config() -> ScopeConfig:
-    with open(resource("scope", "scope.toml"), "rb") as f:
-        raw = tomllib.load(f)
-    return ScopeConfig(
-        servo_rate_hz=float(raw["trace"]["servo_rate_hz"]),
-        servo_rate_assumed=bool(raw["trace"].get("servo_rate_assumed", True)),
-        stale_after_s=float(raw["live"]["stale_after_s"]),
-        stale_after_periods=float(raw["live"]["stale_after_periods"]),
-    )
-
-
-# --- the line's budget ------------------------------------------------------------------------------
-
-
-def mmr_reply_chars(values: Sequence[int]) -> int:
-    """Characters of an MMR reply carrying ``values``: the data line, its CR, then ``q`` CR."""
-    return len(",".join(str(int(v)) for v in values)) + 1 + 2
-
-
-def sample_line_time_s(values: Sequence[int], baudrate: int = p.BAUDRATE) -> float:
-    """Line time of one polled sample: the 10-character request plus the reply (8N1: 10 bits)."""
-    return (p.FRAME_LENGTH + mmr_reply_chars(values)) * p.character_time_s(baudrate)
-
-
-def theoretical_rate_hz(values: Sequence[int], baudrate: int = p.BAUDRATE) -> float:
-    """The most samples per second the line can carry for replies of these values."""
-    return 1.0 / sample_line_time_s(values, baudrate)
-
-
-def estimated_rate_hz(item_count: int, digits_per_value: int = 6, baudrate: int = p.BAUDRATE) -> float:
-    """The bound before any reply is known: ``digits_per_value`` characters per value (sign incl.)."""
-    return theoretical_rate_hz([10 ** (digits_per_value - 1)] * item_count, baudrate)
-
-
-#: Characters per value of a trace block, for estimates before the read-out: text (TRB) about 7
-#: digits and a separator; packed (TRP) about 2 (a moving position at 1 kHz, docs/protocol.md).
-READOUT_CHARS_PER_VALUE = {"text": 8.0, "packed": 2.0}
-
-
-def readout_time_s(samples: int, items: int, encoding: str = "text", baudrate: int = p.BAUDRATE) -> float:
-    """Line time to read a trace out (64 samples a block) in ``encoding`` ("text": TRB,
-    "packed": TRP): the values' characters, a CR per line, and the requests."""
-    blocks = math.ceil(samples / p.TRACE_BLOCK_SAMPLES)
-    chars = samples * items * READOUT_CHARS_PER_VALUE[encoding] + blocks * (p.FRAME_LENGTH + 2)
-    return chars * p.character_time_s(baudrate)
-
-
-def dgr_line_time_s(value: int, baudrate: int = p.BAUDRATE) -> float:
-    """Line time of one DGR exchange."""
-    return (p.FRAME_LENGTH + len(str(int(value))) + 1 + 2) * p.character_time_s(baudrate)
 
 
 # --- live state ------------------------------------------------------------------------------------
@@ -310,186 +258,6 @@ class PollingAcquisition:
         # Nothing polled (not live): no rate figure, not the last one
         return LiveStatus(live, "" if live else reason, self.mode, self.samples,
                           self.rate_hz if live else 0.0, self._limit_hz, self.ring.dropped, age)
-
-
-# --- drive-side trace capture ----------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Trigger:
-    """When a trace starts. ``channel``: for level triggers an analog channel (``level`` in its
-    display unit); for edge triggers an I/O bit channel. Alarm and immediate need no channel."""
-
-    kind: p.TriggerKind = p.TriggerKind.IMMEDIATE
-    channel: ScopeChannel | None = None
-    level: float = 0.0
-
-    def wire(self) -> tuple[int, int, int]:
-        """(TTG kind, TTC channel, TTL level) as sent."""
-        k = self.kind
-        if k in (p.TriggerKind.RISING_LEVEL, p.TriggerKind.FALLING_LEVEL):
-            if self.channel is None or self.channel.is_bit or self.channel.monitor_item < p.MONITOR_MASK_BASE:
-                raise ValueError("a level trigger needs an analog monitor channel")
-            return int(k), self.channel.monitor_item, round(self.level / self.channel.scale)
-        if k in (p.TriggerKind.IO_BIT_RISES, p.TriggerKind.IO_BIT_FALLS):
-            if self.channel is None or not self.channel.is_bit:
-                raise ValueError("an edge trigger needs an I/O bit channel")
-            bit = self.channel.io_bit
-            assert bit is not None  # is_bit
-            return int(k), int(bit), 0
-        return int(k), 0, 0
-
-    def describe(self) -> str:
-        k = self.kind
-        if k is p.TriggerKind.IMMEDIATE:
-            return "immediate"
-        if k is p.TriggerKind.ALARM:
-            return "on an alarm"
-        name = self.channel.name if self.channel else "?"
-        if k in (p.TriggerKind.RISING_LEVEL, p.TriggerKind.FALLING_LEVEL):
-            edge = "rises through" if k is p.TriggerKind.RISING_LEVEL else "falls through"
-            return f"{name} {edge} {self.level:g} {self.channel.unit if self.channel else ''}".rstrip()
-        return f"{name} {'rises' if k is p.TriggerKind.IO_BIT_RISES else 'falls'}"
-
-
-@dataclass(frozen=True)
-class TraceSettings:
-    """A capture: channels (their monitor items, at most 4 distinct), rate, length, trigger."""
-
-    channels: tuple[ScopeChannel, ...]
-    sample_rate_hz: float = 1000.0
-    samples: int = 2048
-    pre_trigger: int = 0
-    trigger: Trigger = field(default_factory=Trigger)
-
-    def items(self) -> list[int]:
-        return items_to_poll(self.channels)
-
-    def divider(self, servo_rate_hz: float) -> int:
-        return max(1, round(servo_rate_hz / self.sample_rate_hz))
-
-    def check(self) -> None:
-        items = self.items()
-        if not self.channels:
-            raise ValueError("a trace needs at least one channel")
-        if any(i < p.MONITOR_MASK_BASE for i in items):
-            raise ValueError("a trace takes monitor items 100-115 only")
-        if len(items) > p.TRACE_MAX_CHANNELS:
-            raise ValueError(f"a trace takes at most {p.TRACE_MAX_CHANNELS} monitor items; these channels "
-                             f"need {len(items)} ({', '.join(map(str, items))}); I/O bits share item 106")
-        if not 1 <= self.samples <= p.TRACE_MAX_SAMPLES:
-            raise ValueError(f"a trace has 1 ... {p.TRACE_MAX_SAMPLES} samples, got {self.samples}")
-        if not 0 <= self.pre_trigger < self.samples:
-            raise ValueError(f"pre-trigger {self.pre_trigger} must be 0 ... {self.samples - 1}")
-        if self.sample_rate_hz <= 0:
-            raise ValueError("the trace sample rate must be > 0")
-        self.trigger.wire()
-
-
-@dataclass(frozen=True)
-class TraceResult:
-    """A read-out capture in display units; ``t_s`` is 0 at the trigger (pre-trigger negative)."""
-
-    channels: tuple[ScopeChannel, ...]
-    t_s: np.ndarray
-    values: np.ndarray  # shape (samples, channels)
-    sample_rate_hz: float
-    pre_trigger: int
-    trigger: str
-    captured_at: float  # wall clock (clock.now_s()) of the read-out
-    method: str = "trace"  # "trace" (drive-side) or "polling" (host-side, uneven)
-
-    def column(self, key: str) -> np.ndarray:
-        for j, c in enumerate(self.channels):
-            if c.key == key:
-                return self.values[:, j]
-        raise KeyError(f"no channel {key!r} in this capture ({', '.join(c.key for c in self.channels)})")
-
-    def has(self, key: str) -> bool:
-        return any(c.key == key for c in self.channels)
-
-    def rows(self) -> np.ndarray:
-        """``[t_s, values...]`` rows: the scope's sample layout (recorder, CSV)."""
-        return np.column_stack([self.t_s, self.values])
-
-
-def convert_rows(channels: Sequence[ScopeChannel], items: Sequence[int],
-                 rows: Sequence[Sequence[int]]) -> np.ndarray:
-    """Wire rows (one value per item, in ``items`` order) -> display values per channel."""
-    wire = np.asarray(rows, dtype=np.int64).reshape(len(rows), len(items))
-    out = np.empty((len(rows), len(channels)))
-    for j, c in enumerate(channels):
-        col = wire[:, list(items).index(c.monitor_item)]
-        out[:, j] = ((col >> c.io_bit) & 1) if c.io_bit is not None else col * c.scale
-    return out
-
-
-class TraceAcquisition:
-    """Drive-side capture (TCH/TDV/TTG/TTC/TTL/TPR/TAR/TST/TRB) through the client."""
-
-    def __init__(self, client: DriveApi, config: ScopeConfig | None = None):
-        self.client = client
-        self.config = config or load_scope_config()
-        self.settings: TraceSettings | None = None
-        self._items: tuple[int, ...] = ()
-
-    def available(self) -> tuple[bool, str]:
-        """(True, "") when the drive can trace, else (False, why in a sentence)."""
-        if self.client.capabilities.level is CapabilityLevel.TRACE:
-            return True, ""
-        return False, "this drive has no trace capture: " + self.client.capabilities.describe()
-
-    def actual_rate_hz(self, settings: TraceSettings) -> float:
-        return self.config.servo_rate_hz / settings.divider(self.config.servo_rate_hz)
-
-    def configure(self, settings: TraceSettings) -> None:
-        settings.check()
-        kind, channel, level = settings.trigger.wire()
-        self._items = self.client.configure_trace(
-            settings.items(), divider=settings.divider(self.config.servo_rate_hz),
-            trigger=p.TriggerKind(kind), trigger_channel=channel, trigger_level=level,
-            pre_trigger=settings.pre_trigger)
-        self.settings = settings
-
-    def arm(self) -> None:
-        if self.settings is None:
-            raise ValueError("configure the trace before arming it")
-        self.client.arm_trace(self.settings.samples)
-
-    def status(self) -> TraceStatus:
-        """The drive's ``TraceStatus`` (state, samples held)."""
-        return self.client.trace_status()
-
-    def ready_for_trigger(self, status: TraceStatus) -> bool:
-        """True once the pre-trigger part is full (a trigger before that would shorten it)."""
-        if status.state is p.TraceState.ARMED:
-            return bool(status.count >= (self.settings.pre_trigger if self.settings else 0))
-        return status.state in (p.TraceState.CAPTURING, p.TraceState.DONE)
-
-    @property
-    def encoding(self) -> str:
-        """How the blocks come: "packed" (TRP, listed in CAP) or "text" (TRB)."""
-        return "packed" if self.client.capabilities.supports(p.Command.TRP) else "text"
-
-    def readout_estimate_s(self, samples: int) -> float:
-        """Line time of reading ``samples`` of the configured channels out."""
-        items = len(self.settings.items()) if self.settings else p.TRACE_MAX_CHANNELS
-        return readout_time_s(samples, items, self.encoding)
-
-    def read(self, should_abort: Callable[[], bool] | None = None,
-             progress: Callable[[int, int], None] | None = None) -> TraceResult:
-        """Read the finished capture out (TRP or TRB blocks of 64 samples). ``should_abort`` is
-        asked between blocks; True gives up with ``ReadAborted`` (a STOP must not wait for the
-        whole read-out). ``progress(done, total)`` after every block (samples)."""
-        settings = self.settings
-        if settings is None:
-            raise ValueError("no trace configured")
-        capture = self.client.read_trace(should_abort=should_abort, progress=progress)
-        values = convert_rows(settings.channels, capture.channels, capture.samples)
-        rate = self.actual_rate_hz(settings)
-        t = (np.arange(len(values)) - settings.pre_trigger) / rate
-        return TraceResult(settings.channels, t, values, rate, settings.pre_trigger,
-                           settings.trigger.describe(), clock.now_s())
 
 
 # --- the built-in tests: move and step response ------------------------------------------------------
@@ -723,3 +491,31 @@ class MoveTest:
             self._restore_accel = None
         self.result = MoveTestResult(self.kind, self.angle_deg, self.speed_rpm, capture, metrics,
                                      self._in_pos_deg, error)
+
+
+__all__ = [
+    "COMMAND_KEY",
+    "DGR_ITEM",
+    "FEEDBACK_KEY",
+    "READOUT_CHARS_PER_VALUE",
+    "LiveMode",
+    "LiveStatus",
+    "MoveTest",
+    "MoveTestResult",
+    "PollingAcquisition",
+    "ScopeConfig",
+    "TraceAcquisition",
+    "TraceResult",
+    "TraceSettings",
+    "Trigger",
+    "convert_rows",
+    "dgr_channel",
+    "dgr_line_time_s",
+    "estimated_rate_hz",
+    "load_scope_config",
+    "mmr_reply_chars",
+    "plan_live",
+    "readout_time_s",
+    "sample_line_time_s",
+    "theoretical_rate_hz",
+]
