@@ -1,17 +1,24 @@
 """A stand-in drive in memory, for GUI tests that must not depend on the simulated drive's timing.
 
 It implements ``fha_studio.hardware.api.DriveApi`` with the real result types and the real errors
-(mypy checks that it does: tests/typecheck_drive_api.py), and follows the protocol's rules:
-servo-on refusals, alarms that need a power cycle, a jog that stops 100 ms after the last JOG.
-Commands it does not model raise ``CommandNotSupported``, as the client does for a drive without
-the extension.
+(mypy checks that it does: tests/test_drive_api.py) and behaves as ``DriveClient`` does on the
+simulated drive: the same arguments refused before anything is sent (same ``ValueError`` text),
+the same refusals in the same words (``protocol.servo_on_text`` / ``rejected_text``, the
+client's wording of a refused write), ``CommandNotSupported`` for a command it lacks. The shared
+client suite (tests/hardware/test_client_buses.py) runs over it beside ``sim://``, TCP and a pty.
+
+Its time is its own: the jog stops 100 ms after the last JOG, a trace is captured at once from
+what the monitors show over the capture's time. A drive that answers only the manual's DGR and
+OWW is not this fake: it is ``tests.support.scripted.documented_only`` behind a real client.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Iterable
 
+from fha_studio.catalog.model_code import parse_model_code
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.api import (
     INPUT_NAMES,
@@ -23,42 +30,73 @@ from fha_studio.hardware.api import (
     Identity,
     IoState,
     LinkLost,
+    ReadAborted,
+    SensorName,
     ServoOnRefused,
     TraceCapture,
     TraceStatus,
     WriteResult,
 )
-from fha_studio.hardware.client import SELECT_COMMAND
+from fha_studio.hardware.client import SELECT_COMMAND, _steps
 from fha_studio.hardware.parameters import (
     Mode,
     MonitorItem,
+    ParameterItem,
     ParameterModel,
     ParameterValueError,
+    load_alarm_table,
     load_parameter_model,
 )
 from fha_studio.hardware.protocol import Command, IoBit, rejected_text, servo_on_text
+from fha_studio.hardware.sim.constants import load_sim_constants
 
-#: What the fake answers: the manual's commands, parameters, monitors, motion, alarms, I/O and the
-#: simulated power cycle; no trace capture and no other sim-only command (inputs, alarms, sensors).
+#: Every row of the protocol's table: what the simulated drive's full profile answers (the fake
+#: in the shared client suite).
+SIMULATED_COMMANDS = frozenset(p.COMMAND_FACTS)
+#: The GUI tests' fake: the manual's commands and the extensions without a trace capture, and of
+#: the simulated drive's own commands only the power cycle (the pages poll; no sim panel, no
+#: training controls).
 FAKE_COMMANDS = frozenset(
     c for c, facts in p.COMMAND_FACTS.items() if facts.trace is None and not facts.sim_only
 ) | {Command.PWC}
+#: Output pulses a turn of the fake's output (its feedback position's unit), and what a jog
+#: adds a second for each r/min.
+PULSES_PER_TURN = 1_000_000
+JOG_PULSES_PER_RPM_S = 1000
+_SENSOR_COMMANDS = {SensorName.ORIGIN: Command.SNO, SensorName.LS1: Command.SNA, SensorName.LS2: Command.SNB}
 
 
 class FakeDriveClient:
-    """An HA-655-2-200 adjusted for an FHA-25C-50-US250, in memory (a ``DriveApi``).
+    """An HA-655 adjusted for ``actuator`` (FHA-25C-50-US250: an HA-655-2-200), in memory.
 
     ``values`` maps ``(mode name, number)`` to the wire value; ``calls`` records jog and stop;
-    ``raise_alarm(code)`` plays the drive's supervision. ``commands`` narrows what it supports.
+    ``raise_alarm(code)`` plays the drive's supervision. ``commands`` narrows what it supports
+    (``without`` takes some away). DGR answers a position unless ``absolute_encoder`` is False.
     """
 
-    def __init__(self, model: ParameterModel | None = None, commands: Iterable[Command] = FAKE_COMMANDS):
+    def __init__(
+        self,
+        model: ParameterModel | None = None,
+        commands: Iterable[Command] = FAKE_COMMANDS,
+        *,
+        actuator: str = "FHA-25C-50-US250",
+        absolute_encoder: bool = True,
+    ):
         self.model = model or load_parameter_model()
+        self.alarm_table = load_alarm_table(self.model.driver)
+        code = parse_model_code(actuator)
+        self.actuator = actuator
+        self.driver_model = next(d for d in _compatible_drivers(actuator) if d.startswith(self.model.driver))
+        self.absolute_encoder = absolute_encoder
+        self.has_sensors = "L" in code.options
         self.values: dict[tuple[str, int], int] = {
             (i.mode.value, i.number): i.default for i in self.model if i.default is not None
         }
         self.effective = dict(self.values)
-        self._capabilities = Capabilities(frozenset(commands), True, True)
+        commands = frozenset(commands)
+        if not commands - p.DOCUMENTED_COMMANDS:
+            raise ValueError("a drive of only the manual's commands is tests.support's, not this fake")
+        self._capabilities = Capabilities(commands, absolute_encoder, True)
         self.closed = False
         self.servo_on = False
         self.alarm_code = 0
@@ -70,6 +108,16 @@ class FakeDriveClient:
         self.move_speed_rpm = 10.0
         self.t = time.monotonic()
         self.calls: list[tuple[object, ...]] = []
+        constants = load_sim_constants()
+        self.sensors = {
+            SensorName.ORIGIN.value: constants.origin_angle_deg,
+            SensorName.LS1.value: constants.limit_switch_1_angle_deg,
+            SensorName.LS2.value: constants.limit_switch_2_angle_deg,
+        }
+        self._trace_channels: tuple[int, ...] = ()
+        self._trace_divider = 1
+        self._trace_rows: list[tuple[int, ...]] = []
+        self._trace_state = p.TraceState.IDLE
 
     # --- the link ----------------------------------------------------------------------------
     @property
@@ -88,17 +136,27 @@ class FakeDriveClient:
         self.closed = True
 
     def _check(self, *commands: Command) -> None:
+        """As the client's ``_require`` and then its transaction: the link, the commands."""
         if self.closed:
             raise LinkLost("fake:// is closed", port=self.port)
         missing = [c.value for c in commands if c not in self._capabilities.commands]
         if missing:
-            raise CommandNotSupported(f"this drive does not have {', '.join(missing)}")
+            raise CommandNotSupported(
+                f"this drive does not have {', '.join(missing)}. {self._capabilities.describe()}"
+            )
         now = time.monotonic()
-        if self.jog_speed_rpm and now < self.jog_until:
-            self.position_pulse += self.jog_speed_rpm * (now - self.t) * 1000
-        elif now >= self.jog_until:
+        self.position_pulse = self._position_at(now)
+        if now >= self.jog_until:
             self.jog_speed_rpm = 0.0
         self.t = now
+
+    def _position_at(self, when: float) -> float:
+        """Where the output is at ``when`` (no earlier than the last look), jogging until the
+        jog's 100 ms run out."""
+        moving_until = min(when, self.jog_until)
+        if not self.jog_speed_rpm or moving_until <= self.t:
+            return self.position_pulse
+        return self.position_pulse + self.jog_speed_rpm * (moving_until - self.t) * JOG_PULSES_PER_RPM_S
 
     # --- what the drive is -------------------------------------------------------------------
     @property
@@ -111,7 +169,9 @@ class FakeDriveClient:
 
     def without(self, *commands: Command) -> FakeDriveClient:
         """The same fake lacking ``commands`` (e.g. the parameter commands); returns self."""
-        self._capabilities = Capabilities(self._capabilities.commands - set(commands), True, True)
+        self._capabilities = Capabilities(
+            self._capabilities.commands - set(commands), self.absolute_encoder, True
+        )
         return self
 
     def detect_capabilities(self) -> Capabilities:
@@ -119,15 +179,23 @@ class FakeDriveClient:
         return self._capabilities
 
     def identify(self) -> Identity | None:
-        self._check()
-        return Identity("HA-655-2-200", "FHA-25C-50-US250", "fake 1.0")
+        if Command.IDN not in self._capabilities.commands:
+            return None
+        self._check(Command.IDN)
+        return Identity(self.driver_model, self.actuator, "fake 1.0")
 
     # --- parameters ----------------------------------------------------------------------------
+    def _item(self, mode: Mode | str, number: int) -> ParameterItem:
+        try:
+            return self.model.item(mode, number)
+        except (KeyError, ValueError) as exc:
+            raise ParameterValueError(str(exc).strip("'\"")) from None
+
     def read_parameter(self, mode: Mode | str, number: int) -> int:
         mode = Mode(mode)
         if mode is Mode.MONITOR:
             return self.read_monitor(number)
-        self._check(Command.PRD)
+        self._check(SELECT_COMMAND[mode], Command.PRD)
         try:
             return self.values[(mode.value, number)]
         except KeyError:
@@ -143,16 +211,18 @@ class FakeDriveClient:
         return values
 
     def write_parameter(self, mode: Mode | str, number: int, value: int) -> WriteResult:
-        mode = Mode(mode)
-        self._check(Command.PRD, Command.PWR)
-        item = self.model.item(mode, number)
+        item = self._item(mode, number)
         if not item.writable:
             raise ParameterValueError(f"{item.label} is read-only")
         item.check(value)
-        if mode is Mode.SYSTEM and self.servo_on:
-            raise ServoOnRefused(servo_on_text(Command.PWR))
-        key = (mode.value, number)
+        self._check(SELECT_COMMAND[item.mode], Command.PRD, Command.PWR)
+        key = (item.mode.value, number)
         previous = self.values[key]
+        if item.mode is Mode.SYSTEM and self.servo_on:
+            raise ServoOnRefused(
+                f"{item.label}: not written ({servo_on_text(Command.PWR)}); "
+                f"the drive holds {item.format(previous)}, the old value"
+            )
         self.values[key] = value
         if not item.restart_required:
             self.effective[key] = value
@@ -162,15 +232,19 @@ class FakeDriveClient:
         return WriteResult(item, value, previous, value, Held.NEW, message)
 
     # --- monitors ------------------------------------------------------------------------------
-    def _monitor_wire(self, item: int) -> int:
-        if item == MonitorItem.FEEDBACK_POSITION:
-            return int(self.position_pulse)
+    def _monitor_wire(self, item: int, when: float | None = None) -> int:
+        position = self.position_pulse if when is None else self._position_at(when)
+        speed_rpm = self.jog_speed_rpm if when is None or when < self.jog_until else 0.0
+        if item in (MonitorItem.FEEDBACK_POSITION, MonitorItem.COMMAND_POSITION, MonitorItem.LOAD_POSITION):
+            return int(position)
         if item == MonitorItem.OUTPUT_SPEED:
-            return round(self.jog_speed_rpm / self.model.item(Mode.MONITOR, item).scale)
+            return round(speed_rpm / self.model.item(Mode.MONITOR, item).scale)
         if item == MonitorItem.MOTOR_CURRENT:
-            return round((0.5 if self.jog_speed_rpm else 0.0) / self.model.item(Mode.MONITOR, item).scale)
+            return round((0.5 if speed_rpm else 0.0) / self.model.item(Mode.MONITOR, item).scale)
         if item == MonitorItem.IO_STATE:
-            return self._io_bits()
+            return self._io_bits(moving=bool(speed_rpm))
+        if (Mode.MONITOR, item) in {(i.mode, i.number) for i in self.model.in_mode(Mode.MONITOR)}:
+            return 0  # an item the fake does not model: the axis at rest, no load
         raise CommandRejected(rejected_text(Command.MON, item))
 
     def read_monitor(self, item: int) -> int:
@@ -178,8 +252,11 @@ class FakeDriveClient:
         return self._monitor_wire(item)
 
     def read_monitors(self, items: Iterable[int]) -> dict[int, int]:
+        items = sorted(set(items))
+        if not items:
+            return {}
         self._check(Command.MON)
-        return {i: self._monitor_wire(i) for i in sorted(set(items))}
+        return {i: self._monitor_wire(i) for i in items}
 
     # --- motion --------------------------------------------------------------------------------
     def servo(self, on: bool) -> None:
@@ -187,9 +264,12 @@ class FakeDriveClient:
         if on and self.alarm_code:
             raise CommandRejected(rejected_text(Command.SVO))
         self.servo_on = bool(on)
+        if not on:
+            self.jog_speed_rpm = 0.0
 
     def jog(self, speed_rpm: float) -> None:
         self._check(Command.JOG)
+        _steps(speed_rpm, p.SPEED_STEP_RPM, "jog speed", "r/min")
         if not self.servo_on:
             raise CommandRejected(rejected_text(Command.JOG))
         self.calls.append(("jog", speed_rpm))
@@ -200,13 +280,15 @@ class FakeDriveClient:
         if speed_rpm <= 0:
             raise ValueError(f"move speed must be positive, got {speed_rpm} r/min")
         self._check(Command.SPD)
+        _steps(speed_rpm, p.SPEED_STEP_RPM, "move speed", "r/min")
         self.move_speed_rpm = speed_rpm
 
     def move_by(self, angle_deg: float) -> None:
         self._check(Command.MOV)
+        _steps(angle_deg, p.ANGLE_STEP_DEG, "move angle", "deg")
         if not self.servo_on:
             raise CommandRejected(rejected_text(Command.MOV))
-        self.position_pulse += angle_deg / 360 * 1_000_000
+        self.position_pulse += angle_deg / 360 * PULSES_PER_TURN
 
     def stop(self) -> None:
         self._check(Command.STP)
@@ -226,18 +308,20 @@ class FakeDriveClient:
         """The drive's supervision raises alarm ``code`` (servo off, history entry)."""
         self.alarm_code = code
         self.servo_on = False
+        self.jog_speed_rpm = 0.0
         self.history.insert(0, AlarmRecord(code, 123))
 
     def clear_alarm(self) -> None:
         self._check(Command.ACL)
-        if self.alarm_code not in (0, 20, 60):
-            raise CommandRejected(f"{rejected_text(Command.ACL)}: it needs a power cycle")
+        alarm = self.alarm_table.get(self.alarm_code)
+        if alarm is not None and not alarm.clearable:
+            raise CommandRejected(rejected_text(Command.ACL))  # it needs a power cycle
         self.alarm_code = 0
 
-    def _io_bits(self) -> int:
+    def _io_bits(self, moving: bool | None = None) -> int:
         bits = self.inputs | 1 << IoBit.READY
         bits |= int(self.servo_on) << IoBit.SERVO_ON | int(bool(self.alarm_code)) << IoBit.ALARM
-        if self.jog_speed_rpm:
+        if self.jog_speed_rpm if moving is None else moving:
             bits |= 1 << IoBit.MOVING
         return bits
 
@@ -248,7 +332,7 @@ class FakeDriveClient:
     def set_inputs(self, **inputs: bool) -> IoState:
         unknown = sorted(set(inputs) - set(INPUT_NAMES))
         if unknown:
-            raise ValueError(f"unknown inputs {unknown}")
+            raise ValueError(f"unknown inputs {unknown}; known: {', '.join(sorted(INPUT_NAMES))}")
         self._check(Command.INP, Command.IOS)
         for name, on in inputs.items():
             bit = 1 << INPUT_NAMES[name]
@@ -264,28 +348,40 @@ class FakeDriveClient:
 
     def inject_alarm(self, code: int) -> None:
         self._check(Command.FLT)
+        if self.alarm_table.get(code) is None:
+            raise CommandRejected(rejected_text(Command.FLT, code))
         self.raise_alarm(code)
 
     def set_sensor_angle(self, which: str, angle_deg: float) -> None:
-        self._check(Command.SNO, Command.SNA, Command.SNB)
+        try:
+            command = _SENSOR_COMMANDS[SensorName(which)]
+        except ValueError:
+            raise ValueError(f"sensor {which!r}: origin, ls1 or ls2") from None
+        self._check(command)
+        _steps(angle_deg, p.ANGLE_STEP_DEG, "sensor angle", "deg")
+        if not self.has_sensors:
+            raise CommandRejected(rejected_text(command))  # no option L: nothing to move
+        self.sensors[which] = round(angle_deg / p.ANGLE_STEP_DEG) * p.ANGLE_STEP_DEG
 
     def sensor_angles(self) -> dict[str, float]:
         self._check(Command.SNQ)
-        return {}
+        return dict(self.sensors)
 
     # --- the documented commands ------------------------------------------------------------
     def absolute_position(self) -> int:
         self._check(Command.DGR)
         if self.servo_on:
             raise ServoOnRefused(servo_on_text(Command.DGR))
+        if not self.absolute_encoder:
+            raise CommandRejected(rejected_text(Command.DGR))
         return int(self.position_pulse)
 
     def clear_multiturn(self) -> None:
         self._check(Command.OWW)
-        if self.servo_on:
+        if self.servo_on or not self.absolute_encoder:
             raise CommandRejected(rejected_text(Command.OWW))
 
-    # --- trace capture (not modelled: a drive without the extension) --------------------------
+    # --- trace capture: taken at once, from what the monitors show over the capture's time ----
     def configure_trace(
         self,
         channels: Iterable[int],
@@ -296,24 +392,74 @@ class FakeDriveClient:
         trigger_level: int = 0,
         pre_trigger: int = 0,
     ) -> tuple[int, ...]:
-        self._check(Command.TCH)
-        return ()
+        ordered = tuple(p.mask_items(p.monitor_mask(channels)))
+        if not 1 <= len(ordered) <= p.TRACE_MAX_CHANNELS:
+            raise ValueError(f"a trace has 1 ... {p.TRACE_MAX_CHANNELS} channels, got {len(ordered)}")
+        self._check(*p.TRACE_COMMANDS)
+        if not 1 <= divider <= 99999:
+            raise CommandRejected(rejected_text(Command.TDV))
+        if not 0 <= pre_trigger < p.TRACE_MAX_SAMPLES:
+            raise CommandRejected(rejected_text(Command.TPR))
+        self._trace_channels, self._trace_divider = ordered, divider
+        return ordered
 
     def arm_trace(self, samples: int) -> None:
+        if not 1 <= samples <= p.TRACE_MAX_SAMPLES:
+            raise ValueError(f"trace samples must be 1 ... {p.TRACE_MAX_SAMPLES}, got {samples}")
         self._check(Command.TAR)
+        if not self._trace_channels:
+            raise CommandRejected(rejected_text(Command.TAR))
+        start, step_s = time.monotonic(), self._trace_divider / 1000
+        self._trace_rows = [
+            tuple(self._monitor_wire(c, start + k * step_s) for c in self._trace_channels)
+            for k in range(samples)
+        ]
+        self._trace_state = p.TraceState.DONE
 
     def trace_status(self) -> TraceStatus:
         self._check(Command.TST)
-        return TraceStatus(p.TraceState.IDLE, 0)
+        done = self._trace_state is p.TraceState.DONE
+        return TraceStatus(self._trace_state, len(self._trace_rows) if done else 0)
 
     def read_trace_block(self, block: int, count: int) -> list[tuple[int, ...]]:
         self._check(Command.TRB)
-        return []
+        if not self._trace_channels:
+            raise ValueError("read_trace_block: configure_trace first (the channels are not known)")
+        expect = min(p.TRACE_BLOCK_SAMPLES, count - block * p.TRACE_BLOCK_SAMPLES)
+        if block < 0 or expect <= 0:
+            raise ValueError(f"read_trace_block: block {block} is outside a capture of {count} samples")
+        first = block * p.TRACE_BLOCK_SAMPLES
+        rows = self._trace_rows[first:first + expect] if self._trace_state is p.TraceState.DONE else []
+        if not rows:
+            raise CommandRejected(rejected_text(Command.TRB))
+        return rows
 
     def read_trace(
         self,
         should_abort: Callable[[], bool] | None = None,
         progress: Callable[[int, int], None] | None = None,
     ) -> TraceCapture:
-        self._check(Command.TRB)
-        return TraceCapture((), ())
+        self._check(Command.TST, Command.TRB)
+        channels = self._trace_channels
+        if not channels:
+            raise ValueError("read_trace: configure_trace first (the channels are not known)")
+        status = self.trace_status()
+        if status.state is not p.TraceState.DONE:
+            raise CommandRejected(f"no finished capture (state {status.state.name.lower()})")
+        rows: list[tuple[int, ...]] = []
+        if progress is not None:
+            progress(0, status.count)
+        for block in range(math.ceil(status.count / p.TRACE_BLOCK_SAMPLES)):
+            if should_abort is not None and should_abort():
+                raise ReadAborted(f"trace read-out stopped after {len(rows)} of {status.count} samples",
+                                  len(rows), status.count)
+            rows += self.read_trace_block(block, status.count)
+            if progress is not None:
+                progress(len(rows), status.count)
+        return TraceCapture(channels, tuple(rows))
+
+
+def _compatible_drivers(actuator: str) -> tuple[str, ...]:
+    from fha_studio.catalog.actuator import get_actuator
+
+    return tuple(get_actuator(actuator).compatible_drivers)

@@ -1,9 +1,13 @@
 """One client suite over every way to reach a drive, as python-can runs one suite over every bus.
 
 The same tests talk to the simulated drive embedded in this process (``sim://``), to
-``fha-studio sim --tcp`` in another process (``socket://``) and to ``fha-studio sim --pty`` in
-another process (a pseudo-terminal). Each subprocess is started once per module. Every test
-leaves the drive as it found it (servo off, no alarm, inputs released, values restored).
+``fha-studio sim --tcp`` in another process (``socket://``), to ``fha-studio sim --pty`` in
+another process (a pseudo-terminal), and to the GUI tests' fake (``FakeDriveClient`` in memory,
+with every command of the protocol's table as the simulated drive has them): what passes here,
+a GUI test on the fake can take for what ``DriveClient`` does. Each subprocess is started once
+per module. Every test leaves the drive as it found it (servo off, no alarm, inputs released,
+values restored). No case here is about bytes on a line (framing, resynchronisation: those are
+tests/hardware/test_client.py and test_hostile_lines.py), so none is left out for the fake.
 
 The held jog repeats JOG on every pass of its loop (one read of the monitors a pass, a few ms)
 and stops when the monitors show the motion, not after a time: a pass that comes late on a loaded
@@ -13,6 +17,7 @@ machine lets the drive's 100 ms watchdog stop the axis, and the next JOG starts 
 from __future__ import annotations
 
 import os
+import re
 import select
 import subprocess
 import sys
@@ -34,13 +39,16 @@ from fha_studio.hardware.api import (
 )
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import Mode, MonitorItem
+from fha_studio.hardware.protocol import Command, rejected_text, servo_on_text
+from tests.gui.fake_drive import SIMULATED_COMMANDS, FakeDriveClient
 
 ROOT = Path(__file__).resolve().parents[2]
 #: An absolute-encoder actuator, so that DGR answers a position.
 ACTUATOR = "FHA-25C-50-S248"
 #: Only a hang takes this long: the output reaches the jog speed within some 0.1 s.
 HELD_JOG_LIMIT_S = 15.0
-BUSES = ["sim", pytest.param("tcp", marks=pytest.mark.e2e), pytest.param("pty", marks=pytest.mark.e2e)]
+E2E = pytest.mark.e2e
+BUSES = ["sim", pytest.param("tcp", marks=E2E), pytest.param("pty", marks=E2E), "fake"]
 
 
 def _start(tmp: Path, where: str) -> tuple[subprocess.Popen[bytes], str]:
@@ -74,6 +82,9 @@ def _stop(proc: subprocess.Popen[bytes]) -> None:
 @pytest.fixture(scope="module", params=BUSES)
 def bus(request, tmp_path_factory) -> Iterator[str]:
     """The URL of a drive on one bus; a subprocess lives as long as the module's tests of its bus."""
+    if request.param == "fake":
+        yield "fake://"
+        return
     tmp = tmp_path_factory.mktemp(request.param)
     if request.param == "sim":
         yield f"sim://{ACTUATOR}?paced=0&eeprom={tmp / 'eeprom.json'}"
@@ -86,7 +97,11 @@ def bus(request, tmp_path_factory) -> Iterator[str]:
 
 @pytest.fixture
 def drive(bus: str) -> Iterator[DriveApi]:
-    client = DriveClient.open(bus)
+    client: DriveApi
+    if bus == "fake://":
+        client = FakeDriveClient(commands=SIMULATED_COMMANDS, actuator=ACTUATOR)
+    else:
+        client = DriveClient.open(bus)
     try:
         yield client
     finally:
@@ -179,3 +194,49 @@ def test_a_trace_is_captured_and_read_out(drive):
     assert capture.channels == channels and len(capture.samples) == 100
     assert all(len(row) == 2 for row in capture.samples)
     assert all(IoState(bits).ready for bits in capture.column(MonitorItem.IO_STATE))
+
+
+def exactly(text: str) -> str:
+    return f"^{re.escape(text)}$"
+
+
+def test_refusals_say_what_was_refused_in_the_same_words_on_every_bus(drive):
+    direction = drive.model.by_key("rotary_direction")
+    with pytest.raises(CommandRejected, match=exactly(rejected_text(Command.JOG))):
+        drive.jog(10.0)  # the servo is off
+    drive.servo(True)
+    held = f"{direction.label}: not written ({servo_on_text(Command.PWR)}); the drive holds "
+    with pytest.raises(ServoOnRefused, match=exactly(held + f"{direction.format(0)}, the old value")):
+        drive.write_parameter(direction.mode, direction.number, 1)
+    with pytest.raises(ServoOnRefused, match=exactly(servo_on_text(Command.DGR))):
+        drive.absolute_position()
+    with pytest.raises(ServoOnRefused, match=exactly(servo_on_text(Command.PWC))):
+        drive.power_cycle()
+    drive.servo(False)
+    with pytest.raises(CommandRejected, match=exactly(rejected_text(Command.TSL, 99))):
+        drive.read_parameter(Mode.TUNE, 99)
+    with pytest.raises(CommandRejected, match=exactly(rejected_text(Command.FLT, 99))):
+        drive.inject_alarm(99)  # no such alarm
+    drive.inject_alarm(30)  # over current: only a power cycle clears it
+    try:
+        with pytest.raises(CommandRejected, match=exactly(rejected_text(Command.ACL))):
+            drive.clear_alarm()
+        with pytest.raises(CommandRejected, match=exactly(rejected_text(Command.SVO))):
+            drive.servo(True)
+    finally:
+        drive.power_cycle()
+    assert drive.alarm() == 0
+
+
+@pytest.mark.parametrize(("call", "said"), [
+    (lambda d: d.jog(1e9), "jog speed 1000000000.0 r/min is outside -999.99 ... 999.99 r/min"),
+    (lambda d: d.set_move_speed(0), "move speed must be positive, got 0 r/min"),
+    (lambda d: d.configure_trace([]), "a trace has 1 ... 4 channels, got 0"),
+    (lambda d: d.configure_trace([99]), "monitor item 99 cannot be in a mask (items 100 ... 115)"),
+    (lambda d: d.arm_trace(0), "trace samples must be 1 ... 4096, got 0"),
+    (lambda d: d.read_trace(), "read_trace: configure_trace first (the channels are not known)"),
+    (lambda d: d.set_sensor_angle("x", 1.0), "sensor 'x': origin, ls1 or ls2"),
+], ids=["jog", "move-speed", "no-channel", "channel-99", "no-samples", "unconfigured", "sensor"])
+def test_arguments_are_refused_before_anything_is_sent_in_the_same_words(drive, call, said):
+    with pytest.raises(ValueError, match=exactly(said)):
+        call(drive)
