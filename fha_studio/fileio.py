@@ -7,7 +7,9 @@
   content goes to a temporary file beside the target, is flushed to the disk, and only then
   renamed over the target; a failed write (disk full, no permission, a path under a file)
   leaves the previous file untouched and no temporary file behind, and raises before the caller
-  can print that it succeeded.
+  can print that it succeeded. A write killed halfway leaves its temporary, which the next write
+  of the target removes, and the next start too (:mod:`fha_studio.temporaries` notes every
+  temporary in flight with its writer's pid).
 - :func:`check_output_path`: the same checks as the writers, before any work is done, so that a
   long computation is not lost to a target that can never be written.
 
@@ -23,10 +25,11 @@ import json
 import math
 import os
 import stat
-import tempfile
 import tomllib
 from pathlib import Path
 from typing import Any
+
+from fha_studio import temporaries
 
 #: Default bound on what a reader reads: far above any file FHA Studio writes or reads as input
 #: (parameter, session, model and EEPROM files are kilobytes), so a larger file is not one of ours.
@@ -215,9 +218,10 @@ def write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
     except OSError as exc:
         raise FileProblem(target, os_reason(exc)) from None
     remove_stale_temporaries(target)
-    tmp = None
+    tmp: Path | None = None
+    note = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+        fd, tmp, note = _create_temporary(target)
         with os.fdopen(fd, "wb") as handle:
             handle.write(data)
             handle.flush()
@@ -231,7 +235,27 @@ def write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
         if tmp is not None:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
+        if note is not None:
+            note.done()
     return target
+
+
+def _create_temporary(target: Path) -> tuple[int, Path, temporaries.Note]:
+    """A new ``.NAME.XXXXXXXX.tmp`` beside ``target``, noted in the journal of temporaries in
+    flight before it exists (so a kill at any moment leaves nothing the next start cannot find)."""
+    for _ in range(100):
+        tmp = temporaries.temporary_name(target)
+        note = temporaries.note(tmp)
+        try:
+            fd = os.open(tmp, os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0), 0o600)
+        except FileExistsError:
+            note.done()
+            continue
+        except OSError:
+            note.done()
+            raise
+        return fd, tmp, note
+    raise FileExistsError(errno.EEXIST, "no free temporary file name")
 
 
 #: A temporary file of a write (``.NAME.XXXXXXXX.tmp``) untouched for this long is left over from

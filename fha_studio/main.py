@@ -2,6 +2,8 @@
 
 It sits above both so that the CLI never imports Qt and the GUI is imported only when asked for.
 ``fha-studio --url URL`` (options but no command) starts the GUI too, as does ``fha-studio gui ...``.
+Either start first removes the temporary files that writes killed in an earlier run left
+(:mod:`fha_studio.temporaries`).
 """
 
 from __future__ import annotations
@@ -21,6 +23,9 @@ def _wants_gui(args: list[str]) -> bool:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
+    from fha_studio import temporaries
+
+    temporaries.sweep()  # what writes killed in an earlier run left (a living writer's stays)
     if args[:2] == ["training", "start"] and len(args) == 3 and args[2] not in _HELP:
         args = ["gui", "--training", args[2]]  # a trainee's session is the GUI's
     if _wants_gui(args):
