@@ -22,8 +22,11 @@ Counts are per sample: ``counts[i]`` is the position after sample ``i``, 0 at th
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
+
+from fha_studio.logic.bench.edges import Lines, Steps, changes
 
 #: A state that reverts within this many samples is a glitch (a spike on one phase).
 GLITCH_SAMPLES = 2
@@ -41,6 +44,10 @@ PULSE_FORMS = {0: "two-pulse", 1: "pulse + sign", 2: "two-phase"}
 _PHASE = np.array([0, 1, 3, 2], np.int8)  # index: A + 2 B
 # phase step (mod 4) -> count step; 2 is illegal (both phases changed)
 _STEP = np.array([0, 1, 0, -1], np.int8)
+# (code before << 2 | code after) -> count step and illegal (both phases changed): the lookup table
+_DELTA16 = np.array([(int(_PHASE[new]) - int(_PHASE[old])) % 4 for old in range(4) for new in range(4)])
+_STEP16 = _STEP[_DELTA16]
+_ILLEGAL16 = _DELTA16 == 2
 
 
 class DecodeError(ValueError):
@@ -49,43 +56,51 @@ class DecodeError(ValueError):
 
 @dataclass(frozen=True)
 class QuadratureResult:
-    """Encoder counts per sample and what was wrong with the edges."""
+    """Encoder counts per sample (held where they change) and what was wrong with the edges."""
 
-    counts: np.ndarray  # int64, per sample
+    steps: Steps  # the counts, 0 at the first sample
     edges: int
     glitches: int
     illegal_transitions: int
     edge_samples: np.ndarray  # sample index of each counted edge
 
+    @cached_property
+    def counts(self) -> np.ndarray:
+        """int64 per sample."""
+        return self.steps.dense().astype(np.int64)
+
     @property
     def total_counts(self) -> int:
-        return int(self.counts[-1]) if self.counts.size else 0
+        return int(self.steps.final) if self.steps.n else 0
 
 
 def _changes(state: np.ndarray) -> np.ndarray:
     """Indices i >= 1 where state[i] != state[i-1]."""
-    return np.flatnonzero(state[1:] != state[:-1]) + 1
+    return changes(state)
 
 
 def quadrature(a: np.ndarray, b: np.ndarray) -> QuadratureResult:
     """Count A/B x4; see the module docstring."""
-    n = a.shape[0]
-    code = a.astype(np.int8) + 2 * b.astype(np.int8)
-    phase = _PHASE[code]
-    at = _changes(phase)
-    delta = (phase[at] - phase[at - 1]) % 4
-    illegal = int(np.count_nonzero(delta == 2))
-    steps = _STEP[delta].astype(np.int64)
-    counts = np.zeros(n, np.int64)
-    if at.size:
-        counts[at] = steps
-        np.cumsum(counts, out=counts)
+    return quadrature_lines(Lines.from_levels(a, b))
+
+
+def quadrature_lines(lines: Lines) -> QuadratureResult:
+    """Count A (line 0) / B (line 1) x4 from the samples where they change: each change's step
+    from a 16-entry table of (code before, code after)."""
+    at = lines.at
+    codes = lines.codes & np.uint8(3)
+    previous = np.concatenate(([lines.first & 3], codes[:-1])).astype(np.uint8)
+    key = (previous << np.uint8(2)) | codes
+    illegal = int(np.count_nonzero(_ILLEGAL16[key]))
+    steps = _STEP16[key].astype(np.int64)
     # a glitch: a step undone by the next one within GLITCH_SAMPLES samples
     glitches = 0
     if at.size > 1:
         undone = (steps[1:] == -steps[:-1]) & (steps[1:] != 0) & (np.diff(at) <= GLITCH_SAMPLES)
         glitches = int(np.count_nonzero(undone))
-    return QuadratureResult(counts, int(at.size), glitches, illegal, at[steps != 0])
+    counted = steps != 0
+    return QuadratureResult(Steps.from_increments(lines.n, at[counted], steps[counted]), int(at.size),
+                            glitches, illegal, at[counted])
 
 
 def rising_edges(level: np.ndarray) -> np.ndarray:
@@ -103,10 +118,18 @@ class ZCheck:
 
 def z_check(z: np.ndarray, counts: np.ndarray, counts_per_turn: int) -> ZCheck:
     """Z pulses against the counts per motor turn: each one at the first one's count modulo it."""
-    at = rising_edges(z)
+    return _z_check_at(rising_edges(z), np.asarray(counts)[rising_edges(z)], counts_per_turn)
+
+
+def z_check_lines(z: Lines, counts: Steps, counts_per_turn: int) -> ZCheck:
+    """:func:`z_check` from Z's changes and the counts held where they change."""
+    at = z.rising()
+    return _z_check_at(at, counts.sample(at), counts_per_turn)
+
+
+def _z_check_at(at: np.ndarray, where: np.ndarray, counts_per_turn: int) -> ZCheck:
     if at.size == 0:
         return ZCheck(0, 0, counts_per_turn)
-    where = counts[at]
     off = (where - where[0]) % counts_per_turn
     off = np.minimum(off, counts_per_turn - off)
     return ZCheck(int(at.size), int(np.count_nonzero(off > Z_TOLERANCE_COUNTS)), counts_per_turn)
@@ -114,9 +137,19 @@ def z_check(z: np.ndarray, counts: np.ndarray, counts_per_turn: int) -> ZCheck:
 
 @dataclass(frozen=True)
 class CommandPulseResult:
-    pulses: np.ndarray  # int64 per sample: input pulses after the x1/x2/x4 multiplication
-    counts: np.ndarray  # float64 per sample: commanded encoder counts (through the electronic gear)
+    pulse_steps: Steps  # input pulses after the x1/x2/x4 multiplication
+    count_steps: Steps  # commanded encoder counts (through the electronic gear)
     illegal_transitions: int
+
+    @cached_property
+    def pulses(self) -> np.ndarray:
+        """int64 per sample."""
+        return self.pulse_steps.dense().astype(np.int64)
+
+    @cached_property
+    def counts(self) -> np.ndarray:
+        """float64 per sample."""
+        return self.count_steps.dense().astype(np.float64)
 
 
 def command_pulses(
@@ -128,43 +161,67 @@ def command_pulses(
     gear_denominator: int,
 ) -> CommandPulseResult:
     """Commanded counts from the command pulse lines; see the module docstring."""
+    _check_command(pulse_form, multiplication, gear_numerator, gear_denominator, b is not None)
+    lines = Lines.from_levels(a) if b is None else Lines.from_levels(a, b)
+    return command_pulse_lines(lines, b is not None, pulse_form, multiplication, gear_numerator,
+                               gear_denominator)
+
+
+def _check_command(pulse_form: int, multiplication: int, gear_numerator: int, gear_denominator: int,
+                   has_b: bool) -> None:
     if pulse_form not in PULSE_FORMS:
         raise DecodeError(f"parameter 1 (command pulse form) is {pulse_form}; 0, 1 or 2 expected")
     if gear_numerator <= 0 or gear_denominator <= 0:
         raise DecodeError(f"electronic gear {gear_numerator}/{gear_denominator}: both must be at least 1")
-    n = a.shape[0]
-    illegal = 0
     if pulse_form == 2:
-        if b is None:
+        if not has_b:
             raise DecodeError(
                 "two-phase command pulses (parameter 1 = 2) need both lines, command_a and command_b"
             )
         if multiplication not in (1, 2, 4):
             raise DecodeError(f"parameter 2 (multiplication) is {multiplication}; 1, 2 or 4 expected")
-        q = quadrature(a, b)
+
+
+def command_pulse_lines(
+    lines: Lines,
+    has_b: bool,
+    pulse_form: int,
+    multiplication: int,
+    gear_numerator: int,
+    gear_denominator: int,
+) -> CommandPulseResult:
+    """:func:`command_pulses` from the lines' changes (line 0 = A, line 1 = B where ``has_b``)."""
+    _check_command(pulse_form, multiplication, gear_numerator, gear_denominator, has_b)
+    n = lines.n
+    illegal = 0
+    if pulse_form == 2:
+        q = quadrature_lines(lines)
         illegal = q.illegal_transitions
-        pulses = np.floor_divide(q.counts, 4 // multiplication)
+        s = q.steps
+        pulses = Steps(n, s.at, np.floor_divide(s.values, 4 // multiplication)).compressed()
     else:
-        steps = np.zeros(n, np.int64)
-        up = rising_edges(a)
+        up = lines.rising(0)
         if pulse_form == 0:
-            steps[up] += 1
-            if b is not None:
-                steps[rising_edges(b)] -= 1
+            down = lines.rising(1) if has_b else np.zeros(0, np.int64)
+            at = np.concatenate((up, down))
+            inc = np.concatenate((np.ones(up.size, np.int64), -np.ones(down.size, np.int64)))
         else:
-            sign = np.ones(up.size, np.int64)
-            if b is not None:
-                sign[b.astype(bool)[up]] = -1  # the sign line high (ON) = REV
-            steps[up] = sign
-        pulses = np.cumsum(steps)
-    counts = pulses * (gear_numerator / gear_denominator)
+            at = up
+            inc = np.ones(up.size, np.int64)
+            if has_b:
+                inc[lines.level_at(up, 1)] = -1  # the sign line high (ON) = REV
+        pulses = Steps.from_increments(n, at, inc)
+    counts = pulses.scaled(gear_numerator / gear_denominator)
     return CommandPulseResult(pulses, counts, illegal)
 
 
 def standstill_mask(counts: np.ndarray, rate_hz: float, window_s: float = 0.01) -> np.ndarray:
     """Samples inside a stretch of at least ``window_s`` in which the encoder did not move."""
-    n = counts.shape[0]
-    at = _changes(counts)
+    return standstill_mask_at(counts.shape[0], _changes(counts), rate_hz, window_s)
+
+
+def standstill_mask_at(n: int, at: np.ndarray, rate_hz: float, window_s: float = 0.01) -> np.ndarray:
+    """:func:`standstill_mask` from the samples ``at`` where the counts change."""
     bounds = np.concatenate(([0], at, [n]))
     lengths = np.diff(bounds)
     still = lengths >= max(1, int(window_s * rate_hz))
@@ -223,6 +280,24 @@ def peak_rpm_from_counts(
         return 0.0
     moved = np.abs(counts[step:] - counts[:-step])
     return float(moved.max()) / (step / rate_hz) / counts_per_turn * 60.0
+
+
+def peak_rpm_from_steps(
+    counts: Steps, rate_hz: float, counts_per_turn: int, window_s: float = 1e-3
+) -> float:
+    """:func:`peak_rpm_from_counts` from the counts held where they change: ``c[i + w] - c[i]``
+    changes only where ``i`` or ``i + w`` is a change, so those starts are all it is read at."""
+    step = max(1, int(window_s * rate_hz))
+    if counts.n <= step:
+        return 0.0
+    n, at, values = counts.n, counts.at, counts.values
+    moved = [abs(counts.sample([step])[0] - counts.initial)]  # from sample 0
+    if at.size:
+        ahead = at < n - step  # i = a change: c[i] is its value
+        moved.append(np.max(np.abs(counts.sample(at[ahead] + step) - values[ahead]), initial=0))
+        behind = at >= step  # i + w = a change (sorted needles: searchsorted runs along)
+        moved.append(np.max(np.abs(values[behind] - counts.sample(at[behind] - step)), initial=0))
+    return float(max(moved)) / (step / rate_hz) / counts_per_turn * 60.0
 
 
 def _hz(value: float) -> str:

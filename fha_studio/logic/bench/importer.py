@@ -29,6 +29,7 @@ import numpy as np
 from fha_studio.hardware.bench.capture import Capture
 from fha_studio.hardware.bench.readers import read_capture
 from fha_studio.logic.bench import decode
+from fha_studio.logic.bench.edges import Lines
 from fha_studio.recording import Recording, RecordingMetadata, make_recording
 
 ROLES = (
@@ -221,19 +222,27 @@ def import_bench(
         raise BenchImportError(f"{first_path}: fewer than 2 samples")
     channel_of = {role: _channel(captures[spec.path], spec) for role, spec in roles.items()}
 
-    def logic(role: str) -> np.ndarray:
-        return captures[roles[role].path].logic(channel_of[role])[:n]
+    def lines(*of: str) -> Lines:
+        """The roles' lines as lines 0, 1, ...: from one packed word when they share one."""
+        paths = {roles[role].path for role in of}
+        block = captures[roles[of[0]].path].block
+        if len(paths) == 1 and all(channel_of[role] in block.logic_channels for role in of):
+            bits = [block.logic_channels.index(channel_of[role]) for role in of]
+            return Lines.from_packed(block.logic[:n], *bits)
+        if len(of) > 1:
+            return Lines.merge(*(lines(role) for role in of))
+        return Lines.from_levels(captures[roles[of[0]].path].logic(channel_of[of[0]])[:n])
 
     def analog(role: str) -> np.ndarray:
         return captures[roles[role].path].analog(channel_of[role])[:n]
 
     encoder = z = command = speed = None
     if "encoder_a" in roles:
-        encoder = decode.quadrature(logic("encoder_a"), logic("encoder_b"))
+        encoder = decode.quadrature_lines(lines("encoder_a", "encoder_b"))
         if "encoder_z" in roles:
-            z = decode.z_check(logic("encoder_z"), encoder.counts, axis.counts_per_motor_turn)
+            z = decode.z_check_lines(lines("encoder_z"), encoder.steps, axis.counts_per_motor_turn)
     if "speed_monitor" in roles:
-        still = decode.standstill_mask(encoder.counts, rate) if encoder is not None else None
+        still = decode.standstill_mask_at(n, encoder.steps.at, rate) if encoder is not None else None
         speed = decode.speed_from_monitor(analog("speed_monitor"), settings.speed_conversion_rpm, still)
     # the edge rate at the speed reached: refused before anything is trusted
     if encoder is not None:
@@ -241,16 +250,18 @@ def import_bench(
             window = max(1, int(rate * 1e-3))
             peak = _peak_mean(speed.motor_rpm, window)
         else:
-            peak = decode.peak_rpm_from_counts(encoder.counts, rate, axis.counts_per_motor_turn)
+            peak = decode.peak_rpm_from_steps(encoder.steps, rate, axis.counts_per_motor_turn)
         try:
             decode.check_edge_rate(rate, peak, axis.counts_per_motor_turn)
         except decode.DecodeError as exc:
             raise BenchImportError(f"{roles['encoder_a'].path}: {exc}") from None
     if "command_a" in roles:
+        has_b = "command_b" in roles
+        command_lines = lines("command_a", "command_b") if has_b else lines("command_a")
         try:
-            command = decode.command_pulses(
-                logic("command_a"),
-                logic("command_b") if "command_b" in roles else None,
+            command = decode.command_pulse_lines(
+                command_lines,
+                has_b,
                 settings.pulse_form,
                 settings.multiplication,
                 settings.gear_numerator,
@@ -268,7 +279,7 @@ def import_bench(
         current_scale_a_per_v,
         output_rate_hz,
         {role: analog(role) for role in ("current_probe",) if role in roles},
-        {role: logic(role) for role in ("in_position", "alarm") if role in roles},
+        {role: lines(role) for role in ("in_position", "alarm") if role in roles},
     )
 
 
@@ -321,7 +332,7 @@ def _make(
     current_scale: float | None,
     output_rate_hz: float,
     analog: Mapping[str, np.ndarray],
-    logic: Mapping[str, np.ndarray],
+    logic: Mapping[str, Lines],
 ) -> BenchImport:
     rate, n = decoded.sample_rate_hz, decoded.samples
     out_rate = min(output_rate_hz, rate)
@@ -337,7 +348,7 @@ def _make(
         return f"{roles[role].path}#{channel_of[role]}"
 
     if decoded.encoder is not None:
-        columns["pos"] = decoded.encoder.counts[idx] * deg_per_count
+        columns["pos"] = decoded.encoder.steps.sample(idx) * deg_per_count
         sources["pos"] = (
             f"{src('encoder_a')} and {src('encoder_b')}, x4, {axis.counts_per_output_turn} counts "
             f"per output turn ({axis.counts_per_motor_turn} per motor turn x {axis.ratio})"
@@ -349,7 +360,7 @@ def _make(
         sources["pos"] = f"{src('speed_monitor')} integrated (no encoder mapped)"
         notes.append("pos is the speed monitor integrated: no encoder was mapped")
     if decoded.command is not None:
-        columns["cmd_pos"] = decoded.command.counts[idx] * deg_per_count
+        columns["cmd_pos"] = decoded.command.count_steps.sample(idx) * deg_per_count
         line_b = f" and {src('command_b')}" if "command_b" in roles else ""
         sources["cmd_pos"] = (
             f"{src('command_a')}{line_b}, {decode.PULSE_FORMS[settings.pulse_form]}"
@@ -363,10 +374,10 @@ def _make(
             f"(parameter 9) / {axis.ratio}, offset {decoded.speed.offset_v * 1000:.1f} mV"
         )
     if "in_position" in logic:
-        columns["in_pos"] = logic["in_position"][idx].astype(np.float64)
+        columns["in_pos"] = logic["in_position"].level_at(idx).astype(np.float64)
         sources["in_pos"] = f"{src('in_position')}, high = on"
     if "alarm" in logic:
-        columns["alarm"] = logic["alarm"][idx].astype(np.float64)
+        columns["alarm"] = logic["alarm"].level_at(idx).astype(np.float64)
         sources["alarm"] = f"{src('alarm')}, high = on"
     if "current_probe" in analog and current_scale is not None:
         columns["current"] = _window_means(analog["current_probe"], idx, n) * current_scale
@@ -441,7 +452,7 @@ def _summary(
             "counts_per_motor_turn": axis.counts_per_motor_turn,
         }
     if decoded.command is not None:
-        final = float(decoded.command.counts[-1])
+        final = float(decoded.command.count_steps.final)
         summary["command_counts"] = int(final) if math.isclose(final, round(final)) else final
     if decoded.speed is not None:
         summary["speed_offset_v"] = decoded.speed.offset_v
