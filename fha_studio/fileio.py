@@ -111,7 +111,8 @@ def read_bytes(path: str | os.PathLike[str], *, limit_bytes: int = DEFAULT_READ_
         chunks: list[bytes] = []
         total = 0
         while True:
-            chunk = os.read(fd, min(1 << 20, limit_bytes + 1 - total))
+            # the size the file states in one read (no copies joined), then on until it ends
+            chunk = os.read(fd, min(max(1 << 20, info.st_size + 1 - total), limit_bytes + 1 - total))
             if not chunk:
                 break
             chunks.append(chunk)

@@ -42,27 +42,26 @@ SEMICOLON = bytes.maketrans(b";", b",")
 TAB = bytes.maketrans(b"\t", b",")
 
 
-def parse_rows(data: bytes, columns: int, *, digits: bool = False) -> np.ndarray | None:
-    """The rows of ``data`` (each ending in ``\\n``) as a ``(rows, columns)`` float64 array, or
-    None when a field is not a number or a row has another number of fields. ``digits``: rows of
-    single digits (a logic analyzer's) come as uint8 instead."""
-    if not data:
+def parse_rows(data: bytes, columns: int, *, digits: bool = False, start: int = 0) -> np.ndarray | None:
+    """The rows of ``data`` from byte ``start`` on (each ending in ``\\n``) as a ``(rows, columns)``
+    float64 array, or None when a field is not a number or a row has another number of fields.
+    ``digits``: rows of single digits (a logic analyzer's) come as uint8 instead."""
+    if len(data) <= start:
         return np.zeros((0, columns))
     if not data.endswith(b"\n"):
-        data += b"\n"
-    if any(bytes([ch]) in data for ch in _SPACES):
-        if _INNER_SPACE.search(data):
+        data, start = data[start:] + b"\n", 0
+    if any(data.find(bytes([ch]), start) >= 0 for ch in _SPACES):
+        if _INNER_SPACE.search(data, start):
             return None
-        data = data.translate(None, _SPACES)
-    fixed = _fixed_width_digits(data, columns)
+        data, start = data[start:].translate(None, _SPACES), 0
+    fixed = _fixed_width_digits(data, columns, start)
     if fixed is not None and not digits:
         fixed = fixed.astype(np.float64)
     if fixed is None:
-        fixed = _fixed_width_fields(data, columns)
+        fixed = _fixed_width_fields(data, columns, start)
     if fixed is not None:
         return fixed
     parts: list[np.ndarray] = []
-    start = 0
     while start < len(data):
         end = data.rfind(b"\n", start, start + CHUNK_BYTES) + 1
         if end <= start:  # one row longer than a chunk
@@ -75,39 +74,44 @@ def parse_rows(data: bytes, columns: int, *, digits: bool = False) -> np.ndarray
     return np.concatenate(parts) if len(parts) > 1 else parts[0]
 
 
-def _fixed_width_digits(data: bytes, columns: int) -> np.ndarray | None:
+def _fixed_width_digits(data: bytes, columns: int, start: int = 0) -> np.ndarray | None:
     """Rows of single digits (a logic analyzer's ``1,0,1``): the bytes as a 2-D array."""
-    width = 2 * columns
-    if len(data) % width or data[width - 1 : width] != b"\n":
+    width, size = 2 * columns, len(data) - start
+    if size % width or data[start + width - 1 : start + width] != b"\n":
         return None
-    grid = np.frombuffer(data, np.uint8).reshape(-1, width)
-    values = grid[:, 0::2]
-    seps = grid[:, 1::2]
-    if not (np.all(seps[:, :-1] == ord(",")) and np.all(seps[:, -1] == ord("\n"))):
-        return None
-    digits = values - np.uint8(ord("0"))
-    if np.any(digits > 9):
-        return None
-    return digits
+    grid = np.frombuffer(data, np.uint8, size, start).reshape(-1, width)
+    out = np.empty((grid.shape[0], columns), np.uint8, order="F")
+    expected = np.full(columns, ord(","), np.uint8)
+    expected[-1] = ord("\n")
+    for row in range(0, grid.shape[0], CHUNK_ROWS):  # rows the caches hold: each pass stays there
+        rows = grid[row : row + CHUNK_ROWS]
+        if np.any(rows[:, 1::2] != expected):
+            return None
+        digits = rows[:, 0::2] - np.uint8(ord("0"))
+        if digits.size and int(digits.max()) > 9:
+            return None
+        out[row : row + rows.shape[0]] = digits
+    return out
 
 
-def _fixed_width_fields(data: bytes, columns: int) -> np.ndarray | None:
+#: Rows of a fixed-width CSV worked on at once: a block the caches hold (a pass per field's
+#: place over the whole file would read it from memory once per place).
+CHUNK_ROWS = 1 << 15
+
+
+def _fixed_width_fields(data: bytes, columns: int, start: int = 0) -> np.ndarray | None:
     """Rows of one length whose fields keep their places (most instruments' exports): the
-    character kinds of the first row hold in every row, so every digit of every field is checked
-    in one pass and weighted by its place in one matrix product per field."""
-    width = data.find(b"\n") + 1
-    if width <= 1 or len(data) % width:
+    character kinds of the first row hold in every row, so a block of rows at a time (one the
+    caches hold) is checked place by place and the digits summed by their places
+    (:class:`_FixedLayout`). Columns come out in column order."""
+    width, size = data.find(b"\n", start) + 1 - start, len(data) - start
+    if width <= 1 or size % width:
         return None
-    first = np.frombuffer(data, np.uint8, width)
+    first = np.frombuffer(data, np.uint8, width, start)
     seps = np.flatnonzero(first == ord(","))
     if seps.size != columns - 1:
         return None
-    grid = np.frombuffer(data, np.uint8).reshape(-1, width)
-    rows = grid.shape[0]
-    marks = np.concatenate((seps, [width - 1]))
-    expected = first[marks]
-    if np.any(np.bitwise_or.reduce(np.take(grid, marks, axis=1) ^ expected, axis=0)):
-        return None
+    grid = np.frombuffer(data, np.uint8, size, start).reshape(-1, width)
     bounds = np.concatenate(([-1], seps, [width - 1]))
     plans = []
     for k in range(columns):
@@ -115,52 +119,87 @@ def _fixed_width_fields(data: bytes, columns: int) -> np.ndarray | None:
         if plan is None:
             return None
         plans.append(plan)
-    # every place that must hold a digit, in every row, checked at once
-    digit_at = np.array([j for plan in plans for j in plan["mantissa"] + plan["exponent"]], np.int64)
-    digits = np.take(grid, digit_at, axis=1)
-    digits -= np.uint8(ord("0"))
-    if digits.size and int(digits.max()) > 9:
-        return None
-    # the other places: the same character as in the first row (points, exponent marks)
-    fixed_at = np.array([j for plan in plans for j in plan["same"]], np.int64)
-    if fixed_at.size and np.any(
-        np.bitwise_or.reduce(np.take(grid, fixed_at, axis=1) ^ first[fixed_at], axis=0)
-    ):
-        return None
-    out = np.empty((rows, columns))
-    used = 0
-    for k, plan in enumerate(plans):
-        m, e = len(plan["mantissa"]), len(plan["exponent"])
-        block = digits[:, used : used + m + e]
-        used += m + e
-        values = np.zeros(rows)
-        for j in range(m):  # Horner over the places, one column at a time
+    layout = _FixedLayout(first, plans)
+    out = np.empty((grid.shape[0], columns), order="F")
+    for row in range(0, grid.shape[0], CHUNK_ROWS):
+        rows = grid[row : row + CHUNK_ROWS]
+        if not layout.read(rows, out[row : row + rows.shape[0]]):
+            return None
+    return out
+
+
+class _FixedLayout:
+    """What :func:`_fixed_width_fields` checks and weighs in every row, from the first row.
+
+    Every place of a row is checked in two passes over a block: the byte less a base (``'0'`` at a
+    digit's place, the first row's character at a separator's, a point's or an exponent mark's)
+    must be at most a limit (9 at a digit's place, 0 at the others; a field's head, a digit or a
+    sign, and an exponent's sign are checked on their own). What is left at the digits' places
+    are the digits, summed place by place in integers (exact to 18 digits)."""
+
+    def __init__(self, first: np.ndarray, plans: list[dict[str, Any]]):
+        self.plans = plans
+        base = first.copy()
+        limit = np.zeros(first.size, np.uint8)
+        for plan in plans:
+            for at in plan["mantissa"] + plan["exponent"]:
+                base[at], limit[at] = ord("0"), 9
+            for at in (plan["head"], plan["exp_sign"]):
+                if at is not None:
+                    base[at], limit[at] = 0, 255
+        self.base, self.limit = base, limit
+        self._buffers: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def read(self, grid: np.ndarray, out: np.ndarray) -> bool:
+        """The block's values into ``out`` ``(rows, columns)``; False when a row is not of the
+        first's shape."""
+        rows = grid.shape[0]
+        if rows not in self._buffers:
+            self._buffers[rows] = (np.empty(grid.shape, np.uint8), np.empty(grid.shape, bool))
+        digits, wrong = self._buffers[rows]
+        np.subtract(grid, self.base, out=digits)
+        np.greater(digits, self.limit, out=wrong)
+        if wrong.any():
+            return False
+        for k, plan in enumerate(self.plans):
+            values = self._field(grid, digits, plan)
+            if values is None:
+                return False
+            out[:, k] = values
+        return True
+
+    @staticmethod
+    def _field(grid: np.ndarray, digits: np.ndarray, plan: dict[str, Any]) -> np.ndarray | None:
+        rows = grid.shape[0]
+        m = len(plan["mantissa"])
+        whole: np.ndarray = np.zeros(rows, np.int32 if m < 9 else np.int64)
+        for j, at in enumerate(plan["mantissa"]):
             if j:
-                values *= 10.0
-            values += block[:, j]
+                whole *= 10
+            whole += digits[:, at]
+        sign = None
         head_at = plan["head"]
-        negative = None
-        if head_at is not None:  # a digit here, or a sign in some rows
+        if head_at is not None:  # a digit here, or a sign in some rows (not without digits)
             head = grid[:, head_at]
-            head_digit = head - np.uint8(ord("0"))
+            head_digit = (_HEAD_DIGIT_OF if m else _DIGIT_OF)[head]
             if int(head_digit.max()) > 9:
-                if m == 0:
-                    return None  # a sign without digits
-                negative = head == ord("-")
-                signed = negative | (head == ord("+"))
-                if not np.all(signed | (head_digit <= 9)):
-                    return None
-                head_digit[signed] = 0
-            values += head_digit * 10.0**m
+                return None
+            if m:
+                sign = _HEAD_SIGN[head]
+            whole = whole + head_digit.astype(whole.dtype) * whole.dtype.type(10**m)
+        values = whole.astype(np.float64)
+        e = len(plan["exponent"])
         if plan["exp_sign"] is not None or e:
-            scale = np.full(rows, -plan["frac"], np.int64)
-            exponent = (block[:, m:] @ (10 ** np.arange(e - 1, -1, -1))).astype(np.int64)
+            exponent = np.zeros(rows, np.int64)
+            for at in plan["exponent"]:
+                exponent *= 10
+                exponent += digits[:, at]
             if plan["exp_sign"] is not None:
-                sign = grid[:, plan["exp_sign"]]
-                if not np.all((sign == ord("-")) | (sign == ord("+"))):
+                exp_sign = grid[:, plan["exp_sign"]]
+                if not np.all((exp_sign == ord("-")) | (exp_sign == ord("+"))):
                     return None
-                exponent[sign == ord("-")] *= -1
-            scale += exponent
+                exponent[exp_sign == ord("-")] *= -1
+            scale = exponent - plan["frac"]
             if np.any(np.abs(scale) > 300):
                 return None
             up = scale > 0
@@ -168,12 +207,20 @@ def _fixed_width_fields(data: bytes, columns: int) -> np.ndarray | None:
             values[~up] /= np.power(10.0, -scale[~up])
         elif plan["frac"]:
             values /= 10.0 ** plan["frac"]
-        if negative is not None:
-            np.negative(values, out=values, where=negative)
+        if sign is not None:
+            values *= sign
         elif plan["negative"]:
             values *= -1.0
-        out[:, k] = values
-    return out
+        return values
+
+
+# a field's first character: its digit (a sign counts 0 and gives the sign), 255 for anything else
+_DIGIT_OF = np.full(256, 255, np.uint8)
+_DIGIT_OF[ord("0") : ord("9") + 1] = np.arange(10)
+_HEAD_DIGIT_OF = _DIGIT_OF.copy()
+_HEAD_DIGIT_OF[[ord("-"), ord("+")]] = 0
+_HEAD_SIGN = np.ones(256)
+_HEAD_SIGN[ord("-")] = -1.0
 
 
 def _field_plan(first: np.ndarray, start: int, stop: int) -> dict[str, Any] | None:

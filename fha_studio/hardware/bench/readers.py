@@ -37,7 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fha_studio import fileio
-from fha_studio.hardware.bench import _numbers
+from fha_studio.hardware.bench._lines import HeadLines, all_lines
+from fha_studio.hardware.bench._lines import table as _table
 from fha_studio.hardware.bench.capture import Capture, CaptureError, SampleBlock, logic_dtype, pack_logic
 
 #: What a capture file may weigh (a minute of 8 channels at 24 MS/s is about 1.4 GB as .sr).
@@ -336,7 +337,7 @@ def parse_sigrok_csv(data: bytes, name: str) -> Capture:
         comments_end = data.find(b"\n", comments_end) + 1 or len(data)
     if data.find(b": ", comments_end) >= 0:
         data = _SIGROK_ANALOG_LINE.sub(b"", data)
-    lines = _head_lines(data)
+    lines: Sequence[bytes] = _head_lines(data)
     names: list[str] = []
     rate: float | None = None
     index = -1
@@ -407,23 +408,26 @@ def parse_sigrok_csv(data: bytes, name: str) -> Capture:
 HEAD_LINES = 200
 
 
-def _head_lines(data: bytes) -> list[bytes]:
+def _head_lines(data: bytes) -> HeadLines:
     """The first HEAD_LINES lines, then the rest of the file as one element (joined back with
-    ``\n`` it is the file again); :func:`_all_lines` splits it when a line must be named."""
-    return data.split(b"\n", HEAD_LINES)
+    ``\n`` it is the file again, left in place); :func:`_all_lines` splits it when a line must be
+    named."""
+    return HeadLines(data, HEAD_LINES)
 
 
 def _line(lines: Sequence[bytes], i: int) -> bytes:
     """Line ``i`` (of the rest of the file, its first line)."""
-    text = lines[i]
     if i < HEAD_LINES:
-        return text
+        return lines[i]
+    if isinstance(lines, HeadLines):
+        return lines.first_of_rest()
+    text = lines[i]
     end = text.find(b"\n")
     return text if end < 0 else text[:end]
 
 
 def _all_lines(lines: Sequence[bytes]) -> list[bytes]:
-    return b"\n".join(lines).split(b"\n") if len(lines) > HEAD_LINES else list(lines)
+    return all_lines(lines)
 
 
 def _sigrok_unit(label: str) -> str:
@@ -551,7 +555,7 @@ def parse_csv(data: bytes, name: str) -> Capture:
         if column == time_column:
             continue
         col = table[:, column]
-        if np.any(np.isnan(col)):
+        if not math.isfinite(col.sum()) and np.any(np.isnan(col)):
             bad_row = int(np.flatnonzero(np.isnan(col))[0])
             raise CaptureError(f"{name}: line {_data_line(lines, data_start, bad_row, comment)}: column "
                                f"'{label}' is empty, expected a number")
@@ -609,53 +613,6 @@ def _has_decimal_comma(lines: Sequence[bytes], start: int) -> bool:
     return False
 
 
-def _table(lines: Sequence[bytes], start: int, width: int, name: str, delimiter: bytes,
-           decimal_comma: bool = False, comment: str = ";", digits: bool = False) -> np.ndarray:
-    """The numeric rows from line index ``start`` on, as ``(rows, width)`` float64."""
-    marks = tuple(c.encode() for c in comment)
-    body_lines = lines[start:]
-    data = b"\n".join(body_lines)
-    # comment and empty lines inside the rows are taken out (rarely there: the fast path is whole)
-    if any(m in data for m in marks) or b"\n\n" in data or data.startswith(b"\n"):
-        data = b"\n".join(ln for ln in _all_lines(body_lines)
-                          if ln.strip() and not ln.lstrip().startswith(marks))
-    if delimiter == b";":
-        data = data.translate(_numbers.SEMICOLON_DECIMAL_COMMA if decimal_comma else _numbers.SEMICOLON)
-    elif delimiter == b"\t":
-        data = data.translate(_numbers.TAB)
-    if data.startswith(b"\n"):
-        data = data.lstrip(b"\n")
-    if data and not data.endswith(b"\n"):
-        data += b"\n"
-    if data.endswith(b"\n\n"):
-        data = data.rstrip(b"\n") + b"\n"
-    table = _numbers.parse_rows(data, width, digits=digits)
-    if table is None:
-        _find_bad_row(_all_lines(lines), start, width, name, delimiter, decimal_comma, marks)
-        raise CaptureError(f"{name}: line {start + 1}: the rows are not numbers in {width} columns")
-    return table
-
-
-def _find_bad_row(lines: Sequence[bytes], start: int, width: int, name: str, delimiter: bytes,
-                  decimal_comma: bool, marks: tuple[bytes, ...]) -> None:
-    """Raises the CaptureError naming the first row that is not ``width`` numbers."""
-    for i in range(start, len(lines)):
-        raw = lines[i].strip()
-        if not raw or raw.startswith(marks):
-            continue
-        text = raw.decode("utf-8", "replace")
-        fields = text.split(delimiter.decode())
-        if len(fields) != width:
-            raise CaptureError(f"{name}: line {i + 1}: {len(fields)} fields, expected {width} (as the "
-                               "header has)")
-        for k, field in enumerate(fields, 1):
-            cell = field.strip().replace(",", ".") if decimal_comma else field.strip()
-            if cell and _numbers.parse_rows(cell.encode() + b"\n", 1) is None:
-                shown = field if len(field) <= 30 else field[:29] + "…"
-                raise CaptureError(f"{name}: line {i + 1}: field {k} '{shown}' is not a number "
-                                   "(a plain decimal like 12, -0.5 or 1.5e-3)")
-
-
 def _data_line(lines: Sequence[bytes], start: int, row: int, comment: str = ";") -> int:
     marks = tuple(c.encode() for c in comment)
     lines = _all_lines(lines)
@@ -672,6 +629,9 @@ def _data_line(lines: Sequence[bytes], start: int, row: int, comment: str = ";")
 def _steady_rate(t: np.ndarray, name: str, lines: Sequence[bytes], start: int, comment: str) -> float:
     n = t.size
     steps = np.diff(t)
+    mean = (t[-1] - t[0]) / (n - 1)  # all steps within 20 % of the mean: within half the median too
+    if mean > 0 and math.isfinite(mean) and mean * 0.8 <= steps.min() and steps.max() <= 1.2 * mean:
+        return float(f"{(n - 1) / (t[-1] - t[0]):.9g}")
     step = float(np.median(steps))
     if not (step > 0 and math.isfinite(step)):
         raise CaptureError(f"{name}: line {_data_line(lines, start, 1, comment)}: the time does not "
