@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from fha_studio.logic.modelcheck.shapes import cycles_within, stribeck_within
 from fha_studio.logic.modelcheck.signals import ARCSEC_PER_RAD, Signals
 from fha_studio.logic.wording import with_unit
 
@@ -133,6 +134,9 @@ class Candidate:
     only_as_alternative: bool = False
     # one line for a person: what to do next, from the fitted parameters
     advice: Callable[[dict[str, float]], str] = lambda p: "add it to the model (Save updated model…)"
+    # why a fitted shape lies outside what the recording spans ("" when it does not): checked in
+    # every re-fit, since the joint refinement of all parameters is not bounded
+    shape_check: Callable[[tuple[float, ...], ChannelContext], str] | None = None
 
 
 def _amp_phase(beta: np.ndarray, cov: np.ndarray) -> tuple[float, float, float, float]:
@@ -380,6 +384,7 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         shape_refine=True,
         shape_names=("cycles_per_motor_rev",),
         look_elsewhere=True,
+        shape_check=cycles_within(RIPPLE_CYCLES),
         primary="amplitude_nm",
         needs_ratio=True,
         motor_side=True,
@@ -419,6 +424,7 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         shape_refine=True,
         shape_names=("velocity_rad_s",),
         shape_bounds=lambda s: ([0.5 * s[0]], [2.0 * s[0]]),
+        shape_check=stribeck_within,
         sign=1,
         primary="static_torque_nm",
         motor_side=True,
@@ -513,6 +519,7 @@ POSITION_CANDIDATES: tuple[Candidate, ...] = (
         shape_refine=True,
         shape_names=("cycles_per_motor_rev",),
         look_elsewhere=True,
+        shape_check=cycles_within(KINEMATIC_CYCLES),
         primary="amplitude_arcsec",
         needs_ratio=True,
         advice=lambda p: (

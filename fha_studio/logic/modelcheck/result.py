@@ -12,6 +12,7 @@ import numpy as np
 
 from fha_studio.logic.modelcheck.bandwidth import BandwidthPoint
 from fha_studio.logic.modelcheck.candidates import LABELS, PARAM_WORDS, label_of
+from fha_studio.logic.modelcheck.consistency import Refused
 from fha_studio.logic.modelcheck.selection import BIC_MIN, SelectionStep
 from fha_studio.logic.wording import unit_words
 from fha_studio.physics import AxisModel
@@ -94,6 +95,12 @@ class Structure:
     fraction: float  # of the residual variance
     unit: str
     spans: list[tuple[float, float, float]] = field(default_factory=list)  # "time": (start s, end s, peak)
+    # effects the fit found that each exceed the residual but cancel each other (consistency.py):
+    # their ids and RMS sizes, and where in ``variable`` their small sum is largest (a range)
+    cancelled: tuple[str, ...] = ()
+    sizes: tuple[float, ...] = ()
+    at: tuple[float, float] | None = None
+    at_unit: str = ""
 
 
 @dataclass
@@ -202,6 +209,8 @@ class ModelCheckResult:
     channel_status: dict[str, ChannelStatus] = field(default_factory=dict)
     window_reason: str = ""  # why this analysis bandwidth
     bandwidth_profile: tuple[BandwidthPoint, ...] = ()  # the bandwidths tried and what each left unexplained
+    refused: list[Refused] = field(default_factory=list)  # fitted, not named, and why (consistency.py)
+    not_seen: list[str] = field(default_factory=list)  # what this recording cannot show, and what would
 
     @property
     def found(self) -> bool:
@@ -244,7 +253,13 @@ class ModelCheckResult:
                 + " — not separable from this data; "
                 f"to separate them: {a.separating_test}"
             )
+        for refused in self.refused:
+            value = "".join(f" {fmt(v)}" for v in list(refused.params.values())[:1])
+            lines.append(f"  Not named: {refused.label.lower()}{value} — {refused.reason}")
         for s in self.structures:
+            if s.cancelled:
+                lines.append(_cancelled_line(s, unit))
+                continue
             if s.variable == "time":
                 where = ", ".join(f"{a:.2f}-{b:.2f} s" for a, b, _ in s.spans[:6])
                 more = f" and {len(s.spans) - 6} more" if len(s.spans) > 6 else ""
@@ -261,6 +276,7 @@ class ModelCheckResult:
                 f"{fmt(s.rms)} {unit(s.unit)} rms organised by {s.variable.replace('_', ' ')} "
                 f"({100 * s.fraction:.0f} % of the residual); not forced onto a named effect"
             )
+        lines.extend(self.not_seen)
         if not self.effects and any(st.checked for st in self.channel_status.values()):
             lines.append("No missing effect found.")
             for ch, gap in self.gap.items():
@@ -332,6 +348,7 @@ class ModelCheckResult:
                     "unit": s.unit,
                     "spans_s": [[a, b] for a, b, _ in s.spans],
                     "peaks": [peak for _, _, peak in s.spans],
+                    "cancelling_effects": list(s.cancelled),
                 }
                 for s in self.structures
             ],
@@ -370,12 +387,28 @@ class ModelCheckResult:
                 "torque_rms_nominal_nm": self.resimulation.rms_nominal_nm,
                 "torque_rms_updated_nm": self.resimulation.rms_updated_nm,
             },
+            "not_named": [r.to_json() for r in self.refused],
+            "not_seen": list(self.not_seen),
             "notes": list(self.notes),
         }
 
     def write_model(self, path: str | Path) -> None:
         """Write the updated model file (fha-axis-model/1 TOML, loadable by the sim and later checks)."""
         self.updated_model.save(path)
+
+
+def _cancelled_line(s: Structure, unit: Any) -> str:
+    """A cancelling set of effects as one structured residual: what it is, and where it sits."""
+    sizes = zip(s.cancelled, s.sizes, strict=True)
+    pair = " and ".join(f"{label_of(i).lower()} ({fmt(z)} {unit(s.unit)} rms)" for i, z in sizes)
+    at = f", largest at {s.variable} {fmt(s.at[0])} to {fmt(s.at[1])} {unit(s.at_unit)}" if s.at else ""
+    when = ", ".join(f"{a:.2f}-{b:.2f} s" for a, b, _ in s.spans[:4])
+    more = f" and {len(s.spans) - 4} more" if len(s.spans) > 4 else ""
+    return (
+        f"Structured residual in the {s.channel} channel that no candidate explains: "
+        f"{fmt(s.rms)} {unit(s.unit)} rms{at}" + (f", at t = {when}{more}" if when else "")
+        + f"; the fit offered {pair}, which cancel each other: not named"
+    )
 
 
 def fmt(x: float) -> str:

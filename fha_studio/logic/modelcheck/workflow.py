@@ -33,6 +33,8 @@ from fha_studio.logic.modelcheck.candidates import (
     label_of,
     separating_test,
 )
+from fha_studio.logic.modelcheck.consistency import Refused, set_verdict, settle
+from fha_studio.logic.modelcheck.excitation import Excitation, excitation_of
 from fha_studio.logic.modelcheck.linalg import block_cv, block_edges
 from fha_studio.logic.modelcheck.resimulation import resimulate as resimulate_axis
 from fha_studio.logic.modelcheck.result import (
@@ -93,6 +95,8 @@ class ChannelStep:
     zero_arbitrary: bool = False  # the residual's zero means nothing (an external encoder's): centred
     bursts: bool = False  # look for bursts in time (an unmeasured load acts on the torque)
     torque_is_cause: bool = True  # the measured torque contains the torque residual itself: not a cause
+    max_torque_nm: float | None = None  # what the actuator can produce (a larger effect is refused)
+    actuator: str = "the actuator"
 
 
 @dataclass
@@ -106,6 +110,8 @@ class Selected:
     fit: np.ndarray  # the fitted residual (decimated)
     base_beta: np.ndarray
     report: ChannelReport
+    refused: list[Refused] = field(default_factory=list)
+    cancelled: list[Structure] = field(default_factory=list)  # cancelling pairs, as structures
 
 
 @dataclass
@@ -118,6 +124,7 @@ class Findings:
     limits: list[DetectionLimit] = field(default_factory=list)
     gaps: dict[str, Gap] = field(default_factory=dict)
     where: dict[str, ChannelWhere] = field(default_factory=dict)
+    refused: list[Refused] = field(default_factory=list)
 
 
 # ------------------------------------------------------------------------------------------ workflow
@@ -160,7 +167,8 @@ def run_modelcheck(
 
     # ---- step 3, channel by channel: the torque first (the position channel needs its motor-side effects)
     status: dict[str, ChannelStatus] = {TORQUE: _torque_status(sig, axis, torque_nominal, floor_t)}
-    torque = _torque_step(sig, axis, residual["torque_residual_nm"], floor_t, index)
+    excitation = excitation_of(sig)
+    torque = _torque_step(sig, axis, residual["torque_residual_nm"], floor_t, index, excitation)
     chosen: list[Selected] = []
     delay_ms = 0.0
     if status[TORQUE].checked:
@@ -181,9 +189,12 @@ def run_modelcheck(
     for s in chosen:
         _name(s, sig, index, step, found)
 
-    # ---- add: the updated model
+    # ---- add: the updated model, named only when it is consistent with the recording
     updated = _updated_model(model, found.effects)
     resim = resimulate_axis(sig, axis, model, updated, servo, RESIM_MAX_S) if resimulate else None
+    _hold_to_the_set(found, resim, floor_t)
+    if len(found.effects) < len(_updated_effects(updated)):
+        updated = _updated_model(model, found.effects)
     filt = sig.filt
     return ModelCheckResult(
         source=rec.source,
@@ -207,6 +218,8 @@ def run_modelcheck(
         channel_status=status,
         window_reason=sig.window_reason,
         bandwidth_profile=() if bandwidth is None else bandwidth.profile,
+        refused=found.refused,
+        not_seen=excitation.lines() if status[TORQUE].checked else [],
     )
 
 
@@ -247,9 +260,15 @@ def _analysis_signals(
 
 
 def _torque_step(
-    sig: Signals, axis: DeclaredAxis, y_nm: np.ndarray, floor_nm: float, index: np.ndarray
+    sig: Signals,
+    axis: DeclaredAxis,
+    y_nm: np.ndarray,
+    floor_nm: float,
+    index: np.ndarray,
+    excitation: Excitation,
 ) -> ChannelStep:
-    """The torque channel: Kt x current - J x acceleration, against the torque candidates."""
+    """The torque channel: Kt x current - J x acceleration, against the torque candidates the
+    motion can show (``excitation``)."""
     # Nuisance, always fitted: a time offset between the current monitor and the encoder (sampling
     # instants, monitor delay) shows as -delay x J x jerk. It belongs to the recorder, not the axis.
     jerk_col = (axis.nominal_inertia_kgm2 * sig.jerk_rad_s3)[index][:, None]
@@ -257,13 +276,15 @@ def _torque_step(
         TORQUE,
         ChannelContext(sig, TORQUE, nominal_inertia_kgm2=axis.nominal_inertia_kgm2),
         y_nm,
-        TORQUE_CANDIDATES,
+        tuple(c for c in TORQUE_CANDIDATES if c.id not in excitation.excluded()),
         floor_nm,
         base=jerk_col,
         torque_nm=sig.torque_f_nm,
         nominal_first=tuple(c.id for c in TORQUE_CANDIDATES if c.nominal),
         bursts=True,
         torque_is_cause=False,
+        max_torque_nm=axis.model.max_torque_nm or axis.model.peak_torque_nm,
+        actuator=axis.code if axis.code != "custom" else "the declared axis",
     )
 
 
@@ -318,9 +339,22 @@ def _select(ch: ChannelStep, index: np.ndarray) -> Selected:
     unit = CHANNEL_UNITS[ch.channel]
     sel = ChannelSelector(ch.ctx, ch.y[index], ch.candidates, index, ch.floor, unit, base=ch.base)
     terms, steps = sel.select(nominal_first=ch.nominal_first)
-    fitted, fit, base_beta, ar = sel.final_fit(terms)
-    report = ChannelReport(ch.channel, unit, ch.floor, steps, ar, len(index))
-    return Selected(ch, sel, terms, fitted, fit, base_beta, report)
+    # every effect holds its floor, shape and the actuator's torque in the joint fit; cancelling
+    # pairs are taken out as one structure (consistency.py)
+    settled = settle(sel, terms, max_torque_nm=ch.max_torque_nm, actuator=ch.actuator)
+    report = ChannelReport(ch.channel, unit, ch.floor, steps, settled.ar_order, len(index))
+    total = max(float(np.mean(sel.y**2)), 1e-300)
+    cancelled = [
+        Structure(
+            c.channel, c.variable, c.net_rms, min(c.net_rms**2 / total, 1.0), c.unit, c.spans,
+            c.ids, c.sizes, c.at, c.variable_unit,
+        )
+        for c in settled.cancelling
+    ]
+    return Selected(
+        ch, sel, settled.terms, settled.fitted, settled.fit, settled.base_beta, report,
+        settled.refused, cancelled,
+    )
 
 
 def _name(s: Selected, sig: Signals, index: np.ndarray, step: int, found: Findings) -> None:
@@ -329,6 +363,8 @@ def _name(s: Selected, sig: Signals, index: np.ndarray, step: int, found: Findin
     residual lies before and after, and the gap on held-out data."""
     ch, sel, terms = s.step.channel, s.sel, s.terms
     unit = CHANNEL_UNITS[ch]
+    found.refused.extend(s.refused)
+    found.structures.extend(s.cancelled)
     for a, b, dbic, alt_params in sel.substitutes(terms):
         found.ambiguities.append(Ambiguity(ch, a, b, dbic, separating_test(a, b), alt_params))
     for ft in s.fitted:
@@ -459,6 +495,39 @@ def _gap(sel: ChannelSelector, terms, ch: str, unit: str, t: np.ndarray) -> Gap:
     return Gap(
         ch, unit, before, after, t, measured, pred - pred0, [(float(t[a]), float(t[b - 1])) for a, b in edges]
     )
+
+
+def _hold_to_the_set(found: Findings, resim, floor_nm: float) -> None:
+    """The named set as a whole: per channel, it must shrink the held-out gap; over the axis, its
+    re-simulation must not be worse than the nominal model's. Otherwise nothing of it is named."""
+    for ch, gap in found.gaps.items():
+        mine = [e for e in found.effects if e.channel == ch]
+        why = set_verdict(resim_nominal=None, resim_updated=None, floor=floor_nm,
+                          gaps=[(ch, gap.rms_before, gap.rms_after, gap.unit)]) if mine else ""
+        if why:
+            _refuse_all(found, mine, why)
+    if resim is not None and found.effects:
+        why = set_verdict(resim_nominal=resim.rms_nominal_nm, resim_updated=resim.rms_updated_nm,
+                          floor=floor_nm, gaps=[])
+        if why:
+            _refuse_all(found, list(found.effects), why)
+
+
+def _refuse_all(found: Findings, effects: list[Effect], why: str) -> None:
+    names = " + ".join(e.label.lower() for e in effects)
+    for e in effects:
+        found.refused.append(
+            Refused(e.id, e.channel, e.label, dict(e.params), e.size, CHANNEL_UNITS[e.channel],
+                    f"the set {names} is not named: {why}")
+        )
+    gone = {id(e) for e in effects}
+    found.effects[:] = [e for e in found.effects if id(e) not in gone]
+    found.ambiguities[:] = [a for a in found.ambiguities if any(e.id in a.chosen.split(" + ")
+                                                                for e in found.effects)]
+
+
+def _updated_effects(model: AxisModel) -> list[str]:
+    return [e["id"] for e in model.effects.to_list()]
 
 
 def _updated_model(model: AxisModel, effects: list[Effect]) -> AxisModel:
