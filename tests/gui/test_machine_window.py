@@ -19,6 +19,7 @@ from fha_studio.logic.machine import MachineProject
 from fha_studio.logic.register import Register
 from fha_studio.logic.register.words import value_text
 from tests.gui.procedure_answers import answer_by_hand
+from tests.support.read_only import ReadOnlyPlace
 
 MACHINE = "Line 3 positioner"
 TABLE = "FHA-25C-50-US250"
@@ -406,37 +407,58 @@ def test_closing_with_a_servo_on_asks_and_cancel_keeps_every_link(make_machine, 
     assert not x.link._thread.isRunning() and not y.link._thread.isRunning()
 
 
-def test_a_read_only_register_is_a_message_in_the_machine_window(make_machine, qtbot, tmp_path, monkeypatch):
-    from fha_studio.logic.register import guard
+#: The machine window on a register, as the program shows it: built, shown, its message read,
+#: closed (run as a user that cannot write the register: see tests/support/read_only.py).
+MACHINE_WINDOW_ON = """
+import sys
+from PySide6.QtWidgets import QApplication
+from fha_studio.gui.machine_window import MachineWindow
+from fha_studio.logic.machine import MachineProject
+from fha_studio.logic.register import Register
 
-    path = tmp_path / "plant.sqlite"
+app = QApplication([])
+project = MachineProject("Press 9")
+project.add_axis("feed", "FHA-17C-50-US250", port_url="sim://FHA-17C-50-US250?paced=0")
+window = MachineWindow(project, Register(sys.argv[1]))
+window.show()
+print(window.current_window.message_area.text_label.text())
+window._closing_confirmed = True
+window.shutdown()
+window.register.close()
+window.close()
+"""
+
+
+def _register_nobody_may_write(place):
+    path = place.folder / "plant.sqlite"
     with Register(path) as register:
         register.add_machine("Press 7")
-    before = path.read_bytes()
-    monkeypatch.setattr(guard, "writable", lambda p: False)
-    project = MachineProject("Press 9")
-    project.add_axis("feed", "FHA-17C-50-US250", port_url="sim://FHA-17C-50-US250?paced=0")
-    window = make_machine(project, Register(path))
-    shown = window.current_window.message_area.text_label.text()
-    assert shown.endswith(f"  Register: the machine was not recorded (the register {path} is "
-                          "read-only: nothing was changed (it needs write access to the file and its "
-                          "folder)).")
-    window.register.close()
-    assert path.read_bytes() == before
+    place.seal()
+    return path, path.read_bytes()
 
 
-def test_the_gui_on_a_read_only_register_opens_a_new_machine_file(qtbot, tmp_path, monkeypatch):
-    from fha_studio.gui.app import run
-    from fha_studio.logic.register import guard
+def test_a_read_only_register_is_a_message_in_the_machine_window():
+    with ReadOnlyPlace() as place:
+        path, before = _register_nobody_may_write(place)
+        done = place.run("-c", MACHINE_WINDOW_ON, str(path))
+        assert done.returncode == 0, done.stderr
+        assert "Traceback" not in done.stderr
+        assert done.stdout.rstrip("\n").endswith(
+            f"  Register: the machine was not recorded (the register {path} is read-only: nothing "
+            "was changed (it needs write access to the file and its folder)).")
+        assert path.read_bytes() == before
+        assert sorted(p.name for p in place.folder.iterdir()) == ["plant.sqlite"]
 
-    path = tmp_path / "plant.sqlite"
-    with Register(path) as register:
-        register.add_machine("Press 7")
-    before = path.read_bytes()
-    monkeypatch.setattr(guard, "writable", lambda p: False)
-    project = MachineProject("Press 9")
-    project.add_axis("feed", "FHA-17C-50-US250", port_url="sim://FHA-17C-50-US250?paced=0")
-    machine_file = project.save(tmp_path / "press9.json")
-    assert run(["--machine-file", str(machine_file), "--register", str(path), "--no-connect",
-                "--quit-after-ms", "200"]) == 0
-    assert path.read_bytes() == before
+
+def test_the_gui_on_a_read_only_register_opens_a_new_machine_file():
+    with ReadOnlyPlace() as place:
+        path, before = _register_nobody_may_write(place)
+        project = MachineProject("Press 9")
+        project.add_axis("feed", "FHA-17C-50-US250", port_url="sim://FHA-17C-50-US250?paced=0")
+        machine_file = project.save(place.folder / "press9.json")
+        place.seal()
+        done = place.run("-m", "fha_studio", "gui", "--machine-file", str(machine_file), "--register",
+                         str(path), "--no-connect", "--quit-after-ms", "200")
+        assert done.returncode == 0, done.stderr  # it aborted (134) with the thread running
+        assert "Traceback" not in done.stderr and "QThread: Destroyed" not in done.stderr
+        assert path.read_bytes() == before
