@@ -5,10 +5,11 @@ The drive keeps its tune / parameter / test items in an EEPROM file, switches th
 41, 60, encoder alarms on demand), reads its I/O (inhibits, option-L sensors, brake coil) and
 captures traces. The axis itself is :mod:`fha_studio.physics`, stepped at the servo rate.
 
-This module holds the servo, motion, positions, monitors and time; the other jobs have their own
-modules: :mod:`.memory` (items and EEPROM), :mod:`.io` (inputs, sensors, brake, I/O bits),
-:mod:`.supervision` (alarms and their checks), :mod:`.trace` (trace capture) and
-:mod:`.recorder` (``fha-recording/1`` output). The drive's methods speak units (r/min, degrees,
+This module holds the servo, positions and time; the other jobs have their own modules:
+:mod:`.memory` (items and EEPROM), :mod:`.motion` (jog, move, stop, the watchdog), :mod:`.io`
+(inputs, sensors, brake, I/O bits), :mod:`.supervision` (alarms and their checks), :mod:`.trace`
+(trace capture), :mod:`.monitors` (the monitor items' wire values) and :mod:`.recorder`
+(``fha-recording/1`` output). The drive's methods speak units (r/min, degrees,
 item values); its CN3 face is :class:`fha_studio.hardware.sim.responder.SimResponder`.
 
 Time: in *stepped* mode nothing moves until :meth:`SimDrive.advance` is called (deterministic,
@@ -28,19 +29,11 @@ from __future__ import annotations
 import math
 import tempfile
 import threading
-import time
 from pathlib import Path
 from typing import Any
 
 from fha_studio import __version__ as _version
-from fha_studio.hardware.parameters import (
-    Mode,
-    MonitorItem,
-    driver_family,
-    load_alarm_table,
-    load_parameter_model,
-    split_low_high,
-)
+from fha_studio.hardware.parameters import Mode, driver_family, load_alarm_table, load_parameter_model
 from fha_studio.hardware.protocol import ABSOLUTE_COUNTS_PER_TURN
 from fha_studio.hardware.sim.axis import (
     DEFAULT_SERVO_RATE_HZ,
@@ -50,10 +43,13 @@ from fha_studio.hardware.sim.axis import (
     servo_settings,
 )
 from fha_studio.hardware.sim.constants import SimConstants, load_sim_constants
-from fha_studio.hardware.sim.eeprom import EepromFile, default_eeprom_dir
+from fha_studio.hardware.sim.eeprom import EepromFile, eeprom_path
 from fha_studio.hardware.sim.io import SimIo
 from fha_studio.hardware.sim.memory import ItemId, ParameterMemory, PersistentState
+from fha_studio.hardware.sim.monitors import monitor_wire
+from fha_studio.hardware.sim.motion import RPM, MotionKind, SimMotion
 from fha_studio.hardware.sim.options import SimConfig, SimConfigError
+from fha_studio.hardware.sim.realtime import RealTime
 from fha_studio.hardware.sim.recorder import SimRecorder
 from fha_studio.hardware.sim.reply import SimRefused, SimReply, rejected, servo_is_on
 from fha_studio.hardware.sim.supervision import SUPERVISION_PERIOD_S, AlarmSupervisor, SimAlarmRecord
@@ -63,7 +59,6 @@ from fha_studio.physics import ServoAxis, ServoSettings
 TWO_PI = 2.0 * math.pi
 #: wiring faults that leave the motor without useful torque (see _supervise_wiring_fault)
 MOTION_WIRING_FAULTS = ("motor_swapped", "motor_open", "encoder_swapped")
-RPM = TWO_PI / 60.0  # rad/s per r/min
 
 
 class SimDrive:
@@ -93,8 +88,7 @@ class SimDrive:
         #: held by every method; hold it to make several calls one step (the responder does, for
         #: each command and what its journal writes of it)
         self.lock = threading.RLock()
-        self._thread: threading.Thread | None = None
-        self._stop_event = threading.Event()
+        self._realtime = RealTime(self.lock, self._advance, "sim-drive")
         self._closed = False
         self._tempdir: tempfile.TemporaryDirectory[str] | None = None
 
@@ -141,9 +135,11 @@ class SimDrive:
         )
 
         # EEPROM: stored values; the active ones are copied at power-on
+        if not config.eeprom:  # a temporary EEPROM, gone with the drive
+            self._tempdir = tempfile.TemporaryDirectory(prefix="fha-sim-")
         self.memory = ParameterMemory(
             self.parameters,
-            EepromFile(self._eeprom_path(config.eeprom)),
+            EepromFile(eeprom_path(config.eeprom, self.driver, self.actuator_code, self._tempdir)),
             driver=self.driver,
             actuator_code=self.actuator_code,
         )
@@ -193,14 +189,6 @@ class SimDrive:
             turns = self.constants.lost_multi_turn_turns
             persistent.absolute_zero_rad -= turns * TWO_PI / self.ratio
 
-    def _eeprom_path(self, option: str | None) -> Path:
-        if option is None or option == "":
-            self._tempdir = tempfile.TemporaryDirectory(prefix="fha-sim-")
-            return Path(self._tempdir.name) / "eeprom.json"
-        if option == "user":
-            return default_eeprom_dir() / f"{self.driver}_{self.actuator_code}.json"
-        return Path(option).expanduser()
-
     def _save_eeprom(self) -> None:
         self.memory.save(PersistentState(
             alarm_history=self.supervisor.history,
@@ -223,13 +211,8 @@ class SimDrive:
         self.memory.power_on()
         self.time_s = 0.0
         self.servo_on = False
-        self._motion = "idle"  # idle | jog | move | stop
-        self._still_since = 0.0  # since when the output turns slower than standstill_speed_rpm
-        self._motion_sign = 0.0  # direction of the commanded motion, command frame
-        self._jog_speed_rad_s = 0.0
-        self._jog_deadline = 0.0
+        self.motion = SimMotion(axis, self.model, self.constants, self._param("jog_speed") * 0.01 * RPM)
         self._oww_done_at: float | None = None
-        self._move_speed_rad_s = self._param("jog_speed") * 0.01 * RPM
         self._step_debt = 0.0
         self._steps_to_supervision = 0
         self.trace = SimTrace()
@@ -249,10 +232,6 @@ class SimDrive:
             self.raise_alarm(50)  # no valid signal from the encoder
         elif self.config.battery != "ok":
             self.raise_alarm(56)  # the backup battery's voltage is low
-
-    @property
-    def _axis(self) -> ServoAxis:
-        return self.axis
 
     def power_cycle(self) -> None:
         """Simulated control-power cycle (PWC): restart-required items take effect, alarms clear,
@@ -344,6 +323,33 @@ class SimDrive:
         return self.command_pulses - self.feedback_pulses
 
     @property
+    def input_pulses(self) -> int:
+        """Command pulses counted at the CN2 input since power-on (through the electronic gear)."""
+        s = self.axis.settings
+        pulses = self.command_pulses - self._pulses(self._direction * self._command_zero_rad)
+        return round(pulses * s.electronic_gear_denominator / s.electronic_gear_numerator)
+
+    @property
+    def load_pulses(self) -> int:
+        """Monitor 107: the load-side encoder in output pulses, physical sense."""
+        return self._pulses(self.load_angle_rad)
+
+    @property
+    def output_speed_rpm(self) -> float:
+        """Output speed, r/min, command sense."""
+        return self._direction * self.axis.output_speed_rad_s / RPM
+
+    @property
+    def motor_current_a(self) -> float:
+        """Motor current, A, command sense."""
+        return self._direction * self.axis.current_a
+
+    @property
+    def output_torque_nm(self) -> float:
+        """Output torque, N m, command sense."""
+        return self._direction * self.axis.torque_nm
+
+    @property
     def absolute_counts(self) -> int:
         """Multi-turn x 8192 + single-turn of the absolute motor encoder (DGR), physical sense."""
         angle = self._encoder_sign * (self.axis.output_pos_rad - self._absolute_zero_rad)
@@ -355,21 +361,6 @@ class SimDrive:
         return math.degrees(self.physical_angle_rad)
 
     # ------------------------------------------------------------------ I/O and sensors
-    @property
-    def origin_deg(self) -> float:
-        """Where the origin slit is (option L), physical output degrees."""
-        return self.io.origin_deg
-
-    @property
-    def ls1_deg(self) -> float:
-        """Where the dog of limit switch 1 (CCW end) begins, physical output degrees."""
-        return self.io.ls1_deg
-
-    @property
-    def ls2_deg(self) -> float:
-        """Where the dog of limit switch 2 (CW end) begins, physical output degrees."""
-        return self.io.ls2_deg
-
     def set_inputs(self, mask: int) -> None:
         """Set the simulated CN2 inputs (INP): bits 4, 5, 9, 10. Bits 6-8 (origin, limit switches)
         set sensor signals of an actuator without option L; with option L the sensors drive them
@@ -382,7 +373,7 @@ class SimDrive:
     def _clear_error_counter(self) -> None:
         # CN2-2 CLEAR: the error counter is cleared (command := feedback), and with it alarm 60
         self.axis.clear_error()
-        self._motion = "idle"
+        self.motion.idle()
         if self.supervisor.code == 60:
             self.supervisor.code = 0
 
@@ -396,21 +387,12 @@ class SimDrive:
 
     @property
     def moving(self) -> bool:
-        """The axis is moving: a jog, a move or a stop ramp is in progress, or the command has
-        arrived but the output still turns faster than ``standstill_speed_rpm`` (the servo lags
-        the command; the bit clears when the output stands still, not when the command does)."""
-        return self._motion != "idle"
+        """The axis is moving (:attr:`SimMotion.moving <.motion.SimMotion.moving>`)."""
+        return self.motion.moving
 
     def watchdog_decel_rad_s2(self, speed_rad_s: float) -> float:
-        """The deceleration the JOG watchdog stops the command with [rad/s^2]: the command
-        reaches standstill within ``jog_watchdog_stop_s``, unless that asks for more than
-        ``jog_watchdog_torque_share`` of the axis's torque-limited acceleration (TM / (JA + JL),
-        manual 2-4-4): a heavy load is then braked at that share, slower but without the current
-        limit making the axis overshoot (docs/sim.md states the resulting standstill time)."""
-        c = self.constants
-        wanted = abs(speed_rad_s) / c.jog_watchdog_stop_s
-        followable = c.jog_watchdog_torque_share * self.model.max_acceleration_rad_s2()
-        return max(min(wanted, followable), 1e-6)
+        """The deceleration the JOG watchdog stops the command with [rad/s^2] (.motion)."""
+        return self.motion.watchdog_decel_rad_s2(speed_rad_s)
 
     def io_bits(self) -> int:
         """The I/O bit mask of IOS / monitor 106 (docs/protocol.md, I/O table)."""
@@ -447,7 +429,7 @@ class SimDrive:
                     raise rejected(f"alarm {self.supervisor.describe()} is active: clear it first")
                 if not self.servo_on:
                     self.axis.servo_on()  # the error counter starts empty: command := feedback
-                    self._motion = "idle"
+                    self.motion.idle()
                 self.servo_on = True
             else:
                 self._servo_off()
@@ -471,7 +453,7 @@ class SimDrive:
 
     def _servo_off(self) -> None:
         self.servo_on = False
-        self._motion = "idle"
+        self.motion.idle()
         self.axis.servo_off()
 
     def _check_can_move(self, what: str) -> None:
@@ -487,16 +469,7 @@ class SimDrive:
             max_rpm = self.model.max_speed_rpm or 0.0
             if abs(speed_rpm) > max_rpm + 1e-9:
                 raise rejected(f"JOG {speed_rpm:g} r/min is above the maximum speed {max_rpm:g} r/min")
-            if self._motion == "move":
-                raise rejected("JOG: a move is running (STP first)")
-            speed = speed_rpm * RPM
-            if self._motion != "jog" or speed != self._jog_speed_rad_s:
-                self.axis.jog(speed, self._accel_rad_s2())
-            self._jog_speed_rad_s = speed
-            self._motion = "jog"
-            if speed:
-                self._motion_sign = 1.0 if speed > 0 else -1.0
-            self._jog_deadline = self.time_s + self.constants.jog_watchdog_s
+            self.motion.jog(speed_rpm * RPM, self._accel_rad_s2(), self.time_s)
 
     def set_move_speed(self, speed_rpm: float) -> None:
         """The speed of the next MOV (SPD), output r/min."""
@@ -504,37 +477,19 @@ class SimDrive:
             max_rpm = self.model.max_speed_rpm or 0.0
             if not 0 < speed_rpm <= max_rpm + 1e-9:
                 raise rejected(f"SPD {speed_rpm:g} r/min outside 0 ... {max_rpm:g}")
-            self._move_speed_rad_s = speed_rpm * RPM
+            self.motion.move_speed_rad_s = speed_rpm * RPM
 
     def move_by(self, angle_deg: float) -> None:
         """Move by ``angle_deg`` (output, command sense) at the SPD speed."""
         with self.lock:
             self._check_can_move("MOV")
-            if self.moving:
-                raise rejected("MOV: the axis is moving")
-            if angle_deg == 0:
-                return
-            self.axis.move_by(math.radians(angle_deg), self._move_speed_rad_s, self._accel_rad_s2())
-            self._motion = "move"
-            self._still_since = self.time_s
-            self._motion_sign = 1.0 if angle_deg > 0 else -1.0
+            self.motion.move_by(math.radians(angle_deg), self._accel_rad_s2(), self.time_s)
 
     def stop(self) -> None:
         """Decelerate to standstill and hold (servo stays on)."""
         with self.lock:
             if self.moving and self.servo_on:
-                self.axis.stop(self._accel_rad_s2())
-                self._motion = "stop"
-                self._still_since = self.time_s
-
-    def _halt(self) -> None:
-        """Stop the command at once (an inhibit input or a limit switch); "moving" until the
-        output stands still."""
-        if self._motion == "stop" and self.axis.motion_done:
-            return  # halted already: the output is coming to rest (checked every 1 ms)
-        self.axis.stop(math.inf)
-        self._motion = "stop"
-        self._still_since = self.time_s
+                self.motion.stop(self._accel_rad_s2(), self.time_s)
 
     # ------------------------------------------------------------------ alarms
     @property
@@ -596,7 +551,7 @@ class SimDrive:
     # ------------------------------------------------------------------ time
     def advance(self, seconds: float) -> None:
         """Advance the simulation by ``seconds`` of drive time (stepped mode)."""
-        if self._thread is not None and threading.current_thread() is not self._thread:
+        if self._realtime.elsewhere():
             raise RuntimeError("SimDrive.advance() is for stepped mode; this drive runs in real time")
         with self.lock:
             self._advance(seconds)
@@ -627,7 +582,7 @@ class SimDrive:
 
     def _trace_value(self, item: int) -> int:
         try:
-            return self.monitor(item)
+            return monitor_wire(self, item)
         except SimRefused:
             return 0
 
@@ -637,26 +592,16 @@ class SimDrive:
         axis = self.axis
         if self._oww_done_at is not None and t >= self._oww_done_at:
             self._finish_oww()
-        if self._motion == "jog" and t >= self._jog_deadline:
-            # the watchdog: no JOG for 100 ms -> the command ramps to standstill (docs/sim.md)
-            axis.stop(self.watchdog_decel_rad_s2(self._jog_speed_rad_s))
-            self._motion = "stop"
-            self._still_since = t
-        elif self._motion in ("move", "stop") and axis.motion_done:
-            # idle when the output stands still, not only the command: below standstill_speed_rpm
-            # for standstill_s (a swing through zero speed is not standstill)
-            if abs(axis.output_speed_rad_s) >= self.constants.standstill_speed_rpm * RPM:
-                self._still_since = t
-            elif t - self._still_since >= self.constants.standstill_s:
-                self._motion = "idle"
+        motion = self.motion
+        motion.supervise(t)
         if self.config.wiring in MOTION_WIRING_FAULTS:
             self._supervise_wiring_fault()
-        if self.servo_on and self._motion != "idle" and self.io.blocks(
+        if self.servo_on and motion.moving and self.io.blocks(
             self._angle_deg,
-            forward=self._motion_sign > 0,
-            physical_cw=self._motion_sign * self._direction > 0,
+            forward=motion.sign > 0,
+            physical_cw=motion.sign * self._direction > 0,
         ):
-            self._halt()
+            motion.halt(t)
         self._supervise_alarms()
         if self._recorder is not None:
             self._recorder.tick(self.clock_s, axis)
@@ -665,13 +610,13 @@ class SimDrive:
         """A motor lead open or swapped, or the encoder's A/B swapped: a commanded motion finds no
         useful torque (open) or runs away from the command (swapped) and the error counter
         overflows (alarm 60) within ``wiring_fault_trip_s``."""
-        if not (self.servo_on and self._motion in ("jog", "move")):
+        if not (self.servo_on and self.motion.kind in (MotionKind.JOG, MotionKind.MOVE)):
             self._faulty_motion_s = 0.0
             return
         self._faulty_motion_s += SUPERVISION_PERIOD_S
         if self._faulty_motion_s < self.constants.wiring_fault_trip_s:
             return
-        sign = self._motion_sign * self._direction
+        sign = self.motion.sign * self._direction
         self.raise_alarm(60)
         if self.config.wiring != "motor_open":  # the axis lurched the wrong way before the trip
             self.axis.turn_by_hand(-sign * math.radians(self.constants.wiring_fault_lurch_deg))
@@ -691,34 +636,17 @@ class SimDrive:
     def start(self) -> None:
         """Run in real time in a thread (``sim-drive``) until :meth:`close`."""
         with self.lock:
-            if self._thread is not None or self._closed:
-                return
-            self._stop_event.clear()
-            self._thread = threading.Thread(target=self._run, name="sim-drive", daemon=True)
-            self._thread.start()
-
-    def _run(self) -> None:
-        last = time.monotonic()
-        while not self._stop_event.wait(0.002):
-            now = time.monotonic()
-            # a stalled machine makes the simulation lag instead of jumping
-            elapsed = min(now - last, 0.05)
-            last = now
-            with self.lock:
-                self._advance(elapsed)
+            if not self._closed:
+                self._realtime.start()
 
     @property
     def running(self) -> bool:
-        return self._thread is not None
+        return self._realtime.running
 
     def close(self) -> None:
         """Stop the real-time thread, save the EEPROM (shaft position, absolute data), remove a
         temporary EEPROM. Safe to call twice."""
-        thread = self._thread
-        if thread is not None:
-            self._stop_event.set()
-            thread.join(timeout=5.0)
-            self._thread = None
+        self._realtime.stop()
         with self.lock:
             if self._closed:
                 return
@@ -759,48 +687,10 @@ class SimDrive:
 
     # ------------------------------------------------------------------ monitors
     def monitor(self, item: int) -> int:
-        """Wire value of monitor item ``item`` (docs/protocol.md, monitor table); SimRefused
+        """Wire value of monitor item ``item`` (:func:`.monitors.monitor_wire`); SimRefused
         (``x``) for an item the drive does not have."""
         with self.lock:
-            return self._monitor(item)
-
-    def _monitor(self, item: int) -> int:
-        axis = self.axis
-        d = self._direction
-        if item == MonitorItem.FEEDBACK_POSITION:
-            return self.feedback_pulses
-        if item == MonitorItem.COMMAND_POSITION:
-            return self.command_pulses
-        if item == MonitorItem.ERROR_PULSES:
-            return self.error_pulses
-        if item == MonitorItem.OUTPUT_SPEED:
-            return round(d * axis.output_speed_rad_s / RPM * 100)
-        if item == MonitorItem.MOTOR_CURRENT:
-            return round(d * axis.current_a * 1000)
-        if item == MonitorItem.OVERLOAD_RATE:
-            return round(self.overload_rate * 1000)
-        if item == MonitorItem.IO_STATE:
-            return self.io_bits()
-        if item == MonitorItem.LOAD_POSITION:
-            return self._pulses(self.load_angle_rad)
-        if item == MonitorItem.OUTPUT_TORQUE:
-            return round(d * axis.torque_nm * 100)
-        if item == 0:
-            return round(d * axis.output_speed_rad_s / RPM * self.ratio)
-        if item == 1:
-            return round(100 * d * axis.current_a / self.model.max_current_a)
-        if item in (3, 4, 7, 8, 9, 10):
-            if item in (3, 4):
-                count = self.error_pulses
-            elif item in (7, 8):
-                count = self.feedback_pulses
-            else:  # command pulses counted at the input since power-on: through the electronic gear
-                s = axis.settings
-                pulses = self.command_pulses - self._pulses(self._direction * self._command_zero_rad)
-                count = round(pulses * s.electronic_gear_denominator / s.electronic_gear_numerator)
-            low, high = split_low_high(count)
-            return low if item in (3, 7, 9) else high
-        raise rejected(f"no monitor item {item}")
+            return monitor_wire(self, item)
 
 
 __all__ = ["SimAlarmRecord", "SimDrive", "SimRefused", "SimReply"]

@@ -12,6 +12,7 @@ import json
 import math
 import os
 import re
+import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -36,6 +37,21 @@ def default_eeprom_dir() -> Path:
     """The user data directory for simulated drives (``$XDG_DATA_HOME/fha-studio/sim``)."""
     base = os.environ.get("XDG_DATA_HOME") or os.path.join(os.path.expanduser("~"), ".local", "share")
     return Path(base) / "fha-studio" / "sim"
+
+
+def eeprom_path(
+    option: str | None, driver: str, actuator_code: str, tempdir: tempfile.TemporaryDirectory[str] | None
+) -> Path:
+    """Where a simulated drive keeps its EEPROM: option ``eeprom`` ("" or None: in ``tempdir``,
+    gone with it; "user": in :func:`default_eeprom_dir`, one file per driver and actuator; else
+    the path given)."""
+    if option is None or option == "":
+        if tempdir is None:
+            raise ValueError("a temporary EEPROM needs a temporary directory")
+        return Path(tempdir.name) / "eeprom.json"
+    if option == "user":
+        return default_eeprom_dir() / f"{driver}_{actuator_code}.json"
+    return Path(option).expanduser()
 
 
 class EepromFile:

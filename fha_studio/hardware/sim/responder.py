@@ -44,6 +44,7 @@ from fha_studio.hardware.protocol import (
 from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.journal import Journal, JournalEntry, PanelAction
 from fha_studio.hardware.sim.memory import ItemId
+from fha_studio.hardware.sim.monitors import monitor_wire
 from fha_studio.hardware.sim.options import SimConfigError, training_registration
 from fha_studio.hardware.sim.reply import SimRefused, SimReply, rejected, servo_is_on
 from fha_studio.hardware.sim.trace import TraceError
@@ -266,13 +267,13 @@ def _pwr(r: SimResponder, value: int) -> None:
 
 
 def _mon(r: SimResponder, value: int) -> str:
-    return str(r.drive.monitor(value))
+    return str(monitor_wire(r.drive, value))
 
 
 def _mmr(r: SimResponder, value: int) -> str:
     if value <= 0 or value >= 1 << 16:
         raise rejected(f"MMR: mask {value} selects no monitor item 100-115")
-    return ",".join(str(r.drive.monitor(i)) for i in mask_items(value))
+    return ",".join(str(monitor_wire(r.drive, i)) for i in mask_items(value))
 
 
 def _svo(r: SimResponder, value: int) -> None:
@@ -375,7 +376,7 @@ def _sensor(which: str) -> Handler:
 
 def _snq(r: SimResponder, value: int) -> str:
     d = r.drive
-    return ",".join(str(round(a * 100)) for a in (d.origin_deg, d.ls1_deg, d.ls2_deg))
+    return ",".join(str(round(a * 100)) for a in (d.io.origin_deg, d.io.ls1_deg, d.io.ls2_deg))
 
 
 #: Every command the simulated drive speaks, with its handler.
