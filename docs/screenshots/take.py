@@ -30,7 +30,7 @@ def main() -> int:
     app = QApplication(sys.argv[:1])
     QCoreApplication.setOrganizationName("FHA Studio Screenshots")
     QCoreApplication.setApplicationName("fha-studio-screenshots")
-    from fha_studio.gui.link import Cmd
+    from fha_studio.gui.link import Servo
     from fha_studio.gui.main_window import MainWindow
 
     window = MainWindow()
@@ -70,7 +70,7 @@ def main() -> int:
         page.ccw_radio.setChecked(True)
         shot("rotary-direction")
         page.cw_radio.setChecked(True)
-        window.link.send(Cmd.SERVO, True)
+        window.link.send(Servo(True))
 
     @step(600)
     def jog():

@@ -32,7 +32,7 @@ def main() -> int:
     app = QApplication(sys.argv[:1])
     QCoreApplication.setOrganizationName("FHA Studio Screenshots")
     QCoreApplication.setApplicationName("fha-studio-screenshots")
-    from fha_studio.gui.link import Cmd, SimPanelAction
+    from fha_studio.gui.link import SimPanelAction, SimPanelRequest
     from fha_studio.gui.main_window import MainWindow
 
     window = MainWindow()
@@ -60,9 +60,8 @@ def main() -> int:
         print("saved", path)
 
     def panel(action: str, value) -> None:
-        token = window.link.send(Cmd.SIM_PANEL, SimPanelAction(action), value)
         done = []
-        window.link.sigResult.connect(lambda r: done.append(r) if r.token == token else None)
+        window.link.send(SimPanelRequest(SimPanelAction(action), value), done.append)
         wait_until(lambda: done)
 
     window.connect_to(URL)

@@ -63,7 +63,7 @@ def main() -> int:
     app = QApplication(sys.argv[:1])
     QCoreApplication.setOrganizationName("FHA Studio Screenshots")
     QCoreApplication.setApplicationName("fha-studio-screenshots")
-    from fha_studio.gui.link import Cmd
+    from fha_studio.gui.link import Call
     from fha_studio.gui.main_window import MainWindow
     from fha_studio.hardware import protocol as p
 
@@ -80,9 +80,8 @@ def main() -> int:
     scope.trigger_channel.setCurrentIndex(scope.trigger_channel.findData("moving"))
     scope.arm_trace()
     failures: list[str] = []
-    window.link.sigResult.connect(
-        lambda r: r.cmd is Cmd.CALL and not r.ok and failures.append(str(r.error)))
-    QTimer.singleShot(1000, lambda: window.link.send(Cmd.CALL, back_and_forth))
+    QTimer.singleShot(1000, lambda: window.link.send(
+        Call(back_and_forth), lambda r: r.ok or failures.append(str(r.error))))
     wait_for(scope.sigTraceDone, 30000, "the scope's trace of the move", failures)
     app.processEvents()
     window.grab().save(str(OUT / "modelcheck-capture.png"))

@@ -43,7 +43,7 @@ def main() -> int:
     app = QApplication(sys.argv[:1])
     QCoreApplication.setOrganizationName("FHA Studio Screenshots")
     QCoreApplication.setApplicationName("fha-studio-screenshots")
-    from fha_studio.gui.link import Cmd
+    from fha_studio.gui.link import Servo
     from fha_studio.gui.main_window import MainWindow
     from fha_studio.logic.procedures import ProcedureRun, load_procedure
     from tests.procedures.walk import walk
@@ -57,7 +57,7 @@ def main() -> int:
     direction.answer("cw")  # FWD turned the flange CW, as parameter 8 = 0 says
     scope = window.show_page("scope")
     scope.view.start_live()
-    window.link.send(Cmd.SERVO, True)
+    window.link.send(Servo(True))
     wait(app, lambda: window.link.servo_on)
     window.link.jog_press(20.0)
     end = time.monotonic() + 2.0
@@ -81,7 +81,7 @@ def main() -> int:
         number = int(page.stem.rsplit("-", 1)[1])
         page.rename(OUT / f"report-page-{number}.png")
         print("saved", OUT / f"report-page-{number}.png")
-    window.link.send(Cmd.SERVO, False)
+    window.link.send(Servo(False))
     window._closing_confirmed = True
     window.shutdown()
     window.close()

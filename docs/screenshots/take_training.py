@@ -39,7 +39,7 @@ def main() -> int:
     app = QApplication(sys.argv[:1])
     QCoreApplication.setOrganizationName("FHA Studio Screenshots")
     QCoreApplication.setApplicationName("fha-studio-screenshots")
-    from fha_studio.gui.link import Cmd
+    from fha_studio.gui.link import ReadParameters, Servo, WriteParameters
     from fha_studio.gui.main_window import MainWindow
     from fha_studio.gui.training import ChooseScenarioDialog, RunningDialog, ScoreSheetDialog
 
@@ -68,11 +68,11 @@ def main() -> int:
     wait(app, 10, lambda: window.link.connected)
     wait(app, 1.0)
     window.show_page("parameters")
-    window.link.send(Cmd.READ_PARAMETERS, [("system", 6)])
+    window.link.send(ReadParameters((("system", 6),)))
     wait(app, 1.0)
-    window.link.send(Cmd.WRITE_PARAMETERS, [("system", 6, 500)])
+    window.link.send(WriteParameters((("system", 6, 500),)))
     wait(app, 1.0)
-    window.link.send(Cmd.SERVO, True)
+    window.link.send(Servo(True))
     wait(app, 0.5)
     page = window.show_page("jog")
     page.speed_spin.setValue(5.0)
@@ -80,7 +80,7 @@ def main() -> int:
     wait(app, 1.5)
     window.jog_page.release_jog()
     wait(app, 0.8)
-    window.link.send(Cmd.SERVO, False)
+    window.link.send(Servo(False))
     wait(app, 0.5)
     shot(window, "training-session")
 

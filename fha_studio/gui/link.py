@@ -1,8 +1,10 @@
 """The drive link off the GUI thread: a worker QObject in its own QThread owns the drive (a DriveApi).
 
-PyMoDAQ's pattern: commands go in through one queued signal carrying a small `LinkCommand`
-(an Enum name and its arguments); results and status come out through signals. Qudi's polling
-loop: a single-shot QTimer re-armed at the end of each pass, so passes never overlap.
+PyMoDAQ's pattern: requests go in through one queued signal carrying a small frozen dataclass
+(``link_requests``: one per request, each saying what its reply carries); the reply goes back to
+whoever sent the request, status comes out through signals. Qudi's polling loop: a single-shot
+QTimer re-armed at the end of each pass, so passes never overlap; the pass itself is
+``logic.drive_session.StatusPoller``, without Qt.
 
 The GUI thread never waits on the port. The only thing it shares with the worker directly is a
 `threading.Event` that asks a long operation (read all, write all) to give up between items, so
@@ -11,18 +13,46 @@ that a STOP is not queued behind it.
 
 from __future__ import annotations
 
-import enum
 import itertools
 import logging
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
-from fha_studio.hardware.api import AlarmRecord, DriveApi, DriveRefused, LinkError, LinkLost, SimPanel
+from fha_studio.gui.link_requests import (
+    REQUESTS,
+    Call,
+    ClearAlarm,
+    Close,
+    Identify,
+    Jog,
+    JogLease,
+    LinkInfo,
+    LinkReply,
+    LinkRequest,
+    MoveBy,
+    NotConnected,
+    OnReply,
+    Open,
+    PanelRefused,
+    PowerCycle,
+    ReadAlarmHistory,
+    ReadParameters,
+    Sent,
+    Servo,
+    SetInputs,
+    SetMoveSpeed,
+    SetPollInterval,
+    Shutdown,
+    SimPanelAction,
+    SimPanelRequest,
+    Stop,
+    WriteParameters,
+)
+from fha_studio.hardware.api import AlarmRecord, DriveApi, LinkError, LinkLost, SimPanel
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.protocol import BAUDRATE, EXTENSION_COMMANDS
 from fha_studio.hardware.sim.options import public_url
@@ -34,9 +64,7 @@ from fha_studio.logic.drive_session import (
     SERVO_ON_PROBE_MS,
     STATUS_MONITORS,
     DriveStatus,
-    ParameterKey,
     ParameterReadout,
-    ParameterWrite,
     StatusPoller,
     WriteEntry,
     failure_text,
@@ -45,6 +73,7 @@ from fha_studio.logic.drive_session import (
 )
 
 log = logging.getLogger(__name__)
+R = TypeVar("R")
 
 #: Jog keep-alive period, in ms: the drive's watchdog stops the axis 100 ms after the last JOG.
 JOG_KEEPALIVE_MS = 40
@@ -57,99 +86,6 @@ JOG_LEASE_S = 0.5
 #: rule, ``LinkSettings.max_consecutive_failures``): one exchange left unanswered after its retry
 #: shows the technician a dead link at once. Set once the drive is open (``lose_link_after``).
 LINK_LOST_AFTER_FAILURES = 1
-
-
-class Cmd(enum.Enum):
-    """What the worker is asked to do."""
-
-    OPEN = enum.auto()  # args: url, baud_rate
-    CLOSE = enum.auto()  # stop the axis, close the port
-    IDENTIFY = enum.auto()
-    READ_PARAMETERS = enum.auto()  # args: items [(mode, number), ...]
-    WRITE_PARAMETERS = enum.auto()  # args: writes [(mode, number, value), ...]
-    SERVO = enum.auto()  # args: on
-    JOG = enum.auto()  # args: speed_rpm (0 = release: stop)
-    JOG_LEASE = enum.auto()  # the jog button is still held
-    SET_MOVE_SPEED = enum.auto()  # args: speed_rpm
-    MOVE_BY = enum.auto()  # args: angle_deg
-    STOP = enum.auto()
-    CLEAR_ALARM = enum.auto()
-    ALARM_HISTORY = enum.auto()
-    POWER_CYCLE = enum.auto()
-    SET_INPUTS = enum.auto()  # args: {input name: on} (simulated drive only)
-    CALL = enum.auto()  # args: a callable taking the DriveApi (for procedures of other pages)
-    SIM_PANEL = enum.auto()  # args: SimPanelAction, value (the embedded simulated drive's CN2 and hands)
-    SET_POLL_INTERVAL = enum.auto()  # args: ms between status polls (the scope slows them while live)
-    SHUTDOWN = enum.auto()  # stop the axis, close the port, end the link thread
-
-
-#: Commands that need no open link (the rest answer "not connected" without one).
-_WITHOUT_LINK = frozenset({Cmd.OPEN, Cmd.CLOSE, Cmd.STOP, Cmd.JOG, Cmd.JOG_LEASE, Cmd.SET_POLL_INTERVAL})
-
-
-class NotConnected(LinkError):
-    """A command that needs a drive came while no link was open."""
-
-
-class SimPanelAction(enum.Enum):
-    """What the embedded simulated drive's panel does: the controller's side (CN2) and the
-    technician's hands, which a real drive gets from outside CN3."""
-
-    SERVO = "servo"  # value: on (the controller's servo-ON input, CN2)
-    COMMAND = "command"  # value: output degrees, FWD positive (a command pulse train, servo on)
-    TURN_BY_HAND = "turn"  # value: output degrees, CW positive (servo off, brake released)
-    BRAKE_RELEASED = "brake"  # value: True = 24 V on the brake coil
-
-
-class PanelRefused(DriveRefused):
-    """The simulated drive's panel could not do it (servo on for turning by hand, ...)."""
-
-
-@dataclass(frozen=True)
-class LinkCommand:
-    """One command for the worker. `token` ties the result to the request."""
-
-    cmd: Cmd
-    args: tuple[Any, ...] = ()
-    token: int = 0
-
-
-@dataclass(frozen=True)
-class CommandResult:
-    """What came of one command: `value` on success, else `error` (one line for the user) and
-    `error_type`, the class of the exception (``ServoOnRefused``, ``LinkLost``, ``NotConnected``...)."""
-
-    token: int
-    cmd: Cmd
-    value: Any = None
-    error: str | None = None
-    error_type: type[Exception] | None = None
-
-    @property
-    def ok(self) -> bool:
-        return self.error is None
-
-    def failed_with(self, kind: type[Exception]) -> bool:
-        """True when the command failed with ``kind`` (or a subclass): ``failed_with(DriveRefused)``."""
-        return self.error_type is not None and issubclass(self.error_type, kind)
-
-
-@dataclass(frozen=True)
-class LinkInfo:
-    """What is known about a freshly opened link."""
-
-    url: str
-    driver_model: str = ""
-    adjusted_for: str = ""
-    firmware: str = ""
-    capabilities: str = ""  # the client's plain description of what the drive supports
-    can_move: bool = True  # jog/move/servo extension commands are there
-    can_monitor: bool = True
-    can_parameters: bool = True
-    is_simulated: bool = False
-    documented_only: bool = False  # the drive answers only the manual's DGR and OWW
-    absolute_position: bool | None = None  # DGR answered (True), x (False), unknown (None: s)
-    embedded_sim: bool = False  # an embedded simulated drive: its panel (SIM_PANEL) can be used
 
 
 #: Opens a drive: (url, baud rate) -> an open DriveApi. Raises LinkError when it cannot.
@@ -173,7 +109,7 @@ class LinkWorker(QObject):
     sigConnected = Signal(object)  # LinkInfo
     sigDisconnected = Signal(str, bool)  # reason, lost (True: the link died, not closed by us)
     sigStatus = Signal(object)  # DriveStatus
-    sigResult = Signal(object)  # CommandResult
+    sigResult = Signal(object)  # LinkReply
     sigWrite = Signal(object)  # WriteEntry: one write, for the session log
 
     def __init__(
@@ -197,28 +133,29 @@ class LinkWorker(QObject):
         self._jog_timer: QTimer | None = None
         self._jog_speed_rpm = 0.0
         self._jog_lease_s = 0.0
-        #: What each command runs (every Cmd has one; a test checks it).
-        self.handlers: dict[Cmd, Callable[..., Any]] = {
-            Cmd.OPEN: self._do_open,
-            Cmd.CLOSE: self._do_close,
-            Cmd.IDENTIFY: self._do_identify,
-            Cmd.READ_PARAMETERS: self._do_read_parameters,
-            Cmd.WRITE_PARAMETERS: self._do_write_parameters,
-            Cmd.SERVO: self._do_servo,
-            Cmd.JOG: self._do_jog,
-            Cmd.JOG_LEASE: self._do_jog_lease,
-            Cmd.SET_MOVE_SPEED: self._do_set_move_speed,
-            Cmd.MOVE_BY: self._do_move_by,
-            Cmd.STOP: self._do_stop,
-            Cmd.CLEAR_ALARM: self._do_clear_alarm,
-            Cmd.ALARM_HISTORY: self._do_alarm_history,
-            Cmd.POWER_CYCLE: self._do_power_cycle,
-            Cmd.SET_INPUTS: self._do_set_inputs,
-            Cmd.CALL: self._do_call,
-            Cmd.SIM_PANEL: self._do_sim_panel,
-            Cmd.SET_POLL_INTERVAL: self._do_set_poll_interval,
-            Cmd.SHUTDOWN: self._shutdown,
+        #: What each request runs (every one of link_requests.REQUESTS has one; a test checks it).
+        self.handlers: dict[type[LinkRequest[Any]], Callable[[Any], Any]] = {
+            Open: self._do_open,
+            Close: self._do_close,
+            Identify: self._do_identify,
+            ReadParameters: self._do_read_parameters,
+            WriteParameters: self._do_write_parameters,
+            Servo: self._do_servo,
+            Jog: self._do_jog,
+            JogLease: self._do_jog_lease,
+            SetMoveSpeed: self._do_set_move_speed,
+            MoveBy: self._do_move_by,
+            Stop: self._do_stop,
+            ClearAlarm: self._do_clear_alarm,
+            ReadAlarmHistory: self._do_alarm_history,
+            PowerCycle: self._do_power_cycle,
+            SetInputs: self._do_set_inputs,
+            Call: self._do_call,
+            SimPanelRequest: self._do_sim_panel,
+            SetPollInterval: self._do_set_poll_interval,
+            Shutdown: self._shutdown,
         }
+        assert set(self.handlers) == set(REQUESTS)
 
     # -- life ---------------------------------------------------------------------------------
     @Slot()
@@ -239,30 +176,31 @@ class LinkWorker(QObject):
         return self._client
 
     @Slot(object)
-    def handle(self, command: LinkCommand) -> None:
-        handler = self.handlers[command.cmd]
-        if command.cmd is Cmd.SHUTDOWN:
-            handler()
+    def handle(self, sent: Sent[Any]) -> None:
+        request = sent.request
+        handler = self.handlers[type(request)]
+        if isinstance(request, Shutdown):
+            handler(request)
             return
-        if command.cmd is Cmd.STOP:
+        if isinstance(request, Stop):
             self._abort.clear()
-        if self._client is None and command.cmd not in _WITHOUT_LINK:
-            self._emit(command, error=NotConnected("not connected"))
+        if self._client is None and request.needs_link:
+            self._reply(sent, error=NotConnected("not connected"))
             return
         try:
-            value = handler(*command.args)
+            value = handler(request)
         except Exception as exc:
-            self._emit(command, error=exc)
+            self._reply(sent, error=exc)
             if self._client is not None and isinstance(exc, LinkLost):
                 self._lose(exc)
             return
-        self._emit(command, value=value)
+        self._reply(sent, value=value)
 
-    def _emit(self, command: LinkCommand, value: Any = None, error: Exception | None = None) -> None:
+    def _reply(self, sent: Sent[Any], value: Any = None, error: Exception | None = None) -> None:
         if error is None:
-            self.sigResult.emit(CommandResult(command.token, command.cmd, value))
+            self.sigResult.emit(LinkReply(sent.token, sent.request, value))
         else:
-            self.sigResult.emit(CommandResult(command.token, command.cmd, None, _message(error), type(error)))
+            self.sigResult.emit(LinkReply(sent.token, sent.request, None, _message(error), type(error)))
 
     def _lose(self, exc: Exception) -> None:
         reason = f"link lost: {_message(exc)}"
@@ -289,7 +227,7 @@ class LinkWorker(QObject):
         except (LinkError, OSError) as exc:
             log.info("close failed: %s", exc)
 
-    def _shutdown(self) -> None:
+    def _shutdown(self, _: Shutdown) -> None:
         """The last command: runs in the link thread, so the timers die in their own thread."""
         self._final = True  # the STOP below must reach the drive although the window is closing
         self._shut(stop_axis=True)
@@ -308,11 +246,12 @@ class LinkWorker(QObject):
         return DriveClient.open(url, link_settings(baud_rate), should_abort=self._abandon)
 
     # -- commands -----------------------------------------------------------------------------
-    def _do_open(self, url: str, baud_rate: int = BAUDRATE) -> LinkInfo:
+    def _do_open(self, request: Open) -> LinkInfo:
+        url = request.url
         if self._client is not None:
             self._shut(stop_axis=True)
             self.sigDisconnected.emit("switched to another drive", False)
-        self._client = self._open_client(url, baud_rate)
+        self._client = self._open_client(url, request.baud_rate)
         if isinstance(self._client, DriveClient):  # the transaction layer's verdict, made prompt
             self._client.lose_link_after(LINK_LOST_AFTER_FAILURES)
         self._url = url
@@ -349,28 +288,28 @@ class LinkWorker(QObject):
             embedded_sim=_embedded_sim(client) is not None,
         )
 
-    def _do_close(self) -> None:
+    def _do_close(self, _: Close) -> None:
         was_open = self._client is not None
         self._shut(stop_axis=True)
         if was_open:
             self.sigDisconnected.emit("closed", False)
 
-    def _do_identify(self) -> LinkInfo:
+    def _do_identify(self, _: Identify) -> LinkInfo:
         return self._describe(self._url)
 
-    def _do_read_parameters(self, items: list[ParameterKey]) -> ParameterReadout:
-        return read_parameters(self.client, items, self._abort.is_set)
+    def _do_read_parameters(self, request: ReadParameters) -> ParameterReadout:
+        return read_parameters(self.client, request.items, self._abort.is_set)
 
-    def _do_write_parameters(self, writes: list[ParameterWrite]) -> list[WriteEntry]:
+    def _do_write_parameters(self, request: WriteParameters) -> list[WriteEntry]:
         """Writes one by one; each entry says old, new, verified (by read-back) or the error."""
-        return write_parameters(self.client, writes, self._abort.is_set, self.sigWrite.emit)
+        return write_parameters(self.client, request.writes, self._abort.is_set, self.sigWrite.emit)
 
-    def _do_servo(self, on: bool) -> bool:
-        self.client.servo(bool(on))
-        return bool(on)
+    def _do_servo(self, request: Servo) -> bool:
+        self.client.servo(bool(request.on))
+        return bool(request.on)
 
-    def _do_jog(self, speed_rpm: float) -> float:
-        speed_rpm = float(speed_rpm)
+    def _do_jog(self, request: Jog) -> float:
+        speed_rpm = float(request.speed_rpm)
         assert self._jog_timer is not None
         if speed_rpm == 0.0:
             was = self._jog_speed_rpm
@@ -392,7 +331,7 @@ class LinkWorker(QObject):
         self._jog_timer.start()
         return speed_rpm
 
-    def _do_jog_lease(self) -> None:
+    def _do_jog_lease(self, _: JogLease) -> None:
         self._jog_lease_s = time.monotonic()
 
     @Slot()
@@ -404,61 +343,63 @@ class LinkWorker(QObject):
             return
         if time.monotonic() - self._jog_lease_s > JOG_LEASE_S:
             # The GUI stopped renewing (frozen, or the release got lost): stop, do not run on.
-            self.handle(LinkCommand(Cmd.JOG, (0.0,)))
+            self.handle(Sent(0, Jog(0.0)))
             return
         try:
             self._client.jog(self._jog_speed_rpm)
         except (LinkError, ValueError) as exc:
-            self._jog_speed_rpm = 0.0
+            speed_rpm, self._jog_speed_rpm = self._jog_speed_rpm, 0.0
             self._jog_timer.stop()
-            self._emit(LinkCommand(Cmd.JOG), error=exc)
+            self._reply(Sent(0, Jog(speed_rpm)), error=exc)  # to whoever holds the jog
             if isinstance(exc, LinkLost):
                 self._lose(exc)
 
-    def _do_set_move_speed(self, speed_rpm: float) -> float:
-        self.client.set_move_speed(float(speed_rpm))
-        return float(speed_rpm)
+    def _do_set_move_speed(self, request: SetMoveSpeed) -> float:
+        self.client.set_move_speed(float(request.speed_rpm))
+        return float(request.speed_rpm)
 
-    def _do_move_by(self, angle_deg: float) -> float:
-        self.client.move_by(float(angle_deg))
-        return float(angle_deg)
+    def _do_move_by(self, request: MoveBy) -> float:
+        self.client.move_by(float(request.angle_deg))
+        return float(request.angle_deg)
 
-    def _do_stop(self) -> None:
+    def _do_stop(self, _: Stop) -> None:
         self._jog_speed_rpm = 0.0
         if self._jog_timer is not None:
             self._jog_timer.stop()
         if self._client is not None:
             self._client.stop()
 
-    def _do_clear_alarm(self) -> int:
+    def _do_clear_alarm(self, _: ClearAlarm) -> int:
         self.client.clear_alarm()
         return self.client.alarm()
 
-    def _do_alarm_history(self) -> list[AlarmRecord]:
+    def _do_alarm_history(self, _: ReadAlarmHistory) -> list[AlarmRecord]:
         return self.client.alarm_history()
 
-    def _do_power_cycle(self) -> None:
+    def _do_power_cycle(self, _: PowerCycle) -> None:
         self.client.power_cycle()
 
-    def _do_set_inputs(self, inputs: dict[str, bool]) -> int:
+    def _do_set_inputs(self, request: SetInputs) -> int:
         """Simulated CN2 inputs by name (fwd_inhibit=True, ...); the simulated drive only."""
-        return self.client.set_inputs(**inputs).raw
+        return self.client.set_inputs(**request.inputs).raw
 
-    def _do_set_poll_interval(self, interval_ms: int) -> int:
-        self._poll_interval_ms = max(POLL_INTERVAL_MS, int(interval_ms))
+    def _do_set_poll_interval(self, request: SetPollInterval) -> int:
+        self._poll_interval_ms = max(POLL_INTERVAL_MS, int(request.interval_ms))
         if self._poller is not None:
             self._poller.set_interval(self._poll_interval_ms)
         return self._poll_interval_ms
 
-    def _do_call(self, function: Callable[[DriveApi], Any]) -> Any:
-        return function(self.client)
+    def _do_call(self, request: Call[Any]) -> Any:
+        return request.function(self.client)
 
-    def _do_sim_panel(self, action: SimPanelAction, value: Any) -> str:
+    def _do_sim_panel(self, request: SimPanelRequest) -> str:
         """Do what the embedded simulated drive's panel asks; one line saying what happened."""
         sim = _embedded_sim(self.client)
         if sim is None:
             raise NotConnected("this is not an embedded simulated drive: it has no panel")
         from fha_studio.hardware.sim import SimRefused
+
+        action, value = request.action, request.value
 
         try:
             if action is SimPanelAction.SERVO:
@@ -518,13 +459,19 @@ class LinkController(QObject):
     """The GUI-thread face of the link: sends commands, re-emits what the worker says, and keeps
     the last known state for the pages. Never blocks."""
 
-    sigCommand = Signal(object)  # LinkCommand, queued into the worker
-    sigConnected = Signal(object)
+    sigCommand = Signal(object)  # Sent: a request, queued into the worker
+    sigConnected = Signal(object)  # LinkInfo
     sigDisconnected = Signal(str, bool)
-    sigStatus = Signal(object)
+    sigStatus = Signal(object)  # DriveStatus
+    #: Every LinkReply, for the one observer of them all (the window's message area); a request's
+    #: sender gets its own reply through ``send(request, on_reply)``.
     sigResult = Signal(object)
-    sigWrite = Signal(object)
+    sigWrite = Signal(object)  # WriteEntry: one parameter write, for the session log
     sigBusyChanged = Signal(bool)
+    #: The drive's control power was cycled (whoever asked): restart-required items are in effect.
+    sigPowerCycled = Signal()
+    #: A STOP was answered (whoever pressed it): its LinkReply.
+    sigStopped = Signal(object)
 
     def __init__(self, parent: QObject | None = None, open_client: OpenClient | None = None):
         super().__init__(parent)
@@ -545,10 +492,12 @@ class LinkController(QObject):
         self.info: LinkInfo | None = None
         self.status: DriveStatus | None = None
         self.last_disconnect_reason = ""
-        self._pending: dict[int, Cmd] = {}
+        self._pending: set[int] = set()
+        self._on_reply: dict[int, OnReply[Any]] = {}
+        self._jog_owner: OnReply[float] | None = None
         self._jog_lease_timer = QTimer(self)
         self._jog_lease_timer.setInterval(JOG_LEASE_RENEW_MS)
-        self._jog_lease_timer.timeout.connect(lambda: self.send(Cmd.JOG_LEASE))
+        self._jog_lease_timer.timeout.connect(lambda: self.send(JogLease()))
         self._thread.start()
 
     # -- state ---------------------------------------------------------------------------------
@@ -575,36 +524,47 @@ class LinkController(QObject):
         return self._abort
 
     # -- commands ------------------------------------------------------------------------------
-    def send(self, cmd: Cmd, *args) -> int:
+    def send(self, request: LinkRequest[R], on_reply: OnReply[R] | None = None) -> int:
+        """Queue ``request`` into the link thread; its reply goes to ``on_reply`` (and to the
+        observer, ``sigResult``). Returns the request's token."""
         token = next(self._tokens)
-        if cmd not in (Cmd.JOG_LEASE,):
+        if request.counts_as_busy:
             was_busy = self.busy
-            self._pending[token] = cmd
+            self._pending.add(token)
             if not was_busy:
                 self.sigBusyChanged.emit(True)
-        self.sigCommand.emit(LinkCommand(cmd, tuple(args), token))
+        if on_reply is not None:
+            self._on_reply[token] = on_reply
+        self.sigCommand.emit(Sent(token, request))
         return token
 
     def open(self, url: str, baud_rate: int = BAUDRATE) -> int:
-        return self.send(Cmd.OPEN, url, baud_rate)
+        return self.send(Open(url, baud_rate))
 
     def close_link(self) -> int:
-        self._jog_lease_timer.stop()
-        return self.send(Cmd.CLOSE)
+        self._let_go_of_jog()
+        return self.send(Close())
 
     def stop_now(self) -> int:
         """STOP: abandons a long operation at the next item and stops the axis."""
-        self._jog_lease_timer.stop()
+        self._let_go_of_jog()
         self._abort.set()
-        return self.send(Cmd.STOP)
+        return self.send(Stop())
 
-    def jog_press(self, speed_rpm: float) -> int:
+    def jog_press(self, speed_rpm: float, on_reply: OnReply[float] | None = None) -> int:
+        """Jog while held (the lease is renewed until ``jog_release``). ``on_reply`` gets the
+        jog's reply, and a failure of the worker's renewal of it later."""
         self._jog_lease_timer.start()
-        return self.send(Cmd.JOG, float(speed_rpm))
+        self._jog_owner = on_reply
+        return self.send(Jog(float(speed_rpm)), on_reply)
 
     def jog_release(self) -> int:
+        self._let_go_of_jog()
+        return self.send(Jog(0.0))
+
+    def _let_go_of_jog(self) -> None:
         self._jog_lease_timer.stop()
-        return self.send(Cmd.JOG, 0.0)
+        self._jog_owner = None
 
     def shutdown(self, timeout_ms: int = 10000) -> bool:
         """Stops the axis, closes the port, ends the thread. True when the thread ended in time.
@@ -612,12 +572,12 @@ class LinkController(QObject):
         Whatever the worker is doing (connecting to a silent or babbling line, a long read-out)
         gives up at its next read; only the port's own opening (a TCP connect: at most 5 s) and
         the final STOP (``transaction_limit_s``) can hold it, both well inside ``timeout_ms``."""
-        self._jog_lease_timer.stop()
+        self._let_go_of_jog()
         if not self._thread.isRunning():
             return True
         self._closing.set()
         self._abort.set()
-        self.sigCommand.emit(LinkCommand(Cmd.SHUTDOWN, (), 0))  # the worker quits its thread when done
+        self.sigCommand.emit(Sent(0, Shutdown()))  # the worker quits its thread when done
         ended = self._thread.wait(timeout_ms)
         if not ended:
             self._thread.quit()
@@ -637,7 +597,7 @@ class LinkController(QObject):
     def _on_disconnected(self, reason: str, lost: bool) -> None:
         self.info = None
         self.status = None
-        self._jog_lease_timer.stop()
+        self._let_go_of_jog()
         self.last_disconnect_reason = reason
         self.sigDisconnected.emit(reason, lost)
 
@@ -647,31 +607,63 @@ class LinkController(QObject):
         self.sigStatus.emit(status)
 
     @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if self._pending.pop(result.token, None) is not None and not self._pending:
-            self.sigBusyChanged.emit(False)
-        if result.cmd is Cmd.JOG and not result.ok:
-            self._jog_lease_timer.stop()
-        self.sigResult.emit(result)
+    def _on_result(self, reply: LinkReply[Any]) -> None:
+        request = reply.request
+        if reply.token in self._pending:
+            self._pending.discard(reply.token)
+            if not self._pending:
+                self.sigBusyChanged.emit(False)
+        on_reply = self._on_reply.pop(reply.token, None)
+        if isinstance(request, Jog) and not reply.ok:
+            if reply.token == 0:  # the worker's renewal of a held jog failed: to the jog's sender
+                on_reply = self._jog_owner
+            self._let_go_of_jog()
+        if on_reply is not None:
+            on_reply(reply)
+        if isinstance(request, PowerCycle) and reply.ok:
+            self.sigPowerCycled.emit()
+        elif isinstance(request, Stop):
+            self.sigStopped.emit(reply)
+        self.sigResult.emit(reply)
 
 
-__all__ = [  # the poll's figures and types re-exported: the pages know them from here
+__all__ = [  # the poll's figures and the message types re-exported: the pages know them from here
     "POLL_INTERVAL_MS",
     "PROBE_INTERVAL_MS",
     "SERVO_ON_NOTE",
     "SERVO_ON_PROBE_MS",
     "STATUS_MONITORS",
-    "Cmd",
-    "CommandResult",
+    "Call",
+    "ClearAlarm",
+    "Close",
     "DriveStatus",
-    "LinkCommand",
+    "Identify",
+    "Jog",
+    "JogLease",
     "LinkController",
     "LinkInfo",
+    "LinkReply",
+    "LinkRequest",
     "LinkWorker",
+    "MoveBy",
     "NotConnected",
+    "OnReply",
+    "Open",
     "OpenClient",
     "PanelRefused",
     "ParameterReadout",
+    "PowerCycle",
+    "ReadAlarmHistory",
+    "ReadParameters",
+    "Sent",
+    "Servo",
+    "SetInputs",
+    "SetMoveSpeed",
+    "SetPollInterval",
+    "Shutdown",
     "SimPanelAction",
+    "SimPanelRequest",
+    "Stop",
     "WriteEntry",
+    "WriteParameters",
 ]

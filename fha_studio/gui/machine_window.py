@@ -41,7 +41,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio import fileio
-from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo, OpenClient
+from fha_studio.gui.link import DriveStatus, LinkController, LinkInfo, LinkReply, OpenClient, ParameterReadout
 from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
@@ -96,7 +96,7 @@ class AxisRecorder(QObject):
         self._alarm_code = 0
         self._hooked: set[int] = set()
         link = window.link
-        link.sigResult.connect(self._on_result)
+        window.session.sigParametersRead.connect(self._on_read)
         link.sigWrite.connect(self._on_write)
         link.sigStatus.connect(self._on_status)
         link.sigConnected.connect(self._on_connected)
@@ -162,14 +162,14 @@ class AxisRecorder(QObject):
             self._record([DriverFact(info.driver_model, self.who)])
 
     @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if result.cmd is not Cmd.READ_PARAMETERS or not result.ok or not result.value.values:
+    def _on_read(self, result: LinkReply[ParameterReadout]) -> None:
+        if not result.ok or not result.answer.values:
             return
         info = self.window.link.info
         self._record(
             read_facts(
                 self.window.session.parameter_model,
-                result.value.values,
+                {(str(mode), number): value for (mode, number), value in result.answer.values.items()},
                 self.who,
                 driver_model=info.driver_model if info else "",
             )
@@ -426,7 +426,7 @@ class MachineWindow(QMainWindow):
         index = len(self.axis_windows) - 1
         for signal in (link.sigConnected, link.sigDisconnected, link.sigStatus):
             signal.connect(lambda *_args, i=index: self._refresh_axis(i))
-        link.sigResult.connect(lambda result, i=index: self._on_axis_result(i, result))
+        link.sigStopped.connect(lambda _reply, i=index: self._refresh_axis(i))
         window.state.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
         if self.register is not None:
             self.recorders.append(
@@ -564,10 +564,6 @@ class MachineWindow(QMainWindow):
                     f"Register: the actuator was not recorded ({exc}).", Level.WARNING
                 )
         self._refresh_axis(index)
-
-    def _on_axis_result(self, index: int, result: CommandResult) -> None:
-        if result.cmd is Cmd.STOP:
-            self._refresh_axis(index)
 
     # -- actions --------------------------------------------------------------------------------------
     def connect_axis(self, name: str) -> bool:

@@ -20,7 +20,17 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.catalog import DEFAULT_ACTUATOR
-from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo
+from fha_studio.gui.link import (
+    DriveStatus,
+    JogLease,
+    LinkController,
+    LinkInfo,
+    LinkReply,
+    Open,
+    Servo,
+    SimPanelRequest,
+    Stop,
+)
 from fha_studio.gui.messages import Level, MessageArea
 from fha_studio.gui.mnemonics import mnemonic, resolve_mnemonics
 from fha_studio.gui.pages.alarms import AlarmsPage
@@ -369,7 +379,7 @@ class MainWindow(QMainWindow):
 
     @Slot(bool)
     def _servo_clicked(self, checked: bool) -> None:
-        self.link.send(Cmd.SERVO, checked)
+        self.link.send(Servo(checked))
         self.servo_action.setChecked(self.link.servo_on)  # the drive's state decides, not the click
 
     # -- from the link --------------------------------------------------------------------------
@@ -445,8 +455,10 @@ class MainWindow(QMainWindow):
             self.alarm_lamp.setToolTip(f"Alarm {status.alarm_code}" if status.alarm_code else "Alarm: none")
 
     @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if result.cmd is Cmd.STOP:
+    def _on_result(self, result: LinkReply) -> None:
+        """Every reply, whoever asked: STOP's outcome and each failure, in the message area."""
+        request = result.request
+        if isinstance(request, Stop):
             if result.ok:
                 self.show_message("STOP done: the drive decelerated the axis and holds it (servo stays on).")
             else:
@@ -458,13 +470,13 @@ class MainWindow(QMainWindow):
             return
         if result.ok:
             return
-        if result.cmd is Cmd.OPEN:
+        if isinstance(request, Open):
             self.show_message(f"Could not connect: {result.error}", Level.ERROR)
             self._set_caps(f"Could not connect: {result.error}")
             self.caps_label.setStyleSheet("color: #b00020; font-weight: bold;")
             self.link_lamp.set_state(True, RED)
-        elif result.cmd not in (Cmd.JOG_LEASE, Cmd.SIM_PANEL):
-            self.show_message(f"{_command_words(result.cmd)} failed: {result.error}", Level.ERROR)
+        elif not isinstance(request, JogLease | SimPanelRequest):  # the panel says its own
+            self.show_message(f"{request.words} failed: {result.error}", Level.ERROR)
 
     @Slot(int, bool)
     def _on_alarm_attention(self, code: int, attention: bool) -> None:
@@ -528,28 +540,3 @@ class LazyPage(QWidget):
     def showEvent(self, event) -> None:
         _ = self.page
         super().showEvent(event)
-
-
-#: What the person asked for, as the message names it ("Move failed: ...").
-_CMD_WORDS = {
-    Cmd.OPEN: "Connecting",
-    Cmd.CLOSE: "Disconnecting",
-    Cmd.IDENTIFY: "Identifying the drive",
-    Cmd.READ_PARAMETERS: "Reading the parameters",
-    Cmd.WRITE_PARAMETERS: "Writing the parameters",
-    Cmd.SERVO: "Servo on/off",
-    Cmd.JOG: "Jog",
-    Cmd.SET_MOVE_SPEED: "Setting the move speed",
-    Cmd.MOVE_BY: "Move",
-    Cmd.STOP: "STOP",
-    Cmd.CLEAR_ALARM: "Clearing the alarm",
-    Cmd.ALARM_HISTORY: "Reading the alarm history",
-    Cmd.POWER_CYCLE: "Power cycle",
-    Cmd.SET_INPUTS: "Setting the simulated inputs",
-    Cmd.CALL: "The drive request",
-    Cmd.SIM_PANEL: "The simulated drive's panel",
-}
-
-
-def _command_words(cmd: Cmd) -> str:
-    return _CMD_WORDS.get(cmd, cmd.name.replace("_", " ").lower().capitalize())

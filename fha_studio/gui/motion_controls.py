@@ -28,7 +28,16 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkController, LinkInfo
+from fha_studio.gui.link import (
+    DriveStatus,
+    Jog,
+    LinkController,
+    LinkInfo,
+    LinkReply,
+    MoveBy,
+    Servo,
+    SetMoveSpeed,
+)
 from fha_studio.gui.widgets import AMBER, Lamp, StopButton
 
 #: Why the controls are disabled, one reason at a time.
@@ -38,9 +47,6 @@ CANNOT_MOVE_TEXT = ("This drive answers only the documented CN3 commands: servo,
 SERVO_OFF_TEXT = "Servo OFF: switch it ON to jog or move."
 SERVO_FIRST_TEXT = "Switch the servo ON first: nothing moves without it."
 _REASONS = (NOT_CONNECTED_TEXT, CANNOT_MOVE_TEXT, SERVO_OFF_TEXT, SERVO_FIRST_TEXT)
-
-#: The commands of these controls: a refusal of one is said under them.
-MOTION_COMMANDS = (Cmd.JOG, Cmd.MOVE_BY, Cmd.SERVO, Cmd.SET_MOVE_SPEED)
 
 HOLD_TIP = "Hold (mouse or Space key) to jog; release to stop"
 MOVE_TIP = "Move the output by the angle (+ = FWD) at the speed, then hold"
@@ -170,15 +176,14 @@ class MotionControls(QWidget):
                 self.stop_button.clicked.connect(link.stop_now)
             self._lay_out_panel(outer)
 
-        self.servo_on_button.clicked.connect(lambda: self.link.send(Cmd.SERVO, True))
-        self.servo_off_button.clicked.connect(lambda: self.link.send(Cmd.SERVO, False))
+        self.servo_on_button.clicked.connect(lambda: self.link.send(Servo(True), self._on_reply))
+        self.servo_off_button.clicked.connect(lambda: self.link.send(Servo(False), self._on_reply))
         self.fwd_button.sigHeld.connect(lambda: self._jog(+1))
         self.rev_button.sigHeld.connect(lambda: self._jog(-1))
         self.fwd_button.sigReleased.connect(self._released)
         self.rev_button.sigReleased.connect(self._released)
         self.move_button.clicked.connect(self.move_by)
         link.sigStatus.connect(self._on_status)
-        link.sigResult.connect(self._on_result)
         self._set_enabled(link.connected, link.servo_on)
 
     def _lay_out_page(self, outer: QVBoxLayout) -> None:
@@ -244,7 +249,7 @@ class MotionControls(QWidget):
             return
         if self.message.text() == SERVO_FIRST_TEXT:
             self.message.setText("")
-        self.link.jog_press(sign * self.speed_spin.value())
+        self.link.jog_press(sign * self.speed_spin.value(), self._on_reply)
 
     @Slot()
     def _released(self) -> None:
@@ -262,8 +267,8 @@ class MotionControls(QWidget):
         if not self.link.servo_on:
             self.message.setText(SERVO_FIRST_TEXT)
             return
-        self.link.send(Cmd.SET_MOVE_SPEED, self.move_speed_spin.value())
-        self.link.send(Cmd.MOVE_BY, self.angle_spin.value())
+        self.link.send(SetMoveSpeed(self.move_speed_spin.value()), self._on_reply)
+        self.link.send(MoveBy(self.angle_spin.value()), self._on_reply)
 
     # -- from the link ----------------------------------------------------------------------------
     def _set_enabled(self, connected: bool, servo_on: bool) -> None:
@@ -296,13 +301,13 @@ class MotionControls(QWidget):
         self._set_enabled(self.link.connected, bool(status.servo_on))
         self.servo_lamp.set_state(status.servo_on)
 
-    @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if result.cmd in MOTION_COMMANDS and not result.ok:
+    def _on_reply(self, result: LinkReply) -> None:
+        """The reply to one of these controls' requests: a refusal is said under them."""
+        if not result.ok:
             self.message.setText(f"The drive refused: {result.error}")
-            if result.cmd is Cmd.JOG:
+            if isinstance(result.request, Jog):
                 self.release_jog()
-        elif result.cmd is Cmd.SERVO and result.ok and self.message.text().startswith("The drive refused"):
+        elif isinstance(result.request, Servo) and self.message.text().startswith("The drive refused"):
             self.message.setText("")
 
     def changeEvent(self, event) -> None:

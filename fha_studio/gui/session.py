@@ -12,8 +12,9 @@ from PySide6.QtCore import QObject, QStandardPaths, Signal, Slot
 
 from fha_studio import clock, fileio
 from fha_studio.catalog import DEFAULT_ACTUATOR
-from fha_studio.gui.link import Cmd, CommandResult, LinkController, LinkInfo
+from fha_studio.gui.link import LinkController, LinkInfo, LinkReply, ReadParameters, WriteParameters
 from fha_studio.gui.state import AxisState
+from fha_studio.hardware.parameters import Mode
 from fha_studio.logic.commissioning import CommissioningState
 from fha_studio.logic.paramfile import dump_parameter_file
 from fha_studio.logic.session_log import SessionLog, WriteRecord
@@ -43,6 +44,7 @@ class Session(QObject):
     commissioning state (one per window; the pages read and edit the axis through it)."""
 
     sigWritesDone = Signal(object)  # list of write entries of one request
+    sigParametersRead = Signal(object)  # the LinkReply of each read of the session (a ParameterReadout)
     sigMessage = Signal(str)  # something for the status bar
 
     def __init__(self, link: LinkController, state: AxisState | None = None, parent: QObject | None = None):
@@ -51,10 +53,7 @@ class Session(QObject):
         self.state = state if state is not None else new_axis_state(self)
         self._models: dict[str, object] = {}
         self._pending_writes: list[tuple[str, int, int]] | None = None
-        self._backup_read_token: int | None = None
-        self._write_tokens: set[int] = set()
         link.sigWrite.connect(self._on_write)
-        link.sigResult.connect(self._on_result)
         link.sigConnected.connect(self._on_connected)
 
     # -- the driver's parameter model ---------------------------------------------------------------
@@ -82,7 +81,21 @@ class Session(QObject):
 
     # -- reading and writing ------------------------------------------------------------------------
     def read_all(self) -> int:
-        return self.link.send(Cmd.READ_PARAMETERS, [(i.mode, i.number) for i in self.editable_items()])
+        """Read every editable item; the values go into the state, the reply to
+        ``sigParametersRead``."""
+        return self._read_all()
+
+    def _read_all(self, then=None) -> int:
+        items = tuple((Mode(i.mode), i.number) for i in self.editable_items())
+
+        def on_reply(result: LinkReply) -> None:
+            if result.ok:
+                self.state.record_read(result.value.values)
+            if then is not None:
+                then(result)
+            self.sigParametersRead.emit(result)
+
+        return self.link.send(ReadParameters(items), on_reply)
 
     def known_values(self) -> dict[tuple[str, int], int]:
         """The items' values as known: read from the drive, else entered from its front panel."""
@@ -109,11 +122,18 @@ class Session(QObject):
             return
         if self.state.needs_backup:
             self._pending_writes = list(writes)
-            self._backup_read_token = self.read_all()
+            self._read_all(then=self._backup_read)
             self.sigMessage.emit("Reading the drive's parameters for the backup before the first write …")
             return
         self.state.require_backup()
-        self._write_tokens.add(self.link.send(Cmd.WRITE_PARAMETERS, list(writes)))
+        self._send_writes(writes)
+
+    def _send_writes(self, writes: list[tuple[str, int, int]]) -> None:
+        typed = tuple((Mode(mode), number, value) for mode, number, value in writes)
+        self.link.send(WriteParameters(typed), self._writes_answered)
+
+    def _writes_answered(self, result: LinkReply) -> None:
+        self.sigWritesDone.emit(result.value if result.ok else [])
 
     def write_backup(self) -> Path:
         """Saves the drive's values as read before the first write of the session."""
@@ -143,31 +163,22 @@ class Session(QObject):
             except ValueError as exc:  # the label's line is not a model code: the technician types it
                 self.sigMessage.emit(f"ADJUSTED FOR USE WITH {info.adjusted_for}: not a model code ({exc})")
 
-    @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if result.cmd is Cmd.READ_PARAMETERS and result.ok:
-            self.state.record_read(result.value.values)
-        if result.token == self._backup_read_token:
-            self._backup_read_token = None
-            writes, self._pending_writes = self._pending_writes, None
-            if not result.ok or result.value.errors:
-                why = result.error or "; ".join(
-                    f"{m} {n}: {e}" for (m, n), e in result.value.errors.items()
-                )
-                self.sigMessage.emit(f"Nothing written: the backup read failed ({why}).")
-                self.sigWritesDone.emit([])
-                return
-            try:
-                self.write_backup()
-            except (OSError, ValueError) as exc:  # fileio.FileProblem is a ValueError
-                self.sigMessage.emit(f"Nothing written: the backup could not be saved ({exc}).")
-                self.sigWritesDone.emit([])
-                return
-            if writes:
-                self._write_tokens.add(self.link.send(Cmd.WRITE_PARAMETERS, writes))
-        elif result.token in self._write_tokens:
-            self._write_tokens.discard(result.token)
-            self.sigWritesDone.emit(result.value if result.ok else [])
+    def _backup_read(self, result: LinkReply) -> None:
+        """The read before the first write: saved as the backup, then the writes go."""
+        writes, self._pending_writes = self._pending_writes, None
+        if not result.ok or result.value.errors:
+            why = result.error or "; ".join(f"{m} {n}: {e}" for (m, n), e in result.value.errors.items())
+            self.sigMessage.emit(f"Nothing written: the backup read failed ({why}).")
+            self.sigWritesDone.emit([])
+            return
+        try:
+            self.write_backup()
+        except (OSError, ValueError) as exc:  # fileio.FileProblem is a ValueError
+            self.sigMessage.emit(f"Nothing written: the backup could not be saved ({exc}).")
+            self.sigWritesDone.emit([])
+            return
+        if writes:
+            self._send_writes(writes)
 
     @Slot(object)
     def _on_write(self, entry: dict) -> None:

@@ -4,7 +4,7 @@ On a real HA-655 the servo-ON input and the command pulses come from the control
 and the technician turns the output by hand for the encoder and sensor checks. The embedded
 simulated drive (``sim://``) has no controller and no hands, so this toolbar plays them: shown
 for an embedded drive only, never for a real one. Everything goes through the link thread
-(``Cmd.SIM_PANEL``); the result comes back as a message.
+(``SimPanelRequest``); the result comes back as a message.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from __future__ import annotations
 from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import QCheckBox, QDoubleSpinBox, QLabel, QPushButton, QToolBar, QWidget
 
-from fha_studio.gui.link import Cmd, CommandResult, LinkController, SimPanelAction
+from fha_studio.gui.link import LinkController, LinkReply, SimPanelAction, SimPanelRequest
 from fha_studio.gui.messages import Level
 
 #: The angle of one controller command and one hand turn, output degrees (defaults).
@@ -30,7 +30,6 @@ class SimPanelBar(QToolBar):
         self.setObjectName("simPanel")
         self.setMovable(False)
         self.link = link
-        self._tokens: set[int] = set()
         title = QLabel("  Simulated drive — controller (CN2): ")
         title.setToolTip("The embedded simulated drive has no controller: these play its CN2 inputs "
                          "and your hands. A real drive gets them from outside FHA Studio.")
@@ -64,7 +63,6 @@ class SimPanelBar(QToolBar):
         self.brake_check = QCheckBox("Brake released (24 V)")
         self.brake_check.toggled.connect(lambda on: self._send(SimPanelAction.BRAKE_RELEASED, on))
         self.addWidget(self.brake_check)
-        link.sigResult.connect(self._on_result)
         link.sigStatus.connect(self._on_status)
         self.set_available(False)
 
@@ -73,8 +71,8 @@ class SimPanelBar(QToolBar):
         self.setVisible(available)
         self.setEnabled(available)
 
-    def _send(self, action: SimPanelAction, value: object) -> None:
-        self._tokens.add(self.link.send(Cmd.SIM_PANEL, action, value))
+    def _send(self, action: SimPanelAction, value: float | bool) -> None:
+        self.link.send(SimPanelRequest(action, value), self._on_reply)
 
     @Slot(bool)
     def _servo_toggled(self, on: bool) -> None:
@@ -90,11 +88,7 @@ class SimPanelBar(QToolBar):
         self.turn_button.setToolTip("Switch the servo off to turn the axis by hand" if status.servo_on
                                     else "Turn the output flange by hand (servo off, brake released)")
 
-    @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if result.token not in self._tokens:
-            return
-        self._tokens.discard(result.token)
+    def _on_reply(self, result: LinkReply[str]) -> None:
         if result.ok:
             self.sigMessage.emit(f"Simulated drive: {result.value}.", Level.INFO)
         else:

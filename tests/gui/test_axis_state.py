@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from fha_studio.gui.connect_dialog import ConnectDialog
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import MoveBy, Servo
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.transport import pipe_pair
@@ -25,8 +25,8 @@ def documented_drive():
 
     def documented(request):
         if isinstance(request, p.Request) and request.command is p.Command.DGR:
-            return p.Reply((str(DGR_COUNTS),))
-        return p.Reply((), p.Status.REJECTED)
+            return p.LinkReply((str(DGR_COUNTS),))
+        return p.LinkReply((), p.Status.REJECTED)
 
     def open_client(url, baud):
         host, end = pipe_pair("documented")
@@ -78,10 +78,10 @@ def test_a_live_scope_rescales_at_once_when_the_actuator_changes(make_window, qt
 def test_jog_page_scales_position_pulses_with_the_actuator_typed_after_connecting(make_window, qtbot):
     window = make_window(connect="sim://FHA-25C-50-US250?paced=0")
     link = window.link
-    link.send(Cmd.SERVO, True)
+    link.send(Servo(True))
     qtbot.waitUntil(lambda: link.servo_on, timeout=10000)
-    with qtbot.waitSignal(link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.MOVE_BY, timeout=10000):
-        link.send(Cmd.MOVE_BY, 30.0)
+    with qtbot.waitSignal(link.sigResult, check_params_cb=lambda r: r.answers(MoveBy), timeout=10000):
+        link.send(MoveBy(30.0))
     qtbot.waitUntil(lambda: link.status.position_pulse and link.status.position_pulse > 40000, timeout=15000)
     type_actuator(window, "FHA-32C-100-US250")  # another actuator: 1 000 000 pulses per output turn
     page = window.show_page("jog")

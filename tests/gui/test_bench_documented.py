@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import SimPanelRequest
 from fha_studio.hardware.sim import cn2_live
 
 CODE = "FHA-25C-50-US250"
@@ -18,7 +18,7 @@ COUNTS_PER_OUTPUT_TURN = 500000  # 10000 counts per motor turn (x4) x 50
 
 
 def _panel_done(window, qtbot, action) -> None:
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SIM_PANEL,
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
                           timeout=10000) as done:
         action()
     assert done.args[0].ok, done.args[0].error

@@ -10,7 +10,7 @@ import time
 import pytest
 from PySide6.QtCore import Qt
 
-from fha_studio.gui.link import PROBE_INTERVAL_MS, SERVO_ON_NOTE, SERVO_ON_PROBE_MS, Cmd
+from fha_studio.gui.link import PROBE_INTERVAL_MS, SERVO_ON_NOTE, SERVO_ON_PROBE_MS, SimPanelRequest
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.transport import pipe_pair
 from tests.support.scripted import ScriptedDrive, documented_only
@@ -31,7 +31,7 @@ def window(make_window, qtbot):
 
 
 def switch_servo(window, qtbot, on: bool) -> None:
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SIM_PANEL,
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
                           timeout=10000) as done:
         window.sim_panel.servo_check.setChecked(on)
     assert done.args[0].ok, done.args[0].error
@@ -128,11 +128,11 @@ SENSOR_URL = "sim://FHA-25C-50-S248?paced=0&profile=documented&oww_clear_s=1&sen
 
 
 def panel(window, qtbot, action, value):
-    from fha_studio.gui.link import SimPanelAction
+    from fha_studio.gui.link import SimPanelAction, SimPanelRequest
 
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SIM_PANEL,
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
                           timeout=10000) as done:
-        window.link.send(Cmd.SIM_PANEL, SimPanelAction(action), value)
+        window.link.send(SimPanelRequest(SimPanelAction(action), value))
     assert done.args[0].ok, done.args[0].error
     return done.args[0].value
 

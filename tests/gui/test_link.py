@@ -6,7 +6,20 @@ import threading
 
 import pytest
 
-from fha_studio.gui.link import Cmd, CommandResult, LinkController, LinkWorker, NotConnected
+from fha_studio.gui.link import (
+    ClearAlarm,
+    LinkController,
+    LinkReply,
+    LinkRequest,
+    LinkWorker,
+    NotConnected,
+    PowerCycle,
+    ReadAlarmHistory,
+    Servo,
+    Stop,
+    WriteParameters,
+)
+from fha_studio.gui.link_requests import REQUESTS
 from fha_studio.gui.pages.scope.driver import ScopeCmd, ScopeDriver
 from fha_studio.hardware.api import CommandRejected, DriveRefused, ServoOnRefused
 from tests.gui.fake_drive import FakeDriveClient
@@ -14,7 +27,7 @@ from tests.gui.fake_drive import FakeDriveClient
 
 def test_every_link_command_has_a_handler(qtbot):
     worker = LinkWorker(threading.Event())
-    assert set(worker.handlers) == set(Cmd)
+    assert set(worker.handlers) == set(REQUESTS)
 
 
 def test_every_scope_command_has_a_handler(qtbot):
@@ -41,19 +54,19 @@ def link(qtbot):
         assert controller.shutdown(10000)
 
 
-def _result_of(qtbot, link: LinkController, cmd: Cmd, *args) -> CommandResult:
-    token = None
-    with qtbot.waitSignal(link.sigResult, timeout=10000, check_params_cb=lambda r: r.token == token) as got:
-        token = link.send(cmd, *args)
-    return got.args[0]
+def _result_of(qtbot, link: LinkController, request: LinkRequest) -> LinkReply:
+    got: list[LinkReply] = []
+    link.send(request, got.append)  # the reply goes to whoever asked
+    qtbot.waitUntil(lambda: bool(got), timeout=10000)
+    return got[0]
 
 
 def test_a_command_without_a_link_fails_as_not_connected(qtbot, link):
     controller = link()
-    result = _result_of(qtbot, controller, Cmd.SERVO, True)
+    result = _result_of(qtbot, controller, Servo(True))
     assert not result.ok and result.error_type is NotConnected and result.error == "not connected"
     assert not controller.busy  # STOP without a link answers too: nothing stays pending
-    assert _result_of(qtbot, controller, Cmd.STOP).ok
+    assert _result_of(qtbot, controller, Stop()).ok
     assert not controller.busy
 
 
@@ -61,12 +74,12 @@ def test_failures_carry_the_exception_class(qtbot, link, fake):
     controller = link(lambda url, baud: fake)
     with qtbot.waitSignal(controller.sigConnected, timeout=10000):
         controller.open("fake://")
-    assert _result_of(qtbot, controller, Cmd.SERVO, True).ok
-    refused = _result_of(qtbot, controller, Cmd.POWER_CYCLE)
+    assert _result_of(qtbot, controller, Servo(True)).ok
+    refused = _result_of(qtbot, controller, PowerCycle())
     assert refused.error_type is ServoOnRefused and refused.failed_with(DriveRefused)
     assert "servo is on" in refused.error
     fake.raise_alarm(71)  # needs a power cycle
-    rejected = _result_of(qtbot, controller, Cmd.CLEAR_ALARM)
+    rejected = _result_of(qtbot, controller, ClearAlarm())
     assert rejected.failed_with(CommandRejected) and not rejected.failed_with(ServoOnRefused)
 
 
@@ -75,8 +88,8 @@ def test_writes_are_reported_from_the_typed_write_result(qtbot, link, fake):
     with qtbot.waitSignal(controller.sigConnected, timeout=10000):
         controller.open("fake://")
     direction = fake.model.by_key("rotary_direction")
-    writes = [(direction.mode.value, direction.number, 1)]
-    result = _result_of(qtbot, controller, Cmd.WRITE_PARAMETERS, writes)
+    writes = ((direction.mode, direction.number, 1),)
+    result = _result_of(qtbot, controller, WriteParameters(writes))
     [entry] = result.value
     assert entry["old"] == 0 and entry["read_back"] == 1 and entry["verified"]
     assert entry["restart_required"] and "power cycle" in entry["message"]
@@ -87,5 +100,5 @@ def test_alarm_history_is_alarm_records(qtbot, link, fake):
     with qtbot.waitSignal(controller.sigConnected, timeout=10000):
         controller.open("fake://")
     fake.raise_alarm(20)
-    result = _result_of(qtbot, controller, Cmd.ALARM_HISTORY)
+    result = _result_of(qtbot, controller, ReadAlarmHistory())
     assert [(r.code, r.seconds_since_power_on) for r in result.value] == [(20, 123)]

@@ -14,7 +14,7 @@ import pytest
 from PySide6.QtCore import QCoreApplication
 from PySide6.QtWidgets import QApplication
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import ClearAlarm, Servo, Stop
 from fha_studio.logic.machine import MachineProject
 from fha_studio.logic.register import Register
 from fha_studio.logic.register.words import value_text
@@ -193,12 +193,12 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
 
     # STOP reaches every axis that can be stopped: both tables, not the documented-only tilt
     for w in (table, twin):
-        w.link.send(Cmd.SERVO, True)
+        w.link.send(Servo(True))
     qtbot.waitUntil(lambda: table.link.servo_on and twin.link.servo_on, timeout=10000)
     with qtbot.waitSignals(
         [table.link.sigResult, twin.link.sigResult],
         timeout=10000,
-        check_params_cbs=[lambda r: r.cmd is Cmd.STOP] * 2,
+        check_params_cbs=[lambda r: r.answers(Stop)] * 2,
     ):
         twin.stop_button.click()  # the STOP of any axis's pages is the machine's STOP
     said = [m.text for m in twin.message_area.messages if m.text.startswith("STOP sent")]
@@ -210,7 +210,7 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     with qtbot.waitSignals(
         [table.link.sigResult, twin.link.sigResult],
         timeout=10000,
-        check_params_cbs=[lambda r: r.cmd is Cmd.STOP] * 2,
+        check_params_cbs=[lambda r: r.answers(Stop)] * 2,
     ):
         twin.show_page("scope").jog_panel.stop_button.click()  # the scope's Move panel: the same STOP
 
@@ -331,7 +331,7 @@ def test_alarms_recordings_and_model_checks_go_into_the_register(make_machine, q
     qtbot.waitUntil(lambda: any(e.kind == "alarm" for e in register.history(ref)), timeout=15000)
     alarm = next(e for e in register.history(ref) if e.kind == "alarm")
     assert alarm.text.startswith("alarm 20: ") and alarm.who == "ben"
-    feed.link.send(Cmd.CLEAR_ALARM)
+    feed.link.send(ClearAlarm())
     qtbot.waitUntil(lambda: feed.link.status is not None and feed.link.status.alarm_code == 0, timeout=15000)
 
     # a move captured in the scope, handed to the model check
@@ -390,7 +390,7 @@ def test_closing_with_a_servo_on_asks_and_cancel_keeps_every_link(make_machine, 
     window.connect_all()
     x, y = window.axis_windows
     qtbot.waitUntil(lambda: x.link.connected and y.link.connected, timeout=15000)
-    y.link.send(Cmd.SERVO, True)
+    y.link.send(Servo(True))
     qtbot.waitUntil(lambda: y.link.servo_on, timeout=10000)
     asked = []
 

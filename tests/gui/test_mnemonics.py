@@ -65,7 +65,7 @@ def test_every_page_letter_is_unique_on_every_page_and_switches_at_the_first_pre
 
 def test_space_jogs_on_the_jog_buttons_only(make_window, qtbot):
     """Space held on FWD jogs; on Move or Servo ON (focus left there) it does nothing."""
-    from fha_studio.gui.link import Cmd
+    from fha_studio.gui.link import Jog, MoveBy, Servo
 
     window = make_window(connect="sim://FHA-25C-50-US250?paced=0")
     page = window.show_page("jog")
@@ -73,15 +73,15 @@ def test_space_jogs_on_the_jog_buttons_only(make_window, qtbot):
     qtbot.waitUntil(lambda: motion.move_button.isEnabled() or motion.servo_on_button.isEnabled(),
                     timeout=10000)
     sent = []
-    window.link.sigCommand.connect(lambda command: sent.append(command.cmd))
+    window.link.sigCommand.connect(lambda command: sent.append(type(command.request)))
     for button in (page.motion.move_button, page.motion.servo_on_button):
         button.setFocus()
         qtbot.keyPress(button, Qt.Key.Key_Space)
         qtbot.keyRelease(button, Qt.Key.Key_Space)
     qtbot.wait(50)
-    assert Cmd.MOVE_BY not in sent and Cmd.SERVO not in sent
+    assert MoveBy not in sent and Servo not in sent
     page.motion.fwd_button.setEnabled(True)
     page.motion.fwd_button.setFocus()
     qtbot.keyPress(page.motion.fwd_button, Qt.Key.Key_Space)
-    qtbot.waitUntil(lambda: Cmd.JOG in sent, timeout=10000)
+    qtbot.waitUntil(lambda: Jog in sent, timeout=10000)
     qtbot.keyRelease(page.motion.fwd_button, Qt.Key.Key_Space)

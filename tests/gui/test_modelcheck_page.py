@@ -11,7 +11,7 @@ import json
 
 import pytest
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import Call
 from fha_studio.hardware import protocol as p
 from fha_studio.recording import RecordingError
 
@@ -45,7 +45,7 @@ def capture_a_move(window, qtbot) -> None:
     scope.arm_trace()
     qtbot.waitUntil(lambda: "waiting for the trigger" in scope.trace_state.text(), timeout=10000)
     with qtbot.waitSignal(scope.sigTraceDone, timeout=30000):
-        window.link.send(Cmd.CALL, _back_and_forth)
+        window.link.send(Call(_back_and_forth))
 
 
 @pytest.mark.slow

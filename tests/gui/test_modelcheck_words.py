@@ -8,7 +8,7 @@ import re
 import numpy as np
 import pytest
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import Call
 
 CODE = "FHA-25C-50-US250"
 SNAKE_CASE = re.compile(r"\b[a-z]+(?:_[a-z0-9]+)+\b")
@@ -26,8 +26,8 @@ def test_the_readme_flow_with_the_default_capture_is_not_refused(make_window, qt
     window = make_window(connect="sim://FHA-25C-50-US250?paced=0")
     scope = window.show_page("scope").view
     with qtbot.waitSignal(window.link.sigResult, timeout=20000,
-                          check_params_cb=lambda r: r.cmd == Cmd.CALL) as on:
-        window.link.send(Cmd.CALL, _servo_on)
+                          check_params_cb=lambda r: r.answers(Call)) as on:
+        window.link.send(Call(_servo_on))
     assert on.args[0].error is None, on.args[0].error
     assert window.session.state.load_inertia_kgm2 == 0.0
     with qtbot.waitSignal(scope.sigTestDone, timeout=60000) as test:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from PySide6.QtCore import Qt
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import Jog, Servo
 from fha_studio.gui.motion_controls import NOT_CONNECTED_TEXT, MotionControls, MotionLayout
 
 
@@ -24,12 +24,12 @@ def test_the_jog_page_and_the_scope_panel_show_one_widget_that_says_why_nothing_
 def test_a_held_jog_on_the_jog_page_is_let_go_when_the_servo_goes_off(make_window, qtbot):
     window = make_window(connect="sim://FHA-25C-50-US250?paced=0")
     motion = window.show_page("jog").motion
-    window.link.send(Cmd.SERVO, True)
+    window.link.send(Servo(True))
     qtbot.waitUntil(lambda: motion.fwd_button.isEnabled(), timeout=10000)
     qtbot.mousePress(motion.fwd_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: (window.link.status.speed_rpm or 0) > 1.0, timeout=10000)
     jogs: list[float] = []
-    window.link.sigCommand.connect(lambda c: c.cmd is Cmd.JOG and jogs.append(c.args[0]))
-    window.link.send(Cmd.SERVO, False)
+    window.link.sigCommand.connect(lambda c: isinstance(c.request, Jog) and jogs.append(c.request.speed_rpm))
+    window.link.send(Servo(False))
     qtbot.waitUntil(lambda: not motion.fwd_button.isEnabled(), timeout=10000)
     assert not motion.jog_held and jogs == [0.0]  # let go once: the lease is not renewed

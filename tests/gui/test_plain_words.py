@@ -20,7 +20,7 @@ from PySide6.QtWidgets import (
     QTextEdit,
 )
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import MoveBy
 from fha_studio.gui.pages.registry import PAGES
 
 SIM_URL = "sim://FHA-25C-50-US250?paced=0"
@@ -161,7 +161,7 @@ def test_every_page_speaks_the_manuals_words(make_window, qtbot):
     assert model.setData(model.index(model.row_of("in_position_range"), 3), "20")
     with qtbot.waitSignal(window.session.sigWritesDone, timeout=15000):
         parameters.write_changed()
-    window.link.send(Cmd.MOVE_BY, 10.0)  # servo off: refused
+    window.link.send(MoveBy(10.0))  # servo off: refused
     qtbot.waitUntil(lambda: "failed" in window.message_area.text_label.text(), timeout=15000)
     window.link._worker._client.transaction.transport.inner.sim_drive.raise_alarm(20)
     qtbot.waitUntil(lambda: window.alarm_lamp.state is True, timeout=15000)

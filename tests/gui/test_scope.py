@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt, QTimer
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import Call, MoveBy, Servo, SetMoveSpeed, Stop
 from fha_studio.gui.pages.scope.driver import ScopeCmd, ScopeController
 from fha_studio.gui.pages.scope.view import ScopeContext, ScopeView
 from fha_studio.hardware import protocol as p
@@ -208,8 +208,8 @@ def test_a_documented_only_drive_shows_dgr_position_and_backs_off_with_the_servo
 
     def documented(request):
         if isinstance(request, p.Request) and request.command is p.Command.DGR:
-            return p.Reply((), p.Status.SERVO_ON) if servo["on"] else p.Reply(("204800",))
-        return p.Reply((), p.Status.REJECTED)
+            return p.LinkReply((), p.Status.SERVO_ON) if servo["on"] else p.LinkReply(("204800",))
+        return p.LinkReply((), p.Status.REJECTED)
 
     host, end = pipe_pair("documented")
     drive = ScriptedDrive(end, documented)
@@ -244,7 +244,7 @@ def test_the_main_window_scope_runs_in_the_link_thread(make_window, qtbot):
     qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=10000)
     # the line is the scope's: the worker's status poll slows down while live
     qtbot.waitUntil(lambda: window.link._worker._poll_interval_ms == 500, timeout=10000)
-    window.link.send(Cmd.SERVO, True)
+    window.link.send(Servo(True))
     qtbot.waitUntil(lambda: window.link.servo_on, timeout=10000)
     window.link.jog_press(20.0)
     try:
@@ -270,10 +270,10 @@ def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_w
     page = window.show_page("scope")
     view = page.view
     qtbot.waitUntil(lambda: view.indicator_text() == "NOT LIVE: not started", timeout=10000)
-    link.send(Cmd.SERVO, True)
+    link.send(Servo(True))
     qtbot.waitUntil(lambda: link.servo_on, timeout=10000)
-    link.send(Cmd.SET_MOVE_SPEED, 5.0)
-    link.send(Cmd.MOVE_BY, 360.0)  # 12 s at 5 r/min: the axis moves through the whole read-out
+    link.send(SetMoveSpeed(5.0))
+    link.send(MoveBy(360.0))  # 12 s at 5 r/min: the axis moves through the whole read-out
     qtbot.waitUntil(lambda: link.status is not None and abs(link.status.speed_rpm or 0.0) > 4.0,
                     timeout=10000)
     # two channels, 2048 samples at the servo rate: 32 packed blocks, each ~0.15 s of line time
@@ -287,12 +287,12 @@ def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_w
     done = []
     view.sigTraceDone.connect(done.append)
     sent = []  # requests on the line, seen in the link thread (the client's bus monitor)
-    link.send(Cmd.CALL, lambda c: setattr(c, "trace_packet", lambda out, data: out and sent.append(data)))
+    link.send(Call(lambda c: setattr(c, "trace_packet", lambda out, data: out and sent.append(data))))
     view.arm_trace()
     qtbot.waitUntil(lambda: view.trace_state.text().startswith("reading out 2048 samples"), timeout=10000)
     qtbot.waitUntil(lambda: sum(b"TRP" in d for d in sent) >= 2, timeout=10000)  # block 0 is in
     stops = []
-    link.sigResult.connect(lambda r: stops.append((time.monotonic(), r)) if r.cmd is Cmd.STOP else None)
+    link.sigResult.connect(lambda r: stops.append((time.monotonic(), r)) if r.answers(Stop) else None)
     pressed = time.monotonic()
     qtbot.keyClick(window, Qt.Key.Key_Escape)  # the main window's STOP
     qtbot.waitUntil(lambda: bool(stops), timeout=10000)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import Servo
 
 SIM_URL = "sim://FHA-25C-50-US250?paced=0"
 
@@ -33,7 +33,7 @@ def test_jog_from_the_scope_panel_moves_the_axis_the_plot_shows_it_and_release_s
     assert "Servo OFF" in panel.message.text()
     view.start_live()
     qtbot.waitUntil(lambda: view.indicator_text() == "LIVE", timeout=10000)
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO, timeout=10000):
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(Servo), timeout=10000):
         panel.servo_on_button.click()
     qtbot.waitUntil(lambda: panel.fwd_button.isEnabled(), timeout=10000)
     start = float(latest(view, "feedback_position")[-1])
@@ -54,7 +54,7 @@ def test_jog_from_the_scope_panel_moves_the_axis_the_plot_shows_it_and_release_s
 def test_hiding_the_scope_lets_go_of_a_held_jog(scope_window, qtbot):
     window, page = scope_window
     panel = page.jog_panel
-    window.link.send(Cmd.SERVO, True)
+    window.link.send(Servo(True))
     qtbot.waitUntil(lambda: panel.fwd_button.isEnabled(), timeout=10000)
     panel.speed_spin.setValue(10.0)
     qtbot.mousePress(panel.fwd_button, Qt.MouseButton.LeftButton)
@@ -67,7 +67,7 @@ def test_hiding_the_scope_lets_go_of_a_held_jog(scope_window, qtbot):
 def test_stop_on_the_scope_panel_stops_a_move(scope_window, qtbot):
     window, page = scope_window
     panel = page.jog_panel
-    window.link.send(Cmd.SERVO, True)
+    window.link.send(Servo(True))
     qtbot.waitUntil(lambda: panel.move_button.isEnabled(), timeout=10000)
     panel.angle_spin.setValue(900.0)
     panel.speed_spin.setValue(20.0)
@@ -166,7 +166,7 @@ def test_the_toolbar_does_not_shift_when_the_indicator_text_changes(scope_window
 def test_space_on_the_scope_page_acts_only_on_the_jog_buttons(scope_window, qtbot):
     window, page = scope_window
     panel = page.jog_panel
-    window.link.send(Cmd.SERVO, True)
+    window.link.send(Servo(True))
     qtbot.waitUntil(lambda: panel.move_button.isEnabled(), timeout=10000)
     pressed = []
     for button in (panel.move_button, panel.servo_off_button, page.view.live_button):

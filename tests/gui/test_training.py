@@ -7,9 +7,10 @@ import re
 
 from PySide6.QtWidgets import QWidget
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import ReadParameters, Servo, WriteParameters
 from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.training import ScoreSheetDialog, briefing_html
+from fha_studio.hardware.parameters import Mode
 from fha_studio.logic.training.scenario import find_scenario
 from tests.gui.test_plain_words import visible_texts
 
@@ -22,10 +23,9 @@ GIVEAWAYS = re.compile(
 )
 
 
-def _send(qtbot, window, cmd, *args):
+def _send(qtbot, window, request):
     results = []
-    token = window.link.send(cmd, *args)
-    window.link.sigResult.connect(lambda r: results.append(r) if r.token == token else None)
+    window.link.send(request, results.append)
     qtbot.waitUntil(lambda: bool(results), timeout=WAIT_MS)
     return results[0]
 
@@ -54,14 +54,14 @@ def test_a_trainee_finds_one_fault_and_misses_the_other(make_window, qtbot, tmp_
     assert not GIVEAWAYS.search(briefing_html(scenario))
 
     # the trainee reads parameter 6, sees it is far too low and writes the default back
-    read = _send(qtbot, window, Cmd.READ_PARAMETERS, [("system", 6)])
+    read = _send(qtbot, window, ReadParameters(((Mode.SYSTEM, 6),)))
     assert read.ok, read.error
-    wrote = _send(qtbot, window, Cmd.WRITE_PARAMETERS, [("system", 6, 500)])
+    wrote = _send(qtbot, window, WriteParameters(((Mode.SYSTEM, 6, 500),)))
     assert wrote.ok, wrote.error
     # ... but never checks the brake, and writes a parameter with the servo on (refused)
-    assert _send(qtbot, window, Cmd.SERVO, True).ok
-    refused = _send(qtbot, window, Cmd.WRITE_PARAMETERS, [("system", 8, 0)])
-    assert _send(qtbot, window, Cmd.SERVO, False).ok
+    assert _send(qtbot, window, Servo(True)).ok
+    refused = _send(qtbot, window, WriteParameters(((Mode.SYSTEM, 8, 0),)))
+    assert _send(qtbot, window, Servo(False)).ok
 
     sheet = window.training.finish("Parameter 6 was 1: alarm 60 on any move. Set it to 500.")
     assert not window.training.running

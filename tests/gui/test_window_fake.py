@@ -9,7 +9,7 @@ import re
 import pytest
 from PySide6.QtCore import Qt
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import Servo
 from fha_studio.hardware.protocol import Command
 from tests.gui.fake_drive import FakeDriveClient
 
@@ -73,7 +73,7 @@ def test_rotary_direction_written_read_back_and_power_cycle_offered(window, fake
 
 def test_jog_hold_runs_release_stops_and_stop_key(window, fake, qtbot):
     page = window.show_page("jog")
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO):
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(Servo)):
         page.motion.servo_on_button.click()
     qtbot.waitUntil(lambda: page.motion.fwd_button.isEnabled(), timeout=10000)
     qtbot.mousePress(page.motion.fwd_button, Qt.MouseButton.LeftButton)
@@ -112,7 +112,7 @@ def test_lost_link_is_shown_within_a_second(window, fake, qtbot):
 def test_closing_with_the_servo_on_asks_and_cancel_keeps_the_window(window, fake, qtbot, monkeypatch):
     from PySide6.QtWidgets import QMessageBox
 
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO):
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(Servo)):
         window.jog_page.motion.servo_on_button.click()
     qtbot.waitUntil(lambda: window.link.servo_on, timeout=10000)
     asked = []

@@ -6,7 +6,16 @@ from __future__ import annotations
 import pytest
 from PySide6.QtCore import Qt
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import (
+    ClearAlarm,
+    MoveBy,
+    PowerCycle,
+    ReadParameters,
+    Servo,
+    SetInputs,
+    Stop,
+    WriteParameters,
+)
 
 SIM_URL = "sim://FHA-25C-50-US250?paced=0"
 
@@ -24,7 +33,7 @@ def window(make_window, qtbot):
 
 
 def servo_on(window, qtbot):
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO, timeout=10000):
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(Servo), timeout=10000):
         window.jog_page.motion.servo_on_button.click()
     qtbot.waitUntil(lambda: window.link.servo_on, timeout=10000)
 
@@ -50,12 +59,12 @@ def test_rotary_direction_written_power_cycled_and_read_back(window, qtbot):
     assert "power cycle" in page.status_label.text()
     assert page.power_cycle_button.isVisible()
     with qtbot.waitSignal(
-        window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.POWER_CYCLE, timeout=10000
+        window.link.sigResult, check_params_cb=lambda r: r.answers(PowerCycle), timeout=10000
     ):
         page.power_cycle_button.click()
     # read back from the drive after the power cycle: the value is still there (EEPROM)
     window.state.forget_drive()  # what was read before is forgotten: the value must come from the drive
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.READ_PARAMETERS):
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(ReadParameters)):
         window.session.read_all()
     assert page.drive_value() == 1
     assert "counter-clockwise" in page.drive_label.text()
@@ -134,8 +143,8 @@ def test_stop_key_stops_a_move(window, qtbot):
 
 def test_inputs_shown_live(window, qtbot):
     page = window.show_page("jog")
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SET_INPUTS):
-        window.link.send(Cmd.SET_INPUTS, {"fwd_inhibit": True})
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SetInputs)):
+        window.link.send(SetInputs({"fwd_inhibit": True}))
     from fha_studio.hardware.protocol import IoBit
 
     qtbot.waitUntil(lambda: page.signal_lamps[IoBit.FWD_INHIBIT].state is True, timeout=10000)
@@ -165,7 +174,7 @@ def test_alarm_that_needs_a_power_cycle_says_so(window, qtbot):
     page = window.show_page("alarms")
     sim_drive(window).raise_alarm(50)
     qtbot.waitUntil(lambda: page.current_code == 50, timeout=10000)
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.CLEAR_ALARM):
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(ClearAlarm)):
         page.clear_button.click()
     assert "power cycle" in page.result_label.text()
     assert page.current_code == 50
@@ -186,7 +195,7 @@ def test_stop_and_failures_are_seen_in_the_message_area_and_kept_in_its_log(wind
     message area is not covered by the status bar's other widgets, and every message is kept."""
     window.resize(1366, 740)
     area = window.message_area
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.STOP, timeout=10000):
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(Stop), timeout=10000):
         qtbot.keyClick(window, Qt.Key.Key_Escape)
     qtbot.waitUntil(lambda: "STOP done" in area.text_label.text(), timeout=10000)
     assert area.isVisible() and not area.text_label.visibleRegion().isEmpty()
@@ -195,7 +204,7 @@ def test_stop_and_failures_are_seen_in_the_message_area_and_kept_in_its_log(wind
         window.caps_label.parentWidget().mapTo(window, window.caps_label.parentWidget().rect().topLeft())
     )
     assert not text_rect.intersects(caps_rect)
-    window.link.send(Cmd.MOVE_BY, 10.0)  # servo off: the drive refuses to move
+    window.link.send(MoveBy(10.0))  # servo off: the drive refuses to move
     refused = "Move failed: the drive refused to move by an angle"
     qtbot.waitUntil(lambda: refused in area.text_label.text(), timeout=10000)
     assert "#b00020" in area.text_label.styleSheet()
@@ -213,10 +222,10 @@ def test_parameter_mode_writes_are_prevented_up_front_while_the_servo_is_on(wind
     assert not page.write_changed_button.isEnabled() and not page.write_all_button.isEnabled()
     assert "servo off" in page.servo_note.text()
     sent = []
-    window.link.sigCommand.connect(lambda command: sent.append(command.cmd))
+    window.link.sigCommand.connect(lambda command: sent.append(type(command.request)))
     page.write_changed()  # e.g. a keyboard shortcut: still refused, nothing sent
-    assert Cmd.WRITE_PARAMETERS not in sent and "Nothing written" in page.message.text()
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.cmd is Cmd.SERVO, timeout=10000):
+    assert WriteParameters not in sent and "Nothing written" in page.message.text()
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(Servo), timeout=10000):
         window.jog_page.motion.servo_off_button.click()
     qtbot.waitUntil(page.write_changed_button.isEnabled, timeout=10000)
     assert not page.servo_note.isVisible()
@@ -235,7 +244,7 @@ def test_after_the_power_cycle_nothing_is_pending(window, qtbot):
         return model.data(model.index(row, COLUMNS.index("State")))
 
     assert "power cycle needed" in state()
-    cycled = lambda r: r.cmd is Cmd.POWER_CYCLE  # noqa: E731
+    cycled = lambda r: r.answers(PowerCycle)  # noqa: E731
     with qtbot.waitSignal(window.link.sigResult, check_params_cb=cycled, timeout=10000):
         page.power_cycle_button.click()
     qtbot.waitUntil(lambda: "power cycle" not in state() and "restart" not in state(), timeout=10000)

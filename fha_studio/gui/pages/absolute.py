@@ -43,7 +43,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui.link import SERVO_ON_NOTE, Cmd, CommandResult, DriveStatus, LinkInfo
+from fha_studio.gui.link import SERVO_ON_NOTE, Call, DriveStatus, LinkInfo, LinkReply
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import data_dir
 from fha_studio.hardware.api import CommandNotSupported, CommandRejected, ServoOnRefused
@@ -86,12 +86,11 @@ class AbsolutePage(BasePage):
         self.servo_on: bool | None = None
         self.encoder: str = "unknown"  # "absolute" | "incremental" | "unknown"
         self.last_counts: int | None = None
-        self._pending: dict[int, Callable[[CommandResult], None]] = {}
         self._encoder_start: int | None = None
         self._direction_start: int | None = None
+        self._origin_token: int | None = None  # an OWW on its way
         self.dog_angles: dict[str, float] = {}
         self._build()
-        self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status)
         gui_session.state.sigActuatorChanged.connect(lambda _code: self._refresh())
         gui_session.state.sigFrontPanelChanged.connect(self._panel_value_changed)
@@ -368,21 +367,20 @@ class AbsolutePage(BasePage):
                                        + (f" {origin_reason}" if origin_reason else ""))
 
     def _pending_origin(self) -> bool:
-        return any(getattr(f, "__name__", "") == "_origin_done" for f in self._pending.values())
+        return self._origin_token is not None
 
     # -- reading -------------------------------------------------------------------------------
     def _read(self, then: Callable[[int], None]) -> None:
         if self.why_not():
             self._refresh()
             return
-        token = self.link.send(Cmd.CALL, _read_position)
-        self._pending[token] = partial(self._position_answer, then)
+        self.link.send(Call(_read_position), partial(self._position_answer, then))
 
-    def _position_answer(self, then: Callable[[int], None], result: CommandResult) -> None:
+    def _position_answer(self, then: Callable[[int], None], result: LinkReply[int]) -> None:
         if result.ok:
             self.encoder = "absolute"
-            self._set_position(result.value)
-            then(result.value)
+            self._set_position(result.answer)
+            then(result.answer)
         elif result.failed_with(ServoOnRefused):
             self.servo_on = True
             self.reason_label.setText(f"The {SERVO_ON_NOTE}: nothing read.")
@@ -393,12 +391,6 @@ class AbsolutePage(BasePage):
             self.reason_label.setText(f"The position could not be read: {result.error}")
             return
         self._refresh()
-
-    @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        handler = self._pending.pop(result.token, None)
-        if handler is not None:
-            handler(result)
 
     def _set_position(self, counts: int, polled: bool = False) -> None:
         self.last_counts = counts
@@ -544,14 +536,14 @@ class AbsolutePage(BasePage):
         if self.why_not() or self.encoder == "incremental":
             self._refresh()
             return
-        token = self.link.send(Cmd.CALL, partial(_set_origin, self.ratio))
-        self._pending[token] = self._origin_done
+        self._origin_token = self.link.send(Call(partial(_set_origin, self.ratio)), self._origin_done)
         self.origin_result.setText("OWW sent: waiting for the drive's acknowledgement (about 5 s) …")
         self._refresh()
 
-    def _origin_done(self, result: CommandResult) -> None:
+    def _origin_done(self, result: LinkReply[ab.OriginResult]) -> None:
+        self._origin_token = None
         if result.ok:
-            origin: ab.OriginResult = result.value
+            origin = result.answer
             self._set_position(origin.after_counts)
             detail = (f"multi-turn data cleared (acknowledged after {origin.oww_s:.1f} s); position before "
                       f"{origin.before_counts} counts, read back "

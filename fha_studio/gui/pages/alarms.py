@@ -20,7 +20,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio import clock
-from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
+from fha_studio.gui.link import ClearAlarm, DriveStatus, LinkInfo, LinkReply, PowerCycle, ReadAlarmHistory
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
 from fha_studio.hardware.api import AlarmRecord
@@ -172,11 +172,11 @@ class AlarmsPage(BasePage):
         layout.addWidget(history_box, 1)
 
         self.ack_button.clicked.connect(self.acknowledge)
-        self.clear_button.clicked.connect(lambda: self.link.send(Cmd.CLEAR_ALARM))
-        self.power_cycle_button.clicked.connect(lambda: self.link.send(Cmd.POWER_CYCLE))
-        self.refresh_button.clicked.connect(lambda: self.link.send(Cmd.ALARM_HISTORY))
+        self.clear_button.clicked.connect(lambda: self.link.send(ClearAlarm(), self._cleared))
+        self.power_cycle_button.clicked.connect(lambda: self.link.send(PowerCycle(), self._power_cycled))
+        self.refresh_button.clicked.connect(self._read_history)
         self.link.sigStatus.connect(self._on_status)
-        self.link.sigResult.connect(self._on_result)
+        self.link.sigPowerCycled.connect(lambda: self.result_label.setText("Power cycled."))
         self._show(None)
 
     # -- from the link ----------------------------------------------------------------------------
@@ -191,7 +191,7 @@ class AlarmsPage(BasePage):
             button.setToolTip(reason or button.toolTip())
         self.refresh_button.setEnabled(self.reports_alarms)
         if self.reports_alarms:
-            self.link.send(Cmd.ALARM_HISTORY)
+            self._read_history()
         self._show(self.current_code)
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
@@ -254,25 +254,31 @@ class AlarmsPage(BasePage):
             self._appeared_at[code] = clock.now_s() if previous is not None else 0.0
             self.unacknowledged = code
             self.sigAlarmAttention.emit(code, True)
-            self.link.send(Cmd.ALARM_HISTORY)
+            self._read_history()
         self._show(code)
 
-    @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if result.cmd is Cmd.ALARM_HISTORY and result.ok:
-            self._fill_history(result.value)
-        elif result.cmd is Cmd.CLEAR_ALARM:
-            if result.ok:
-                left = result.value
-                self.result_label.setText("Alarm cleared." if not left else f"Alarm {left} is still active.")
-            else:
-                self.result_label.setText(
-                    f"The drive did not clear the alarm ({result.error}). Only alarms 20 and 60 clear "
-                    "without a power cycle: remove the cause, then switch the driver's control power "
-                    "off and on."
-                )
-        elif result.cmd is Cmd.POWER_CYCLE:
-            self.result_label.setText("Power cycled." if result.ok else f"Power cycle failed: {result.error}")
+    @Slot()
+    def _read_history(self) -> None:
+        self.link.send(ReadAlarmHistory(), self._history_read)
+
+    def _history_read(self, result: LinkReply[list[AlarmRecord]]) -> None:
+        if result.ok:
+            self._fill_history(result.answer)
+
+    def _cleared(self, result: LinkReply[int]) -> None:
+        if result.ok:
+            left = result.value
+            self.result_label.setText("Alarm cleared." if not left else f"Alarm {left} is still active.")
+        else:
+            self.result_label.setText(
+                f"The drive did not clear the alarm ({result.error}). Only alarms 20 and 60 clear "
+                "without a power cycle: remove the cause, then switch the driver's control power "
+                "off and on."
+            )
+
+    def _power_cycled(self, result: LinkReply[None]) -> None:
+        if not result.ok:  # done: sigPowerCycled says so, whoever asked
+            self.result_label.setText(f"Power cycle failed: {result.error}")
 
     # -- showing ----------------------------------------------------------------------------------
     def _show(self, code: int | None) -> None:

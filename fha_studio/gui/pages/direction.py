@@ -17,7 +17,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.catalog.tables import default_rotary_direction, rotary_direction_setting
-from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
+from fha_studio.gui.link import DriveStatus, LinkInfo, LinkReply, PowerCycle
 from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.session import Session
 from fha_studio.gui.widgets import FlangeWidget, space_jogs_only
@@ -175,7 +175,7 @@ class DirectionPage(BasePage):
         session.state.sigParametersChanged.connect(self._values_changed)
         session.state.sigFrontPanelChanged.connect(self._values_changed)
         session.sigWritesDone.connect(self._writes_done)
-        self.link.sigResult.connect(self._on_result)
+        self.link.sigPowerCycled.connect(self._power_cycled)
         self.link.sigStatus.connect(self._on_status)
         self._stop_timer = QTimer(self)
         self._stop_timer.setSingleShot(True)
@@ -296,16 +296,16 @@ class DirectionPage(BasePage):
         if self.link.servo_on:
             self.status_label.setText("Switch the servo off before the power cycle.")
             return
-        self.link.send(Cmd.POWER_CYCLE)
+        self.link.send(PowerCycle())
 
-    @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if result.cmd is Cmd.POWER_CYCLE and result.ok:
-            self.power_cycle_button.setVisible(False)
-            self.status_label.setText(
-                "Power cycled: the new rotary direction is in effect. Check it live below."
-            )
-        elif result.cmd is Cmd.JOG and not result.ok and self._check_running:
+    @Slot()
+    def _power_cycled(self) -> None:
+        """Whoever asked for it: the new rotary direction is in effect now."""
+        self.power_cycle_button.setVisible(False)
+        self.status_label.setText("Power cycled: the new rotary direction is in effect. Check it live below.")
+
+    def _check_jog_answered(self, result: LinkReply[float]) -> None:
+        if not result.ok and self._check_running:
             self._stop_timer.stop()
             self._check_running = False
             self.check_result.setText(f"The drive refused the jog: {result.error}")
@@ -322,7 +322,7 @@ class DirectionPage(BasePage):
         self.check_result.setText("Jogging FWD … watch the flange.")
         for b in (self.seen_cw, self.seen_ccw, self.seen_none):
             b.setEnabled(False)
-        self.link.jog_press(CHECK_SPEED_RPM)
+        self.link.jog_press(CHECK_SPEED_RPM, self._check_jog_answered)
         self._stop_timer.start(CHECK_JOG_MS)
         self._update()
 

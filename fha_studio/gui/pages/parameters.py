@@ -30,7 +30,7 @@ from PySide6.QtWidgets import (
 
 from fha_studio import fileio
 from fha_studio.gui.diff_dialog import ParameterDiffDialog
-from fha_studio.gui.link import Cmd, CommandResult, LinkInfo
+from fha_studio.gui.link import LinkInfo, LinkReply, ParameterReadout, PowerCycle
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.parameter_text import MODE_WORDS, parse_value, range_text, value_text
 from fha_studio.gui.session import Session
@@ -457,7 +457,8 @@ class ParametersPage(BasePage):
         session.state.sigWriteLogChanged.connect(self._log_changed)
         session.state.sigFrontPanelChanged.connect(self._update_buttons)
         session.sigWritesDone.connect(self._writes_done)
-        self.link.sigResult.connect(self._on_result)
+        session.sigParametersRead.connect(self._parameters_read)
+        self.link.sigPowerCycled.connect(self._power_cycled)
         self.link.sigStatus.connect(self._on_status_for_buttons)
         self.link.sigBusyChanged.connect(lambda _b: self._update_buttons())
         self._update_buttons()
@@ -589,33 +590,35 @@ class ParametersPage(BasePage):
         if self.link.servo_on:
             QMessageBox.information(self, "Servo is on", "Switch the servo off before the power cycle.")
             return
-        self.link.send(Cmd.POWER_CYCLE)
+        self.link.send(PowerCycle(), self._power_cycle_answered)
 
     @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if result.cmd is Cmd.READ_PARAMETERS:
-            if result.ok:
-                errors = result.value.errors
-                n = len(result.value.values)
-                text = f"Read {n} item(s) from the drive."
-                if errors:
-                    text += " Not read: " + "; ".join(f"{m} {k}: {e}" for (m, k), e in errors.items())
-                self.message.setText(text)
-                self.message.setStyleSheet("color: #b00020;" if errors else "")
-            else:
-                self.message.setText(f"Reading failed: {result.error}")
-            self._update_buttons()
-        elif result.cmd is Cmd.POWER_CYCLE:
-            if result.ok:
-                self.model.restart_pending.clear()
-                self.restart_banner.setVisible(False)
-                self.model._all_changed()  # the State column: nothing pending any more
-                self.message.setText(
-                    "Power cycled: the restart-required items are now in effect. Reading back …"
-                )
-                self.session.read_all()
-            else:
-                self.message.setText(f"Power cycle failed: {result.error}")
+    def _parameters_read(self, result: LinkReply[ParameterReadout]) -> None:
+        """A read of the session's (this page's, or after a power cycle, or before a backup)."""
+        if result.ok and result.value is not None:
+            errors = result.value.errors
+            n = len(result.value.values)
+            text = f"Read {n} item(s) from the drive."
+            if errors:
+                text += " Not read: " + "; ".join(f"{m} {k}: {e}" for (m, k), e in errors.items())
+            self.message.setText(text)
+            self.message.setStyleSheet("color: #b00020;" if errors else "")
+        else:
+            self.message.setText(f"Reading failed: {result.error}")
+        self._update_buttons()
+
+    @Slot()
+    def _power_cycled(self) -> None:
+        """Whoever asked for it: the restart-required items are in effect; read them back."""
+        self.model.restart_pending.clear()
+        self.restart_banner.setVisible(False)
+        self.model._all_changed()  # the State column: nothing pending any more
+        self.message.setText("Power cycled: the restart-required items are now in effect. Reading back …")
+        self.session.read_all()
+
+    def _power_cycle_answered(self, result: LinkReply[None]) -> None:
+        if not result.ok:
+            self.message.setText(f"Power cycle failed: {result.error}")
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
         self._update_buttons()

@@ -8,7 +8,7 @@ import subprocess
 
 import pytest
 
-from fha_studio.gui.link import Cmd
+from fha_studio.gui.link import SetInputs
 from fha_studio.hardware.protocol import IoBit
 from fha_studio.logic.procedures import ProcedureSession
 from tests.gui.procedure_answers import answer_by_hand
@@ -87,7 +87,7 @@ def test_trainee_walks_inspection_and_wiring_with_a_failed_check_and_a_resume(wi
     def trainee(step):  # switches the brake's 24 V as the step asks (on the simulated drive: INP)
         if step.id in ("brake-releases", "brake-holds"):
             want = step.id == "brake-releases"
-            window.link.send(Cmd.SET_INPUTS, {"brake_released": want})
+            window.link.send(SetInputs({"brake_released": want}))
             qtbot.waitUntil(lambda: window.link.status.bit(IoBit.BRAKE_RELEASED) is want, timeout=15000)
 
     _walk(page, qtbot, "wiring", before=trainee)

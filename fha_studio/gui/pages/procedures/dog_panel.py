@@ -20,7 +20,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui.link import Cmd, DriveStatus
+from fha_studio.gui.link import Call, DriveStatus, LinkReply, MoveBy, Servo, SetInputs, SetMoveSpeed
 from fha_studio.gui.widgets import AMBER, Lamp
 from fha_studio.hardware.api import IoState
 from fha_studio.logic.procedures.sensor_dogs import SENSOR_NAMES, MoveRefused, SensorDogWizard
@@ -123,7 +123,6 @@ class SensorDogPanel(QWidget):
         layout.addLayout(typed_row)
         layout.addStretch(1)
         link.sigStatus.connect(self.on_status)
-        link.sigResult.connect(self._on_result)
         self.ratio = 0
         self.watching = True
 
@@ -213,7 +212,7 @@ class SensorDogPanel(QWidget):
             self.sigMessage.emit(str(exc))
             return
         if not self.link.servo_on:
-            self.link.send(Cmd.SERVO, True)
+            self.link.send(Servo(True))
         self._jogging = direction
         self.link.jog_press(direction * JOG_SPEED_RPM)
 
@@ -232,22 +231,22 @@ class SensorDogPanel(QWidget):
             self.sigMessage.emit(str(exc))
             return False
         if not self.link.servo_on:
-            self.link.send(Cmd.SERVO, True)
-        self.link.send(Cmd.SET_MOVE_SPEED, MOVE_SPEED_RPM)
-        self.link.send(Cmd.MOVE_BY, target_deg - self.wizard.angle_deg)
+            self.link.send(Servo(True))
+        self.link.send(SetMoveSpeed(MOVE_SPEED_RPM))
+        self.link.send(MoveBy(target_deg - self.wizard.angle_deg))
         return True
 
     # -- simulated drive ----------------------------------------------------------------------
     @Slot(bool)
     def _brake_toggled(self, on: bool) -> None:
-        self.link.send(Cmd.SET_INPUTS, {"brake_released": on})
+        self.link.send(SetInputs({"brake_released": on}))
 
     def set_dog_here(self) -> None:
         """Simulated drive: turn the dog (or disk) of the watched sensor to the present angle."""
         if self.wizard is None or self.wizard.angle_deg is None:
             return
         which, angle = _DOG_OF[self.sensor], self.wizard.angle_deg
-        self.link.send(Cmd.CALL, lambda client: client.set_sensor_angle(which, angle))
+        self.link.send(Call(lambda client: client.set_sensor_angle(which, angle)))
 
     # -- record -------------------------------------------------------------------------------
     def found_angle(self) -> float | None:
@@ -275,13 +274,9 @@ class SensorDogPanel(QWidget):
         if not self.ratio:
             self.sigMessage.emit("The actuator's ratio is not known: the counts cannot become an angle")
             return
-        self._dgr_token = self.link.send(Cmd.CALL, lambda client: client.absolute_position())
+        self.link.send(Call(lambda client: client.absolute_position()), self._dgr_answered)
 
-    @Slot(object)
-    def _on_result(self, result) -> None:
-        if result.token != getattr(self, "_dgr_token", None):
-            return
-        self._dgr_token = None
+    def _dgr_answered(self, result: LinkReply[int]) -> None:
         if not result.ok:
             from fha_studio.gui.link import SERVO_ON_NOTE
             from fha_studio.hardware.api import ServoOnRefused
@@ -291,7 +286,7 @@ class SensorDogPanel(QWidget):
             return
         from fha_studio.logic.absolute import output_deg, wrap_deg
 
-        angle = wrap_deg(output_deg(result.value, self.ratio))
+        angle = wrap_deg(output_deg(result.answer, self.ratio))
         self.angle_label.setText(f"Output angle (DGR, servo off): {angle:+.2f}°")
         self.sigRecord.emit(angle)
 

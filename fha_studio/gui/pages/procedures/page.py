@@ -37,7 +37,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui.link import Cmd, CommandResult, DriveStatus, LinkInfo
+from fha_studio.gui.link import Call, DriveStatus, LinkInfo, LinkReply, SetInputs
 from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
 from fha_studio.hardware.protocol import IoBit
@@ -111,7 +111,6 @@ class ProceduresPage(BasePage):
         self._live_memo: dict = {}  # a live check's state between two presses (the link thread uses it)
         self._relay = _SampleRelay(self)
         self._build()
-        self.link.sigResult.connect(self._on_result)
         self.link.sigStatus.connect(self._on_status)
         self.state.sigActuatorChanged.connect(self._axis_changed)
         self._relay.sigSample.connect(
@@ -231,7 +230,7 @@ class ProceduresPage(BasePage):
         self.sim_brake_check = QCheckBox("Simulated drive: brake supply 24 V on")
         self.sim_brake_check.setObjectName("sim_brake")
         self.sim_brake_check.toggled.connect(
-            lambda on: self.link.send(Cmd.SET_INPUTS, {"brake_released": on}) if self.link.connected else None
+            lambda on: self.link.send(SetInputs({"brake_released": on})) if self.link.connected else None
         )
         lv.addWidget(self.sim_brake_check)
         self.live_label = QLabel("")
@@ -462,7 +461,7 @@ class ProceduresPage(BasePage):
             _live_check_in_link_thread, step, self.context, dict(self.session.sensor_angles_deg), self._relay,
             self._live_memo
         )
-        self._live_token = self.link.send(Cmd.CALL, function)
+        self._live_token = self.link.send(Call(function), self._live_answered)
 
     @Slot(float, int)
     def _live_progress(self, angle_deg: float, io_bits: int) -> None:
@@ -479,17 +478,14 @@ class ProceduresPage(BasePage):
             f"{angle_deg:+.1f}°{sensors} …"
         )
 
-    @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
-        if result.token != self._live_token:
-            return
+    def _live_answered(self, result: LinkReply[Observation]) -> None:
         self._live_token = None
         self.live_button.setEnabled(True)
         if not result.ok:
             self.live_label.setText(f"The check could not run: {result.error}")
             self.sigLiveDone.emit(None)
             return
-        observation: Observation = result.value
+        observation = result.answer
         self.live_label.setText(observation.detail)
         if observation.available:
             self.answer(observation)

@@ -12,7 +12,7 @@ from functools import partial
 from PySide6.QtWidgets import QVBoxLayout
 
 from fha_studio.catalog import DEFAULT_ACTUATOR
-from fha_studio.gui.link import POLL_INTERVAL_MS, Cmd, LinkInfo
+from fha_studio.gui.link import POLL_INTERVAL_MS, Call, LinkInfo, SetPollInterval
 from fha_studio.gui.motion_controls import MotionControls, MotionLayout
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.widgets import space_jogs_only
@@ -98,7 +98,7 @@ class ScopePage(BasePage):
     def _on_live_changed(self, live: bool) -> None:
         if self.session.link.connected:
             interval_ms = STATUS_POLL_WHILE_LIVE_MS if live else POLL_INTERVAL_MS
-            self.session.link.send(Cmd.SET_POLL_INTERVAL, interval_ms)
+            self.session.link.send(SetPollInterval(interval_ms))
 
     def _context(self) -> ScopeContext:
         state = self.state
@@ -114,7 +114,7 @@ class ScopePage(BasePage):
         self.jog_panel.link_connected(info)
         self.view.set_context(self._context())
         self.controller.connected = True
-        self.session.link.send(Cmd.CALL, partial(_attach_in_link_thread, self.controller, self.state.ratio))
+        self.session.link.send(Call(partial(_attach_in_link_thread, self.controller, self.state.ratio)))
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
         self.jog_panel.link_disconnected()
