@@ -161,7 +161,7 @@ def view_load(seconds: float, rate_hz: float = 1000.0, channels: int = 4, span_s
 def gui_polling(seconds: float) -> dict:
     """The main window on the paced simulated drive, Scope page showing, live with its default
     channels: samples/s where the view gets them, against the line's limit."""
-    from fha_studio.gui.link import Cmd
+    from fha_studio.gui.link import Call
     from fha_studio.gui.main_window import MainWindow
 
     window = MainWindow()
@@ -176,7 +176,7 @@ def gui_polling(seconds: float) -> dict:
         run_for(0.05)
     if not connected:
         raise SystemExit("the GUI did not connect to the simulated drive within 30 s")
-    window.link.send(Cmd.CALL, lambda client: setattr(client, "trace_packet", counter))
+    window.link.send(Call(lambda client: setattr(client, "trace_packet", counter)))
     try:
         window.show_page("scope")
         view = window.scope_page.view

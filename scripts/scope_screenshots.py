@@ -23,7 +23,7 @@ from fha_studio.hardware import protocol as p  # noqa: E402
 OUT = sys.argv[1] if len(sys.argv) > 1 else str(Path(__file__).resolve().parents[1] / "docs" / "screenshots")
 app = QApplication([])
 QCoreApplication.setOrganizationName("FHA Studio Shots")
-from fha_studio.gui.link import Cmd, LinkController  # noqa: E402
+from fha_studio.gui.link import LinkController, MoveBy, Servo, SetMoveSpeed  # noqa: E402
 from fha_studio.gui.main_window import MainWindow  # noqa: E402
 
 
@@ -57,7 +57,7 @@ wait_until(lambda: page.controller.connected)
 run(0.5)
 view.start_live()
 wait_until(lambda: view.indicator_text() == "LIVE")
-link.send(Cmd.SERVO, True)
+link.send(Servo(True))
 wait_until(lambda: link.servo_on)
 view.time_base.setCurrentIndex(view.time_base.findData(10.0))
 panel = page.jog_panel  # the scope's own Move panel, as a technician jogs while watching
@@ -83,8 +83,8 @@ view.trace_samples.setValue(1024)
 view.trace_rate.setValue(1000)
 view.arm_trace()
 wait_until(lambda: "waiting for the trigger" in view.trace_state.text())
-link.send(Cmd.SET_MOVE_SPEED, 20.0)
-link.send(Cmd.MOVE_BY, 45.0)
+link.send(SetMoveSpeed(20.0))
+link.send(MoveBy(45.0))
 wait_until(lambda: view.last_trace is not None, timeout=120)
 run(0.5)
 view.set_cursors(0.0, 0.3)
