@@ -81,7 +81,7 @@ def main() -> int:
     @step(700)
     def jog_shot():
         shot("jog")
-        window.jog_page.release_jog()
+        window.jog_page.release_held()
         window.link._worker._client.transaction.transport.inner.sim_drive.raise_alarm(20)
 
     @step(800)

@@ -78,7 +78,7 @@ def main() -> int:
     page.speed_spin.setValue(5.0)
     page._jog(+1)  # as if FWD were held: the brake still holds
     wait(app, 1.5)
-    window.jog_page.release_jog()
+    window.jog_page.release_held()
     wait(app, 0.8)
     window.link.send(Servo(False))
     wait(app, 0.5)

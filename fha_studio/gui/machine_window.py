@@ -17,7 +17,7 @@ import logging
 from collections.abc import Callable, Iterable
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeGuard, TypeVar
 
 from PySide6.QtCore import QObject, QSettings, Qt, Slot
 from PySide6.QtGui import QAction, QColor
@@ -65,7 +65,14 @@ from fha_studio.logic.register.facts_from_session import (
     write_fact,
 )
 
+if TYPE_CHECKING:
+    from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
+    from fha_studio.gui.pages.procedures.page import ProceduresPage
+    from fha_studio.logic.modelcheck import ModelCheckResult
+
 log = logging.getLogger(__name__)
+
+_P = TypeVar("_P")
 
 #: Width of the axis list [px].
 AXIS_LIST_WIDTH_PX = 230
@@ -108,32 +115,23 @@ class AxisRecorder(QObject):
     # -- pages built later (plots, procedures) ------------------------------------------------------
     def hook_pages(self) -> None:
         """Connects to the pages built so far (a page with plots is built when first shown)."""
-        procedures = self.window.built_page(PageId.PROCEDURES)
-        scope = self.window.built_page(PageId.SCOPE)
-        modelcheck = self.window.built_page(PageId.MODELCHECK)
-        absolute = self.window.built_page(PageId.ABSOLUTE)
-        for page, hook in (
-            (procedures, self._hook_procedures),
-            (scope, self._hook_scope),
-            (modelcheck, self._hook_modelcheck),
-            (absolute, self._hook_absolute),
-        ):
-            if page is not None and id(page) not in self._hooked:
-                self._hooked.add(id(page))
-                hook(page)
+        window = self.window
+        if self._first_time(procedures := window.built_page(PageId.PROCEDURES)):
+            procedures.sigStepChanged.connect(lambda: self._on_procedures(procedures))
+            procedures.sigReportWritten.connect(lambda html, pdf: self._on_report(procedures, html, pdf))
+        if self._first_time(scope := window.built_page(PageId.SCOPE)):
+            scope.view.sigRecordingSaved.connect(self._on_recording)
+        if self._first_time(modelcheck := window.built_page(PageId.MODELCHECK)):
+            modelcheck.sigFinished.connect(lambda result: self._on_model_check(modelcheck, result))
+        if self._first_time(absolute := window.built_page(PageId.ABSOLUTE)):
+            absolute.sigRecorded.connect(self._on_dgr_check)
 
-    def _hook_procedures(self, page) -> None:
-        page.sigStepChanged.connect(lambda: self._on_procedures(page))
-        page.sigReportWritten.connect(lambda html, pdf: self._on_report(page, html, pdf))
-
-    def _hook_scope(self, page) -> None:
-        page.view.sigRecordingSaved.connect(self._on_recording)
-
-    def _hook_modelcheck(self, page) -> None:
-        page.sigFinished.connect(lambda result: self._on_model_check(page, result))
-
-    def _hook_absolute(self, page) -> None:
-        page.sigRecorded.connect(self._on_dgr_check)
+    def _first_time(self, page: _P | None) -> TypeGuard[_P]:
+        """A page built and not hooked yet (it is hooked now)."""
+        if page is None or id(page) in self._hooked:
+            return False
+        self._hooked.add(id(page))
+        return True
 
     # -- writing, never failing the GUI ---------------------------------------------------------------
     def _record(self, facts: Iterable[Fact]) -> None:
@@ -200,7 +198,7 @@ class AxisRecorder(QObject):
         )
 
     # -- from the pages -------------------------------------------------------------------------------
-    def _on_procedures(self, page) -> None:
+    def _on_procedures(self, page: ProceduresPage) -> None:
         session = page.session
         if session is None:
             return
@@ -213,7 +211,7 @@ class AxisRecorder(QObject):
                 self._record_action("session file", session.save)
         self._record_action("procedure check", lambda: record_session(self.register, self.axis_ref, session))
 
-    def _on_report(self, page, html: Path, pdf: Path | None) -> None:
+    def _on_report(self, page: ProceduresPage, html: Path, pdf: Path | None) -> None:
         self._record(report_facts(page.session, page.context, html, pdf, self.who))
 
     @Slot(object, str)
@@ -225,7 +223,7 @@ class AxisRecorder(QObject):
         """A check of the DGR checks page (what it becomes: ``facts_from_dgr_check``)."""
         self._record(facts_from_dgr_check(record))
 
-    def _on_model_check(self, page, result) -> None:
+    def _on_model_check(self, page: ModelCheckPage, result: ModelCheckResult) -> None:
         self._record(
             model_check_facts(result.summary_lines(manual_units=True), page.recording_path or "", self.who)
         )
@@ -589,7 +587,7 @@ class MachineWindow(QMainWindow):
         """STOP to every connected axis; returns the names of the axes it was sent to."""
         sent, idle, elsewhere = [], [], []
         for axis, window in zip(self.project, self.axis_windows, strict=True):
-            window.jog_page.release_jog()
+            window.release_held()
             info = window.link.info
             if info is None:
                 idle.append(axis.name)
@@ -617,7 +615,8 @@ class MachineWindow(QMainWindow):
         """Each axis's procedure session as its pages hold it (axes without one are left out)."""
         out: dict[str, ProcedureSession] = {}
         for axis, window in zip(self.project, self.axis_windows, strict=True):
-            session = getattr(window.built_page(PageId.PROCEDURES), "session", None)
+            procedures = window.built_page(PageId.PROCEDURES)
+            session = procedures.session if procedures is not None else None
             if session is not None:
                 out[axis.name] = session
                 axis.session_file = session.path

@@ -4,7 +4,7 @@ status bar with link, servo, alarm and what the drive supports."""
 from __future__ import annotations
 
 import logging
-from typing import cast
+from typing import TYPE_CHECKING, cast
 
 from PySide6.QtCore import QSettings, Qt, Slot
 from PySide6.QtGui import QAction, QKeySequence, QShortcut
@@ -38,6 +38,7 @@ from fha_studio.gui.pages.base import Page, PageId
 from fha_studio.gui.pages.connection import ConnectionPage
 from fha_studio.gui.pages.direction import DirectionPage
 from fha_studio.gui.pages.jog import JogPage
+from fha_studio.gui.pages.lookup import PageLookup
 from fha_studio.gui.pages.parameters import ParametersPage
 from fha_studio.gui.pages.registry import PAGES, PageEntry
 from fha_studio.gui.session import Session, new_axis_state
@@ -45,6 +46,12 @@ from fha_studio.gui.state import AxisState
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton
 from fha_studio.hardware.protocol import BAUDRATE
 from fha_studio.logic.commissioning import CommissioningState
+
+if TYPE_CHECKING:
+    from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
+    from fha_studio.gui.pages.procedures.page import ProceduresPage
+    from fha_studio.gui.pages.scope.page import ScopePage
+    from fha_studio.gui.pages.sizing import SizingPage
 
 log = logging.getLogger(__name__)
 
@@ -57,14 +64,15 @@ CAPS_WIDTH_PX = 420
 CAPS_WIDTH_SHARE = 0.25
 
 
-class MainWindow(QMainWindow):
-    """FHA Studio's main window."""
+class MainWindow(QMainWindow, PageLookup):
+    """FHA Studio's main window (its pages by id: :class:`PageLookup`)."""
 
     def __init__(self, link: LinkController | None = None, parent: QWidget | None = None,
                  state: CommissioningState | None = None):
         """``state``: the axis's commissioning state when it lives elsewhere (an axis of a machine
         project); by default the window has its own, whose declared load is kept in the settings."""
         super().__init__(parent)
+        self._caps_text = ""  # the link summary the status bar shows (elided again on a resize)
         self.setWindowTitle("FHA Studio")
         self.setObjectName("mainWindow")
         self.link = link or LinkController(self)
@@ -173,54 +181,49 @@ class MainWindow(QMainWindow):
         letters.discard(None)
         return letters  # type: ignore[return-value]
 
-    def page(self, name: PageId | str) -> Page:
-        """The page ``name`` (a :class:`PageId` or its value), built now if it is a lazy page not
-        yet shown; ValueError naming the pages otherwise."""
+    def _find_page(self, name: PageId | str, build: bool) -> Page | None:
         try:
             tab = self._tabs[PageId(name)]
         except ValueError:
             raise ValueError(f"no page {name!r}; pages: {', '.join(PageId)}") from None
-        return tab.page if isinstance(tab, LazyPage) else cast(Page, tab)
-
-    def built_page(self, name: PageId) -> Page | None:
-        """The page ``name`` if it has been built (a lazy page is built when first shown), else None."""
-        tab = self._tabs[name]
-        return tab.built if isinstance(tab, LazyPage) else cast(Page, tab)
+        if isinstance(tab, LazyPage):
+            return tab.page if build else tab.built
+        return cast(Page, tab)
 
     @property
     def connection_page(self) -> ConnectionPage:
-        return cast(ConnectionPage, self.page(PageId.CONNECTION))
+        return self.page(PageId.CONNECTION)
 
     @property
     def parameters_page(self) -> ParametersPage:
-        return cast(ParametersPage, self.page(PageId.PARAMETERS))
+        return self.page(PageId.PARAMETERS)
 
     @property
     def direction_page(self) -> DirectionPage:
-        return cast(DirectionPage, self.page(PageId.DIRECTION))
+        return self.page(PageId.DIRECTION)
 
     @property
     def alarms_page(self) -> AlarmsPage:
-        return cast(AlarmsPage, self.page(PageId.ALARMS))
+        return self.page(PageId.ALARMS)
 
     @property
     def jog_page(self) -> JogPage:
-        return cast(JogPage, self.page(PageId.JOG))
+        return self.page(PageId.JOG)
 
     @property
-    def sizing_page(self) -> Page:
+    def sizing_page(self) -> SizingPage:
         return self.page(PageId.SIZING)
 
     @property
-    def scope_page(self) -> Page:
+    def scope_page(self) -> ScopePage:
         return self.page(PageId.SCOPE)
 
     @property
-    def procedures_page(self) -> Page:
+    def procedures_page(self) -> ProceduresPage:
         return self.page(PageId.PROCEDURES)
 
     @property
-    def modelcheck_page(self) -> Page:
+    def modelcheck_page(self) -> ModelCheckPage:
         return self.page(PageId.MODELCHECK)
 
     def _build_status_bar(self) -> None:
@@ -253,8 +256,8 @@ class MainWindow(QMainWindow):
 
     def resizeEvent(self, event) -> None:
         super().resizeEvent(event)
-        text = getattr(self, "_caps_text", None)
-        if text is not None:
+        text = self._caps_text
+        if text:
             tooltip = self.caps_label.toolTip()
             self._set_caps(text)
             self.caps_label.setToolTip(tooltip)  # a connected drive's tooltip says more than the text
@@ -301,10 +304,7 @@ class MainWindow(QMainWindow):
     @Slot()
     def stop_axis(self) -> None:
         """STOP: decelerate and hold. Sent even when the link looks idle."""
-        for page in self._pages():  # a jog held anywhere (the Jog page, the scope's panel) lets go
-            release = getattr(page, "release_jog", None)
-            if release is not None:
-                release()
+        self.release_held()
         if not self.link.connected:
             self.show_message("STOP: no drive is connected, nothing was sent.", Level.WARNING)
             return
@@ -313,6 +313,11 @@ class MainWindow(QMainWindow):
             return
         self.link.stop_now()
         self.show_message("STOP sent: the axis decelerates and holds (servo stays on) …")
+
+    def release_held(self) -> None:
+        """A jog held anywhere (the Jog page, the scope's panel) lets go."""
+        for page in self._pages():
+            page.release_held()
 
     def show_message(self, text: str, level: Level = Level.INFO) -> None:
         """Show an outcome the person caused in the message area (kept in its log with the time)."""

@@ -5,6 +5,8 @@ the sizing page asks for. Without it a technician cannot tell which side is A, B
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import ClassVar
 
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QPainter, QPainterPath, QPen, QPolygonF
@@ -56,9 +58,9 @@ class ShapeFigure(QWidget):
         side = QRectF(8, 8, w * 0.55 - 16, h - 16)
         section = QRectF(w * 0.55 + 8, 8, w * 0.45 - 16, h - 16)
         letters = LETTERS.get(self.shape, {})
-        draw = getattr(self, f"_draw_{self.shape}", None)
+        draw = self._DRAWERS.get(self.shape)
         if draw is not None:
-            draw(painter, side, section, letters)
+            draw(self, painter, side, section, letters)
         painter.end()
 
     def _pen(self, color: QColor, width: float = 1.5) -> QPen:
@@ -371,6 +373,22 @@ class ShapeFigure(QWidget):
                 (QPointF(r.left() - 8, r.top()), QPointF(r.left() - 8, r.bottom()), letters["leg_c_m"]),
             ],
         )
+
+    #: How each shape is drawn, by its name (a name built into a method's name is not looked up).
+    _DRAWERS: ClassVar[dict[str, Callable[..., None]]] = {
+        "cylinder": _draw_cylinder,
+        "slanted_cylinder": _draw_slanted_cylinder,
+        "elliptic_cylinder": _draw_elliptic_cylinder,
+        "rectangular_pillar": _draw_rectangular_pillar,
+        "circular_pipe": _draw_circular_pipe,
+        "ball": _draw_ball,
+        "cone": _draw_cone,
+        "square_pipe": _draw_square_pipe,
+        "rhombus_pillar": _draw_rhombus_pillar,
+        "hexagonal_pillar": _draw_hexagonal_pillar,
+        "isosceles_triangle_pillar": _draw_isosceles_triangle_pillar,
+        "right_triangle_pillar": _draw_right_triangle_pillar,
+    }
 
 
 __all__ = ["LETTERS", "ShapeFigure"]

@@ -11,7 +11,7 @@ from __future__ import annotations
 import html
 import tempfile
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QObject, Qt, QTimer, Signal, Slot
 from PySide6.QtWidgets import (
@@ -34,12 +34,17 @@ from PySide6.QtWidgets import (
 from fha_studio import clock
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
+from fha_studio.gui.pages.lookup import PageLookup
 from fha_studio.hardware.sim.options import TrainingRegistration, forget_training, register_training
 from fha_studio.logic.training.scenario import Scenario, ScenarioError, list_scenarios
 from fha_studio.logic.training.score import ScoreSheet, TraineeRecord, score
 from fha_studio.logic.training.sheet import render_sheet_html, sheet_title
 
-#: The main window (typed loosely: it imports this module, and the GUI's modules form no cycle).
+if TYPE_CHECKING:
+    from fha_studio.logic.modelcheck import ModelCheckResult
+
+#: The main window (typed loosely: it imports this module, and the GUI's modules form no cycle;
+#: its pages are typed through :class:`PageLookup`).
 _Window = Any
 
 #: How often the running dialog's clock is redrawn [ms].
@@ -82,6 +87,11 @@ class TrainingController(QObject):
         self.draft_findings = ""  # what the trainee wrote so far (kept between two looks)
 
     @property
+    def pages(self) -> PageLookup:
+        """The window's pages, each as its own class."""
+        return self.window
+
+    @property
     def running(self) -> bool:
         return self.scenario is not None
 
@@ -111,31 +121,31 @@ class TrainingController(QObject):
         self.sigStarted.emit(scenario)
 
     def _hook_modelcheck(self) -> None:
-        page = self.window.built_page(PageId.MODELCHECK)
+        page = self.pages.built_page(PageId.MODELCHECK)
         if page is not None and not self._modelcheck_hooked:
             page.sigFinished.connect(self._on_model_check)
             self._modelcheck_hooked = True
 
     @Slot(object)
-    def _on_model_check(self, result: object) -> None:
+    def _on_model_check(self, result: ModelCheckResult) -> None:
         if self.running:
             now = clock.now_s()
-            self._effects.extend((e.id, now) for e in getattr(result, "effects", []))
+            self._effects.extend((e.id, now) for e in result.effects)
 
     def record(self, findings: str = "") -> TraineeRecord:
         """What the trainee did so far."""
         assert self.scenario is not None and self._registration is not None
         effects = list(self._effects)
-        page = self.window.built_page(PageId.MODELCHECK)
-        result = getattr(page, "result", None) if page is not None else None
+        page = self.pages.built_page(PageId.MODELCHECK)
+        result = page.result if page is not None else None
         if result is not None and not effects:  # a check run before this controller could listen
             effects = [(e.id, clock.now_s()) for e in result.effects]
-        procedures = self.window.built_page(PageId.PROCEDURES)
+        procedures = self.pages.built_page(PageId.PROCEDURES)
         return TraineeRecord(
             started_s=self.started_s,
             ended_s=clock.now_s(),
             journal=self._registration.journal.entries(),
-            session=getattr(procedures, "session", None),
+            session=procedures.session if procedures is not None else None,
             model_check_effects=effects,
             findings=findings,
             trainee=self.trainee,

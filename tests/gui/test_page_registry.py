@@ -70,3 +70,38 @@ def test_the_page_option_offers_every_page_and_refuses_another(capsys):
     with pytest.raises(SystemExit):
         _parser().parse_args(["--page", "plots"])
     assert "invalid choice: 'plots'" in capsys.readouterr().err
+
+
+def test_each_page_id_is_typed_as_the_class_of_the_page_it_gives(make_window):
+    """``window.page(PageId.DIRECTION)`` is a DirectionPage to the type checker (the overloads of
+    gui/pages/lookup.py) and at run time: one overload per page, each naming the page's class."""
+    import typing
+
+    from fha_studio.gui.pages import lookup
+    from fha_studio.gui.pages.absolute import AbsolutePage
+    from fha_studio.gui.pages.alarms import AlarmsPage
+    from fha_studio.gui.pages.connection import ConnectionPage
+    from fha_studio.gui.pages.direction import DirectionPage
+    from fha_studio.gui.pages.jog import JogPage
+    from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
+    from fha_studio.gui.pages.parameters import ParametersPage
+    from fha_studio.gui.pages.procedures.page import ProceduresPage
+    from fha_studio.gui.pages.scope.page import ScopePage
+    from fha_studio.gui.pages.sizing import SizingPage
+
+    names = {**vars(lookup), **{c.__name__: c for c in (
+        AbsolutePage, AlarmsPage, ConnectionPage, DirectionPage, JogPage, ModelCheckPage, ParametersPage,
+        ProceduresPage, ScopePage, SizingPage)}}
+    for method in (lookup.PageLookup.page, lookup.PageLookup.built_page):
+        typed = {}
+        for overload in typing.get_overloads(method):
+            hints = typing.get_type_hints(overload, globalns=names)
+            if typing.get_origin(hints["name"]) is typing.Literal:  # not the fallback for any id
+                (page_id,) = typing.get_args(hints["name"])
+                returned = typing.get_args(hints["return"]) or (hints["return"],)  # X or X | None
+                typed[page_id] = returned[0]
+        assert set(typed) == set(PageId), method.__name__
+    window = make_window(show=False)
+    for page_id, cls in typed.items():
+        assert type(window.page(page_id)) is cls, page_id
+        assert type(window.built_page(page_id)) is cls, page_id

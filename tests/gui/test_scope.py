@@ -307,3 +307,18 @@ def test_stop_during_a_trace_read_out_reaches_the_drive_at_the_next_block(make_w
     qtbot.waitUntil(lambda: link.status is not None and abs(link.status.speed_rpm or 0.0) < 0.1
                     and not link.status.moving, timeout=10000)  # the axis stopped and holds
     assert link.servo_on
+
+
+def test_every_file_action_has_its_dialog_and_what_it_does(qtbot):
+    from fha_studio.gui.pages.scope.toolbar import FileAction
+
+    controller = ScopeController()
+    view = ScopeView(controller, ScopeContext(ACTUATOR))
+    qtbot.addWidget(view)
+    try:
+        assert set(view.file_actions()) == set(FileAction)
+        assert all(action.file_filter for action in FileAction)
+        assert [a for a in FileAction if a.opens] == [FileAction.OPEN]
+    finally:
+        view.shutdown()
+        assert controller.shutdown()

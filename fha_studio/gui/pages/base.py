@@ -45,11 +45,29 @@ class Page(Protocol):
     def shutdown(self) -> None:
         """The window closes: release held buttons, stop threads (idempotent)."""
 
+    def release_held(self) -> None:
+        """Let go of whatever the page holds down (a hold-to-run jog): STOP does it on every page."""
+
     def link_connected(self, info: LinkInfo) -> None:
         """A drive is connected (or was already, when the page is built later)."""
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
         """The drive went away: ``lost`` when the link died rather than was closed."""
+
+
+class PageHost(Protocol):
+    """The window a page is on, as the page may use it. A page reaches another page by id and
+    narrows what it gets with ``isinstance`` (the window's own lookup, ``pages/lookup.py``, names
+    every page's class, which a page cannot import without an import circle)."""
+
+    def page(self, name: PageId) -> Page:
+        """The page ``name``, built now if it is a lazy page not yet shown."""
+
+    def built_page(self, name: PageId) -> Page | None:
+        """The page ``name`` if it has been built, else None."""
+
+    def show_page(self, name: PageId) -> Page:
+        """Shows the page ``name`` and returns it."""
 
 
 class BasePage(QWidget):
@@ -62,6 +80,9 @@ class BasePage(QWidget):
         pass
 
     def shutdown(self) -> None:
+        pass
+
+    def release_held(self) -> None:
         pass
 
     def link_connected(self, info: LinkInfo) -> None:

@@ -21,6 +21,7 @@ from fha_studio.gui.link import DriveStatus, LinkInfo, LinkReply, PowerCycle
 from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.session import Session
 from fha_studio.gui.widgets import FlangeWidget, space_jogs_only
+from fha_studio.logic.procedures.direction_check import DirectionCheck
 
 KEY = "rotary_direction"
 #: How long the live check jogs FWD, in ms, and at what output speed, in r/min.
@@ -57,6 +58,7 @@ class DirectionPage(BasePage):
         self.session = session
         self.link = session.link
         self.main_window = main_window
+        self.last_check: DirectionCheck | None = None  # the check confirmed last (the report takes it)
         self._check_running = False
         self._check_start_pulse: int | None = None
         self._check_end_pulse: int | None = None
@@ -351,7 +353,6 @@ class DirectionPage(BasePage):
             )
             return None
         ok = seen == expected
-        from fha_studio.logic.procedures.direction_check import DirectionCheck
         from fha_studio.logic.procedures.session import utc_now
 
         # kept for the commissioning report: a check confirmed here is the 1-10 procedure done

@@ -89,12 +89,12 @@ class JogPage(BasePage):
 
     # -- actions ----------------------------------------------------------------------------------
     @Slot()
-    def release_jog(self) -> None:
+    def release_held(self) -> None:
         """Let go of a held jog (STOP does it on every page)."""
         self.motion.release_jog()
 
     def shutdown(self) -> None:
-        self.release_jog()
+        self.release_held()
 
     # -- from the link ----------------------------------------------------------------------------
     def _clear_live(self) -> None:

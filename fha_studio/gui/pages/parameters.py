@@ -353,7 +353,7 @@ class ParametersPage(BasePage):
         self.who_edit = QLineEdit()
         self.who_edit.setObjectName("panelWho")
         self.who_edit.setPlaceholderText("your name")
-        self.who_edit.textChanged.connect(lambda text: setattr(self.model, "who", text))
+        self.who_edit.textChanged.connect(self._who_changed)
         pb.addWidget(self.panel_note, 1)
         pb.addWidget(QLabel("Entered by:"))
         pb.addWidget(self.who_edit)
@@ -498,6 +498,11 @@ class ParametersPage(BasePage):
             reason = "This drive gives no parameter access over CN3: use its front panel"
             for b in (self.read_button, self.write_all_button, self.write_changed_button):
                 b.setToolTip(reason)
+
+    @Slot(str)
+    def _who_changed(self, text: str) -> None:
+        """The front-panel worksheet's entries are recorded with this name."""
+        self.model.who = text
 
     @Slot()
     def read_all(self) -> None:

@@ -12,11 +12,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from PySide6.QtWidgets import QWidget
-
 from fha_studio.gui.pages.absolute import AbsolutePage
 from fha_studio.gui.pages.alarms import AlarmsPage
-from fha_studio.gui.pages.base import Page, PageId
+from fha_studio.gui.pages.base import Page, PageHost, PageId
 from fha_studio.gui.pages.connection import ConnectionPage
 from fha_studio.gui.pages.direction import DirectionPage
 from fha_studio.gui.pages.jog import JogPage
@@ -32,7 +30,7 @@ class PageEntry:
     id: PageId
     title: str
     mnemonic: str
-    build: Callable[[Session, QWidget], Page]
+    build: Callable[[Session, PageHost], Page]
     lazy: bool = False
 
     def __post_init__(self) -> None:
@@ -51,25 +49,25 @@ class PageEntry:
 
 # pages with plots (pyqtgraph, numpy, scipy) are imported and built when first shown, so that
 # start-up stays short
-def _sizing(session: Session, window: QWidget) -> Page:
+def _sizing(session: Session, window: PageHost) -> Page:
     from fha_studio.gui.pages.sizing import SizingPage
 
     return SizingPage(session, window)
 
 
-def _scope(session: Session, window: QWidget) -> Page:
+def _scope(session: Session, window: PageHost) -> Page:
     from fha_studio.gui.pages.scope.page import ScopePage
 
     return ScopePage(session, window)
 
 
-def _procedures(session: Session, window: QWidget) -> Page:
+def _procedures(session: Session, window: PageHost) -> Page:
     from fha_studio.gui.pages.procedures.page import ProceduresPage
 
     return ProceduresPage(session, window)
 
 
-def _modelcheck(session: Session, window: QWidget) -> Page:
+def _modelcheck(session: Session, window: PageHost) -> Page:
     from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
 
     return ModelCheckPage(session, window)

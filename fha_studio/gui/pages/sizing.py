@@ -299,7 +299,8 @@ class SizingPage(BasePage):
             for name, spin in self.dim_spins.items()
         }
         shape = function(density_kg_m3=float(self.material_combo.currentData()), **kwargs)
-        axes = {a: getattr(shape, f"i{a}_kgm2") for a in "xyz" if getattr(shape, f"i{a}_kgm2") is not None}
+        moments = {"x": shape.ix_kgm2, "y": shape.iy_kgm2, "z": shape.iz_kgm2}
+        axes = {a: moment for a, moment in moments.items() if moment is not None}
         if [self.axis_combo.itemData(i) for i in range(self.axis_combo.count())] != list(axes):
             self.axis_combo.blockSignals(True)
             self.axis_combo.clear()

@@ -294,10 +294,13 @@ def report_facts(
     ]
 
 
-def model_check_facts(summary_lines: Sequence[str], recording_file: str, who: str) -> list[ModelCheckFact]:
-    """A model check run: its first three summary lines, and the recording it ran on."""
+def model_check_facts(
+    summary_lines: Sequence[str], recording_file: str | Path, who: str
+) -> list[ModelCheckFact]:
+    """A model check run: its first three summary lines, and the recording it ran on ("" when
+    not known)."""
     summary = "; ".join(summary_lines[:3]) if summary_lines else "model check run"
-    return [ModelCheckFact(summary, recording_file, who)]
+    return [ModelCheckFact(summary, str(recording_file), who)]
 
 
 # -- facts into the register ------------------------------------------------------------------------

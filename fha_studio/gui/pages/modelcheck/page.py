@@ -292,9 +292,9 @@ class ModelCheckPage(BasePage):
             return
         m = recording.metadata
         declared = self.state.load_inertia_kgm2
-        columns = ", ".join(["t", "pos", "current"] + [c for c in ("cmd_pos", "load_pos", "vel")
-                                                        if getattr(recording, f"{c}_deg", None) is not None
-                                                        or (c == "vel" and recording.vel_rpm is not None)])
+        optional = {"cmd_pos": recording.cmd_pos_deg, "load_pos": recording.load_pos_deg,
+                    "vel": recording.vel_rpm}
+        columns = ", ".join(["t", "pos", "current"] + [c for c, v in optional.items() if v is not None])
         self.source_label.setText(
             f"Recording: {label} — {m.actuator}, {len(recording)} samples over {recording.duration_s:.2f} s, "
             f"columns {columns}. "

@@ -44,6 +44,7 @@ class SensorDogPanel(QWidget):
         self.output_ppr = 0
         self.sensor = "limit_switch_2"
         self._jogging = 0
+        self.watching = True  # the drive reports its inputs (else the angle comes from DGR)
         layout = QVBoxLayout(self)
 
         live = QGroupBox("Live")
@@ -124,7 +125,6 @@ class SensorDogPanel(QWidget):
         layout.addStretch(1)
         link.sigStatus.connect(self.on_status)
         self.ratio = 0
-        self.watching = True
 
     # -- set up for a step --------------------------------------------------------------------
     def start(self, sensor: str, context: Mapping[str, Any]) -> None:
@@ -259,7 +259,7 @@ class SensorDogPanel(QWidget):
         return found
 
     def record(self) -> None:
-        if not getattr(self, "watching", True):
+        if not self.watching:
             self._record_from_dgr()
             return
         angle = self.found_angle()

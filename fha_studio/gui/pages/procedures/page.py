@@ -38,7 +38,9 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.gui.link import Call, DriveStatus, LinkInfo, LinkReply, SetInputs
-from fha_studio.gui.pages.base import BasePage, PageId
+from fha_studio.gui.pages.absolute import AbsolutePage
+from fha_studio.gui.pages.base import BasePage, PageHost, PageId
+from fha_studio.gui.pages.direction import DirectionPage
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
 from fha_studio.hardware.protocol import IoBit
 from fha_studio.logic.procedures import (
@@ -97,7 +99,7 @@ class ProceduresPage(BasePage):
     sigLiveDone = Signal(object)  # Observation of a live check (after it was recorded or shown)
     sigReportWritten = Signal(object, object)  # HTML path, PDF path (or None): a report was written
 
-    def __init__(self, gui_session, main_window=None):
+    def __init__(self, gui_session, main_window: PageHost | None = None):
         super().__init__()
         self.gui_session = gui_session
         self.state = gui_session.state  # the axis: its actuator is the one on the Connection page
@@ -108,6 +110,7 @@ class ProceduresPage(BasePage):
         self.procedures: list[Procedure] = []
         self.run: ProcedureRun | None = None
         self._live_token: int | None = None
+        self._by_hand_why = ""  # why the drive cannot answer the live step on show
         self._live_memo: dict = {}  # a live check's state between two presses (the link thread uses it)
         self._relay = _SampleRelay(self)
         self._build()
@@ -435,7 +438,7 @@ class ProceduresPage(BasePage):
             self._message(f"Enter {self.by_hand_edit.placeholderText()} first: it is what the record keeps.")
             return False
         passed = self.by_hand_result.currentIndex() == 0
-        why = getattr(self, "_by_hand_why", "") or "the drive cannot tell"
+        why = self._by_hand_why or "the drive cannot tell"
         observation = Observation(value, passed, f"entered by hand ({why})")
         if self.answer(observation):
             self.by_hand_edit.clear()
@@ -529,6 +532,7 @@ class ProceduresPage(BasePage):
         window = self.main_window
         direction = window.built_page(PageId.DIRECTION) if window is not None else None
         checks = window.built_page(PageId.ABSOLUTE) if window is not None else None
+        # another page is a Page to this one: what it is, isinstance says
         return ReportInputs(
             who=self.who,
             parameter_model=self.gui_session.parameter_model,
@@ -537,8 +541,8 @@ class ProceduresPage(BasePage):
             read=set(self.state.drive_values),
             front_panel=dict(self.state.front_panel),
             parameter_file_text=self.gui_session.parameter_file_text(values) if values else "",
-            direction_check=getattr(direction, "last_check", None),
-            dgr_checks=list(getattr(checks, "records", [])),
+            direction_check=direction.last_check if isinstance(direction, DirectionPage) else None,
+            dgr_checks=list(checks.records) if isinstance(checks, AbsolutePage) else [],
         )
 
     def add_plot(self, title: str, png_path: str | Path) -> None:
@@ -550,8 +554,10 @@ class ProceduresPage(BasePage):
         """Save the Scope page's plot as a PNG beside the session and add it to the report."""
         if self.session is None or self.session.path is None or self.main_window is None:
             return None
-        scope = self.main_window.scope_page
-        if scope is None:
+        from fha_studio.gui.pages.scope.page import ScopePage
+
+        scope = self.main_window.page(PageId.SCOPE)
+        if not isinstance(scope, ScopePage):
             return None
         number = len(self.session.plots) + 1
         path = self.session.path.with_name(f"{self.session.path.stem}-plot{number}.png")

@@ -334,9 +334,15 @@ class ScopeController(QObject):
         self.driver = ScopeDriver(config, abort)
         self.driver.moveToThread(thread)
         self.sigRequest.connect(self.driver.handle)
-        for name in ("sigLiveStarted", "sigStatus", "sigTraceState", "sigTraceDone", "sigTestDone",
-                     "sigTestState", "sigError", "sigCallDone", "sigReadoutProgress"):
-            getattr(self.driver, name).connect(getattr(self, name))  # queued: into this thread
+        driver = self.driver
+        for theirs, ours in (
+            (driver.sigLiveStarted, self.sigLiveStarted), (driver.sigStatus, self.sigStatus),
+            (driver.sigTraceState, self.sigTraceState), (driver.sigTraceDone, self.sigTraceDone),
+            (driver.sigTestDone, self.sigTestDone), (driver.sigTestState, self.sigTestState),
+            (driver.sigError, self.sigError), (driver.sigCallDone, self.sigCallDone),
+            (driver.sigReadoutProgress, self.sigReadoutProgress),
+        ):
+            theirs.connect(ours)  # queued: into this thread
         self.connected = False
         self._shut = False
 

@@ -106,7 +106,7 @@ class ScopePage(BasePage):
                             load_inertia_kgm2=state.load_inertia_kgm2, supply_voltage=state.supply_voltage_v,
                             driver=state.driver, actuator_declared=bool(state.actuator_code))
 
-    def release_jog(self) -> None:
+    def release_held(self) -> None:
         """Let go of a jog held on the page's panel (STOP does it on every page)."""
         self.jog_panel.release_jog()
 

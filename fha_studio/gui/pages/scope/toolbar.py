@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from enum import StrEnum
+
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtGui import QFont, QFontMetrics
 from PySide6.QtWidgets import QCheckBox, QComboBox, QGridLayout, QLabel, QToolBar, QToolButton, QWidget
@@ -33,6 +35,34 @@ def _button(text: str, checkable: bool = False) -> QToolButton:
     return button
 
 
+class FileAction(StrEnum):
+    """What a file the scope asks for is for."""
+
+    SAVE = "save"  # the capture on show, as an fha-recording
+    PNG = "png"  # the plot as an image
+    CSV = "csv"  # the data on show as a plain table
+    OPEN = "open"  # a recording (or capture) to show
+    RECORD = "record"  # a recording streamed from now on
+
+    @property
+    def opens(self) -> bool:
+        """The file is read (an open dialog), not written."""
+        return self is FileAction.OPEN
+
+    @property
+    def file_filter(self) -> str:
+        return _FILE_FILTERS[self]
+
+
+_FILE_FILTERS = {
+    FileAction.SAVE: "FHA recording (*.csv)",
+    FileAction.PNG: "PNG image (*.png)",
+    FileAction.CSV: "CSV (*.csv)",
+    FileAction.OPEN: "FHA recording (*.csv);;All files (*)",
+    FileAction.RECORD: "FHA recording (*.csv)",
+}
+
+
 class ScopeToolbar(QWidget):
     """Says what the plot shows and carries the user's view-wide actions out as signals.
 
@@ -47,7 +77,7 @@ class ScopeToolbar(QWidget):
     sigFit = Signal()
     sigCursors = Signal(bool)
     sigRecord = Signal(bool)  # the Record button clicked: True start (ask a file), False stop
-    sigFile = Signal(str)  # "save", "png", "csv" or "open": ask for a path
+    sigFile = Signal(object)  # FileAction (save, png, csv, open): ask for a path
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -99,7 +129,8 @@ class ScopeToolbar(QWidget):
         self.record_button = _button("Record…", checkable=True)
         self.record_button.clicked.connect(self.sigRecord)
         files.addWidget(self.record_button)
-        for text, what in (("Save capture…", "save"), ("PNG…", "png"), ("CSV…", "csv"), ("Open…", "open")):
+        for text, what in (("Save capture…", FileAction.SAVE), ("PNG…", FileAction.PNG),
+                           ("CSV…", FileAction.CSV), ("Open…", FileAction.OPEN)):
             button = _button(text)
             button.clicked.connect(lambda _=False, w=what: self.sigFile.emit(w))
             files.addWidget(button)

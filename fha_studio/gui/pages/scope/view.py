@@ -19,6 +19,7 @@ import dataclasses
 import io
 import logging
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -53,7 +54,7 @@ from .driver import LiveStarted, ScopeCmd, ScopeController
 from .move_test_panel import MoveTestPanel
 from .spectrum_panel import SpectrumPanel
 from .time_plot import TimePlot
-from .toolbar import ScopeToolbar
+from .toolbar import FileAction, ScopeToolbar
 from .trigger_panel import TriggerPanel
 
 log = logging.getLogger(__name__)
@@ -522,22 +523,25 @@ class ScopeView(QWidget):
         return live.channels, np.array(data[max(0, i0 - 1): i1 + 1])
 
     # ------------------------------------------------------------------------------------- files
-    def _ask_path(self, what: str) -> None:
-        filters = {"png": "PNG image (*.png)", "csv": "CSV (*.csv)", "save": "FHA recording (*.csv)",
-                   "open": "FHA recording (*.csv);;All files (*)", "record": "FHA recording (*.csv)"}
-        if what == "open":
-            path, _ = QFileDialog.getOpenFileName(self, "Open a recording", "", filters[what])
+    def file_actions(self) -> dict[FileAction, Callable[[str], object]]:
+        """What each file action does with the path given."""
+        return {FileAction.PNG: self.export_png, FileAction.CSV: self.export_csv,
+                FileAction.SAVE: self.save_capture, FileAction.OPEN: self.open_recording,
+                FileAction.RECORD: self.start_recording}
+
+    def _ask_path(self, what: FileAction) -> None:
+        if what.opens:
+            path, _ = QFileDialog.getOpenFileName(self, "Open a recording", "", what.file_filter)
         else:
-            path, _ = QFileDialog.getSaveFileName(self, "Save", "", filters[what])
+            path, _ = QFileDialog.getSaveFileName(self, "Save", "", what.file_filter)
         if not path:
-            if what == "record":
+            if what is FileAction.RECORD:
                 self.toolbar.set_recording(False)
             return
         try:
-            {"png": self.export_png, "csv": self.export_csv, "save": self.save_capture,
-             "open": self.open_recording, "record": self.start_recording}[what](path)
+            self.file_actions()[what](path)
         except (OSError, ValueError) as exc:
-            if what == "record":
+            if what is FileAction.RECORD:
                 self.toolbar.set_recording(False)
             self._message(str(exc))
 
@@ -579,7 +583,7 @@ class ScopeView(QWidget):
 
     def _record_clicked(self, checked: bool) -> None:
         if checked:
-            self._ask_path("record")
+            self._ask_path(FileAction.RECORD)
         else:
             self.stop_recording()
 
