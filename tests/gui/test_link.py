@@ -8,6 +8,7 @@ import pytest
 
 from fha_studio.gui.link import (
     ClearAlarm,
+    Jog,
     LinkController,
     LinkReply,
     LinkRequest,
@@ -21,7 +22,7 @@ from fha_studio.gui.link import (
 )
 from fha_studio.gui.link_requests import REQUESTS
 from fha_studio.gui.pages.scope.driver import ScopeCmd, ScopeDriver
-from fha_studio.hardware.api import CommandRejected, DriveRefused, ServoOnRefused
+from fha_studio.hardware.api import CommandRejected, DriveRefused, LinkTimeout, ServoOnRefused
 from tests.gui.fake_drive import FakeDriveClient
 
 
@@ -102,3 +103,49 @@ def test_alarm_history_is_alarm_records(qtbot, link, fake):
     fake.raise_alarm(20)
     result = _result_of(qtbot, controller, ReadAlarmHistory())
     assert [(r.code, r.seconds_since_power_on) for r in result.value] == [(20, 123)]
+
+
+def test_a_reply_goes_to_whoever_asked(qtbot, link, fake):
+    controller = link(lambda url, baud: fake)
+    with qtbot.waitSignal(controller.sigConnected, timeout=10000):
+        controller.open("fake://")
+    servo: list[LinkReply] = []
+    history: list[LinkReply] = []
+    controller.send(Servo(True), servo.append)
+    controller.send(ReadAlarmHistory(), history.append)
+    qtbot.waitUntil(lambda: bool(servo and history), timeout=10000)
+    assert [type(r.request) for r in servo] == [Servo] and servo[0].answer is True
+    assert [type(r.request) for r in history] == [ReadAlarmHistory] and history[0].answer == []
+
+
+def test_a_held_jog_that_fails_later_is_told_to_its_sender(qtbot, link, fake):
+    controller = link(lambda url, baud: fake)
+    with qtbot.waitSignal(controller.sigConnected, timeout=10000):
+        controller.open("fake://")
+    assert _result_of(qtbot, controller, Servo(True)).ok
+    jog: list[LinkReply] = []
+    controller.jog_press(5.0, jog.append)
+    qtbot.waitUntil(lambda: bool(jog), timeout=10000)
+    assert jog[0].ok and jog[0].answer == 5.0
+    fake.servo_on = False  # the controller's servo-OFF: the next renewal is refused
+    qtbot.waitUntil(lambda: len(jog) == 2, timeout=10000)
+    assert jog[1].answers(Jog) and jog[1].failed_with(CommandRejected) and jog[1].token == 0
+    assert not controller.moving  # the lease is let go
+
+
+def test_the_link_is_lost_only_on_the_transaction_layers_verdict(qtbot, link, fake, monkeypatch):
+    controller = link(lambda url, baud: fake)
+    with qtbot.waitSignal(controller.sigConnected, timeout=10000):
+        controller.open("fake://")
+
+    def timed_out() -> None:
+        raise LinkTimeout("ALC on fake://: no reply after 2 attempt(s)")
+
+    monkeypatch.setattr(fake, "clear_alarm", timed_out)
+    lost: list[bool] = []
+    controller.sigDisconnected.connect(lambda reason, was_lost: lost.append(was_lost))
+    failed = _result_of(qtbot, controller, ClearAlarm())
+    assert failed.failed_with(LinkTimeout) and controller.connected  # not LinkLost: the link stays
+    fake.close()  # now the drive's side says LinkLost
+    qtbot.waitUntil(lambda: bool(lost), timeout=10000)
+    assert lost == [True] and not controller.connected

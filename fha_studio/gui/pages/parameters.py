@@ -597,13 +597,16 @@ class ParametersPage(BasePage):
             return
         self.link.send(PowerCycle(), self._power_cycle_answered)
 
+    def _power_cycle_answered(self, result: LinkReply[None]) -> None:
+        if not result.ok:
+            self.message.setText(f"Power cycle failed: {result.error}")
+
     @Slot(object)
     def _parameters_read(self, result: LinkReply[ParameterReadout]) -> None:
         """A read of the session's (this page's, or after a power cycle, or before a backup)."""
-        if result.ok and result.value is not None:
-            errors = result.value.errors
-            n = len(result.value.values)
-            text = f"Read {n} item(s) from the drive."
+        if result.ok:
+            errors = result.answer.errors
+            text = f"Read {len(result.answer.values)} item(s) from the drive."
             if errors:
                 text += " Not read: " + "; ".join(f"{m} {k}: {e}" for (m, k), e in errors.items())
             self.message.setText(text)
@@ -620,10 +623,6 @@ class ParametersPage(BasePage):
         self.model._all_changed()  # the State column: nothing pending any more
         self.message.setText("Power cycled: the restart-required items are now in effect. Reading back …")
         self.session.read_all()
-
-    def _power_cycle_answered(self, result: LinkReply[None]) -> None:
-        if not result.ok:
-            self.message.setText(f"Power cycle failed: {result.error}")
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
         self._update_buttons()
