@@ -6,27 +6,21 @@ its own pages and its own commissioning session, so several axes are connected a
 banner above the pages always says which axis they act on. STOP (the button, or Esc on any page)
 stops every connected axis that can be stopped, not only the one on show.
 
-What happens on each axis goes into the register as it happens (:class:`AxisRecorder`): parameter
-reads and verified writes, alarms, procedure checks, reports, recordings and model-check results.
+What happens on each axis goes into the register as it happens (``gui/axis_recorder.py``):
+parameter reads and verified writes, alarms, procedure checks, reports, recordings and model-check
+results. An axis is added through ``gui/axis_dialog.py``.
 """
 
 from __future__ import annotations
 
 import getpass
 import logging
-from collections.abc import Callable, Iterable
-from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeGuard, TypeVar
 
-from PySide6.QtCore import QObject, QSettings, Qt, Slot
+from PySide6.QtCore import QSettings, Qt, Slot
 from PySide6.QtGui import QAction, QColor
 from PySide6.QtWidgets import (
-    QDialog,
-    QDialogButtonBox,
-    QDoubleSpinBox,
     QFileDialog,
-    QFormLayout,
     QHBoxLayout,
     QLabel,
     QLineEdit,
@@ -41,38 +35,19 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio import fileio
-from fha_studio.gui.link import DriveStatus, LinkController, LinkInfo, LinkReply, OpenClient, ParameterReadout
+from fha_studio.gui.axis_dialog import AxisDialog
+from fha_studio.gui.axis_recorder import AxisRecorder
+from fha_studio.gui.link import LinkController, OpenClient
 from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.register_dialog import RegisterDialog
 from fha_studio.gui.widgets import StopButton
-from fha_studio.logic.absolute import DgrCheckRecord
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures import ProcedureSession
-from fha_studio.logic.register import Register, RegisterError, record_session
-from fha_studio.logic.register.facts_from_session import (
-    DriverFact,
-    Fact,
-    RecordingFact,
-    alarm_facts,
-    facts_from_dgr_check,
-    front_panel_facts,
-    model_check_facts,
-    read_facts,
-    record_fact,
-    report_facts,
-    write_fact,
-)
-
-if TYPE_CHECKING:
-    from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
-    from fha_studio.gui.pages.procedures.page import ProceduresPage
-    from fha_studio.logic.modelcheck import ModelCheckResult
+from fha_studio.logic.register import Register, RegisterError
 
 log = logging.getLogger(__name__)
-
-_P = TypeVar("_P")
 
 #: Width of the axis list [px].
 AXIS_LIST_WIDTH_PX = 230
@@ -83,208 +58,6 @@ def _login_name() -> str:
         return getpass.getuser()
     except (KeyError, OSError):  # no login name in the environment or the password database
         return ""
-
-
-class AxisRecorder(QObject):
-    """Writes one axis's commissioning facts into the register as they happen.
-
-    A fact the register cannot take (the file locked for longer than its busy timeout, a full
-    disk) is said in the axis's message area; the commissioning goes on."""
-
-    def __init__(
-        self, register: Register, axis_ref: str, window: MainWindow, who: Callable[[], str], site: str = ""
-    ):
-        super().__init__(window)
-        self.register = register
-        self.axis_ref = axis_ref
-        self.site = site
-        self.window = window
-        self._who = who
-        self._alarm_code = 0
-        self._hooked: set[int] = set()
-        link = window.link
-        window.session.sigParametersRead.connect(self._on_read)
-        link.sigWrite.connect(self._on_write)
-        link.sigStatus.connect(self._on_status)
-        link.sigConnected.connect(self._on_connected)
-        window.state.sigFrontPanelChanged.connect(self._on_front_panel)
-        self._front_panel_seen: set[tuple[str, int, int, str]] = set()
-        window.tabs.currentChanged.connect(lambda _index: self.hook_pages())
-        self.hook_pages()
-
-    # -- pages built later (plots, procedures) ------------------------------------------------------
-    def hook_pages(self) -> None:
-        """Connects to the pages built so far (a page with plots is built when first shown)."""
-        window = self.window
-        if self._first_time(procedures := window.built_page(PageId.PROCEDURES)):
-            procedures.sigStepChanged.connect(lambda: self._on_procedures(procedures))
-            procedures.sigReportWritten.connect(lambda html, pdf: self._on_report(procedures, html, pdf))
-        if self._first_time(scope := window.built_page(PageId.SCOPE)):
-            scope.view.sigRecordingSaved.connect(self._on_recording)
-        if self._first_time(modelcheck := window.built_page(PageId.MODELCHECK)):
-            modelcheck.sigFinished.connect(lambda result: self._on_model_check(modelcheck, result))
-        if self._first_time(absolute := window.built_page(PageId.ABSOLUTE)):
-            absolute.sigRecorded.connect(self._on_dgr_check)
-
-    def _first_time(self, page: _P | None) -> TypeGuard[_P]:
-        """A page built and not hooked yet (it is hooked now)."""
-        if page is None or id(page) in self._hooked:
-            return False
-        self._hooked.add(id(page))
-        return True
-
-    # -- writing, never failing the GUI ---------------------------------------------------------------
-    def _record(self, facts: Iterable[Fact]) -> None:
-        for fact in facts:
-            self._record_action(fact.what, partial(record_fact, self.register, self.axis_ref, fact))
-
-    def _record_action(self, what: str, action: Callable[[], object]) -> None:
-        try:
-            action()
-        except (RegisterError, OSError, ValueError) as exc:
-            log.warning("register: %s of %s not recorded: %s", what, self.axis_ref, exc)
-            self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
-        except Exception as exc:  # sqlite3 errors (a locked or damaged file): said, not raised
-            log.exception("register: %s of %s not recorded", what, self.axis_ref)
-            self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
-
-    @property
-    def who(self) -> str:
-        return self._who()
-
-    # -- from the link --------------------------------------------------------------------------------
-    @Slot(object)
-    def _on_connected(self, info: LinkInfo) -> None:
-        self._alarm_code = 0
-        if info.driver_model:
-            self._record([DriverFact(info.driver_model, self.who)])
-
-    @Slot(object)
-    def _on_read(self, result: LinkReply[ParameterReadout]) -> None:
-        if not result.ok or not result.answer.values:
-            return
-        info = self.window.link.info
-        self._record(
-            read_facts(
-                self.window.session.parameter_model,
-                {(str(mode), number): value for (mode, number), value in result.answer.values.items()},
-                self.who,
-                driver_model=info.driver_model if info else "",
-            )
-        )
-
-    @Slot(object)
-    def _on_write(self, entry: dict) -> None:
-        self._record([write_fact(self.window.session.parameter_model, entry, self.who)])
-
-    @Slot(object)
-    def _on_status(self, status: DriveStatus) -> None:
-        code = status.alarm_code
-        if code is None or code == self._alarm_code:
-            return
-        self._alarm_code = code
-        self._record(alarm_facts(code, self.window.session.driver, self.who))
-
-    @Slot()
-    def _on_front_panel(self) -> None:
-        """Values read off the drive's front panel by a person: a front-panel snapshot per
-        entry time and person (an entry already recorded is not recorded again)."""
-        self._record(
-            front_panel_facts(
-                self.window.session.parameter_model,
-                self.window.state.front_panel.values(),
-                self._front_panel_seen,
-            )
-        )
-
-    # -- from the pages -------------------------------------------------------------------------------
-    def _on_procedures(self, page: ProceduresPage) -> None:
-        session = page.session
-        if session is None:
-            return
-        axis_name = self.axis_ref.split("/", 1)[1]
-        if session.axis != axis_name and not any(s.records for s in session.runs.values()):
-            # a session started on this axis's pages is this axis's, on this machine's site
-            session.axis = axis_name
-            session.site = session.site or self.site
-            if session.path is not None:
-                self._record_action("session file", session.save)
-        self._record_action("procedure check", lambda: record_session(self.register, self.axis_ref, session))
-
-    def _on_report(self, page: ProceduresPage, html: Path, pdf: Path | None) -> None:
-        self._record(report_facts(page.session, page.context, html, pdf, self.who))
-
-    @Slot(object, str)
-    def _on_recording(self, path: Path, what: str) -> None:
-        self._record([RecordingFact(path, what, self.who)])
-
-    @Slot(object)
-    def _on_dgr_check(self, record: DgrCheckRecord) -> None:
-        """A check of the DGR checks page (what it becomes: ``facts_from_dgr_check``)."""
-        self._record(facts_from_dgr_check(record))
-
-    def _on_model_check(self, page: ModelCheckPage, result: ModelCheckResult) -> None:
-        self._record(
-            model_check_facts(result.summary_lines(manual_units=True), page.recording_path or "", self.who)
-        )
-
-
-class AxisDialog(QDialog):
-    """A new axis: name, actuator model code, driver, port, declared load inertia, serial number,
-    notes. What is wrong is said in the dialog, which stays open."""
-
-    def __init__(self, parent: QWidget | None = None):
-        super().__init__(parent)
-        self.setWindowTitle("Add an axis")
-        form = QFormLayout(self)
-        self.name_edit = QLineEdit()
-        self.name_edit.setPlaceholderText("e.g. table, tilt, wrist roll")
-        self.actuator_edit = QLineEdit()
-        self.actuator_edit.setPlaceholderText("model code on the label, e.g. FHA-25C-50-US250")
-        self.driver_edit = QLineEdit()
-        self.driver_edit.setPlaceholderText(
-            "TYPE line of the driver, e.g. HA-655-2-200 (the drive says it too)"
-        )
-        self.port_edit = QLineEdit()
-        self.port_edit.setPlaceholderText("/dev/ttyUSB0, COM3, socket://host:port or sim://FHA-25C-50-US250")
-        self.inertia_spin = QDoubleSpinBox()
-        self.inertia_spin.setRange(0.0, 10000.0)
-        self.inertia_spin.setDecimals(4)
-        self.inertia_spin.setSuffix(" kg·m²")
-        self.serial_edit = QLineEdit()
-        self.serial_edit.setPlaceholderText("from the actuator's label")
-        self.notes_edit = QLineEdit()
-        self.error_label = QLabel("")
-        self.error_label.setWordWrap(True)
-        self.error_label.setStyleSheet("color: #b00020; font-weight: bold;")
-        for label, widget in (
-            ("&Name:", self.name_edit),
-            ("&Actuator:", self.actuator_edit),
-            ("&Driver:", self.driver_edit),
-            ("&Port:", self.port_edit),
-            ("&Load inertia:", self.inertia_spin),
-            ("&Serial number:", self.serial_edit),
-            ("N&otes:", self.notes_edit),
-        ):
-            form.addRow(label, widget)
-        form.addRow(self.error_label)
-        buttons = QDialogButtonBox(
-            QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel
-        )
-        buttons.accepted.connect(self.accept)
-        buttons.rejected.connect(self.reject)
-        form.addRow(buttons)
-
-    def values(self) -> dict[str, Any]:
-        return {
-            "name": self.name_edit.text().strip(),
-            "actuator_code": self.actuator_edit.text().strip(),
-            "driver_model": self.driver_edit.text().strip(),
-            "port_url": self.port_edit.text().strip(),
-            "load_inertia_kgm2": self.inertia_spin.value(),
-            "notes": self.notes_edit.text(),
-            "serial_number": self.serial_edit.text().strip(),
-        }
 
 
 class MachineWindow(QMainWindow):

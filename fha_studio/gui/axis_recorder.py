@@ -1,0 +1,190 @@
+"""What happens on one axis of a machine goes into the register as it happens.
+
+:class:`AxisRecorder` hears the axis's link (parameter reads, verified writes, alarms, the driver
+it names) and its pages (procedure checks and reports, recordings, model checks, the DGR checks,
+values entered from the front panel); what each becomes in the register is decided below the GUI,
+in :mod:`fha_studio.logic.register.facts_from_session`.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable
+from functools import partial
+from pathlib import Path
+from typing import TYPE_CHECKING, TypeGuard, TypeVar
+
+from PySide6.QtCore import QObject, Slot
+
+from fha_studio.gui.link import DriveStatus, LinkInfo, LinkReply, ParameterReadout
+from fha_studio.gui.main_window import MainWindow
+from fha_studio.gui.messages import Level
+from fha_studio.gui.pages.base import PageId
+from fha_studio.logic.absolute import DgrCheckRecord
+from fha_studio.logic.register import Register, RegisterError, record_session
+from fha_studio.logic.register.facts_from_session import (
+    DriverFact,
+    Fact,
+    RecordingFact,
+    alarm_facts,
+    facts_from_dgr_check,
+    front_panel_facts,
+    model_check_facts,
+    read_facts,
+    record_fact,
+    report_facts,
+    write_fact,
+)
+
+if TYPE_CHECKING:
+    from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
+    from fha_studio.gui.pages.procedures.page import ProceduresPage
+    from fha_studio.logic.modelcheck import ModelCheckResult
+
+log = logging.getLogger(__name__)
+
+_P = TypeVar("_P")
+
+
+class AxisRecorder(QObject):
+    """Writes one axis's commissioning facts into the register as they happen.
+
+    A fact the register cannot take (the file locked for longer than its busy timeout, a full
+    disk) is said in the axis's message area; the commissioning goes on."""
+
+    def __init__(
+        self, register: Register, axis_ref: str, window: MainWindow, who: Callable[[], str], site: str = ""
+    ):
+        super().__init__(window)
+        self.register = register
+        self.axis_ref = axis_ref
+        self.site = site
+        self.window = window
+        self._who = who
+        self._alarm_code = 0
+        self._hooked: set[int] = set()
+        link = window.link
+        window.session.sigParametersRead.connect(self._on_read)
+        link.sigWrite.connect(self._on_write)
+        link.sigStatus.connect(self._on_status)
+        link.sigConnected.connect(self._on_connected)
+        window.state.sigFrontPanelChanged.connect(self._on_front_panel)
+        self._front_panel_seen: set[tuple[str, int, int, str]] = set()
+        window.tabs.currentChanged.connect(lambda _index: self.hook_pages())
+        self.hook_pages()
+
+    # -- pages built later (plots, procedures) ------------------------------------------------------
+    def hook_pages(self) -> None:
+        """Connects to the pages built so far (a page with plots is built when first shown)."""
+        window = self.window
+        if self._first_time(procedures := window.built_page(PageId.PROCEDURES)):
+            procedures.sigStepChanged.connect(lambda: self._on_procedures(procedures))
+            procedures.sigReportWritten.connect(lambda html, pdf: self._on_report(procedures, html, pdf))
+        if self._first_time(scope := window.built_page(PageId.SCOPE)):
+            scope.view.sigRecordingSaved.connect(self._on_recording)
+        if self._first_time(modelcheck := window.built_page(PageId.MODELCHECK)):
+            modelcheck.sigFinished.connect(lambda result: self._on_model_check(modelcheck, result))
+        if self._first_time(absolute := window.built_page(PageId.ABSOLUTE)):
+            absolute.sigRecorded.connect(self._on_dgr_check)
+
+    def _first_time(self, page: _P | None) -> TypeGuard[_P]:
+        """A page built and not hooked yet (it is hooked now)."""
+        if page is None or id(page) in self._hooked:
+            return False
+        self._hooked.add(id(page))
+        return True
+
+    # -- writing, never failing the GUI ---------------------------------------------------------------
+    def _record(self, facts: Iterable[Fact]) -> None:
+        for fact in facts:
+            self._record_action(fact.what, partial(record_fact, self.register, self.axis_ref, fact))
+
+    def _record_action(self, what: str, action: Callable[[], object]) -> None:
+        try:
+            action()
+        except (RegisterError, OSError, ValueError) as exc:
+            log.warning("register: %s of %s not recorded: %s", what, self.axis_ref, exc)
+            self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
+        except Exception as exc:  # sqlite3 errors (a locked or damaged file): said, not raised
+            log.exception("register: %s of %s not recorded", what, self.axis_ref)
+            self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
+
+    @property
+    def who(self) -> str:
+        return self._who()
+
+    # -- from the link --------------------------------------------------------------------------------
+    @Slot(object)
+    def _on_connected(self, info: LinkInfo) -> None:
+        self._alarm_code = 0
+        if info.driver_model:
+            self._record([DriverFact(info.driver_model, self.who)])
+
+    @Slot(object)
+    def _on_read(self, result: LinkReply[ParameterReadout]) -> None:
+        if not result.ok or not result.answer.values:
+            return
+        info = self.window.link.info
+        self._record(
+            read_facts(
+                self.window.session.parameter_model,
+                {(str(mode), number): value for (mode, number), value in result.answer.values.items()},
+                self.who,
+                driver_model=info.driver_model if info else "",
+            )
+        )
+
+    @Slot(object)
+    def _on_write(self, entry: dict) -> None:
+        self._record([write_fact(self.window.session.parameter_model, entry, self.who)])
+
+    @Slot(object)
+    def _on_status(self, status: DriveStatus) -> None:
+        code = status.alarm_code
+        if code is None or code == self._alarm_code:
+            return
+        self._alarm_code = code
+        self._record(alarm_facts(code, self.window.session.driver, self.who))
+
+    @Slot()
+    def _on_front_panel(self) -> None:
+        """Values read off the drive's front panel by a person: a front-panel snapshot per
+        entry time and person (an entry already recorded is not recorded again)."""
+        self._record(
+            front_panel_facts(
+                self.window.session.parameter_model,
+                self.window.state.front_panel.values(),
+                self._front_panel_seen,
+            )
+        )
+
+    # -- from the pages -------------------------------------------------------------------------------
+    def _on_procedures(self, page: ProceduresPage) -> None:
+        session = page.session
+        if session is None:
+            return
+        axis_name = self.axis_ref.split("/", 1)[1]
+        if session.axis != axis_name and not any(s.records for s in session.runs.values()):
+            # a session started on this axis's pages is this axis's, on this machine's site
+            session.axis = axis_name
+            session.site = session.site or self.site
+            if session.path is not None:
+                self._record_action("session file", session.save)
+        self._record_action("procedure check", lambda: record_session(self.register, self.axis_ref, session))
+
+    def _on_report(self, page: ProceduresPage, html: Path, pdf: Path | None) -> None:
+        self._record(report_facts(page.session, page.context, html, pdf, self.who))
+
+    @Slot(object, str)
+    def _on_recording(self, path: Path, what: str) -> None:
+        self._record([RecordingFact(path, what, self.who)])
+
+    @Slot(object)
+    def _on_dgr_check(self, record: DgrCheckRecord) -> None:
+        """A check of the DGR checks page (what it becomes: ``facts_from_dgr_check``)."""
+        self._record(facts_from_dgr_check(record))
+
+    def _on_model_check(self, page: ModelCheckPage, result: ModelCheckResult) -> None:
+        self._record(
+            model_check_facts(result.summary_lines(manual_units=True), page.recording_path or "", self.who)
+        )
