@@ -7,7 +7,26 @@ import json
 
 from fha_studio.logic.register import guard, words
 from fha_studio.logic.register.queries import Queries
-from fha_studio.logic.register.records import SNAPSHOT_SOURCE_WORDS, Axis, Event, check_name, utc_stamp
+from fha_studio.logic.register.records import (
+    SNAPSHOT_SOURCE_WORDS,
+    Axis,
+    Event,
+    EventKind,
+    check_name,
+    utc_stamp,
+)
+
+#: Facts recorded at the same time are told in this order.
+HISTORY_ORDER = (
+    EventKind.AXIS,
+    EventKind.SNAPSHOT,
+    EventKind.WRITE,
+    EventKind.CHECK,
+    EventKind.ALARM,
+    EventKind.RECORDING,
+    EventKind.MODEL_CHECK,
+    EventKind.REPORT,
+)
 
 
 @guard.in_words
@@ -21,13 +40,13 @@ class History(Queries):
         db = self._db
         events: list[Event] = []
         for r in db.execute("SELECT * FROM axis_event WHERE axis_id = ?", (a,)):
-            events.append(Event(r["at_utc"], "axis", r["who"], r["text"], r["id"]))
+            events.append(Event(r["at_utc"], EventKind.AXIS, r["who"], r["text"], r["id"]))
         for r in self.snapshots(current):
             where = f" ({r['file']})" if r["file"] else ""
             events.append(
                 Event(
                     r["at_utc"],
-                    "snapshot",
+                    EventKind.SNAPSHOT,
                     r["who"],
                     f"parameters {SNAPSHOT_SOURCE_WORDS[r['source']]}: {r['count']} values,"
                     f" snapshot {r['id']}{where}",
@@ -42,7 +61,7 @@ class History(Queries):
             events.append(
                 Event(
                     r["at_utc"],
-                    "write",
+                    EventKind.WRITE,
                     r["who"],
                     f"{name}: {change}, {outcome}",
                     r["id"],
@@ -62,7 +81,7 @@ class History(Queries):
             events.append(
                 Event(
                     r["at_utc"],
-                    "check",
+                    EventKind.CHECK,
                     r["who"],
                     f"{check_name(r, titles)}: {shown} — {verdict}",
                     r["id"],
@@ -81,7 +100,7 @@ class History(Queries):
             events.append(
                 Event(
                     r["at_utc"],
-                    "alarm",
+                    EventKind.ALARM,
                     r["who"],
                     f"alarm {r['code']}: {r['name']}{note}",
                     r["id"],
@@ -93,7 +112,7 @@ class History(Queries):
             events.append(
                 Event(
                     r["at_utc"],
-                    "report",
+                    EventKind.REPORT,
                     r["who"],
                     f"report {r['file']} ({signed}, {r['open_warnings']} open warnings)",
                     r["id"],
@@ -105,7 +124,7 @@ class History(Queries):
             events.append(
                 Event(
                     r["at_utc"],
-                    "recording",
+                    EventKind.RECORDING,
                     r["who"],
                     f"recording {r['file']}{summary}",
                     r["id"],
@@ -116,7 +135,7 @@ class History(Queries):
             events.append(
                 Event(
                     r["at_utc"],
-                    "model_check",
+                    EventKind.MODEL_CHECK,
                     r["who"],
                     f"model check: {r['summary']}",
                     r["id"],
@@ -126,14 +145,5 @@ class History(Queries):
         if since is not None:
             cutoff = utc_stamp(since)
             events = [e for e in events if e.at_utc >= cutoff]
-        order = {
-            "axis": 0,
-            "snapshot": 1,
-            "write": 2,
-            "check": 3,
-            "alarm": 4,
-            "recording": 5,
-            "model_check": 6,
-            "report": 7,
-        }
+        order = {kind: n for n, kind in enumerate(HISTORY_ORDER)}
         return sorted(events, key=lambda e: (e.at_utc, order[e.kind], e.ref or 0))

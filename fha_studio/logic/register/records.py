@@ -8,6 +8,7 @@ import hashlib
 import sqlite3
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
+from enum import StrEnum
 from pathlib import Path
 from typing import Any
 
@@ -121,19 +122,32 @@ class Difference:
     b: int | None
 
 
+class EventKind(StrEnum):
+    """What a line of an axis's history is (the text is what exports and ``--json`` carry)."""
+
+    AXIS = "axis"
+    SNAPSHOT = "snapshot"
+    WRITE = "write"
+    CHECK = "check"
+    ALARM = "alarm"
+    REPORT = "report"
+    RECORDING = "recording"
+    MODEL_CHECK = "model_check"
+
+
 @dataclass(frozen=True)
 class Event:
     """One line of an axis's history."""
 
     at_utc: str
-    kind: str  # axis, snapshot, write, check, alarm, report, recording, model_check
+    kind: EventKind
     who: str
     text: str  # for people
     ref: int | None = None  # the row (a snapshot's number is what `diff` takes)
     data: Mapping[str, Any] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
-        return {**asdict(self), "data": dict(self.data)}
+        return {**asdict(self), "kind": str(self.kind), "data": dict(self.data)}
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,7 @@ from functools import cache
 from typing import Any
 
 from fha_studio.hardware.parameters import MODE_WORDS, driver_family
+from fha_studio.logic.register.records import EventKind
 
 #: Where a known value comes from.
 SOURCE_WORDS = {
@@ -17,15 +18,15 @@ SOURCE_WORDS = {
 }
 
 #: What a history entry is.
-KIND_WORDS = {
-    "axis": "axis",
-    "snapshot": "parameters",
-    "write": "write",
-    "check": "check",
-    "alarm": "alarm",
-    "report": "report",
-    "recording": "recording",
-    "model_check": "model check",
+KIND_WORDS: dict[EventKind, str] = {
+    EventKind.AXIS: "axis",
+    EventKind.SNAPSHOT: "parameters",
+    EventKind.WRITE: "write",
+    EventKind.CHECK: "check",
+    EventKind.ALARM: "alarm",
+    EventKind.REPORT: "report",
+    EventKind.RECORDING: "recording",
+    EventKind.MODEL_CHECK: "model check",
 }
 
 
