@@ -496,7 +496,7 @@ class DriveClient:
         ``{"origin": ..., "ls1": ..., "ls2": ...}``."""
         self._require(Command.SNQ)
         values = self._transact(Command.SNQ, parse=_values(3))
-        return {k: v * p.ANGLE_STEP_DEG for k, v in zip(("origin", "ls1", "ls2"), values, strict=True)}
+        return {k: v * p.ANGLE_STEP_DEG for k, v in zip(SensorName, values, strict=True)}
 
     # --- the documented commands -----------------------------------------------------------------
 

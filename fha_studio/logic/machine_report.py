@@ -18,6 +18,7 @@ from typing import Any
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures.report import CommissioningReport, build_report, render_html
+from fha_studio.logic.procedures.sensor_dogs import Sensor
 from fha_studio.logic.procedures.session import ProcedureSession, SessionError, utc_now
 
 #: (mode, number) of the rotary direction item (HA-655 manual, parameter mode 8; FHA-C manual 1-10).
@@ -78,8 +79,8 @@ def _checks(session: ProcedureSession | None) -> tuple[int, int]:
 
 def _origin(axis: MachineAxis, session: ProcedureSession | None, register: Any, axis_ref: str) -> str:
     angles = session.sensor_angles_deg if session is not None else {}
-    if "origin_sensor" in angles:
-        return f"origin sensor at {float(angles['origin_sensor']):+.2f}° (4-7-2)"
+    if Sensor.ORIGIN_SENSOR in angles:
+        return f"origin sensor at {float(angles[Sensor.ORIGIN_SENSOR]):+.2f}° (4-7-2)"
     if register is not None:
         try:
             origin = register.latest_origin(axis_ref)

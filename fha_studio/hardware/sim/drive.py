@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import __version__ as _version
+from fha_studio.hardware.api import SensorName
 from fha_studio.hardware.parameters import Mode, driver_family, load_alarm_table, load_parameter_model
 from fha_studio.hardware.protocol import ABSOLUTE_COUNTS_PER_TURN
 from fha_studio.hardware.sim.axis import (
@@ -48,7 +49,7 @@ from fha_studio.hardware.sim.io import SimIo
 from fha_studio.hardware.sim.memory import ItemId, ParameterMemory, PersistentState
 from fha_studio.hardware.sim.monitors import monitor_wire
 from fha_studio.hardware.sim.motion import RPM, MotionKind, SimMotion
-from fha_studio.hardware.sim.options import SimConfig, SimConfigError
+from fha_studio.hardware.sim.options import Battery, SimConfig, SimConfigError, Wiring
 from fha_studio.hardware.sim.realtime import RealTime
 from fha_studio.hardware.sim.recorder import SimRecorder
 from fha_studio.hardware.sim.reply import SimRefused, SimReply, rejected, servo_is_on
@@ -58,7 +59,7 @@ from fha_studio.physics import ServoAxis, ServoSettings
 
 TWO_PI = 2.0 * math.pi
 #: wiring faults that leave the motor without useful torque (see _supervise_wiring_fault)
-MOTION_WIRING_FAULTS = ("motor_swapped", "motor_open", "encoder_swapped")
+MOTION_WIRING_FAULTS = (Wiring.MOTOR_SWAPPED, Wiring.MOTOR_OPEN, Wiring.ENCODER_SWAPPED)
 
 
 class SimDrive:
@@ -118,11 +119,11 @@ class SimDrive:
             ls2_deg=config.ls2_deg if config.ls2_deg is not None else c.limit_switch_2_angle_deg,
             brake_supply=config.brake_supply,
         )
-        if config.battery != "ok" and not self.absolute_encoder:
+        if config.battery is not Battery.OK and not self.absolute_encoder:
             raise SimConfigError(f"simulated drive option battery={config.battery}: {self.actuator_code} "
                                  "has an incremental encoder (no backup battery)")
         # the encoder's A/B leads swapped: it counts the other way (docs/sim.md, wiring faults)
-        self._encoder_sign = -1.0 if config.wiring == "encoder_swapped" else 1.0
+        self._encoder_sign = -1.0 if config.wiring is Wiring.ENCODER_SWAPPED else 1.0
         self._faulty_motion_s = 0.0  # how long a motion has been commanded into a wiring fault
         self.oww_clear_s = config.oww_clear_s if config.oww_clear_s is not None else c.oww_clear_s
         self.supervisor = AlarmSupervisor(
@@ -185,7 +186,7 @@ class SimDrive:
                 raise SimConfigError(
                     f"simulated drive option preset {mode}.{number}={value}: {exc.reason}"
                 ) from None
-        if self.config.battery == "lost":
+        if self.config.battery is Battery.LOST:
             turns = self.constants.lost_multi_turn_turns
             persistent.absolute_zero_rad -= turns * TWO_PI / self.ratio
 
@@ -228,9 +229,9 @@ class SimDrive:
         axis.reset_peaks()
         self._update_brake()
         self._faulty_motion_s = 0.0
-        if self.config.wiring == "encoder_open":
+        if self.config.wiring is Wiring.ENCODER_OPEN:
             self.raise_alarm(50)  # no valid signal from the encoder
-        elif self.config.battery != "ok":
+        elif self.config.battery is not Battery.OK:
             self.raise_alarm(56)  # the backup battery's voltage is low
 
     def power_cycle(self) -> None:
@@ -412,7 +413,7 @@ class SimDrive:
         with self.lock:
             return self.io.blocked(self._angle_deg, self._direction)
 
-    def set_sensor_angle(self, which: str, angle_deg: float) -> None:
+    def set_sensor_angle(self, which: SensorName | str, angle_deg: float) -> None:
         """Move the origin slit (``"origin"``) or a limit-switch dog (``"ls1"``, ``"ls2"``), as in
         the sensor adjustment procedure of FHA-C manual 4-7-2 (sim only)."""
         with self.lock:
@@ -618,7 +619,7 @@ class SimDrive:
             return
         sign = self.motion.sign * self._direction
         self.raise_alarm(60)
-        if self.config.wiring != "motor_open":  # the axis lurched the wrong way before the trip
+        if self.config.wiring is not Wiring.MOTOR_OPEN:  # the axis lurched the wrong way before the trip
             self.axis.turn_by_hand(-sign * math.radians(self.constants.wiring_fault_lurch_deg))
 
     def _supervise_alarms(self) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from fha_studio.hardware.api import SensorName
 from fha_studio.hardware.sim.constants import SimConstants
 from fha_studio.hardware.sim.reply import rejected
 
@@ -25,7 +26,7 @@ BIT_MOVING = 15
 INPUT_MASK = sum(1 << b for b in (4, 5, 6, 7, 8, 9, 10))
 SENSOR_MASK = sum(1 << b for b in (BIT_ORIGIN, BIT_LIMIT_1, BIT_LIMIT_2))
 
-SENSORS = ("origin", "ls1", "ls2")
+SENSORS = tuple(SensorName)
 #: More than one output encoder pulse of any FHA-C (the coarsest, 409600 pulses per turn, is 0.00088 deg)
 DOG_EDGE_TOLERANCE_DEG = 0.001
 
@@ -81,17 +82,18 @@ class SimIo:
         """24 V is on the brake coil: the controller switched it on and the supply is there."""
         return bool(self.inputs >> BIT_BRAKE_RELEASED & 1) and self.brake_supply
 
-    def set_sensor_angle(self, which: str, angle_deg: float) -> None:
+    def set_sensor_angle(self, which: SensorName | str, angle_deg: float) -> None:
         """Move the origin slit (``"origin"``) or a limit-switch dog (``"ls1"``, ``"ls2"``)."""
         if which not in SENSORS:
             raise ValueError(f"sensor {which!r}: origin, ls1 or ls2")
+        which = SensorName(which)
         if not self.has_sensors:
             raise rejected("this actuator has no option-L sensor set")
         if not math.isfinite(angle_deg):
             raise rejected("sensor angle must be finite")
-        if which == "origin":
+        if which is SensorName.ORIGIN:
             self.origin_deg = float(angle_deg)
-        elif which == "ls1":
+        elif which is SensorName.LS1:
             self.ls1_deg = float(angle_deg)
         else:
             self.ls2_deg = float(angle_deg)

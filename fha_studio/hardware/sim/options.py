@@ -53,6 +53,7 @@ import re
 import secrets
 import threading
 from dataclasses import dataclass, field, replace
+from enum import StrEnum
 from typing import Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
@@ -60,12 +61,35 @@ from fha_studio import plausible
 from fha_studio.catalog import DEFAULT_ACTUATOR
 from fha_studio.hardware.sim.journal import Journal
 
-#: The command sets a simulated drive can speak (see ``profile`` above).
-PROFILES = ("full", "documented")
-#: Wiring faults a simulated drive can carry (see ``wiring`` above and docs/sim.md).
-WIRING_FAULTS = ("ok", "motor_swapped", "motor_open", "encoder_swapped", "encoder_open")
-#: States of the absolute encoder's backup battery (see ``battery`` above).
-BATTERY_STATES = ("ok", "low", "lost")
+
+class Profile(StrEnum):
+    """The command set a simulated drive speaks (see ``profile`` above)."""
+
+    FULL = "full"
+    DOCUMENTED = "documented"
+
+
+class Wiring(StrEnum):
+    """A wiring fault a simulated drive can carry (see ``wiring`` above and docs/sim.md)."""
+
+    OK = "ok"
+    MOTOR_SWAPPED = "motor_swapped"
+    MOTOR_OPEN = "motor_open"
+    ENCODER_SWAPPED = "encoder_swapped"
+    ENCODER_OPEN = "encoder_open"
+
+
+class Battery(StrEnum):
+    """The state of the absolute encoder's backup battery (see ``battery`` above)."""
+
+    OK = "ok"
+    LOW = "low"
+    LOST = "lost"
+
+
+PROFILES = tuple(Profile)
+WIRING_FAULTS = tuple(Wiring)
+BATTERY_STATES = tuple(Battery)
 
 
 class SimConfigError(ValueError):
@@ -92,28 +116,27 @@ class SimConfig:
     quantised: bool = True
     oww_clear_s: float | None = None
     packed_trace: bool = True
-    profile: str = "full"
-    wiring: str = "ok"
+    profile: Profile = Profile.FULL
+    wiring: Wiring = Wiring.OK
     brake_supply: bool = True
-    battery: str = "ok"
+    battery: Battery = Battery.OK
     #: items stored into a new EEPROM, as delivered: ((mode, number, value), ...)
     preset: tuple[tuple[str, int, int], ...] = ()
     #: the training registration this drive belongs to (its journal), or None
     training: str | None = None
 
     def __post_init__(self) -> None:
-        if self.profile not in PROFILES:
-            raise SimConfigError(
-                f"simulated drive option profile: {self.profile!r} is not one of {', '.join(PROFILES)}"
-            )
-        if self.wiring not in WIRING_FAULTS:
-            raise SimConfigError(
-                f"simulated drive option wiring: {self.wiring!r} is not one of {', '.join(WIRING_FAULTS)}"
-            )
-        if self.battery not in BATTERY_STATES:
-            raise SimConfigError(
-                f"simulated drive option battery: {self.battery!r} is not one of {', '.join(BATTERY_STATES)}"
-            )
+        kinds: tuple[tuple[str, type[StrEnum]], ...] = (
+            ("profile", Profile), ("wiring", Wiring), ("battery", Battery)
+        )
+        for name, kind in kinds:  # the text of a URL or a keyword becomes its kind
+            value = getattr(self, name)
+            try:
+                object.__setattr__(self, name, kind(value))
+            except ValueError:
+                raise SimConfigError(
+                    f"simulated drive option {name}: {value!r} is not one of {', '.join(kind)}"
+                ) from None
         if not isinstance(self.actuator, str) or not self.actuator.strip():
             raise SimConfigError("simulated drive: an actuator model code is needed, e.g. FHA-25C-50-US250")
         _ranged("load_inertia_kgm2", self.load_inertia_kgm2, plausible.LOAD_INERTIA_KGM2)

@@ -27,7 +27,7 @@ from typing import Final
 
 from fha_studio import __version__ as _version
 from fha_studio import clock
-from fha_studio.hardware.api import IoState
+from fha_studio.hardware.api import IoState, SensorName
 from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.protocol import (
     DOCUMENTED_COMMANDS,
@@ -45,7 +45,7 @@ from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.journal import Journal, JournalEntry, PanelAction
 from fha_studio.hardware.sim.memory import ItemId
 from fha_studio.hardware.sim.monitors import monitor_wire
-from fha_studio.hardware.sim.options import SimConfigError, training_registration
+from fha_studio.hardware.sim.options import Profile, SimConfigError, training_registration
 from fha_studio.hardware.sim.reply import SimRefused, SimReply, rejected, servo_is_on
 from fha_studio.hardware.sim.trace import TraceError
 
@@ -84,7 +84,7 @@ class SimResponder:
         table = COMMANDS
         if not config.packed_trace:  # a drive from before the packed encoding: no TRP
             table = {c: h for c, h in table.items() if c is not Command.TRP}
-        if config.profile == "documented":
+        if config.profile is Profile.DOCUMENTED:
             table = DOCUMENTED_ONLY
         #: The commands this drive speaks and their handlers.
         self.command_table: Mapping[Command, Handler] = table
@@ -367,7 +367,7 @@ def _flt(r: SimResponder, value: int) -> None:
     r.drive.raise_alarm(value)
 
 
-def _sensor(which: str) -> Handler:
+def _sensor(which: SensorName) -> Handler:
     def move(r: SimResponder, value: int) -> None:
         r.drive.set_sensor_angle(which, value / 100.0)
 
@@ -414,9 +414,9 @@ COMMANDS: Mapping[Command, Handler] = {
     Command.TRB: _trb,
     Command.TRP: _trp,
     Command.FLT: _flt,
-    Command.SNO: _sensor("origin"),
-    Command.SNA: _sensor("ls1"),
-    Command.SNB: _sensor("ls2"),
+    Command.SNO: _sensor(SensorName.ORIGIN),
+    Command.SNA: _sensor(SensorName.LS1),
+    Command.SNB: _sensor(SensorName.LS2),
     Command.SNQ: _snq,
 }
 

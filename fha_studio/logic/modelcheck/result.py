@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from enum import StrEnum
 from pathlib import Path
 from typing import Any
 
@@ -161,27 +162,35 @@ class ChannelReport:
     n_samples: int
 
 
-CHECKED = "checked"
-TOO_LITTLE_SIGNAL = "too little signal"
-ABSENT = "absent"
+class ChannelCheck(StrEnum):
+    """Whether a channel was checked, and if not, why (the text is the JSON report's)."""
+
+    CHECKED = "checked"
+    TOO_LITTLE_SIGNAL = "too little signal"
+    ABSENT = "absent"
+
+
+CHECKED = ChannelCheck.CHECKED
+TOO_LITTLE_SIGNAL = ChannelCheck.TOO_LITTLE_SIGNAL
+ABSENT = ChannelCheck.ABSENT
 
 
 @dataclass(frozen=True)
 class ChannelStatus:
-    """Whether a channel was checked, and why not: "checked" | "too little signal" | "absent"."""
+    """Whether a channel was checked, and why not."""
 
     channel: str
-    status: str
+    status: ChannelCheck
     reason: str
     level: float = 0.0  # channel unit: what the channel shows at most (too little signal)
     unit: str = ""
 
     @property
     def checked(self) -> bool:
-        return self.status == CHECKED
+        return self.status is ChannelCheck.CHECKED
 
     def to_json(self) -> dict[str, Any]:
-        return {"status": self.status, "reason": self.reason, "level": self.level, "unit": self.unit}
+        return {"status": str(self.status), "reason": self.reason, "level": self.level, "unit": self.unit}
 
 
 @dataclass
@@ -312,7 +321,9 @@ class ModelCheckResult:
         else:
             rest = "nothing is checked; record a move with more acceleration, speed or load"
         return [
-            f"The {st.channel} channel {st.reason}: {rest}." for st in skipped if st.status != ABSENT
+            f"The {st.channel} channel {st.reason}: {rest}."
+            for st in skipped
+            if st.status is not ChannelCheck.ABSENT
         ] or ([f"Nothing is checked: {'; '.join(st.reason for st in skipped)}."] if not checked else [])
 
     def to_json(self) -> dict[str, Any]:

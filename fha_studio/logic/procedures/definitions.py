@@ -34,10 +34,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fha_studio.logic.procedures.sensor_dogs import SENSORS, Sensor
 from fha_studio.paths import resource
 
 KINDS = ("confirm", "measure", "text", "choose", "live", "sensor_angle")
-_SENSORS = ("limit_switch_1", "limit_switch_2", "origin_sensor")
 _WHOLE_FIELD = re.compile(r"^\{([A-Za-z0-9_.\-]+)\}$")
 # Fields that are templates; everything else in a step is kept as written.
 _TEMPLATED = ("text", "warning", "minimum", "maximum", "expect", "expect_any", "unit")
@@ -120,7 +120,7 @@ class Step:
     expect_any: tuple[str, ...] = ()
     choices: tuple[str, ...] = ()
     check: str = ""
-    sensor: str = ""
+    sensor: str = ""  # a sensor_angle step's Sensor (whose switching angle it takes)
     params: Mapping[str, Any] = field(default_factory=dict)
     stop_on_fail: bool = True
 
@@ -211,7 +211,7 @@ class StepDef:
             expect_any=tuple(str(v) for v in expect_any),
             choices=tuple(str(c) for c in raw.get("choices", ())),
             check=str(raw.get("check", "")),
-            sensor=str(raw.get("sensor", "")),
+            sensor=Sensor(raw["sensor"]) if raw.get("sensor") in SENSORS else str(raw.get("sensor", "")),
             params=params,
             stop_on_fail=bool(raw.get("stop_on_fail", True)),
         )
@@ -270,9 +270,9 @@ def _check_step(raw: Mapping[str, Any], where: str) -> None:
         raise ProcedureError(f"{where}: text step '{raw['id']}' has neither expect nor expect_any")
     if kind == "live" and not raw.get("check"):
         raise ProcedureError(f"{where}: live step '{raw['id']}' names no check")
-    if kind == "sensor_angle" and raw.get("sensor") not in _SENSORS:
+    if kind == "sensor_angle" and raw.get("sensor") not in SENSORS:
         raise ProcedureError(
-            f"{where}: sensor_angle step '{raw['id']}' needs sensor = one of {', '.join(_SENSORS)}"
+            f"{where}: sensor_angle step '{raw['id']}' needs sensor = one of {', '.join(SENSORS)}"
         )
     when = raw.get("when", [])
     if not isinstance(when, list) or not all(isinstance(c, str) for c in when):

@@ -28,7 +28,7 @@ from fha_studio.hardware.errors import (
 from fha_studio.hardware.parameters import MonitorItem
 from fha_studio.logic.procedures.definitions import Step
 from fha_studio.logic.procedures.engine import Observation, normalise_label
-from fha_studio.logic.procedures.sensor_dogs import SENSORS, SensorDogWizard
+from fha_studio.logic.procedures.sensor_dogs import SENSORS, Sensor, SensorDogWizard
 
 LOW_SPEED_RPM = 2.0  # output speed of the moves a live check makes (slow: a person is watching)
 ROTARY_DIRECTION = ("system", 8)  # [parameter mode] -> [8: rotary direction] (1-10)
@@ -277,9 +277,9 @@ def _check_sensor_test_run(client: DriveApi, step: Step, env: LiveEnv) -> Observ
 
 def _sensor_states(io: IoState) -> dict[str, bool]:
     return {
-        "limit_switch_1": io.limit_switch_1,
-        "limit_switch_2": io.limit_switch_2,
-        "origin_sensor": io.origin_sensor,
+        Sensor.LIMIT_SWITCH_1: io.limit_switch_1,
+        Sensor.LIMIT_SWITCH_2: io.limit_switch_2,
+        Sensor.ORIGIN_SENSOR: io.origin_sensor,
     }
 
 

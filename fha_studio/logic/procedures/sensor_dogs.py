@@ -11,13 +11,24 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Any
 
-SENSORS = ("limit_switch_1", "limit_switch_2", "origin_sensor")
-SENSOR_NAMES = {
-    "limit_switch_1": "limit switch 1 (CCW end)",
-    "limit_switch_2": "limit switch 2 (CW end)",
-    "origin_sensor": "origin sensor",
+
+class Sensor(StrEnum):
+    """A sensor of the rotary position sensor set (option L, 4-7), as procedures and session files
+    name it."""
+
+    LIMIT_SWITCH_1 = "limit_switch_1"  # at the CCW end
+    LIMIT_SWITCH_2 = "limit_switch_2"  # at the CW end
+    ORIGIN_SENSOR = "origin_sensor"
+
+
+SENSORS = tuple(Sensor)
+SENSOR_NAMES: dict[str, str] = {
+    Sensor.LIMIT_SWITCH_1: "limit switch 1 (CCW end)",
+    Sensor.LIMIT_SWITCH_2: "limit switch 2 (CW end)",
+    Sensor.ORIGIN_SENSOR: "origin sensor",
 }
 
 
@@ -39,12 +50,12 @@ def angle_problem(
     name = SENSOR_NAMES.get(sensor, sensor)
     if not ccw <= angle_deg <= cw:
         return f"{name} at {angle_deg:+.2f}° is outside the movable range {ccw:+.1f}° … {cw:+.1f}° (4-7-3)"
-    ls1, ls2 = recorded.get("limit_switch_1"), recorded.get("limit_switch_2")
-    if sensor == "limit_switch_1" and ls2 is not None and angle_deg >= ls2:
+    ls1, ls2 = recorded.get(Sensor.LIMIT_SWITCH_1), recorded.get(Sensor.LIMIT_SWITCH_2)
+    if sensor == Sensor.LIMIT_SWITCH_1 and ls2 is not None and angle_deg >= ls2:
         return f"limit switch 1 (CCW end) at {angle_deg:+.2f}° must be CCW of limit switch 2 at {ls2:+.2f}°"
-    if sensor == "limit_switch_2" and ls1 is not None and angle_deg <= ls1:
+    if sensor == Sensor.LIMIT_SWITCH_2 and ls1 is not None and angle_deg <= ls1:
         return f"limit switch 2 (CW end) at {angle_deg:+.2f}° must be CW of limit switch 1 at {ls1:+.2f}°"
-    if sensor == "origin_sensor" and ls1 is not None and ls2 is not None and not ls1 < angle_deg < ls2:
+    if sensor == Sensor.ORIGIN_SENSOR and ls1 is not None and ls2 is not None and not ls1 < angle_deg < ls2:
         return f"the origin at {angle_deg:+.2f}° must lie between the stroke ends {ls1:+.2f}° and {ls2:+.2f}°"
     return ""
 
@@ -70,7 +81,7 @@ class SensorDogWizard:
         tolerance = float(context["sensor_set"].get("test_tolerance_deg", 2.0))
         return cls(ccw_limit_deg=ccw, cw_limit_deg=cw, tolerance_deg=tolerance)
 
-    def observe(self, angle_deg: float, states: Mapping[str, bool]) -> list[str]:
+    def observe(self, angle_deg: float, states: Mapping[str, bool]) -> list[Sensor]:
         """Feed one sample; returns the sensors that switched on at it (their angle is remembered)."""
         switched_on = []
         previous = self.angle_deg
@@ -123,8 +134,8 @@ class SensorDogWizard:
         if missing:
             raise MoveRefused(f"no test run before these are recorded: {', '.join(missing)}")
         return [
-            self.clamp_target(recorded["limit_switch_2"] + self.tolerance_deg),
-            self.clamp_target(recorded["limit_switch_1"] - self.tolerance_deg),
+            self.clamp_target(recorded[Sensor.LIMIT_SWITCH_2] + self.tolerance_deg),
+            self.clamp_target(recorded[Sensor.LIMIT_SWITCH_1] - self.tolerance_deg),
         ]
 
     def test_run_result(

@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 import tomllib
 from dataclasses import dataclass, field
+from enum import StrEnum
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote
@@ -42,17 +43,32 @@ FAULT_KINDS: dict[str, tuple[str, tuple[str, ...]]] = {
     ),
 }
 
-#: Evidence kinds and the fields each takes (besides ``kind``); docs/training.md says what each means.
-EVIDENCE_FIELDS: dict[str, tuple[str, ...]] = {
-    "procedure": ("procedure", "step", "passed", "value", "completed"),
-    "parameter_read": ("item",),
-    "parameter_written": ("item", "value", "minimum", "maximum"),
-    "alarm_seen": ("code",),
-    "alarm_cleared": ("code",),
-    "multi_turn_cleared": (),
-    "jog": ("direction",),
-    "model_check": ("effect",),
-    "said": ("words",),
+
+class EvidenceKind(StrEnum):
+    """What a piece of evidence is (the ``kind`` of a scenario file; docs/training.md)."""
+
+    PROCEDURE = "procedure"
+    PARAMETER_READ = "parameter_read"
+    PARAMETER_WRITTEN = "parameter_written"
+    ALARM_SEEN = "alarm_seen"
+    ALARM_CLEARED = "alarm_cleared"
+    MULTI_TURN_CLEARED = "multi_turn_cleared"
+    JOG = "jog"
+    MODEL_CHECK = "model_check"
+    SAID = "said"
+
+
+#: The fields each evidence kind takes (besides ``kind``); docs/training.md says what each means.
+EVIDENCE_FIELDS: dict[EvidenceKind, tuple[str, ...]] = {
+    EvidenceKind.PROCEDURE: ("procedure", "step", "passed", "value", "completed"),
+    EvidenceKind.PARAMETER_READ: ("item",),
+    EvidenceKind.PARAMETER_WRITTEN: ("item", "value", "minimum", "maximum"),
+    EvidenceKind.ALARM_SEEN: ("code",),
+    EvidenceKind.ALARM_CLEARED: ("code",),
+    EvidenceKind.MULTI_TURN_CLEARED: (),
+    EvidenceKind.JOG: ("direction",),
+    EvidenceKind.MODEL_CHECK: ("effect",),
+    EvidenceKind.SAID: ("words",),
 }
 _ITEM = re.compile(r"(tune|system|test)\.([0-9]+)")
 _ID = re.compile(r"[a-z0-9][a-z0-9-]*")
@@ -66,7 +82,7 @@ class ScenarioError(ValueError):
 class Evidence:
     """One thing the trainee can do or record that counts (see docs/training.md)."""
 
-    kind: str
+    kind: EvidenceKind
     procedure: str = ""
     step: str = ""
     passed: bool | None = None
@@ -83,7 +99,7 @@ class Evidence:
     def describe(self) -> str:
         """What counts, in plain words."""
         k = self.kind
-        if k == "procedure":
+        if k is EvidenceKind.PROCEDURE:
             what = f"in the procedure {procedure_title(self.procedure)}"
             if self.step:
                 what += f", the step {self.step.replace('-', ' ')}"
@@ -94,9 +110,9 @@ class Evidence:
             if self.completed:
                 what += " completed"
             return what
-        if k in ("parameter_read", "parameter_written") and self.item is not None:
+        if k in (EvidenceKind.PARAMETER_READ, EvidenceKind.PARAMETER_WRITTEN) and self.item is not None:
             mode, number = self.item
-            what = f"{'read' if k == 'parameter_read' else 'wrote'} {mode} item {number}"
+            what = f"{'read' if k is EvidenceKind.PARAMETER_READ else 'wrote'} {mode} item {number}"
             if self.value is not None:
                 what += f" = {self.value}"
             if self.minimum is not None:
@@ -104,15 +120,15 @@ class Evidence:
             if self.maximum is not None:
                 what += f" <= {self.maximum}"
             return what
-        if k == "alarm_seen":
+        if k is EvidenceKind.ALARM_SEEN:
             return f"alarm {self.code} came up"
-        if k == "alarm_cleared":
+        if k is EvidenceKind.ALARM_CLEARED:
             return f"alarm {self.code} cleared"
-        if k == "multi_turn_cleared":
+        if k is EvidenceKind.MULTI_TURN_CLEARED:
             return "cleared the multi-turn data (OWW)"
-        if k == "jog":
+        if k is EvidenceKind.JOG:
             return f"jogged {self.direction.upper() or 'the axis'}".strip()
-        if k == "model_check":
+        if k is EvidenceKind.MODEL_CHECK:
             return f"model check named {self.effect.replace('_', ' ')}"
         return "wrote in the findings: " + " or ".join(f"“{w}”" for w in self.words)
 
@@ -269,12 +285,13 @@ def _unknown(r: _Reader, table: dict[str, Any], allowed: tuple[str, ...], where:
 def _evidence(r: _Reader, data: Any, where: str, line: int) -> Evidence:
     if not isinstance(data, dict):
         raise r.fail(where, line, "must be a table with kind = ...")
-    kind = data.get("kind")
-    if kind not in EVIDENCE_FIELDS:
-        raise r.fail(where, line, f"kind {kind!r} is not one of {', '.join(EVIDENCE_FIELDS)}")
+    text = data.get("kind")
+    if text not in EVIDENCE_FIELDS:
+        raise r.fail(where, line, f"kind {text!r} is not one of {', '.join(EVIDENCE_FIELDS)}")
+    kind = EvidenceKind(text)
     _unknown(r, data, ("kind", *EVIDENCE_FIELDS[kind]), where, line)
     values: dict[str, Any] = {"kind": kind}
-    if kind == "procedure":
+    if kind is EvidenceKind.PROCEDURE:
         values["procedure"] = _text(r, data, "procedure", where, line)
         values["step"] = _text(r, data, "step", where, line, required=False)
         for key in ("passed", "completed"):
@@ -284,7 +301,7 @@ def _evidence(r: _Reader, data: Any, where: str, line: int) -> Evidence:
                 values[key] = data[key]
         if "value" in data:
             values["value"] = str(data["value"])
-    elif kind in ("parameter_read", "parameter_written"):
+    elif kind in (EvidenceKind.PARAMETER_READ, EvidenceKind.PARAMETER_WRITTEN):
         item = data.get("item")
         m = _ITEM.fullmatch(item) if isinstance(item, str) else None
         if m is None:
@@ -294,22 +311,23 @@ def _evidence(r: _Reader, data: Any, where: str, line: int) -> Evidence:
         values["item"] = (m.group(1), int(m.group(2)))
         for key in ("value", "minimum", "maximum"):
             if key in data:
-                if kind == "parameter_read" or isinstance(data[key], bool) or not isinstance(data[key], int):
+                number = isinstance(data[key], int) and not isinstance(data[key], bool)
+                if kind is EvidenceKind.PARAMETER_READ or not number:
                     raise r.fail(where, line, f"{key} must be a whole number (parameter_written only)")
                 values[key] = data[key]
-    elif kind in ("alarm_seen", "alarm_cleared"):
+    elif kind in (EvidenceKind.ALARM_SEEN, EvidenceKind.ALARM_CLEARED):
         code = data.get("code")
         if isinstance(code, bool) or not isinstance(code, int) or not 1 <= code <= 99:
             raise r.fail(where, line, f"code {code!r} must be an alarm code (a whole number 1 ... 99)")
         values["code"] = code
-    elif kind == "jog":
+    elif kind is EvidenceKind.JOG:
         direction = data.get("direction", "")
         if direction not in ("", "fwd", "rev"):
             raise r.fail(where, line, f"direction {direction!r} must be fwd or rev (or left out: either)")
         values["direction"] = direction
-    elif kind == "model_check":
+    elif kind is EvidenceKind.MODEL_CHECK:
         values["effect"] = _text(r, data, "effect", where, line)
-    elif kind == "said":
+    elif kind is EvidenceKind.SAID:
         words = data.get("words")
         if (
             not isinstance(words, list)
@@ -502,6 +520,7 @@ __all__ = [
     "FAULT_KINDS",
     "LEVELS",
     "Evidence",
+    "EvidenceKind",
     "ExpectedStep",
     "Fault",
     "Scenario",

@@ -17,7 +17,7 @@ from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.protocol import Command, Status
 from fha_studio.hardware.sim.journal import JournalEntry, PanelAction
 from fha_studio.logic.procedures.session import COMPLETED, ProcedureSession
-from fha_studio.logic.training.scenario import Evidence, ExpectedStep, Fault, Scenario
+from fha_studio.logic.training.scenario import Evidence, EvidenceKind, ExpectedStep, Fault, Scenario
 
 MOTION_COMMANDS = frozenset({Command.JOG, Command.MOV, PanelAction.CN2_MOVE})
 #: repeats of one act closer than this are one act (a held jog sends JOG every 50 ms) [s]
@@ -128,7 +128,7 @@ def evidence_seen(evidence: Evidence, record: TraineeRecord) -> list[Seen]:
     """Every time the trainee produced ``evidence``, oldest first."""
     k = evidence.kind
     seen: list[Seen] = []
-    if k == "procedure":
+    if k is EvidenceKind.PROCEDURE:
         run = record.session.runs.get(evidence.procedure) if record.session else None
         if run is None:
             return []
@@ -151,13 +151,13 @@ def evidence_seen(evidence: Evidence, record: TraineeRecord) -> list[Seen]:
                 Seen(_utc_s(r.at_utc), f"recorded {r.text[:80]}{value} ({'pass' if r.passed else 'fail'})")
             )
         return seen
-    if k == "parameter_read":
+    if k is EvidenceKind.PARAMETER_READ:
         return _journal(
             record,
             lambda e: e.command is Command.PRD and e.terminal is Status.DONE and e.item == evidence.item,
             lambda e: f"read {_item_text(e.item)}",
         )
-    if k == "parameter_written":
+    if k is EvidenceKind.PARAMETER_WRITTEN:
 
         def wrote(e: JournalEntry) -> bool:
             return (
@@ -170,12 +170,12 @@ def evidence_seen(evidence: Evidence, record: TraineeRecord) -> list[Seen]:
             )
 
         return _journal(record, wrote, lambda e: f"wrote {_item_text(e.item)} = {e.value}")
-    if k == "alarm_seen":
+    if k is EvidenceKind.ALARM_SEEN:
         first = [
             e for e in record.journal if e.alarm_after == evidence.code or e.alarm_before == evidence.code
         ][:1]
         return [Seen(e.at_s, f"alarm {evidence.code} came up") for e in first]
-    if k == "alarm_cleared":
+    if k is EvidenceKind.ALARM_CLEARED:
         return _journal(
             record,
             lambda e: (
@@ -186,14 +186,14 @@ def evidence_seen(evidence: Evidence, record: TraineeRecord) -> list[Seen]:
             lambda e: f"cleared alarm {evidence.code} "
             f"({'reset' if e.command is Command.ACL else 'power cycle'})",
         )
-    if k == "multi_turn_cleared":
+    if k is EvidenceKind.MULTI_TURN_CLEARED:
         return _journal(
             record,
             # None: the q comes 5 s later
             lambda e: e.command is Command.OWW and e.terminal in (Status.DONE, None),
             lambda e: "cleared the multi-turn data",
         )
-    if k == "jog":
+    if k is EvidenceKind.JOG:
 
         def jogged(e: JournalEntry) -> bool:
             if e.command not in MOTION_COMMANDS or e.terminal is not Status.DONE or e.value == 0:
@@ -202,13 +202,13 @@ def evidence_seen(evidence: Evidence, record: TraineeRecord) -> list[Seen]:
 
         hits = _journal(record, jogged, lambda e: f"moved the axis {'FWD' if e.value > 0 else 'REV'}")
         return _episodes(hits)
-    if k == "model_check":
+    if k is EvidenceKind.MODEL_CHECK:
         return [
             Seen(at, f"the model check named {effect.replace('_', ' ')}")
             for effect, at in record.model_check_effects
             if effect == evidence.effect
         ]
-    if k == "said":
+    if k is EvidenceKind.SAID:
         text = record.findings.lower()
         words = [w for w in evidence.words if w.lower() in text]
         return [Seen(record.ended_s, f"wrote in the findings: {', '.join(words)}")] if words else []
