@@ -376,6 +376,24 @@ MONITOR_MASK_ITEMS = 16
 TRACE_MAX_CHANNELS = 4
 TRACE_MAX_SAMPLES = 4096
 TRACE_BLOCK_SAMPLES = 64
+#: The excitation (EXG): shortest and longest shift register of its PRBS, in bits
+EXCITATION_MIN_BITS = 4
+EXCITATION_MAX_BITS = 12
+
+
+def excitation_register_bits(hold_periods: int) -> int:
+    """Length of the excitation's shift register for bits held ``hold_periods`` servo periods:
+    the longest whose period, (2^bits - 1) x hold, still fits one trace (TRACE_MAX_SAMPLES), so a
+    capture of one period at the servo rate is leakage-free (docs/protocol.md, EXG)."""
+    bits = EXCITATION_MAX_BITS
+    while bits > EXCITATION_MIN_BITS and ((1 << bits) - 1) * hold_periods > TRACE_MAX_SAMPLES:
+        bits -= 1
+    return bits
+
+
+def excitation_period_periods(hold_periods: int) -> int:
+    """Servo periods in one period of the excitation's PRBS."""
+    return ((1 << excitation_register_bits(hold_periods)) - 1) * hold_periods
 
 
 class IoBit(IntEnum):

@@ -90,8 +90,11 @@ class KernelState:
 
 
 def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_on: bool,
-        rec: tuple[list, ...] | None = None, rec_every: int = 1) -> None:
+        rec: tuple[list, ...] | None = None, rec_every: int = 1,
+        speed_injection: list[float] | None = None) -> None:
     """Advance n servo periods. cmd: n command positions (rad, command frame), or None to hold.
+    speed_injection: n speeds (rad/s, command frame) added to the speed command (an excitation
+    at the speed loop's summing point), or None.
 
     rec: lists (t, cmd_phys, xm, xl, vm, current, vref) appended every rec_every periods.
     """
@@ -158,10 +161,14 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
                 fb_prev = fbp
                 err = c - d * fbp
                 vref = kp * err + ff * vc
+                if speed_injection is not None:
+                    vref += speed_injection[k]
                 ev = vref - d * v_filt
             else:
                 err = c - d * xm
                 vref = kp * err + ff * vc
+                if speed_injection is not None:
+                    vref += speed_injection[k]
                 ev = vref - d * vm
             integ_new = integ + ev * dt * tv_inv
             ic = kv * (ev + integ_new)

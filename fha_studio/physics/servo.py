@@ -246,10 +246,13 @@ class ServoAxis:
         """Simulated time since construction."""
         return self._state.step_index * self._params.dt
 
-    def step(self, n: int = 1) -> None:
-        """Advance n servo periods."""
+    def step(self, n: int = 1, speed_injection: list[float] | None = None) -> None:
+        """Advance n servo periods. ``speed_injection``: n speeds (rad/s, command frame) added to
+        the speed command, one per period (an excitation for a frequency response), or None."""
         if n <= 0:
             return
+        if speed_injection is not None and len(speed_injection) != n:
+            raise ValueError(f"speed_injection: {len(speed_injection)} values for {n} periods")
         p = self._params
         if self._servo_on:
             k0 = self._state.step_index + 1
@@ -262,7 +265,8 @@ class ServoAxis:
         else:
             cmd = None
         rec = self._trace
-        _kernel.run(p, self._state, cmd, n, self._servo_on, rec, self._trace_every)
+        _kernel.run(p, self._state, cmd, n, self._servo_on, rec, self._trace_every,
+                    speed_injection if self._servo_on else None)
         if rec is not None:
             overflow = len(rec[0]) - self._trace_max
             if overflow > 0:

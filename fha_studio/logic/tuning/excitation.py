@@ -1,0 +1,91 @@
+"""The excitation's bounds, stated before it starts: amplitude (r/min), the angle it may travel.
+
+The drive adds a PRBS of +/- the amplitude to the speed command (docs/protocol.md, EXG). For a
+linear loop the largest value any output can reach under an input bounded by A is A x the L1 norm
+of its impulse response (``sum |h|``, python-control's impulse response of the linearised loops):
+so the amplitude is chosen to keep the current within ``CURRENT_SHARE`` of the maximum current,
+and the angle travelled is at most A x the L1 norm from the added speed command to the position
+(the position loop holds the axis). The drive stops the excitation if the output ever travels
+farther than that bound (with a margin) from where it started.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from fha_studio.hardware.protocol import excitation_period_periods
+from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
+
+RPM = 2.0 * math.pi / 60.0
+#: the excitation's current stays below this share of the maximum current (linear bound)
+CURRENT_SHARE = 0.5
+#: at most this share of the maximum speed
+SPEED_SHARE = 0.05
+#: the drive's travel limit is the linear bound times this
+TRAVEL_MARGIN = 2.0
+#: records (one PRBS period each) averaged
+RECORDS = 5
+
+
+@dataclass(frozen=True)
+class ExcitationPlan:
+    amplitude_rpm: float
+    hold_periods: int
+    period_samples: int
+    records: int
+    travel_bound_deg: float  # the linear bound of the angle travelled (either way)
+    travel_limit_deg: float  # where the drive stops it
+    peak_current_a: float  # the linear bound of the current
+    f_max_hz: float
+    duration_s: float
+
+    def describe(self) -> str:
+        return (f"excitation: PRBS of +/-{self.amplitude_rpm:.3g} r/min on the speed command, bits of "
+                f"{self.hold_periods} servo period(s), {self.records} records of {self.period_samples} "
+                f"samples ({self.duration_s:.1f} s); the output travels at most "
+                f"+/-{self.travel_bound_deg:.3g} deg (the drive stops at {self.travel_limit_deg:.3g} deg), "
+                f"current at most {self.peak_current_a:.3g} A")
+
+
+def _l1(sys: object, dt: float, duration_s: float = 2.0) -> float:
+    t = np.arange(0.0, duration_s, dt)
+    resp = control.impulse_response(sys, T=t)
+    # python-control scales a discrete impulse response by 1/dt; the sum of |h[k]| is the bound
+    h = np.asarray(resp.outputs).reshape(-1) * dt
+    return float(np.sum(np.abs(h)))
+
+
+def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> ExcitationPlan:
+    """The excitation for ``lm``'s axis: bits held so that the PRBS covers ~5 x the predicted
+    resonance (or 2 x the speed loop's reach), the largest amplitude within the current and speed
+    shares (or ``requested_rpm`` when lower; a higher request raises ValueError)."""
+    model = lm.model
+    rate = lm.settings.servo_rate_hz
+    dt = 1.0 / rate
+    pred = two_mass_prediction(model)
+    want_hz = 5.0 * pred.resonance_hz if pred.resonance_hz else 500.0
+    hold = 1
+    while hold < 8 and 0.4 * rate / (2 * hold) >= want_hz:
+        hold *= 2
+    loop = lm.speed_loop()
+    per_a = _l1(loop[3, 0], dt)
+    top_rpm = min(CURRENT_SHARE * model.max_current_a / per_a / RPM,
+                  SPEED_SHARE * (model.max_speed_rpm or 60.0))
+    amplitude = top_rpm if requested_rpm is None else float(requested_rpm)
+    if not 0.0 < amplitude <= top_rpm * (1 + 1e-9):
+        raise ValueError(f"excitation amplitude {amplitude:g} r/min: allowed 0 ... {top_rpm:.3g} r/min "
+                         f"for this axis (current within {CURRENT_SHARE:.0%} of {model.max_current_a:g} A, "
+                         f"speed within {SPEED_SHARE:.0%} of the maximum)")
+    travel = math.degrees(amplitude * RPM * _l1(lm.injection_to_position(), dt))
+    period = excitation_period_periods(hold)
+    settle = 1.0
+    return ExcitationPlan(
+        amplitude_rpm=amplitude, hold_periods=hold, period_samples=period, records=RECORDS,
+        travel_bound_deg=travel, travel_limit_deg=TRAVEL_MARGIN * travel + 0.01,
+        peak_current_a=amplitude * RPM * per_a, f_max_hz=0.4 * rate / hold,
+        duration_s=settle + RECORDS * period * dt,
+    )

@@ -1,0 +1,183 @@
+"""Frequency response from measured signals, the gear's resonance in it, the inertia, the margins.
+
+- ``estimate_response``: H1 = Pxy / Pxx and the coherence |Pxy|^2 / (Pxx Pyy) from Welch's
+  cross-spectra (scipy.signal.csd / welch), averaged over records. A record of exactly one period
+  of a periodic excitation is leakage-free with a rectangular window, which is how the excitation
+  and the trace are sized (protocol.excitation_period_periods).
+- ``find_resonance``: on the plant (current -> speed) normalised by the rigid body's 1/s slope,
+  the anti-resonance is the dip and the resonance the peak above it (parabolic interpolation
+  between the bins).
+- ``inertia_from_plant``: the low-frequency plant gain Kt / (J s), corrected for the two-mass
+  shape when a resonance was found; ``inertia_from_move``: least squares of torque against
+  acceleration (with Coulomb and viscous friction) over a move, as the HA-800A estimates it.
+- ``loop_figures``: gain margin, phase margin, crossover, -3 dB bandwidth (python-control).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import control
+import numpy as np
+from scipy import signal
+
+TWO_PI = 2.0 * math.pi
+#: bins of at least this coherence are trusted
+COHERENCE_TRUSTED = 0.9
+
+
+@dataclass(frozen=True)
+class FrequencyResponse:
+    """A measured (or predicted) response: frequency (Hz), magnitude (dB), phase (deg), coherence."""
+
+    freq_hz: np.ndarray
+    magnitude_db: np.ndarray
+    phase_deg: np.ndarray
+    coherence: np.ndarray
+
+    @property
+    def complex(self) -> np.ndarray:
+        return np.asarray(10.0 ** (self.magnitude_db / 20.0) * np.exp(1j * np.radians(self.phase_deg)))
+
+    def trusted(self) -> np.ndarray:
+        return np.asarray(self.coherence >= COHERENCE_TRUSTED)
+
+    def to_dict(self) -> dict[str, list[float]]:
+        return {
+            "freq_hz": [round(float(v), 4) for v in self.freq_hz],
+            "magnitude_db": [round(float(v), 3) for v in self.magnitude_db],
+            "phase_deg": [round(float(v), 2) for v in self.phase_deg],
+            "coherence": [round(float(v), 4) for v in self.coherence],
+        }
+
+
+def estimate_response(records: Sequence[tuple[np.ndarray, np.ndarray]], sample_rate_hz: float,
+                      f_min_hz: float = 0.0, f_max_hz: float | None = None) -> FrequencyResponse:
+    """H1 and coherence from (input, output) records of equal length (one period each)."""
+    if not records:
+        raise ValueError("frequency response: no records")
+    n = min(len(x) for x, _ in records)
+    if n < 16:
+        raise ValueError(f"frequency response: records of {n} samples are too short")
+    pxx = pyy = pxy = 0.0
+    freq = np.empty(0)
+    for x, y in records:
+        xs, ys = np.asarray(x[:n], float), np.asarray(y[:n], float)
+        kw: dict[str, Any] = dict(fs=sample_rate_hz, window="boxcar", nperseg=n, noverlap=0,
+                                  detrend="constant")
+        freq, sxx = signal.welch(xs, **kw)
+        _, syy = signal.welch(ys, **kw)
+        _, sxy = signal.csd(xs, ys, **kw)
+        pxx, pyy, pxy = pxx + sxx, pyy + syy, pxy + sxy
+    pxx_a, pyy_a, pxy_a = np.asarray(pxx), np.asarray(pyy), np.asarray(pxy)
+    top = sample_rate_hz / 2.0 if f_max_hz is None else f_max_hz
+    keep = (freq > max(f_min_hz, 0.0)) & (freq <= top) & (pxx_a > 0) & (pyy_a > 0)
+    h = pxy_a[keep] / pxx_a[keep]
+    coh = np.abs(pxy_a[keep]) ** 2 / (pxx_a[keep] * pyy_a[keep]) if len(records) > 1 else np.ones(keep.sum())
+    return FrequencyResponse(freq[keep], 20.0 * np.log10(np.abs(h)), np.degrees(np.unwrap(np.angle(h))),
+                             np.clip(coh, 0.0, 1.0))
+
+
+@dataclass(frozen=True)
+class Resonance:
+    resonance_hz: float | None
+    antiresonance_hz: float | None
+
+
+def _interpolated(freq: np.ndarray, values: np.ndarray, i: int) -> float:
+    if 0 < i < len(values) - 1:
+        a, b, c = values[i - 1], values[i], values[i + 1]
+        den = a - 2.0 * b + c
+        if den != 0.0:
+            shift = 0.5 * (a - c) / den
+            if abs(shift) <= 1.0:
+                step = freq[i + 1] - freq[i] if shift > 0 else freq[i] - freq[i - 1]
+                return float(freq[i] + shift * step)
+    return float(freq[i])
+
+
+def find_resonance(plant: FrequencyResponse, min_depth_db: float = 3.0) -> Resonance:
+    """The anti-resonance (deepest dip) and resonance (highest peak above it) of the plant
+    magnitude x frequency (the rigid body's 1/s taken out), over trusted bins; None where no dip
+    or peak stands ``min_depth_db`` out of the rigid line."""
+    ok = plant.trusted()
+    f = plant.freq_hz[ok]
+    if len(f) < 5:
+        return Resonance(None, None)
+    norm = plant.magnitude_db[ok] + 20.0 * np.log10(f)  # flat for a rigid body
+    base = float(np.median(norm[: max(3, len(norm) // 10)]))
+    i_dip = int(np.argmin(norm))
+    if base - norm[i_dip] < min_depth_db:
+        return Resonance(None, None)
+    above = norm[i_dip:]
+    i_peak = i_dip + int(np.argmax(above))
+    # the peak stands out of the high-frequency level (the motor side alone: base + 20 log(J/Jm))
+    if norm[i_peak] - norm[i_dip] < 2.0 * min_depth_db or i_peak == i_dip:
+        return Resonance(None, _interpolated(f, norm, i_dip))
+    return Resonance(_interpolated(f, norm, i_peak), _interpolated(f, norm, i_dip))
+
+
+def inertia_from_plant(plant: FrequencyResponse, torque_constant_nm_per_a: float,
+                       resonance: Resonance) -> float | None:
+    """Total inertia (kg m^2, output side) from the plant gain Kt / (J w) at low frequency; with
+    a resonance found the two-mass shape (1 - (f/fa)^2) / (1 - (f/fr)^2) is taken out, so bins up
+    to half the anti-resonance count."""
+    ok = plant.trusted()
+    f = plant.freq_hz[ok]
+    mag = 10.0 ** (plant.magnitude_db[ok] / 20.0)
+    if resonance.antiresonance_hz is not None:
+        fa = resonance.antiresonance_hz
+        fr = resonance.resonance_hz if resonance.resonance_hz is not None else math.inf
+        use = f <= 0.5 * fa
+        shape = np.abs((1.0 - (f / fa) ** 2) / (1.0 - (f / fr) ** 2))
+    else:
+        use = f <= max(float(f[0]) * 10.0, 20.0) if len(f) else np.zeros(0, bool)
+        shape = np.ones_like(f)
+    if not np.any(use):
+        return None
+    estimates = torque_constant_nm_per_a * shape[use] / (TWO_PI * f[use] * mag[use])
+    return float(np.median(estimates))
+
+
+def inertia_from_move(t_s: np.ndarray, speed_rad_s: np.ndarray, torque_nm: np.ndarray) -> float:
+    """Total inertia (kg m^2) from a move: least squares of the motor torque against
+    acceleration, sign of speed (Coulomb friction) and speed (viscous friction)."""
+    t, v, tq = (np.asarray(a, float) for a in (t_s, speed_rad_s, torque_nm))
+    if len(t) < 10:
+        raise ValueError("inertia from a move: fewer than 10 samples")
+    accel = np.gradient(v, t)
+    a = np.column_stack([accel, np.sign(v), v])
+    solution, *_ = np.linalg.lstsq(a, tq, rcond=None)
+    return float(solution[0])
+
+
+@dataclass(frozen=True)
+class LoopFigures:
+    """Margins and bandwidth of a loop (None where the curve never crosses)."""
+
+    gain_margin_db: float | None
+    phase_margin_deg: float | None
+    crossover_hz: float | None
+    bandwidth_hz: float | None
+
+
+def loop_figures(open_loop: Any, closed_loop: Any, f_max_hz: float, f_min_hz: float = 0.1) -> LoopFigures:
+    """Gain and phase margin and the crossover of ``open_loop``, the -3 dB bandwidth of
+    ``closed_loop`` (python-control on a dense frequency grid up to ``f_max_hz``)."""
+    w = TWO_PI * np.logspace(math.log10(f_min_hz), math.log10(f_max_hz), 400)
+    open_tf, closed_loop = control.tf(open_loop), control.tf(closed_loop)  # evaluated much faster
+    gm, pm, _sm, _wg, wp, _ws = control.stability_margins(control.frd(open_tf, w))
+    gm_db = 20.0 * math.log10(gm) if gm is not None and math.isfinite(gm) and gm > 0 else None
+    closed = control.frequency_response(closed_loop, w)
+    mag = np.abs(np.asarray(closed.complex).reshape(-1))
+    below = np.nonzero(mag < mag[0] / math.sqrt(2.0))[0]
+    bw_hz = float(w[below[0]]) / TWO_PI if len(below) else None
+    return LoopFigures(
+        gain_margin_db=gm_db,
+        phase_margin_deg=float(pm) if pm is not None and math.isfinite(pm) else None,
+        crossover_hz=float(wp) / TWO_PI if wp is not None and math.isfinite(wp) and wp > 0 else None,
+        bandwidth_hz=bw_hz,
+    )

@@ -1,0 +1,94 @@
+"""The tuning logic on the physics model itself: the linearised loops against the simulated loop
+excited at the speed command (PRBS, one period per record), the gear's resonance and the inertia
+in the measured plant, and the proposed gains' margins."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fha_studio.hardware.parameters import Mode, load_parameter_model
+from fha_studio.hardware.protocol import excitation_period_periods
+from fha_studio.hardware.sim.axis import servo_settings
+from fha_studio.hardware.sim.excitation import SimExcitation, prbs_bits
+from fha_studio.logic.tuning.excitation import RPM, plan_excitation
+from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
+from fha_studio.logic.tuning.propose import AIMS, Tuner
+from fha_studio.logic.tuning.response import estimate_response, find_resonance, inertia_from_plant
+from fha_studio.physics import AxisModel, Effects, ServoAxis
+
+PARAMETERS = load_parameter_model("HA-655")
+DEFAULTS = {it.key: it.default for it in PARAMETERS if it.mode in (Mode.TUNE, Mode.SYSTEM)
+            and it.default is not None}
+RATE = 5000.0
+
+
+def _model(code: str, load_ratio: float) -> AxisModel:
+    own = AxisModel.from_code(code).total_inertia_kgm2
+    return AxisModel.from_code(code, load_inertia_kgm2=load_ratio * own,
+                               effects=Effects().with_effect("torsional_compliance"))
+
+
+def test_prbs_is_maximum_length() -> None:
+    for bits in (4, 9, 11, 12):
+        seq, _ = prbs_bits(2 * ((1 << bits) - 1), bits)
+        period = (1 << bits) - 1
+        assert seq[:period] == seq[period:]
+        assert sum(seq[:period]) == (period + 1) // 2  # a maximum-length sequence's ones
+
+
+@pytest.mark.parametrize(("code", "load_ratio"), [("FHA-25C-50-US250", 1.0), ("FHA-40C-160-S248", 3.0)])
+def test_linearisation_matches_the_simulated_loop(code: str, load_ratio: float) -> None:
+    model = _model(code, load_ratio)
+    settings = servo_settings(model, DEFAULTS, RATE, quantised_feedback=False)
+    lm = LoopModel(model, settings)
+    plan = plan_excitation(lm)
+    hold = plan.hold_periods
+    axis = ServoAxis(model, settings)
+    axis.servo_on()
+    excitation = SimExcitation(amplitude_rad_s=plan.amplitude_rpm * RPM)
+    excitation.start(hold, 0.0, math.inf, 0.0)
+    period = excitation_period_periods(hold)
+    assert period == plan.period_samples
+    axis.step(5000, excitation.values(5000))
+    closed, plant = [], []
+    for _ in range(5):
+        axis.start_trace(1)
+        axis.step(period, excitation.values(period))
+        trace = axis.read_trace()
+        closed.append((trace["speed_cmd"], trace["vel"]))
+        plant.append((trace["current"], trace["vel"]))
+    assert np.abs(trace["current"]).max() <= plan.peak_current_a < model.max_current_a
+    assert math.degrees(np.ptp(trace["pos"])) <= 2 * plan.travel_bound_deg
+    f_max = plan.f_max_hz
+    for which, records in (("closed", closed), ("plant", plant)):
+        measured = estimate_response(records, RATE, f_max_hz=f_max)
+        mag, phase = lm.response(which, measured.freq_hz)
+        ok = measured.trusted()
+        assert ok.sum() > 0.8 * len(ok)
+        assert np.max(np.abs(measured.magnitude_db - mag)[ok]) <= 1.0
+        assert np.max(np.abs((measured.phase_deg - phase + 180.0) % 360.0 - 180.0)[ok]) <= 5.0
+    measured_plant = estimate_response(plant, RATE, f_max_hz=f_max)
+    found = find_resonance(measured_plant)
+    predicted = two_mass_prediction(model)
+    assert found.resonance_hz == pytest.approx(predicted.resonance_hz, rel=0.1)
+    assert found.antiresonance_hz == pytest.approx(predicted.antiresonance_hz, rel=0.1)
+    inertia = inertia_from_plant(measured_plant, model.torque_constant_nm_per_a, found)
+    assert inertia == pytest.approx(model.total_inertia_kgm2, rel=0.1)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("load_ratio", "softer"), [(1.0, False), (10.0, True)])
+def test_proposal_meets_its_margins(load_ratio: float, softer: bool) -> None:
+    model = _model("FHA-25C-50-US250", load_ratio)
+    proposal = Tuner(model, DEFAULTS, PARAMETERS, RATE).propose("standard")
+    gm, pm = AIMS["standard"]
+    assert proposal.proposed.meets(gm, pm)
+    assert proposal.proposed.overshoot_pct is not None and proposal.proposed.overshoot_pct <= 10.0
+    assert (proposal.warning is not None) is softer
+    assert proposal.used_aim == ("soft" if softer else "standard")
+    if softer:
+        assert "2-1" in (proposal.warning or "")
+        assert proposal.proposed.meets(*AIMS["soft"])
