@@ -6,16 +6,28 @@ writing parameters with the automatic backup before the first write. What is kno
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterable, Mapping
 from pathlib import Path
+from typing import cast
 
 from PySide6.QtCore import QObject, QStandardPaths, Signal, Slot
 
 from fha_studio import clock, fileio
 from fha_studio.catalog import DEFAULT_ACTUATOR
-from fha_studio.gui.link import LinkController, LinkInfo, LinkReply, ReadParameters, WriteParameters
+from fha_studio.gui.link import (
+    LinkController,
+    LinkInfo,
+    LinkReply,
+    OnReply,
+    ParameterReadout,
+    ReadParameters,
+    WriteEntry,
+    WriteParameters,
+)
 from fha_studio.gui.state import AxisState
 from fha_studio.hardware.parameters import Mode
 from fha_studio.logic.commissioning import CommissioningState
+from fha_studio.logic.drive_session import ParameterWrite
 from fha_studio.logic.paramfile import dump_parameter_file
 from fha_studio.logic.session_log import SessionLog, WriteRecord
 
@@ -52,7 +64,7 @@ class Session(QObject):
         self.link = link
         self.state = state if state is not None else new_axis_state(self)
         self._models: dict[str, object] = {}
-        self._pending_writes: list[tuple[str, int, int]] | None = None
+        self._pending_writes: list[ParameterWrite] | None = None
         link.sigWrite.connect(self._on_write)
         link.sigConnected.connect(self._on_connected)
 
@@ -74,7 +86,7 @@ class Session(QObject):
 
     def editable_items(self) -> list:
         """Writable tune and parameter (system) items, in panel order."""
-        return [i for i in self.parameter_model if i.mode in ("tune", "system") and i.writable]
+        return [i for i in self.parameter_model if i.mode in (Mode.TUNE, Mode.SYSTEM) and i.writable]
 
     def item(self, key: str):
         return self.parameter_model.by_key(key)
@@ -85,12 +97,12 @@ class Session(QObject):
         ``sigParametersRead``."""
         return self._read_all()
 
-    def _read_all(self, then=None) -> int:
+    def _read_all(self, then: OnReply[ParameterReadout] | None = None) -> int:
         items = tuple((Mode(i.mode), i.number) for i in self.editable_items())
 
-        def on_reply(result: LinkReply) -> None:
-            if result.ok:
-                self.state.record_read(result.value.values)
+        def on_reply(result: LinkReply[ParameterReadout]) -> None:
+            if result.ok:  # keyed by Mode, a str: the state's (mode name, number) keys
+                self.state.record_read(cast(Mapping[tuple[str, int], int], result.answer.values))
             if then is not None:
                 then(result)
             self.sigParametersRead.emit(result)
@@ -115,24 +127,24 @@ class Session(QObject):
             front_panel=panel,
         )
 
-    def write(self, writes: list[tuple[str, int, int]]) -> None:
+    def write(self, writes: Iterable[tuple[Mode | str, int, int]]) -> None:
         """Writes (mode, number, wire value) items, each verified by read-back. Before the first
         write of a session the drive's values are read and saved as a backup."""
-        if not writes:
+        typed = [(Mode(mode), number, value) for mode, number, value in writes]
+        if not typed:
             return
         if self.state.needs_backup:
-            self._pending_writes = list(writes)
+            self._pending_writes = typed
             self._read_all(then=self._backup_read)
             self.sigMessage.emit("Reading the drive's parameters for the backup before the first write …")
             return
         self.state.require_backup()
-        self._send_writes(writes)
+        self._send_writes(typed)
 
-    def _send_writes(self, writes: list[tuple[str, int, int]]) -> None:
-        typed = tuple((Mode(mode), number, value) for mode, number, value in writes)
-        self.link.send(WriteParameters(typed), self._writes_answered)
+    def _send_writes(self, writes: list[ParameterWrite]) -> None:
+        self.link.send(WriteParameters(tuple(writes)), self._writes_answered)
 
-    def _writes_answered(self, result: LinkReply) -> None:
+    def _writes_answered(self, result: LinkReply[list[WriteEntry]]) -> None:
         self.sigWritesDone.emit(result.value if result.ok else [])
 
     def write_backup(self) -> Path:
@@ -163,7 +175,7 @@ class Session(QObject):
             except ValueError as exc:  # the label's line is not a model code: the technician types it
                 self.sigMessage.emit(f"ADJUSTED FOR USE WITH {info.adjusted_for}: not a model code ({exc})")
 
-    def _backup_read(self, result: LinkReply) -> None:
+    def _backup_read(self, result: LinkReply[ParameterReadout]) -> None:
         """The read before the first write: saved as the backup, then the writes go."""
         writes, self._pending_writes = self._pending_writes, None
         if not result.ok or result.value.errors:
