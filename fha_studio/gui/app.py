@@ -112,12 +112,13 @@ def _machine_window(args):
     from fha_studio.logic.register import Register, RegisterError, default_register_path
 
     try:
-        # a machine file is put into the register (made when missing); a machine by name must be there
+        # a machine file is read (and refused) before the register is opened: a refused file
+        # leaves no new register behind; it is put into the register (made when missing), while
+        # a machine by name must be there
+        project = MachineProject.load(args.machine_file) if args.machine_file else None
         register = Register(default_register_path(args.register), create=bool(args.machine_file))
         try:
-            if args.machine_file:
-                project = MachineProject.load(args.machine_file)
-            else:
+            if project is None:
                 project = MachineProject.from_register(register, args.machine)
         except (MachineError, RegisterError, ValueError):
             register.close()

@@ -246,6 +246,27 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     register.close()
 
 
+def test_a_refused_machine_file_leaves_no_register_behind(qtbot, tmp_path, capsys):
+    from fha_studio.gui.app import run
+
+    for name, content, message in (
+        ("axes-5.json", '{"format": "fha-machine/1", "name": "Press 9", "axes": 5}',
+         "field axes: must be a list of axes, got the number 5"),
+        ("inertia.json", '{"format": "fha-machine/1", "name": "Press 9", "axes": [{"name": "feed", '
+         '"load_inertia_kgm2": 1e308}]}', "axis 1: field load_inertia_kgm2: 1e+308 is outside"),
+    ):
+        machine_file = tmp_path / name
+        machine_file.write_text(content)
+        with pytest.raises(SystemExit) as exit_info:
+            run(["--machine-file", str(machine_file), "--register", str(tmp_path / "new.sqlite"),
+                 "--no-connect"])
+        assert exit_info.value.code == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"fha-studio: {machine_file}: {message}") and err.count("\n") == 1
+        assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+            p.name for p in tmp_path.iterdir() if p.suffix == ".json")  # no new.sqlite made
+
+
 def test_the_gui_opens_a_machine_of_the_register_or_says_why_not(qtbot, tmp_path, capsys):
     from fha_studio.gui.app import run
 

@@ -118,6 +118,23 @@ def test_a_damaged_register_names_the_page_and_the_check(tmp_path):
     assert result.machines == ("Press 7",)
 
 
+def test_a_damaged_register_takes_no_write_even_beside_the_damage(tmp_path):
+    # the machines' table is sound, the axes' is not: SQLite would take a new machine (it finds
+    # damage only where it reads) and the file would be damaged further; the first write of a
+    # connection runs SQLite's quick check
+    path = _filled(tmp_path / "r.sqlite")
+    page = _damage_table(path, "axis")
+    before = path.read_bytes()
+    with Register(path, create=False) as reg:
+        for write in (lambda: reg.add_machine("Press 8"), lambda: reg.ensure_machine("Press 9")):
+            with pytest.raises(RegisterError) as err:
+                write()
+            assert str(err.value) == (f"{path} is damaged at page {page} (axes); "
+                                      "`fha-studio register check` says what can be saved")
+    assert path.read_bytes() == before
+    assert main(["register", "--register", str(path), "add-machine", "Press 8"]) == 2
+
+
 def test_a_locked_register_says_who_holds_it(tmp_path):
     path = _filled(tmp_path / "r.sqlite")
     holder = subprocess.Popen(

@@ -126,9 +126,7 @@ def problem(path: Path, exc: sqlite3.Error, db: sqlite3.Connection | None = None
         return RegisterError(f"the register {where} is locked{by}{waited}: nothing was changed; "
                              "try again when it is done")
     if primary == sqlite3.SQLITE_CORRUPT or "malformed" in text:
-        page = damaged_page(db)
-        at = f" at {page}" if page else ""
-        return RegisterError(f"{where} is damaged{at}; `fha-studio register check` says what can be saved")
+        return damaged(path, db)
     if primary == sqlite3.SQLITE_NOTADB or "not a database" in text:
         return RegisterError(f"{where} is not a register (not an SQLite database file): not changed")
     if primary == sqlite3.SQLITE_FULL or "full" in text:
@@ -143,6 +141,27 @@ def problem(path: Path, exc: sqlite3.Error, db: sqlite3.Connection | None = None
     if opening:
         return RegisterError(f"register {where}: not a usable register file ({said})")
     return RegisterError(f"the register {where}: {said}")
+
+
+def damaged(path: Path, db: sqlite3.Connection | None) -> RegisterError:
+    """The refusal of a damaged register: where it is damaged, and what says what can be saved."""
+    page = damaged_page(db)
+    at = f" at {page}" if page else ""
+    return RegisterError(f"{shown_path(path)} is damaged{at}; `fha-studio register check` says what "
+                         "can be saved")
+
+
+def sound(db: sqlite3.Connection) -> bool:
+    """SQLite's quick check (the pages and their b-trees, not the indexes' contents) finds
+    nothing wrong. A write into a damaged file is refused before it starts: SQLite finds damage
+    only where it reads, so a new machine written beside a damaged table of axes would be taken,
+    and the file damaged further."""
+    try:
+        return [str(r[0]) for r in db.execute("PRAGMA quick_check(1)")] == ["ok"]
+    except sqlite3.DatabaseError as exc:
+        if "malformed" in str(exc) or getattr(exc, "sqlite_errorcode", 0) & 0xFF == sqlite3.SQLITE_CORRUPT:
+            return False
+        raise
 
 
 _Class = TypeVar("_Class", bound=type)

@@ -97,7 +97,12 @@ def _session_parameters(register: Register, axis: Axis, session: Any) -> tuple[i
         return None, not_taken
     at = params.get("read_utc") or session.created_utc
     file = str(params.get("file", "") or session.path or "")
-    if register.has_snapshot(axis, utc_stamp(at), file):
+    try:
+        stamp = utc_stamp(at)
+    except RegisterError as exc:  # past 9999 UTC, not a time: say which field of which file
+        field = "parameters.read_utc" if params.get("read_utc") else "created_utc"
+        raise RegisterError(f"{source or 'session'}: field {field}: {exc}") from None
+    if register.has_snapshot(axis, stamp, file):
         return None, not_taken
     number = register.record_snapshot(
         axis,
