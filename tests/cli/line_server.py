@@ -1,9 +1,10 @@
 """A line at the far end of a pty, run as its own process: ``python line_server.py MODE [options]``.
 
 Prints the pty path, then serves until killed. MODE:
-- ``documented``: a drive of the public HA-655 manual: DGR and OWW, ``x`` to anything else, ``s``
-  to everything while the servo is on (``--servo-on``); ``--incremental`` answers ``x`` to DGR and
-  OWW; OWW acknowledges ``--oww-s`` later and clears the multi-turn data.
+- ``documented``: a drive of the public HA-655 manual (``tests.support.documented.DocumentedDrive``):
+  DGR and OWW, ``x`` to anything else, ``s`` to everything while the servo is on (``--servo-on``);
+  ``--incremental`` answers ``x`` to DGR and OWW; OWW acknowledges ``--oww-s`` later and clears
+  the multi-turn data.
 - ``silent``: reads, never answers (a drive switched off).
 - ``flood``: sends garbage without end.
 - ``slow``: trickles a digit every 0.2 s without ever ending a reply (a line that never goes quiet).
@@ -21,6 +22,7 @@ import time
 import tty
 
 from fha_studio.hardware import protocol as p
+from tests.support.documented import DocumentedDrive
 
 
 def main() -> int:
@@ -40,13 +42,10 @@ def main() -> int:
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
 
     decoder = p.StreamDecoder(p.decode_request)
-    position = args.position
-    oww_due: float | None = None
+    drive = DocumentedDrive(args.position, servo_on=args.servo_on, incremental=args.incremental,
+                            oww_s=args.oww_s)
     out = b""
     next_trickle = time.monotonic()
-
-    def reply(status: p.Status, *lines: str) -> bytes:
-        return p.Reply(tuple(lines), status).encode()
 
     while True:
         readable, _, _ = select.select([master], [], [], 0.01)
@@ -68,22 +67,10 @@ def main() -> int:
             if args.mode == "garbage":
                 out += b"?!\x7f\r"
                 continue
-            command = message.command if isinstance(message, p.Request) else None
-            if args.servo_on:
-                out += reply(p.Status.SERVO_ON)
-            elif command is p.Command.DGR:
-                out += reply(p.Status.REJECTED) if args.incremental else reply(p.Status.DONE, str(position))
-            elif command is p.Command.OWW:
-                if args.incremental or oww_due is not None:
-                    out += reply(p.Status.REJECTED)
-                else:
-                    oww_due = now + args.oww_s
-            else:
-                out += reply(p.Status.REJECTED)
-        if oww_due is not None and now >= oww_due:
-            position %= p.ABSOLUTE_COUNTS_PER_TURN  # multi-turn data cleared
-            oww_due = None
-            out += reply(p.Status.DONE)
+            reply = drive.answer(message, now)
+            out += reply.encode() if reply is not None else b""
+        for reply in drive.due(now) if args.mode == "documented" else ():
+            out += reply.encode()
         if out:
             try:
                 written = os.write(master, out)

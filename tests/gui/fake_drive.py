@@ -9,7 +9,7 @@ client suite (tests/hardware/test_client_buses.py) runs over it beside ``sim://`
 
 Its time is its own: the jog stops 100 ms after the last JOG, a trace is captured at once from
 what the monitors show over the capture's time. A drive that answers only the manual's DGR and
-OWW is not this fake: it is ``tests.support.scripted.documented_only`` behind a real client.
+OWW is not this fake: it is ``tests.support.documented.DocumentedDrive`` behind a real client.
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ class FakeDriveClient:
         self.effective = dict(self.values)
         commands = frozenset(commands)
         if not commands - p.DOCUMENTED_COMMANDS:
-            raise ValueError("a drive of only the manual's commands is tests.support's, not this fake")
+            raise ValueError("a drive of only the manual's commands is tests.support.documented's")
         self._capabilities = Capabilities(commands, absolute_encoder, True)
         self.closed = False
         self.servo_on = False

@@ -8,10 +8,10 @@ import pytest
 
 from fha_studio.gui.connect_dialog import ConnectDialog
 from fha_studio.gui.link import MoveBy, Servo
-from fha_studio.hardware import protocol as p
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.transport import pipe_pair
 from fha_studio.recording import RecordingMetadata, make_recording, read_recording, write_recording
+from tests.support.documented import DocumentedDrive
 from tests.support.scripted import ScriptedDrive
 
 DGR_COUNTS = -40000  # motor encoder counts, 8192 per motor turn
@@ -20,17 +20,12 @@ DGR_COUNTS = -40000  # motor encoder counts, 8192 per motor turn
 @pytest.fixture
 def documented_drive():
     """Factory: open_client for make_window, a drive of the manual's command set that answers DGR
-    with DGR_COUNTS (servo off) and x to everything else, as a real HA-655 does."""
+    with DGR_COUNTS (servo off), as a real HA-655 does."""
     drives = []
-
-    def documented(request):
-        if isinstance(request, p.Request) and request.command is p.Command.DGR:
-            return p.LinkReply((str(DGR_COUNTS),))
-        return p.LinkReply((), p.Status.REJECTED)
 
     def open_client(url, baud):
         host, end = pipe_pair("documented")
-        drives.append(ScriptedDrive(end, documented))
+        drives.append(ScriptedDrive(end, DocumentedDrive(position=DGR_COUNTS)))
         return DriveClient.attach(host)
 
     yield open_client

@@ -13,7 +13,8 @@ from PySide6.QtCore import Qt
 from fha_studio.gui.link import PROBE_INTERVAL_MS, SERVO_ON_NOTE, SERVO_ON_PROBE_MS, SimPanelRequest
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.transport import pipe_pair
-from tests.support.scripted import ScriptedDrive, documented_only
+from tests.support.documented import DocumentedDrive
+from tests.support.scripted import ScriptedDrive
 
 URL = "sim://FHA-25C-50-S248?paced=0&profile=documented&oww_clear_s=1"
 
@@ -90,7 +91,7 @@ def test_a_silent_drive_turns_the_link_lamp_red_at_its_first_unanswered_probe(ma
     host, drive_end = pipe_pair("documented")
     alive = {"on": True}
     unanswered: list[str] = []
-    handler = documented_only()
+    handler = DocumentedDrive()
 
     def answer(request):
         if alive["on"]:

@@ -20,6 +20,7 @@ from fha_studio.hardware import protocol as p
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.transport import pipe_pair
 from fha_studio.recording import read_recording
+from tests.support.documented import DocumentedDrive
 from tests.support.scripted import ScriptedDrive
 
 ACTUATOR = "FHA-25C-50-US250"
@@ -204,13 +205,7 @@ def test_recording_while_plotting_loads_in_numpy(qtbot, scope, sim_client, tmp_p
 
 
 def test_a_documented_only_drive_shows_dgr_position_and_backs_off_with_the_servo_on(qtbot, scope):
-    servo = {"on": False}
-
-    def documented(request):
-        if isinstance(request, p.Request) and request.command is p.Command.DGR:
-            return p.LinkReply((), p.Status.SERVO_ON) if servo["on"] else p.LinkReply(("204800",))
-        return p.LinkReply((), p.Status.REJECTED)
-
+    documented = DocumentedDrive(position=204800)
     host, end = pipe_pair("documented")
     drive = ScriptedDrive(end, documented)
     try:
@@ -222,7 +217,7 @@ def test_a_documented_only_drive_shows_dgr_position_and_backs_off_with_the_servo
         assert view._live.channels[0].key == "feedback_position"
         qtbot.waitUntil(lambda: len(view._live.ring) > 0, timeout=10000)
         assert view._live.ring.window(1)[0, 1] == pytest.approx(204800 * 360 / (8192 * 50))
-        servo["on"] = True
+        documented.servo_on = True
         qtbot.waitUntil(lambda: view.indicator_text().startswith("NOT LIVE: servo on (controller)"),
                         timeout=10000)
         qtbot.waitUntil(lambda: view.info_label.text().startswith("—"), timeout=10000)  # rate cleared

@@ -25,7 +25,7 @@ from fha_studio.hardware.client import (
 from fha_studio.hardware.parameters import ParameterValueError
 from fha_studio.hardware.protocol import Command, Reply
 from fha_studio.hardware.transport import corrupt_at, split_every
-from tests.support.scripted import documented_only
+from tests.support.documented import DocumentedDrive
 
 # --- settings ---------------------------------------------------------------------------------
 
@@ -401,7 +401,7 @@ def test_unplugged_port_raises_link_lost_naming_it(client_for, mini, pipes):
 
 
 def test_documented_only_drive_degrades_to_dgr(client_for):
-    client, drive = client_for(documented_only(position=-8193))
+    client, drive = client_for(DocumentedDrive(position=-8193))
     caps = client.capabilities
     assert caps.level is CapabilityLevel.ABSOLUTE_POSITION
     assert "absolute position (DGR)" in caps.describe() and "servo is off" in caps.describe()
@@ -420,7 +420,7 @@ def test_documented_only_drive_degrades_to_dgr(client_for):
 
 
 def test_documented_only_drive_with_servo_on(client_for):
-    client, _ = client_for(documented_only(servo_on=lambda: True))
+    client, _ = client_for(DocumentedDrive(servo_on=True))
     assert client.capabilities.absolute_position is None
     assert "not known yet" in client.capabilities.describe()
     with pytest.raises(ServoOnRefused):
@@ -428,7 +428,7 @@ def test_documented_only_drive_with_servo_on(client_for):
 
 
 def test_incremental_documented_only_drive_offers_nothing(client_for):
-    client, _ = client_for(lambda r: X)
+    client, _ = client_for(DocumentedDrive(incremental=True))
     assert client.capabilities.level is CapabilityLevel.NOTHING
     assert "front panel" in client.capabilities.describe()
 

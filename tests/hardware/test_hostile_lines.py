@@ -28,7 +28,8 @@ from fha_studio.hardware.api import (
 from fha_studio.hardware.client import DriveClient, LinkSettings
 from fha_studio.hardware.protocol import Command
 from fha_studio.hardware.transport import PipeEnd, pipe_pair
-from tests.support.scripted import ScriptedDrive, documented_only
+from tests.support.documented import DocumentedDrive
+from tests.support.scripted import ScriptedDrive
 
 #: The link worker's settings (gui/link.py): a dead line must show within a few seconds.
 GUI = LinkSettings(response_timeout_s=0.25, retries=1)
@@ -113,7 +114,7 @@ def test_a_babbling_line_says_bytes_arrive_but_no_reply_within_the_bound(pipes, 
 @pytest.mark.parametrize("kind", ["trickle", "flood", "nul"])
 def test_every_call_is_bounded_when_the_line_turns_hostile_after_connecting(pipes, kind):
     line = HostileLine(pipes[1], kind)
-    drive = ScriptedDrive(pipes[1], documented_only())
+    drive = ScriptedDrive(pipes[1], DocumentedDrive())
     try:
         client = DriveClient.attach(pipes[0], GUI)
         assert client.absolute_position() == 123456
@@ -128,13 +129,13 @@ def test_every_call_is_bounded_when_the_line_turns_hostile_after_connecting(pipe
 
 
 def test_the_drive_refusing_is_neither_silence_nor_garbage(pipes):
-    servo_on = {"on": False}
-    drive = ScriptedDrive(pipes[1], documented_only(servo_on=lambda: servo_on["on"]))
+    documented = DocumentedDrive()
+    drive = ScriptedDrive(pipes[1], documented)
     try:
         client = DriveClient.attach(pipes[0], GUI)
         with pytest.raises(CommandRejected):
             client.transaction.transact(Command.IOS, parse=lambda r: None)
-        servo_on["on"] = True
+        documented.servo_on = True
         with pytest.raises(ServoOnRefused):
             client.absolute_position()
         assert not client.link_lost
@@ -171,11 +172,13 @@ def test_the_stated_bound_covers_the_slow_commands_and_the_longest_replies():
 def test_replies_that_come_late_are_a_timeout_not_garbage(pipes):
     slow = LinkSettings(response_timeout_s=0.3, retries=1)
 
+    documented = DocumentedDrive()
+
     def late(request):
         if isinstance(request, p.Request) and request.command is Command.IOS:
             # after the attempt gave up (0.3 s), inside the quiet-line wait before the retry
             return [0.45, p.Reply(("0",))]
-        return documented_only()(request)
+        return documented(request)
 
     drive = ScriptedDrive(pipes[1], late)
     try:

@@ -8,7 +8,7 @@ import pytest
 from fha_studio.hardware.api import SimPanel
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.sim import SimRefused
-from tests.support.scripted import documented_only
+from tests.support.documented import DocumentedDrive
 
 
 def test_a_sim_port_has_the_panel_of_its_drive():
@@ -27,5 +27,5 @@ def test_a_sim_port_has_the_panel_of_its_drive():
 
 
 def test_any_other_drive_has_no_panel(client_for):
-    client, _ = client_for(documented_only())
+    client, _ = client_for(DocumentedDrive())
     assert client.sim_panel is None

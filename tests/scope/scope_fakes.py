@@ -41,18 +41,3 @@ class MonitorDrive:
             rows = self.trace_rows[first:first + p.TRACE_BLOCK_SAMPLES]
             return p.Reply(tuple(p.format_values(r) for r in rows)) if rows else X
         return X
-
-
-class DocumentedDrive:
-    """A drive of the manual's command set: DGR (``s`` while the servo is on), x to the rest."""
-
-    def __init__(self, position: int = 8192 * 50):
-        self.position = position
-        self.servo_on = False
-
-    def __call__(self, request):
-        if isinstance(request, p.Request) and request.command is p.Command.DGR:
-            return S if self.servo_on else p.Reply((str(self.position),))
-        return X
-
-

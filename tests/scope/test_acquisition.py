@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scope_fakes import DocumentedDrive, MonitorDrive
+from scope_fakes import MonitorDrive
 
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.parameters import load_parameter_model
@@ -20,6 +20,7 @@ from fha_studio.logic.scope.acquisition import (
     theoretical_rate_hz,
 )
 from fha_studio.logic.scope.channels import scope_channels
+from tests.support.documented import DocumentedDrive
 
 PPR = 500_000  # output resolution of the channels: 500 000 pulses = 360 deg
 

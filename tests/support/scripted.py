@@ -3,7 +3,8 @@
 It decodes requests with the codec's drive side and writes whatever its handler returns: a
 ``Reply`` (encoded by the codec), raw ``bytes`` (garbage, half frames: anything), a list of those
 and ``float`` pauses in seconds, or None (silence). It is not a simulation of anything; the
-simulated drive is ``fha_studio.hardware.sim``.
+simulated drive is ``fha_studio.hardware.sim``, and a drive of the manual's DGR and OWW is the
+handler ``tests.support.documented.DocumentedDrive``.
 """
 
 from __future__ import annotations
@@ -22,20 +23,6 @@ log = logging.getLogger(__name__)
 
 Answer = Union[p.Reply, bytes, float, None, Iterable["Answer"]]  # noqa: UP007 - recursive alias
 Handler = Callable[[p.Request | p.UnknownRequest], Answer]
-
-
-def documented_only(position: int = 123456, servo_on: Callable[[], bool] = lambda: False) -> Handler:
-    """A handler that behaves like a drive of the public manual: DGR and OWW, ``x`` to the rest,
-    ``s`` to DGR while ``servo_on()``."""
-
-    def handle(request: p.Request | p.UnknownRequest) -> Answer:
-        if isinstance(request, p.Request) and request.command is p.Command.DGR:
-            return p.Reply((), p.Status.SERVO_ON) if servo_on() else p.Reply((str(position),))
-        if isinstance(request, p.Request) and request.command is p.Command.OWW:
-            return p.Reply((), p.Status.REJECTED) if servo_on() else p.Reply()
-        return p.Reply((), p.Status.REJECTED)
-
-    return handle
 
 
 class ScriptedDrive:
