@@ -433,6 +433,18 @@ class DriveClient:
         self._require(Command.STP)
         self._transact(Command.STP)
 
+    def set_excitation(self, amplitude_rpm: float, travel_limit_deg: float) -> None:
+        """The excitation's amplitude (EXA, output r/min) and the angle it may travel (EXL)."""
+        self._require(Command.EXA, Command.EXL)
+        self._transact(Command.EXA, _steps(amplitude_rpm, p.SPEED_STEP_RPM, "excitation amplitude", "r/min"))
+        self._transact(Command.EXL, _steps(travel_limit_deg, p.ANGLE_STEP_DEG, "travel limit", "deg"))
+
+    def excite(self, hold_periods: int) -> None:
+        """Run the excitation (EXG), bits of ``hold_periods`` servo periods; holds 100 ms as JOG:
+        repeat while it is to run. 0 stops it."""
+        self._require(Command.EXG)
+        self._transact(Command.EXG, hold_periods)
+
     # --- alarms and I/O --------------------------------------------------------------------------
 
     def alarm(self) -> int:

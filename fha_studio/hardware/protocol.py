@@ -96,6 +96,9 @@ class Command(StrEnum):
     SNA = "SNA"
     SNB = "SNB"
     SNQ = "SNQ"
+    EXA = "EXA"
+    EXL = "EXL"
+    EXG = "EXG"
 
 
 class Status(StrEnum):
@@ -572,6 +575,9 @@ COMMAND_FACTS: dict[Command, CommandFacts] = {
     Command.SNA: CommandFacts("move the dog of limit switch 1", sim_only=True),
     Command.SNB: CommandFacts("move the dog of limit switch 2", sim_only=True),
     Command.SNQ: CommandFacts("report the sensor angles", sim_only=True),
+    Command.EXA: CommandFacts("set the excitation amplitude"),
+    Command.EXL: CommandFacts("set the excitation travel limit"),
+    Command.EXG: CommandFacts("run the excitation"),  # held by repetition, as JOG
 }
 
 

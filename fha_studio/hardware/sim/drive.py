@@ -45,6 +45,7 @@ from fha_studio.hardware.sim.axis import (
 )
 from fha_studio.hardware.sim.constants import SimConstants, load_sim_constants
 from fha_studio.hardware.sim.eeprom import EepromFile, eeprom_path
+from fha_studio.hardware.sim.excitation import SimExcitation
 from fha_studio.hardware.sim.io import SimIo
 from fha_studio.hardware.sim.memory import ItemId, ParameterMemory, PersistentState
 from fha_studio.hardware.sim.monitors import monitor_wire
@@ -217,6 +218,7 @@ class SimDrive:
         self._step_debt = 0.0
         self._steps_to_supervision = 0
         self.trace = SimTrace()
+        self.excitation = SimExcitation()  # EXA / EXL / EXG: stopped by STP, servo off, an alarm
         axis.servo_off()
         axis.set_settings(self._settings(self.memory.active))
         self._direction = axis.settings.direction_sign
@@ -573,7 +575,7 @@ class SimDrive:
             tracing = self.trace.active
             if tracing:
                 chunk = min(chunk, self.trace.steps_until_sample())
-            axis.step(chunk)
+            axis.step(chunk, self.excitation.values(chunk) if self.excitation.active else None)
             steps -= chunk
             self._steps_to_supervision -= chunk
             self.time_s += chunk * dt
@@ -593,6 +595,7 @@ class SimDrive:
         axis = self.axis
         if self._oww_done_at is not None and t >= self._oww_done_at:
             self._finish_oww()
+        self.excitation.supervise(t, self.servo_on and not self.alarm, axis.output_pos_rad)
         motion = self.motion
         motion.supervise(t)
         if self.config.wiring in MOTION_WIRING_FAULTS:

@@ -10,9 +10,18 @@ and it stops when the output has travelled more than the limit from where it sta
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import Any
 
 from fha_studio.hardware.protocol import excitation_register_bits
+from fha_studio.hardware.sim.reply import rejected
+
+RPM = 2.0 * math.pi / 60.0
+#: EXA: the amplitude may be at most this share of the maximum speed
+MAX_AMPLITUDE_SHARE = 0.1
+#: EXG: longest bit, in servo periods
+MAX_HOLD_PERIODS = 64
 
 #: taps of maximum-length shift registers (Fibonacci, XOR of the tapped bits), by length
 PRBS_TAPS = {4: (4, 3), 5: (5, 3), 6: (6, 5), 7: (7, 6), 8: (8, 6, 5, 4), 9: (9, 5), 10: (10, 7),
@@ -64,6 +73,13 @@ class SimExcitation:
     def stop(self) -> None:
         self.hold_periods = 0
 
+    def supervise(self, now_s: float, may_run: bool, position_rad: float) -> None:
+        """Every 1 ms: stop without a renewal (watchdog), with the servo off or an alarm, or past
+        the travel limit from where it started."""
+        if self.active and (now_s >= self.deadline_s or not may_run
+                            or abs(position_rad - self.start_rad) > self.travel_limit_rad):
+            self.stop()
+
     def values(self, n: int) -> list[float]:
         """The next ``n`` periods' added speed command."""
         out = []
@@ -76,3 +92,42 @@ class SimExcitation:
             self._phase = (self._phase + 1) % hold
             out.append(amp if self._bit else -amp)
         return out
+
+
+# --- the CN3 commands (the drive's lock is held by the responder) ---------------------------------
+
+
+def set_amplitude(drive: Any, value: int) -> None:
+    """EXA: the amplitude in 0.01 r/min (output), up to MAX_AMPLITUDE_SHARE of the maximum speed."""
+    top = MAX_AMPLITUDE_SHARE * (drive.model.max_speed_rpm or 0.0)
+    if not 0 < value * 0.01 <= top + 1e-9:
+        raise rejected(f"EXA {value * 0.01:g} r/min outside 0 ... {top:g} r/min")
+    drive.excitation.amplitude_rad_s = value * 0.01 * RPM
+
+
+def set_travel_limit(drive: Any, value: int) -> None:
+    """EXL: the angle (0.01 deg, output) the excitation may travel from where it started."""
+    if value <= 0:
+        raise rejected(f"EXL {value * 0.01:g} deg: the travel limit must be positive")
+    drive.excitation.travel_limit_rad = math.radians(value * 0.01)
+
+
+def run(drive: Any, value: int) -> None:
+    """EXG: run (or keep running: like JOG, for the jog watchdog's time) the excitation with bits of ``value``
+    servo periods; 0 stops it. Refused with the servo off, an alarm, a motion, or without an
+    amplitude and a travel limit."""
+    exc: SimExcitation = drive.excitation
+    if value == 0:
+        exc.stop()
+        return
+    if drive.alarm:
+        raise rejected(f"EXG: alarm {drive.supervisor.describe()} is active")
+    if not drive.servo_on:
+        raise rejected("EXG: the servo is off")
+    if drive.moving:
+        raise rejected("EXG: the axis is moving (STP first)")
+    if not 1 <= value <= MAX_HOLD_PERIODS:
+        raise rejected(f"EXG {value}: bits of 1 ... {MAX_HOLD_PERIODS} servo periods")
+    if exc.amplitude_rad_s <= 0 or exc.travel_limit_rad <= 0:
+        raise rejected("EXG: set the amplitude (EXA) and the travel limit (EXL) first")
+    exc.start(value, drive.time_s, drive.time_s + drive.constants.jog_watchdog_s, drive.axis.output_pos_rad)

@@ -7,7 +7,7 @@ from typing import Protocol
 
 from fha_studio.hardware.parameters import MonitorItem, split_low_high
 from fha_studio.hardware.sim.reply import rejected
-from fha_studio.physics import AxisModel
+from fha_studio.physics import RAD_S_PER_RPM, AxisModel, ServoAxis
 
 
 class MonitorSource(Protocol):
@@ -15,6 +15,7 @@ class MonitorSource(Protocol):
 
     model: AxisModel
     ratio: float
+    axis: ServoAxis
 
     @property
     def feedback_pulses(self) -> int: ...
@@ -57,6 +58,9 @@ def monitor_wire(drive: MonitorSource, item: int) -> int:
         return drive.load_pulses
     if item == MonitorItem.OUTPUT_TORQUE:
         return round(drive.output_torque_nm * 100)
+    if item == MonitorItem.SPEED_COMMAND:  # the speed loop's reference (command sense)
+        axis = drive.axis
+        return round(axis.speed_command_rad_s / RAD_S_PER_RPM * 100) if axis.servo_is_on else 0
     if item == 0:  # motor speed, r/min
         return round(drive.output_speed_rpm * drive.ratio)
     if item == 1:  # current, % of the maximum

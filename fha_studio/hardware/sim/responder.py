@@ -41,6 +41,7 @@ from fha_studio.hardware.protocol import (
     encode_packed_block,
     mask_items,
 )
+from fha_studio.hardware.sim import excitation
 from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.journal import Journal, JournalEntry, PanelAction
 from fha_studio.hardware.sim.memory import ItemId
@@ -295,6 +296,7 @@ def _mov(r: SimResponder, value: int) -> None:
 
 
 def _stp(r: SimResponder, value: int) -> None:
+    r.drive.excitation.stop()
     r.drive.stop()
 
 
@@ -379,6 +381,18 @@ def _snq(r: SimResponder, value: int) -> str:
     return ",".join(str(round(a * 100)) for a in (d.io.origin_deg, d.io.ls1_deg, d.io.ls2_deg))
 
 
+def _exa(r: SimResponder, value: int) -> None:
+    excitation.set_amplitude(r.drive, value)
+
+
+def _exl(r: SimResponder, value: int) -> None:
+    excitation.set_travel_limit(r.drive, value)
+
+
+def _exg(r: SimResponder, value: int) -> None:
+    excitation.run(r.drive, value)
+
+
 #: Every command the simulated drive speaks, with its handler.
 COMMANDS: Mapping[Command, Handler] = {
     Command.DGR: _dgr,
@@ -418,6 +432,9 @@ COMMANDS: Mapping[Command, Handler] = {
     Command.SNA: _sensor(SensorName.LS1),
     Command.SNB: _sensor(SensorName.LS2),
     Command.SNQ: _snq,
+    Command.EXA: _exa,
+    Command.EXL: _exl,
+    Command.EXG: _exg,
 }
 
 #: What a drive of the public HA-655 manual speaks (the ``documented`` profile): DGR and OWW.

@@ -1,0 +1,120 @@
+"""Measure the speed loop's frequency response on a drive, over the client and the protocol.
+
+The drive adds its PRBS to the speed command (EXA / EXL / EXG, docs/protocol.md) while the
+position loop holds the axis; the drive-side trace records the speed command (monitor 109), the
+output speed (103), the motor current (104) and the position (100) at the servo rate (TDV 1), one
+PRBS period per capture. The excitation is renewed every ``RENEW_S`` like a held JOG (the drive
+stops it without a renewal after 100 ms), stopped when the read-out holds the link, and always
+stopped at the end (also on an error or a STOP: ``should_stop``).
+
+``wait(seconds)`` is the injected clock: ``time.sleep`` on a drive that runs in real time, the
+drive's own ``advance`` on a stepped simulated drive.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fha_studio.hardware.parameters import MonitorItem
+from fha_studio.hardware.protocol import Command, TraceState
+from fha_studio.logic.tuning.excitation import RPM, ExcitationPlan
+
+#: the channels of each capture
+CHANNELS = (MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.MOTOR_CURRENT,
+            MonitorItem.SPEED_COMMAND)
+NEEDED = frozenset({Command.EXA, Command.EXL, Command.EXG, Command.TCH, Command.TAR, Command.TST,
+                    Command.TRB, Command.IOS, Command.ALM, Command.MON})
+RENEW_S = 0.05
+SETTLE_S = 0.5
+
+
+class NotExcitable(Exception):
+    """The drive cannot be excited: the message says what is needed (the CLI's exit 4)."""
+
+
+class Stopped(Exception):
+    """STOP during the measurement: the excitation was stopped."""
+
+
+@dataclass(frozen=True)
+class Records:
+    """The captures in SI: per record (speed command rad/s, speed rad/s, current A, position rad)."""
+
+    records: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]
+    sample_rate_hz: float
+
+    def closed_loop(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        return [(r[0], r[1]) for r in self.records]
+
+    def plant(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        return [(r[2], r[1]) for r in self.records]
+
+    def travel_deg(self) -> float:
+        pos = np.concatenate([r[3] for r in self.records])
+        return float(np.degrees(np.max(np.abs(pos - pos[0])))) if len(pos) else 0.0
+
+
+def check_excitable(client: Any) -> None:
+    """Raise NotExcitable (one line: what is needed) unless the drive can be excited now."""
+    missing = NEEDED - set(client.capabilities.commands)
+    if missing:
+        raise NotExcitable("the drive has no excitation and trace over CN3 (a drive of the manual's "
+                           "commands): "
+                           "measure on the bench (SPD-CMD from a DAQ's analog output, SPD-MON recorded) "
+                           "or use the front-panel worksheet")
+    alarm = client.alarm()
+    if alarm:
+        raise NotExcitable(f"alarm {alarm} is active: clear it before tuning")
+    if not client.io_state().servo_on:
+        raise NotExcitable("the servo is off: switch it on (nothing moves until the excitation starts)")
+
+
+def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, wait: Callable[[float], None],
+            should_stop: Callable[[], bool] = lambda: False) -> Records:
+    """Run ``plan`` on the drive and read the captures (see the module docstring)."""
+    check_excitable(client)
+    channels = client.configure_trace(CHANNELS, divider=1)
+    client.set_excitation(plan.amplitude_rpm, plan.travel_limit_deg)
+    period_s = plan.period_samples / servo_rate_hz
+    records = []
+    try:
+        for _ in range(plan.records):
+            client.excite(plan.hold_periods)
+            _hold(client, plan, SETTLE_S, wait, should_stop)
+            client.arm_trace(plan.period_samples)
+            _hold(client, plan, period_s, wait, should_stop)
+            while client.trace_status().state is not TraceState.DONE:
+                _hold(client, plan, RENEW_S, wait, should_stop)
+            client.excite(0)  # the read-out holds the link: no renewals, so stop it cleanly
+            capture = client.read_trace(should_abort=should_stop)
+            cols = {item: np.asarray(capture.column(item), float) for item in channels}
+            records.append((
+                cols[MonitorItem.SPEED_COMMAND] * 0.01 * RPM,
+                cols[MonitorItem.OUTPUT_SPEED] * 0.01 * RPM,
+                cols[MonitorItem.MOTOR_CURRENT] * 0.001,
+                cols[MonitorItem.FEEDBACK_POSITION],
+            ))
+    finally:
+        # the link may be gone: the drive's watchdog then stops it within 100 ms
+        with contextlib.suppress(Exception):
+            client.excite(0)
+    return Records(tuple(records), servo_rate_hz)
+
+
+def _hold(client: Any, plan: ExcitationPlan, seconds: float, wait: Callable[[float], None],
+          should_stop: Callable[[], bool]) -> None:
+    left = seconds
+    while left > 1e-12:
+        if should_stop():
+            client.excite(0)
+            client.stop()
+            raise Stopped("STOP: the excitation was stopped")
+        step = min(RENEW_S, left)
+        wait(step)
+        left -= step
+        client.excite(plan.hold_periods)
