@@ -88,19 +88,29 @@ def quadrature_lines(lines: Lines) -> QuadratureResult:
     """Count A (line 0) / B (line 1) x4 from the samples where they change: each change's step
     from a 16-entry table of (code before, code after)."""
     at = lines.at
-    codes = lines.codes & np.uint8(3)
-    previous = np.concatenate(([lines.first & 3], codes[:-1])).astype(np.uint8)
-    key = (previous << np.uint8(2)) | codes
+    key = _transitions(lines, 3)
     illegal = int(np.count_nonzero(_ILLEGAL16[key]))
-    steps = _STEP16[key].astype(np.int64)
+    steps = _STEP16[key]
     # a glitch: a step undone by the next one within GLITCH_SAMPLES samples
     glitches = 0
     if at.size > 1:
         undone = (steps[1:] == -steps[:-1]) & (steps[1:] != 0) & (np.diff(at) <= GLITCH_SAMPLES)
         glitches = int(np.count_nonzero(undone))
     counted = steps != 0
-    return QuadratureResult(Steps.from_increments(lines.n, at[counted], steps[counted]), int(at.size),
-                            glitches, illegal, at[counted])
+    edges = at[counted]
+    counts = Steps(lines.n, edges, np.cumsum(steps[counted], dtype=np.int64))
+    return QuadratureResult(counts, int(at.size), glitches, illegal, edges)
+
+
+def _transitions(lines: Lines, mask: int) -> np.ndarray:
+    """Per change: (code before << 2) | code after, of the lines in ``mask`` (uint8)."""
+    codes = lines.codes & np.uint8(mask)
+    previous = np.empty_like(codes)
+    if codes.size:
+        previous[0] = lines.first & mask
+        previous[1:] = codes[:-1]
+    key: np.ndarray = (previous << np.uint8(2)) | codes
+    return key
 
 
 def rising_edges(level: np.ndarray) -> np.ndarray:
@@ -200,17 +210,17 @@ def command_pulse_lines(
         s = q.steps
         pulses = Steps(n, s.at, np.floor_divide(s.values, 4 // multiplication)).compressed()
     else:
-        up = lines.rising(0)
+        # per change of the lines: line A rising, and B rising (two-pulse) or B's level (the sign)
+        key = _transitions(lines, 3 if has_b else 1)
+        a_rises = (key & 0b0101) == 0b0001  # A low before, high after
         if pulse_form == 0:
-            down = lines.rising(1) if has_b else np.zeros(0, np.int64)
-            at = np.concatenate((up, down))
-            inc = np.concatenate((np.ones(up.size, np.int64), -np.ones(down.size, np.int64)))
+            inc = a_rises.astype(np.int8) - ((key & 0b1010) == 0b0010) if has_b else a_rises.astype(np.int8)
         else:
-            at = up
-            inc = np.ones(up.size, np.int64)
+            inc = a_rises.astype(np.int8)
             if has_b:
-                inc[lines.level_at(up, 1)] = -1  # the sign line high (ON) = REV
-        pulses = Steps.from_increments(n, at, inc)
+                inc[a_rises & ((key & 0b0010) != 0)] = -1  # the sign line high (ON) = REV
+        moved = inc != 0
+        pulses = Steps(n, lines.at[moved], np.cumsum(inc[moved], dtype=np.int64))
     counts = pulses.scaled(gear_numerator / gear_denominator)
     return CommandPulseResult(pulses, counts, illegal)
 

@@ -11,11 +11,13 @@ across blocks, so the rows of a stream are the same however sigrok-cli cut it.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 
-from fha_studio.hardware.bench.capture import SampleBlock
+from fha_studio.hardware.bench.capture import SampleBlock, pack_logic
 from fha_studio.logic.bench import decode
+from fha_studio.logic.bench.edges import Lines, Steps
 
 #: Rows per second that go to the scope (each channel).
 DISPLAY_RATE_HZ = 10_000.0
@@ -27,7 +29,11 @@ def display_factor(sample_rate_hz: float, display_rate_hz: float = DISPLAY_RATE_
 
 
 class Decimator:
-    """Cuts consecutive blocks of one stream into display rows (see the module's text)."""
+    """Cuts consecutive blocks of one stream into display rows (see the module's text).
+
+    A block's logic channels are taken as the packed word (one OR over each window's bytes, then
+    each channel's bit of the row), never one array per channel: 24 MS/s stay a few passes over
+    one byte a sample."""
 
     def __init__(self, sample_rate_hz: float, channels: tuple[str, ...], factor: int,
                  extra: tuple[str, ...] = ()):
@@ -35,40 +41,49 @@ class Decimator:
         self.channels = channels
         self.extra = extra  # columns computed per sample (encoder counts): a window's last value
         self.factor = factor
-        self._carry: np.ndarray | None = None  # (m, n_channels) samples short of a window
+        self._carry_logic: np.ndarray | None = None  # the samples short of a window (packed)
+        self._carry_analog: dict[str, np.ndarray] = {}
+        self._carried = 0
         self._next_sample = 0  # index of the first sample in the carry (or of the next block)
 
     @property
     def row_rate_hz(self) -> float:
         return self.sample_rate_hz / self.factor
 
-    def _columns(self, block: SampleBlock, extra: dict[str, np.ndarray]) -> np.ndarray:
-        columns = np.empty((block.samples, len(self.channels) + len(self.extra)), np.float64)
-        for i, name in enumerate(self.channels):
-            columns[:, i] = block.bit(name) if name in block.logic_channels else block.analog[name]
-        for i, name in enumerate(self.extra):
-            columns[:, len(self.channels) + i] = extra[name]
-        return columns
-
-    def feed(self, block: SampleBlock, extra: dict[str, np.ndarray] | None = None) -> np.ndarray:
-        """The rows the block completes: shape ``(rows, 1 + channels + extra)``, ``t_s`` first."""
-        values = self._columns(block, extra or {})
-        width = values.shape[1]
-        if self._carry is not None and len(self._carry):
-            values = np.concatenate([self._carry, values])
-        k = self.factor
-        whole = len(values) // k * k
-        self._carry = values[whole:]
-        windows = values[:whole].reshape(-1, k, width)
-        rows = np.empty((len(windows), 1 + width))
-        rows[:, 0] = (self._next_sample + np.arange(len(windows)) * k) / self.sample_rate_hz
+    def feed(self, block: SampleBlock, extra: Mapping[str, np.ndarray | Steps] | None = None) -> np.ndarray:
+        """The rows the block completes: shape ``(rows, 1 + channels + extra)``, ``t_s`` first.
+        ``extra``: per sample of the block, an array or :class:`Steps`."""
+        extra = extra or {}
+        k, m = self.factor, self._carried
+        n = m + block.samples
+        count = n // k
+        whole = count * k
+        rows = np.empty((count, 1 + len(self.channels) + len(self.extra)))
+        rows[:, 0] = (self._next_sample + np.arange(count) * k) / self.sample_rate_hz
+        logic = block.logic
+        if m and self._carry_logic is not None:
+            logic = np.concatenate([self._carry_logic, logic])
+        windows = None
         for i, name in enumerate(self.channels):
             if name in block.logic_channels:
-                rows[:, 1 + i] = windows[:, :, i].max(axis=1)
+                if windows is None:
+                    windows = np.bitwise_or.reduce(logic[:whole].reshape(count, k), axis=1) if count \
+                        else logic[:0]
+                bit = logic.dtype.type(block.logic_channels.index(name))
+                rows[:, 1 + i] = (windows >> bit) & 1
             else:
-                rows[:, 1 + i] = windows[:, :, i].mean(axis=1)
-        for i in range(len(self.channels), width):
-            rows[:, 1 + i] = windows[:, -1, i]
+                values = block.analog[name]
+                if m:
+                    values = np.concatenate([self._carry_analog[name], values])
+                rows[:, 1 + i] = values[:whole].reshape(count, k).mean(axis=1, dtype=np.float64)
+                self._carry_analog[name] = values[whole:]
+        ends = (k - m - 1) + np.arange(count) * k  # each window's last sample, in the block
+        for i, name in enumerate(self.extra):
+            column = extra[name]
+            rows[:, 1 + len(self.channels) + i] = column.sample(ends) if isinstance(column, Steps) \
+                else column[ends]
+        self._carry_logic = logic[whole:] if block.logic_channels else None
+        self._carried = n - whole
         self._next_sample += whole
         return rows
 
@@ -80,7 +95,7 @@ class LiveQuadrature:
     summed."""
 
     def __init__(self) -> None:
-        self._last: tuple[bool, bool] | None = None
+        self._last: np.ndarray | None = None  # the previous block's last sample (levels or word)
         self.counts = 0  # after the last sample fed
         self.illegal_transitions = 0
 
@@ -88,14 +103,36 @@ class LiveQuadrature:
         """The counts (int64) at each sample of the block."""
         if a.size == 0:
             return np.zeros(0, np.int64)
-        if self._last is None:
-            self._last = (bool(a[0]), bool(b[0]))
-        result = decode.quadrature(np.concatenate([[self._last[0]], a]), np.concatenate([[self._last[1]], b]))
-        counts = result.counts[1:] + self.counts
-        self.counts = int(counts[-1])
+        return self.feed_packed(pack_logic([a, b]), 0, 1).dense().astype(np.int64)
+
+    def feed_packed(self, logic: np.ndarray, bit_a: int, bit_b: int) -> Steps:
+        """The counts at each sample of a block of packed logic words (A and B at those bits),
+        held where they change."""
+        lines = _with_last(self, logic, bit_a, bit_b)
+        if lines is None:
+            return Steps(0, np.zeros(0, np.int64), np.zeros(0, np.int64), self.counts)
+        result = decode.quadrature_lines(lines)
+        counts = _shifted(result.steps, self.counts)
+        self.counts = int(counts.final)
         self.illegal_transitions += result.illegal_transitions
-        self._last = (bool(a[-1]), bool(b[-1]))
         return counts
+
+
+def _with_last(owner: LiveQuadrature | LiveCommandPulses, logic: np.ndarray, *bits: int) -> Lines | None:
+    """The block's lines with the previous block's last sample before its first (the reference
+    of the block's first change)."""
+    if logic.size == 0:
+        return None
+    if owner._last is None or owner._last.dtype != logic.dtype:
+        owner._last = logic[:1]
+    lines = Lines.from_packed(np.concatenate([owner._last, logic]), *bits)
+    owner._last = logic[-1:].copy()
+    return lines
+
+
+def _shifted(steps: Steps, offset: float) -> Steps:
+    """Steps of the previous sample and a block, as the block's alone, carried on from ``offset``."""
+    return Steps(steps.n - 1, steps.at - 1, steps.values + offset, offset)
 
 
 class LiveCommandPulses:
@@ -111,7 +148,7 @@ class LiveCommandPulses:
         self.pulse_form = pulse_form
         self.multiplication = multiplication
         self.gear = (gear_numerator, gear_denominator)
-        self._last: tuple[bool, bool] | None = None
+        self._last: np.ndarray | None = None
         self._edges = LiveQuadrature() if pulse_form == 2 else None
         self.pulses = 0  # after the last sample fed
         self.illegal_transitions = 0
@@ -120,22 +157,48 @@ class LiveCommandPulses:
         """The commanded encoder counts (float64) at each sample of the block."""
         if a.size == 0:
             return np.zeros(0)
+        if b is None:
+            return self.feed_packed(pack_logic([a]), 0, None).dense().astype(np.float64)
+        return self.feed_packed(pack_logic([a, b]), 0, 1).dense().astype(np.float64)
+
+    def feed_packed(self, logic: np.ndarray, bit_a: int, bit_b: int | None) -> Steps:
+        """The commanded encoder counts at each sample of a block of packed logic words, held
+        where they change."""
         numerator, denominator = self.gear
         if self._edges is not None:
-            if b is None:
+            if bit_b is None:
                 raise decode.DecodeError("two-phase command pulses (parameter 1 = 2) need both lines")
-            edges = self._edges.feed(a, b)
+            edges = self._edges.feed_packed(logic, bit_a, bit_b)
             self.illegal_transitions = self._edges.illegal_transitions
-            pulses = np.floor_divide(edges, 4 // self.multiplication)
+            divisor = 4 // self.multiplication
+            pulses = Steps(edges.n, edges.at, np.floor_divide(edges.values, divisor),
+                           edges.initial // divisor).compressed()
         else:
-            b_line = b if b is not None else np.zeros(a.size, bool)
-            if self._last is None:
-                self._last = (bool(a[0]), bool(b_line[0]))
-            line_b = np.concatenate([[self._last[1]], b_line]) if b is not None else None
-            result = decode.command_pulses(np.concatenate([[self._last[0]], a]), line_b,
-                                           self.pulse_form, self.multiplication, 1, 1)
-            pulses = result.pulses[1:] + self.pulses
-            self._last = (bool(a[-1]), bool(b_line[-1]))
-        self.pulses = int(pulses[-1])
-        counts: np.ndarray = pulses * (numerator / denominator)
-        return counts
+            lines = _with_last(self, logic, bit_a) if bit_b is None else _with_last(self, logic, bit_a, bit_b)
+            if lines is None:
+                return Steps(0, np.zeros(0, np.int64), np.zeros(0), self.pulses * numerator / denominator)
+            result = decode.command_pulse_lines(lines, bit_b is not None, self.pulse_form,
+                                                self.multiplication, 1, 1)
+            pulses = _shifted(result.pulse_steps, self.pulses)
+        self.pulses = int(pulses.final)
+        return pulses.scaled(numerator / denominator)
+
+
+def peak_rows(rows: np.ndarray, buckets: int) -> np.ndarray:
+    """At most ``2 x buckets`` rows for a plot ``buckets`` pixels wide: each bucket of
+    consecutive rows as its first row's time with each column's least value, then its last row's
+    time with the largest (a pulse or a dip narrower than a pixel still shows). Fewer rows than
+    that come back as they are."""
+    n = len(rows)
+    if buckets <= 0 or n <= 2 * buckets:
+        return rows
+    size = math.ceil(n / buckets)
+    count = n // size
+    whole = rows[: count * size].reshape(count, size, rows.shape[1])
+    out = np.empty((2 * count, rows.shape[1]))
+    out[0::2, 1:] = whole[:, :, 1:].min(axis=1)
+    out[1::2, 1:] = whole[:, :, 1:].max(axis=1)
+    out[0::2, 0] = whole[:, 0, 0]
+    out[1::2, 0] = whole[:, -1, 0]
+    tail = rows[count * size :]
+    return np.concatenate([out, tail]) if len(tail) else out

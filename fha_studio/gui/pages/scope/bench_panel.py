@@ -25,6 +25,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.hardware.bench import sigrok
+from fha_studio.logic.bench.display import peak_rows
 from fha_studio.logic.bench.importer import DriveSettings
 from fha_studio.logic.bench.move import BenchMoveFigures, bench_move_figures
 
@@ -238,6 +239,13 @@ class BenchPanel(QWidget):
         for i, label in enumerate(started.labels[: len(started.channels)]):
             pen = pg.mkPen(_COLORS[i % len(_COLORS)], width=1)
             self._curves.append(self.plot.plot([], [], pen=pen, name=f"bench {label}"))
+        self.plot.enableAutoRange(axis="x", enable=False)
+        lanes = len(self._curves)
+        if all(name in started.logic for name in started.channels):  # lanes only: a fixed height
+            self.plot.enableAutoRange(axis="y", enable=False)
+            self.plot.setYRange(-0.2, 1.2 * lanes, padding=0)
+        else:
+            self.plot.enableAutoRange(axis="y", enable=True)
         counting = "counts" in started.extra
         self.counts_plot.setVisible(counting)
         self._counts_curve.setData([], [])
@@ -253,6 +261,13 @@ class BenchPanel(QWidget):
         if started is None:
             return
         rows = started.ring.window(int(WINDOW_S * started.row_rate_hz))
+        if not len(rows):
+            return
+        # drawn as the plot's pixels show it (each pixel's least and largest value), over a fixed
+        # window: a redraw neither walks every row nor looks for the data's bounds
+        rows = peak_rows(rows, max(200, self.plot.width()))
+        end = float(rows[-1, 0])
+        self.plot.setXRange(max(0.0, end - WINDOW_S), max(end, WINDOW_S), padding=0)
         for i, (curve, name) in enumerate(zip(self._curves, started.channels, strict=True)):
             values = rows[:, 1 + i]
             if name in started.logic:  # a logic analyzer's look: one lane per channel

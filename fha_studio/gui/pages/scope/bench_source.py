@@ -28,6 +28,7 @@ from fha_studio.logic.bench.display import (
     LiveQuadrature,
     display_factor,
 )
+from fha_studio.logic.bench.edges import Steps
 from fha_studio.logic.bench.importer import DriveSettings
 from fha_studio.logic.scope.ring import RingBuffer
 
@@ -160,13 +161,14 @@ class BenchWorker(QObject):
         last_status = 0.0
         try:
             for block in acquisition.blocks():
-                counts = {}
+                counts: dict[str, Steps] = {}  # decoded on the packed words, held where they change
+                bit = block.logic_channels.index
                 if quadrature is not None and encoder is not None:
-                    counts["counts"] = quadrature.feed(block.bit(encoder[0]), block.bit(encoder[1]))
+                    counts["counts"] = quadrature.feed_packed(block.logic, bit(encoder[0]), bit(encoder[1]))
                 if commands is not None and settings.command is not None:
                     line_a, line_b = settings.command
-                    counts["command"] = commands.feed(block.bit(line_a),
-                                                      block.bit(line_b) if line_b else None)
+                    counts["command"] = commands.feed_packed(block.logic, bit(line_a),
+                                                             bit(line_b) if line_b else None)
                 rows = decimator.feed(block, counts)
                 if len(rows):
                     ring.write(rows)
