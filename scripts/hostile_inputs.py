@@ -493,14 +493,16 @@ def refusal_bounded(d: Path, done: subprocess.CompletedProcess[str], state: dict
     return ""
 
 
-# class 6: the real command, stopped in its write (fsync: after the data, before the rename) and killed
+# class 6: the real command, stopped in its write of $HOLD (fsync: after the data, before the rename)
+# and killed
 KILLED_WRITER = """
 import os, sys, time
 real_fsync = os.fsync
 def hold(fd):
     real_fsync(fd)
-    print("writing", flush=True)
-    time.sleep(600)
+    if os.path.basename(os.readlink(f"/proc/self/fd/{fd}")).startswith("." + os.environ["HOLD"] + "."):
+        print("writing", flush=True)
+        time.sleep(600)
 os.fsync = hold
 from fha_studio.main import main
 sys.exit(main(sys.argv[1:]))
@@ -626,8 +628,8 @@ def run_case(case: Case, number: int) -> Row:
     err = lines_of(done.stderr)
     traceback = "Traceback" in done.stderr
     problems = [*notes]
-    if case.killed:
-        good = not left and not traceback
+    if case.killed:  # caught halfway, killed, and its temporary gone after the next start
+        good = not left and not traceback and not notes
     elif case.answer:
         good = done.returncode == 0 and not traceback and len(err) <= 2
         if not good:
@@ -655,13 +657,15 @@ def run_killed(args: list[str], d: Path) -> tuple[subprocess.CompletedProcess[st
     """The command stopped in its write and killed (SIGKILL); then a start of the program, once the
     temporary is a minute old (its mtime set back: the minute a start waits for)."""
     started = time.monotonic()
-    proc = subprocess.Popen([sys.executable, "-c", KILLED_WRITER, *args], cwd=d, env=_env(False),
+    output = Path(args[args.index(next(a for a in args if a in ("-o", "--out"))) + 1]).name
+    proc = subprocess.Popen([sys.executable, "-c", KILLED_WRITER, *args], cwd=d,
+                            env={**_env(False), "HOLD": output},
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert proc.stdout is not None
     ready, _, _ = select.select([proc.stdout], [], [], 120)
     line = proc.stdout.readline() if ready else ""
     notes = []
-    temporaries = sorted(d.glob(".*.tmp"))
+    temporaries = sorted(d.glob(f".{output}.*.tmp"))
     if line != "writing\n" or not temporaries:
         notes.append("the write was not caught halfway")
     proc.send_signal(signal.SIGKILL)

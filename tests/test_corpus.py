@@ -1,5 +1,6 @@
 """The malformed-input corpus (tests/corpus/expected.toml): each file and command line is refused
-whole with the expected line, exit status 2 on the command line, no traceback."""
+whole with the expected line, exit status 2 on the command line, no traceback; what a write killed
+halfway leaves is gone after the next start."""
 
 from __future__ import annotations
 
@@ -62,3 +63,51 @@ def test_a_malformed_command_line_is_refused_with_one_line(case, scratch, capsys
     # nothing half-written (a register file may have been opened: it is the input, not an output)
     # (and SQLite's -wal and -shm files beside it)
     assert sorted(p.name for p in scratch.iterdir() if not p.name.startswith("r.sqlite")) == ["afile", "fifo"]
+
+
+#: The real command, stopped in its write of $HOLD (fsync: after the data, before the rename) to be
+#: killed.
+KILLED_WRITER = """
+import os, sys, time
+real_fsync = os.fsync
+def hold(fd):
+    real_fsync(fd)
+    if os.path.basename(os.readlink(f"/proc/self/fd/{fd}")).startswith("." + os.environ["HOLD"] + "."):
+        print("writing", flush=True)
+        time.sleep(600)
+os.fsync = hold
+from fha_studio.main import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+@pytest.mark.parametrize("case", MANIFEST["killed"], ids=[c["output"] for c in MANIFEST["killed"]])
+def test_what_a_killed_write_left_is_gone_after_the_next_start(case, tmp_path):
+    import select
+    import signal
+    import subprocess
+    import sys
+
+    from fha_studio.logic.register import Register
+
+    with Register(tmp_path / "r.sqlite") as register:
+        register.add_machine("M")
+    args = [a.format(tmp=tmp_path) for a in case["args"]]
+    env = {**os.environ, "PYTHONPATH": str(CORPUS.parents[1])}
+    writer = subprocess.Popen([sys.executable, "-c", KILLED_WRITER, *args], cwd=tmp_path,
+                              env={**env, "HOLD": case["output"]},
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        ready, _, _ = select.select([writer.stdout], [], [], 120)
+        assert ready and writer.stdout.readline() == "writing\n", writer.stderr.read()
+        (temporary,) = tmp_path.glob(f".{case['output']}.*.tmp")
+    finally:
+        writer.send_signal(signal.SIGKILL)
+        writer.communicate(timeout=60)
+    assert not (tmp_path / case["output"]).exists()
+    then = temporary.stat().st_mtime - 120  # the minute a start leaves a temporary for
+    os.utime(temporary, (then, then))
+    fresh = subprocess.run([sys.executable, "-m", "fha_studio", "--help"], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=120)
+    assert fresh.returncode == 0 and fresh.stderr == ""
+    assert not temporary.exists() and not (tmp_path / case["output"]).exists()
