@@ -7,7 +7,7 @@ from collections.abc import Iterable
 
 from PySide6.QtCore import QEvent, QObject, QPointF, QRectF, QSize, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont, QPainter, QPainterPath, QPen, QPolygonF
-from PySide6.QtWidgets import QAbstractButton, QLabel, QPushButton, QSizePolicy, QWidget
+from PySide6.QtWidgets import QAbstractButton, QLabel, QPushButton, QScrollArea, QSizePolicy, QWidget
 
 GREEN = QColor("#2e9d3a")
 RED = QColor("#d12c2c")
@@ -241,3 +241,14 @@ def space_jogs_only(root: QWidget, jog_buttons: Iterable[QAbstractButton]) -> No
     for button in root.findChildren(QAbstractButton):
         if button not in keep:
             button.installEventFilter(swallower)
+
+
+def scrolling(panel: QWidget, minimum_width_px: int = 240) -> QScrollArea:
+    """``panel`` in a scroll area: on a small screen (1024 x 600) a side panel scrolls instead of
+    widening the window past the screen."""
+    area = QScrollArea()
+    area.setWidgetResizable(True)
+    area.setFrameShape(QScrollArea.Shape.NoFrame)
+    area.setWidget(panel)
+    area.setMinimumWidth(minimum_width_px)
+    return area

@@ -16,7 +16,6 @@ calls old data live: it checks the age of the newest sample itself on every fram
 from __future__ import annotations
 
 import dataclasses
-import io
 import logging
 import time
 from collections.abc import Callable
@@ -31,7 +30,6 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QProgressBar,
-    QScrollArea,
     QSplitter,
     QTabWidget,
     QVBoxLayout,
@@ -39,16 +37,19 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio import fileio
-from fha_studio.catalog import DEFAULT_ACTUATOR
+from fha_studio.gui.widgets import scrolling
 from fha_studio.hardware.parameters import load_parameter_model
 from fha_studio.logic.scope.acquisition import LiveMode, MoveTestResult, TraceResult, TraceSettings
 from fha_studio.logic.scope.analysis import CursorDelta, cursor_delta, spectrum
 from fha_studio.logic.scope.channels import ScopeChannel, scope_channels
+from fha_studio.logic.scope.files import csv_text, recording_rows
+from fha_studio.logic.scope.indicator import IndicatorKind, live_indicator
 from fha_studio.logic.scope.levels import MinMaxLevels
-from fha_studio.logic.scope.recorder import CONTRACT_SOURCES, ScopeRecorder
+from fha_studio.logic.scope.recorder import ScopeRecorder
 from fha_studio.recording import RecordingMetadata, read_recording
 
 from .channel_table import ChannelTable
+from .context import ScopeContext, actuator_text
 from .cursor_table import CursorRow
 from .driver import LiveStarted, ScopeCmd, ScopeController
 from .move_test_panel import MoveTestPanel
@@ -68,44 +69,6 @@ DEFAULT_VISIBLE = ("feedback_position", "command_position", "output_speed", "mot
 #: the channel table): no pale yellow or light pastel.
 COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#e07000", "#9467bd", "#8c564b", "#e377c2", "#008b8b",
           "#555555", "#1a237e", "#b8860b", "#006400", "#c2185b", "#4e342e", "#0097a7", "#6a1b9a")
-# Recording columns back to scope channels (opening a file).
-_COLUMN_KEYS = {column: key for column, key in CONTRACT_SOURCES.items()}
-
-
-@dataclass(frozen=True)
-class ScopeContext:
-    """What the scope must know of the axis: the actuator (resolution, ratio) and the load.
-
-    ``actuator_declared`` is False when nobody said which actuator is on the axis and
-    ``actuator`` is only assumed (the view says so)."""
-
-    actuator: str = DEFAULT_ACTUATOR
-    load_inertia_kgm2: float = 0.0
-    supply_voltage: int = 200
-    driver: str = "HA-655"
-    actuator_declared: bool = True
-
-    def actuator_data(self):
-        from fha_studio.catalog import get_actuator
-
-        return get_actuator(self.actuator)
-
-
-def _actuator_text(context: ScopeContext) -> str:
-    if context.actuator_declared:
-        return context.actuator
-    return f"{context.actuator} (assumed: no actuator given on the Connection page)"
-
-
-def _scrolling(panel: QWidget) -> QScrollArea:
-    """``panel`` in a scroll area: on a small screen (1024 x 600) the side panels scroll instead of
-    widening the window past the screen."""
-    area = QScrollArea()
-    area.setWidgetResizable(True)
-    area.setFrameShape(QScrollArea.Shape.NoFrame)
-    area.setWidget(panel)
-    area.setMinimumWidth(240)
-    return area
 
 
 @dataclass
@@ -212,13 +175,13 @@ class ScopeView(QWidget):
         self.trigger = TriggerPanel(self.all_channels)
         self.trigger.sigArm.connect(self.arm_trace)
         self.trigger.sigCancel.connect(lambda: self.controller.send(ScopeCmd.CANCEL_TRACE))
-        side.addTab(_scrolling(self.trigger), "Trigger")
-        self.tests = MoveTestPanel(_actuator_text(self.context), float(self._actuator.max_speed_rpm),
+        side.addTab(scrolling(self.trigger), "Trigger")
+        self.tests = MoveTestPanel(actuator_text(self.context), float(self._actuator.max_speed_rpm),
                                    self.context.load_inertia_kgm2)
         self.tests.load_inertia.valueChanged.connect(self._load_inertia_edited)
         self.tests.sigRun.connect(self.run_test)
         self.tests.sigAbort.connect(lambda: self.controller.send(ScopeCmd.ABORT_TEST))
-        side.addTab(_scrolling(self.tests), "Tests")
+        side.addTab(scrolling(self.tests), "Tests")
         split.addWidget(side)
         split.setSizes([270, 730, 340])  # the trigger panel whole at 1366 px wide
         split.setStretchFactor(1, 1)
@@ -366,24 +329,11 @@ class ScopeView(QWidget):
         return self.toolbar.indicator_text()
 
     def _update_indicator(self) -> None:
-        kind, text = "not", "NOT LIVE: not started"
+        kind, text = IndicatorKind.NOT, "NOT LIVE: not started"
         if self._static is not None:
             text = f"NOT LIVE: showing {self._static.label}"
         elif self._live is not None:
-            status = self._status
-            age = self._newest_age_s()
-            stale_after = max(0.5, 5.0 / status.rate_hz) if status and status.rate_hz else 0.5
-            if status is None:
-                text = "NOT LIVE: waiting for the first sample"
-            elif not status.live:
-                text = status.label
-            elif age is None or age > stale_after:
-                text = "NOT LIVE: no new sample for " + ("a while" if age is None else f"{age:.1f} s")
-            else:
-                kind, text = "live", status.label
-            if self._paused:
-                text = "PAUSED (acquisition goes on)" if kind == "live" else f"PAUSED · {text}"
-                kind = "paused"
+            kind, text = live_indicator(self._status, self._newest_age_s(), self._paused)
         elif self.controller is not None and not self.controller.connected:
             text = "NOT LIVE: no drive connected"
         if self.toolbar.set_indicator(kind, text):
@@ -572,7 +522,7 @@ class ScopeView(QWidget):
         self._actuator = context.actuator_data()
         self.all_channels = scope_channels(load_parameter_model(context.driver),
                                            self._actuator.output_resolution_ppr)
-        self.tests.set_actuator(_actuator_text(context), float(self._actuator.max_speed_rpm))
+        self.tests.set_actuator(actuator_text(context), float(self._actuator.max_speed_rpm))
         self.trigger.set_channels(self.all_channels)
         self._static = None
         self._fill_channel_table()
@@ -635,30 +585,14 @@ class ScopeView(QWidget):
         data = self.shown_rows()
         if data is None:
             raise ValueError("nothing on show to export")
-        channels, rows = data
-        header = ",".join(["t_s"] + [f"{c.key} [{c.unit}]" for c in channels])
-        text = io.StringIO()
-        np.savetxt(text, rows, delimiter=",", header=header, comments="", fmt="%.9g")
-        fileio.write_text(path, text.getvalue())  # whole or not at all
+        fileio.write_text(path, csv_text(*data))  # whole or not at all
         return Path(path)
 
     def open_recording(self, path) -> None:
         """Show an fha-recording/1 file (contract columns as the scope's channels, extras by name)."""
-        recording = read_recording(path)
-        by_key = {c.key: c for c in self.all_channels}
-        channels, columns = [], []
-        for name, values in recording.channels.items():
-            if name == "t":
-                continue
-            key = _COLUMN_KEYS.get(name, name)
-            channel = by_key.get(key) or ScopeChannel(key, name, "", 0)
-            channels.append(channel)
-            columns.append(values)
-        rows = np.column_stack([recording.t_s, *columns])
-        dt = np.diff(recording.t_s)
-        uniform = len(dt) > 0 and float(np.ptp(dt)) <= 0.01 * float(np.median(dt))
-        self.show_static(channels, rows, f"file {Path(path).name}",
-                         recording.metadata.sample_rate_hz, uniform)
+        shown = recording_rows(read_recording(path), self.all_channels)
+        self.show_static(shown.channels, shown.rows, f"file {Path(path).name}", shown.sample_rate_hz,
+                         shown.uniform)
 
     # -------------------------------------------------------------------------------------- trace
     def trace_settings(self) -> TraceSettings:
