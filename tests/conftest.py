@@ -11,6 +11,7 @@ import time
 import pytest
 
 from fha_studio import clock
+from tests.support.clock import FakeClock
 
 # GUI tests run headless; the environment can override (e.g. xcb under xvfb-run).
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
@@ -76,9 +77,10 @@ def pytest_report_header(config):
 
 @pytest.fixture
 def fixed_clock():
-    """The one clock every stamp reads (fha_studio.clock), standing at 2026-11-30 07:00 UTC
-    until the test sets or advances it; the calendar's clock returns afterwards."""
-    with clock.use(clock.FixedClock("2026-11-30T07:00:00Z")) as fixed:
+    """The one clock every stamp reads (fha_studio.clock): a FakeClock (tests/support/clock.py)
+    standing at 2026-11-30 07:00 UTC until the test sets or advances it; the calendar's clock
+    returns afterwards."""
+    with clock.use(FakeClock("2026-11-30T07:00:00Z")) as fixed:
         yield fixed
 
 

@@ -16,6 +16,7 @@ from fha_studio.recording import (
     read_recording,
     write_recording,
 )
+from tests.support.clock import FakeClock
 
 GOOD = """\
 # format: fha-recording/1
@@ -176,16 +177,16 @@ def test_plain_numpy_loads_the_file(tmp_path):
 
 
 def test_streaming_writer_flushes_within_a_second(tmp_path, monkeypatch):
-    clock = [1000.0]
-    monkeypatch.setattr(rec.time, "monotonic", lambda: clock[0])
+    clock = FakeClock(now=1000.0)
+    monkeypatch.setattr(rec.time, "monotonic", clock)
     path = tmp_path / "s.csv"
     with RecordingWriter(path, _meta(), ["t", "pos", "current", "torque_cmd_nm"]) as w:
         assert w.partial_path == tmp_path / "s.csv.partial" and not path.exists()
         w.append([0.0, 0.0, 0.1, 1.0])
         w.append({"t": 0.001, "pos": 0.1, "current": 0.2, "torque_cmd_nm": 2.0})
-        clock[0] += 0.5
+        clock.now += 0.5
         w.append_rows([[0.002, 0.2, 0.3, 3.0], [0.003, 0.3, 0.4, 4.0]])
-        clock[0] += 0.6  # a second has passed since the last flush: this append reaches the file
+        clock.now += 0.6  # a second has passed since the last flush: this append reaches the file
         w.append([0.004, 0.4, 0.5, 5.0])
         # what a crash now would leave: everything up to the last second, readable
         on_disk = read_recording(w.partial_path)

@@ -18,6 +18,7 @@ import pytest
 
 from fha_studio import clock, fileio, temporaries
 from fha_studio.main import main
+from tests.support.clock import FakeClock
 
 
 def _left_over(folder, name, age_s, middle="abcd1234"):
@@ -145,7 +146,7 @@ def test_the_minute_is_counted_by_the_one_clock_and_a_zombie_is_dead(writer_in_t
     os.kill(proc.pid, signal.SIGKILL)
     os.waitid(os.P_PID, proc.pid, os.WEXITED | os.WNOWAIT)  # dead, not yet reaped: a zombie
     written = _dt.datetime.fromtimestamp(tmp.stat().st_mtime, _dt.UTC)
-    with clock.use(clock.FixedClock(written + _dt.timedelta(seconds=59))) as fixed:
+    with clock.use(FakeClock(written + _dt.timedelta(seconds=59))) as fixed:
         assert temporaries.sweep() == [] and tmp.exists() and len(_notes()) == 1
         fixed.advance(2)
         assert temporaries.sweep() == [tmp]

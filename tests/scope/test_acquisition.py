@@ -20,6 +20,7 @@ from fha_studio.logic.scope.acquisition import (
     theoretical_rate_hz,
 )
 from fha_studio.logic.scope.channels import scope_channels
+from tests.support.clock import FakeClock
 from tests.support.documented import DocumentedDrive
 
 PPR = 500_000  # output resolution of the channels: 500 000 pulses = 360 deg
@@ -64,10 +65,10 @@ def test_polling_delivers_converted_rows_and_the_bound(client_on, channels):
 def test_a_silent_drive_is_not_live_and_old_samples_go_stale(client_on, channels):
     drive = MonitorDrive()
     client = client_on(drive)
-    now = [0.0]
-    acq = PollingAcquisition(client, pick(channels, "feedback_position"), clock=lambda: now[0])
+    clock = FakeClock(now=0.0)
+    acq = PollingAcquisition(client, pick(channels, "feedback_position"), clock=clock)
     assert acq.step(0) == 1 and acq.status().live
-    now[0] = 10.0
+    clock.now = 10.0
     status = acq.status()
     assert not status.live and "no new sample for 10.0 s" in status.reason
     drive.silent = True

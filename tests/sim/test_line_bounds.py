@@ -15,16 +15,9 @@ from fha_studio.hardware.protocol import character_time_s
 from fha_studio.hardware.sim import SimProtocolServer
 from fha_studio.hardware.sim.serve import serve_tcp
 from fha_studio.hardware.sim.server import INPUT_BACKLOG_BYTES
+from tests.support.clock import FakeClock
 
 IDN_REPLY = b"HA-655-2-200\rFHA-25C-50-US250\rFHA Studio simulated drive"
-
-
-class FakeClock:
-    def __init__(self) -> None:
-        self.now = 100.0
-
-    def __call__(self) -> float:
-        return self.now
 
 
 def _time_to_answer(server: SimProtocolServer, clock: FakeClock, limit_s: float) -> float:

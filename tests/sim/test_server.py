@@ -9,14 +9,7 @@ import serial
 
 from fha_studio.hardware.protocol import character_time_s
 from fha_studio.hardware.sim import SimConfigError, SimProtocolServer, config_from_url, register_url_handler
-
-
-class FakeClock:
-    def __init__(self) -> None:
-        self.now = 100.0
-
-    def __call__(self) -> float:
-        return self.now
+from tests.support.clock import FakeClock
 
 
 def test_unpaced_server_answers_at_once_and_resynchronises(make_drive):
