@@ -228,7 +228,7 @@ class LinkWorker(QObject):
             log.info("close failed: %s", exc)
 
     def _shutdown(self, _: Shutdown) -> None:
-        """The last command: runs in the link thread, so the timers die in their own thread."""
+        """The last request: runs in the link thread, so the timers die in their own thread."""
         self._final = True  # the STOP below must reach the drive although the window is closing
         self._shut(stop_axis=True)
         for timer in (self._poll_timer, self._jog_timer):
@@ -245,7 +245,7 @@ class LinkWorker(QObject):
     def _open_drive(self, url: str, baud_rate: int) -> DriveApi:
         return DriveClient.open(url, link_settings(baud_rate), should_abort=self._abandon)
 
-    # -- commands -----------------------------------------------------------------------------
+    # -- requests -----------------------------------------------------------------------------
     def _do_open(self, request: Open) -> LinkInfo:
         url = request.url
         if self._client is not None:
@@ -456,8 +456,8 @@ def _forget_dummy_thread() -> None:
 
 
 class LinkController(QObject):
-    """The GUI-thread face of the link: sends commands, re-emits what the worker says, and keeps
-    the last known state for the pages. Never blocks."""
+    """The GUI-thread face of the link: sends requests (each reply to its sender), re-emits what
+    the worker says, and keeps the last known state for the pages. Never blocks."""
 
     sigCommand = Signal(object)  # Sent: a request, queued into the worker
     sigConnected = Signal(object)  # LinkInfo
@@ -523,7 +523,7 @@ class LinkController(QObject):
         running in the link thread checks it between items of a long operation."""
         return self._abort
 
-    # -- commands ------------------------------------------------------------------------------
+    # -- requests ------------------------------------------------------------------------------
     def send(self, request: LinkRequest[R], on_reply: OnReply[R] | None = None) -> int:
         """Queue ``request`` into the link thread; its reply goes to ``on_reply`` (and to the
         observer, ``sigResult``). Returns the request's token."""
