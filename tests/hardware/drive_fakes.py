@@ -5,16 +5,13 @@ from __future__ import annotations
 from typing import ClassVar
 
 from fha_studio.hardware import protocol as p
-from fha_studio.hardware.client import LinkSettings
 from fha_studio.hardware.parameters import Mode, load_parameter_model
 from fha_studio.hardware.protocol import Command, Reply, Status
+from tests.support.links import FAST as FAST  # the client tests take their settings from here
 
 OK = Reply()
 X = Reply((), Status.REJECTED)
 S = Reply((), Status.SERVO_ON)
-
-#: Short timeouts so that failure tests stay fast; still far above in-process latency.
-FAST = LinkSettings(response_timeout_s=0.08, oww_timeout_s=1.0, eeprom_write_timeout_s=0.1)
 
 
 class MiniDrive:

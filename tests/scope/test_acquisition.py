@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scope_fakes import MonitorDrive
+from scope_fakes import FAST, MonitorDrive
 
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.parameters import load_parameter_model
@@ -43,9 +43,9 @@ def test_line_budget_counts_request_and_reply_characters():
     assert theoretical_rate_hz([1] * 4) > theoretical_rate_hz([1_000_000] * 4)
 
 
-def test_polling_delivers_converted_rows_and_the_bound(client_on, channels):
+def test_polling_delivers_converted_rows_and_the_bound(client_for, channels):
     drive = MonitorDrive()
-    client = client_on(drive)
+    client, _ = client_for(drive, FAST)
     chosen = pick(channels, "feedback_position", "output_speed", "motor_current", "in_position", "servo_on")
     acq = PollingAcquisition(client, chosen, capacity=1000)
     assert acq.mode is LiveMode.MONITORS and acq.items == [100, 103, 104, 106]
@@ -62,9 +62,9 @@ def test_polling_delivers_converted_rows_and_the_bound(client_on, channels):
     assert acq.limit_hz == pytest.approx(1920 / 32)
 
 
-def test_a_silent_drive_is_not_live_and_old_samples_go_stale(client_on, channels):
+def test_a_silent_drive_is_not_live_and_old_samples_go_stale(client_for, channels):
     drive = MonitorDrive()
-    client = client_on(drive)
+    client, _ = client_for(drive, FAST)
     clock = FakeClock(now=0.0)
     acq = PollingAcquisition(client, pick(channels, "feedback_position"), clock=clock)
     assert acq.step(0) == 1 and acq.status().live
@@ -76,9 +76,9 @@ def test_a_silent_drive_is_not_live_and_old_samples_go_stale(client_on, channels
     assert acq.status().label.startswith("NOT LIVE: no answer from the drive")
 
 
-def test_documented_only_drive_shows_position_by_dgr_labelled_as_such(client_on, channels):
+def test_documented_only_drive_shows_position_by_dgr_labelled_as_such(client_for, channels):
     drive = DocumentedDrive(position=8192 * 50 * 3 // 4)  # 3/4 of an output turn on a ratio-50 axis
-    client = client_on(drive)
+    client, _ = client_for(drive, FAST)
     acq = PollingAcquisition(client, pick(channels, "feedback_position", "motor_current"), ratio=50)
     assert acq.mode is LiveMode.POSITION
     assert [c.key for c in acq.channels] == ["feedback_position"]
@@ -98,17 +98,17 @@ def test_documented_only_drive_shows_position_by_dgr_labelled_as_such(client_on,
     assert acq.step(0) == 1 and acq.retry_interval_s == 0.25
 
 
-def test_documented_only_drive_without_a_known_ratio_reads_nothing(client_on, channels):
-    client = client_on(DocumentedDrive())
+def test_documented_only_drive_without_a_known_ratio_reads_nothing(client_for, channels):
+    client, _ = client_for(DocumentedDrive(), FAST)
     acq = PollingAcquisition(client, pick(channels, "feedback_position"))
     assert acq.mode is LiveMode.NONE and acq.step(0) == 0
     assert "ratio" in acq.status().reason
 
 
-def test_trace_is_configured_on_the_wire_and_read_back_in_display_units(client_on, channels):
+def test_trace_is_configured_on_the_wire_and_read_back_in_display_units(client_for, channels):
     drive = MonitorDrive()
     drive.trace_rows = [(k * 100, k * 10, 0b1000 if k >= 30 else 0) for k in range(100)]
-    client = client_on(drive)
+    client, _ = client_for(drive, FAST)
     trace = TraceAcquisition(client)
     assert trace.available() == (True, "")
     chosen = tuple(pick(channels, "feedback_position", "output_speed", "in_position"))
@@ -138,8 +138,8 @@ def test_trace_settings_say_what_is_wrong(channels):
     assert Trigger(p.TriggerKind.ALARM).describe() == "on an alarm"
 
 
-def test_a_drive_without_trace_says_so(client_on):
-    client = client_on(MonitorDrive(caps="MON MMR IOS"))
+def test_a_drive_without_trace_says_so(client_for):
+    client, _ = client_for(MonitorDrive(caps="MON MMR IOS"), FAST)
     ok, why = TraceAcquisition(client).available()
     assert not ok and "no trace capture" in why
 

@@ -2,7 +2,10 @@
 
 - ``scripted``: ``ScriptedDrive``, a stand-in drive on a pipe end answering from a handler.
 - ``documented``: ``DocumentedDrive``, the one drive of the manual's DGR and OWW (a handler).
-- ``clock``: ``FakeClock``, the one injected clock (the calendar and a count of seconds, moved together).
+- ``links``: the fixtures ``pipes``, ``scripted`` and ``client_for`` (a client on a scripted
+  drive), offered to every test.
+- ``clock``: ``FakeClock``, the one injected clock (the calendar and a count of seconds, moved
+  together).
 - ``read_only``: ``ReadOnlyPlace``, files the program really cannot write (as uid 65534 where the
   tests run as root, else by chmod), and the program run on them in a subprocess.
 
