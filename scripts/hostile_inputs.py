@@ -1,8 +1,9 @@
-"""Issue 21's hostile inputs, tried again against the real command line: a table of what each did.
+"""Hostile inputs, tried again against the real command line: a table of what each did.
 
 Run: python scripts/hostile_inputs.py [--only TEXT] [--markdown]
 
-Every case of issue 21 (classes 1-7 and its "Also" list: the register's SQLite errors and
+Every case a hostile tester once found on the register, its imports, machine files, training,
+``drive`` and ``size`` (seven classes and the odd ones: the register's SQLite errors and
 devices, session files of the wrong shape, deep and huge structures, times and numbers in
 arguments, names, files after a kill, an option taken for another) runs ``python -m fha_studio``
 as a script would, in a fresh temporary folder of its own, and the table says: the class, the
