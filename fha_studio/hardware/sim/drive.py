@@ -54,13 +54,17 @@ from fha_studio.hardware.sim.options import Battery, SimConfig, SimConfigError, 
 from fha_studio.hardware.sim.realtime import RealTime
 from fha_studio.hardware.sim.recorder import SimRecorder
 from fha_studio.hardware.sim.reply import SimRefused, SimReply, rejected, servo_is_on
-from fha_studio.hardware.sim.supervision import SUPERVISION_PERIOD_S, AlarmSupervisor, SimAlarmRecord
+from fha_studio.hardware.sim.supervision import (
+    MOTION_WIRING_FAULTS,
+    SUPERVISION_PERIOD_S,
+    AlarmSupervisor,
+    SimAlarmRecord,
+    WiringFaultTrip,
+)
 from fha_studio.hardware.sim.trace import SimTrace
 from fha_studio.physics import ServoAxis, ServoSettings
 
 TWO_PI = 2.0 * math.pi
-#: wiring faults that leave the motor without useful torque (see _supervise_wiring_fault)
-MOTION_WIRING_FAULTS = (Wiring.MOTOR_SWAPPED, Wiring.MOTOR_OPEN, Wiring.ENCODER_SWAPPED)
 
 
 class SimDrive:
@@ -125,7 +129,6 @@ class SimDrive:
                                  "has an incremental encoder (no backup battery)")
         # the encoder's A/B leads swapped: it counts the other way (docs/sim.md, wiring faults)
         self._encoder_sign = -1.0 if config.wiring is Wiring.ENCODER_SWAPPED else 1.0
-        self._faulty_motion_s = 0.0  # how long a motion has been commanded into a wiring fault
         self.oww_clear_s = config.oww_clear_s if config.oww_clear_s is not None else c.oww_clear_s
         self.supervisor = AlarmSupervisor(
             self.alarm_table,
@@ -230,7 +233,7 @@ class SimDrive:
         self.supervisor.power_on(axis)
         axis.reset_peaks()
         self._update_brake()
-        self._faulty_motion_s = 0.0
+        self.wiring_trip = WiringFaultTrip(self.config.wiring, self.constants)
         if self.config.wiring is Wiring.ENCODER_OPEN:
             self.raise_alarm(50)  # no valid signal from the encoder
         elif self.config.battery is not Battery.OK:
@@ -598,8 +601,13 @@ class SimDrive:
         self.excitation.supervise(t, self.servo_on and not self.alarm, axis.output_pos_rad)
         motion = self.motion
         motion.supervise(t)
-        if self.config.wiring in MOTION_WIRING_FAULTS:
-            self._supervise_wiring_fault()
+        if self.wiring_trip.active and self.wiring_trip.tick(
+            self.servo_on and motion.kind in (MotionKind.JOG, MotionKind.MOVE)
+        ):
+            sign = motion.sign * self._direction
+            self.raise_alarm(60)
+            if self.wiring_trip.lurches:  # the axis lurched the wrong way before the trip
+                self.axis.turn_by_hand(-sign * self.wiring_trip.lurch_rad)
         if self.servo_on and motion.moving and self.io.blocks(
             self._angle_deg,
             forward=motion.sign > 0,
@@ -609,21 +617,6 @@ class SimDrive:
         self._supervise_alarms()
         if self._recorder is not None:
             self._recorder.tick(self.clock_s, axis)
-
-    def _supervise_wiring_fault(self) -> None:
-        """A motor lead open or swapped, or the encoder's A/B swapped: a commanded motion finds no
-        useful torque (open) or runs away from the command (swapped) and the error counter
-        overflows (alarm 60) within ``wiring_fault_trip_s``."""
-        if not (self.servo_on and self.motion.kind in (MotionKind.JOG, MotionKind.MOVE)):
-            self._faulty_motion_s = 0.0
-            return
-        self._faulty_motion_s += SUPERVISION_PERIOD_S
-        if self._faulty_motion_s < self.constants.wiring_fault_trip_s:
-            return
-        sign = self.motion.sign * self._direction
-        self.raise_alarm(60)
-        if self.config.wiring is not Wiring.MOTOR_OPEN:  # the axis lurched the wrong way before the trip
-            self.axis.turn_by_hand(-sign * math.radians(self.constants.wiring_fault_lurch_deg))
 
     def _supervise_alarms(self) -> None:
         allowance: float | None = None

@@ -4,16 +4,42 @@ the checks made every :data:`SUPERVISION_PERIOD_S` (10 over speed, 20 overload b
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from fha_studio import clock
 from fha_studio.hardware.parameters import AlarmTable
 from fha_studio.hardware.sim.constants import SimConstants
+from fha_studio.hardware.sim.options import Wiring
 from fha_studio.hardware.sim.reply import rejected
 from fha_studio.physics import ServoAxis
 
 SUPERVISION_PERIOD_S = 0.001  # alarms, watchdog, sensors and inhibits are checked every 1 ms
 ABS_MULTI_TURN_RANGE = (-4096, 4095)  # HA-655 manual (relianca p.5): alarm 54 outside it
+#: wiring faults that leave the motor without useful torque (see WiringFaultTrip)
+MOTION_WIRING_FAULTS = (Wiring.MOTOR_SWAPPED, Wiring.MOTOR_OPEN, Wiring.ENCODER_SWAPPED)
+
+
+class WiringFaultTrip:
+    """A motor lead open or swapped, or the encoder's A/B swapped (a training drive's wiring
+    fault): a commanded motion finds no useful torque (open) or runs away from the command
+    (swapped) and the error counter overflows (alarm 60) within ``wiring_fault_trip_s``; a swapped
+    lead lurches the axis ``wiring_fault_lurch_deg`` the wrong way before the trip."""
+
+    def __init__(self, wiring: Wiring, constants: SimConstants):
+        self.active = wiring in MOTION_WIRING_FAULTS
+        self.lurches = wiring is not Wiring.MOTOR_OPEN
+        self.lurch_rad = math.radians(constants.wiring_fault_lurch_deg)
+        self.trip_s = constants.wiring_fault_trip_s
+        self.faulty_motion_s = 0.0  # how long a motion has been commanded into the fault
+
+    def tick(self, commanded: bool) -> bool:
+        """One supervision period with a motion ``commanded`` (or not); True: alarm 60 trips."""
+        if not commanded:
+            self.faulty_motion_s = 0.0
+            return False
+        self.faulty_motion_s += SUPERVISION_PERIOD_S
+        return self.faulty_motion_s >= self.trip_s
 
 
 @dataclass
