@@ -354,9 +354,13 @@ def test_the_writer_writes_version_1_when_it_can_and_version_2_without_current(t
     assert not back.has_current and list(back.in_pos) == [1, 1, 0]
 
 
-def test_the_model_check_refuses_a_recording_without_current():
+def test_the_model_check_reads_a_recording_without_current_on_its_declared_load():
+    """A recording without current is read through the closed loop (it used to be refused for
+    having no current column); its torques rest on the declared inertia, so the load must be declared."""
     from fha_studio.logic.modelcheck import ModelCheckError
     from fha_studio.logic.modelcheck.axis import declared_axis
 
-    with pytest.raises(ModelCheckError, match="no current column"):
+    with pytest.raises(ModelCheckError, match="declares no load inertia"):
         declared_axis(parse_recording(V2))
+    declared = V2.replace("# sample_rate_hz", "# load_inertia_kgm2: 1.5\n# sample_rate_hz")
+    assert declared_axis(parse_recording(declared)).nominal_inertia_kgm2 > 1.5

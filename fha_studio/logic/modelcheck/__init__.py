@@ -9,6 +9,7 @@ fields hold each step's arrays (see result.py): ``residual`` (step 1), ``where``
 """
 
 from fha_studio.logic.modelcheck.axis import ModelCheckError
+from fha_studio.logic.modelcheck.entry import run_modelcheck
 from fha_studio.logic.modelcheck.result import (
     Ambiguity,
     Binned,
@@ -21,7 +22,6 @@ from fha_studio.logic.modelcheck.result import (
     Resimulation,
     Structure,
 )
-from fha_studio.logic.modelcheck.workflow import run_modelcheck
 
 __all__ = [
     "Ambiguity",

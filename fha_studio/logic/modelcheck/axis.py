@@ -43,15 +43,13 @@ class DeclaredAxis:
 def declared_axis(rec: Recording) -> DeclaredAxis:
     """The nominal model of a recording; ModelCheckError when the declaration is inconsistent."""
     meta = rec.metadata
-    if not rec.has_current:
-        raise ModelCheckError("the recording has no current column (a bench capture without a current "
-                              "probe): the model check needs the motor current")
     if meta.load_inertia_kgm2 is None:
         raise ModelCheckError("the recording declares no load inertia (load_inertia_kgm2): the model "
                               "check needs the declared load")
     load_inertia_kgm2 = float(meta.load_inertia_kgm2)
     if meta.is_custom:
-        peak = float(np.max(np.abs(rec.current_a)))
+        # without a current the peak is unknown: no torque limit to refuse an effect by
+        peak = float(np.max(np.abs(rec.current_a))) if rec.has_current else 1e6
         ppr = _guess_ppr(rec.pos_deg)
         kt, inertia = meta.torque_constant_nm_per_a, meta.actuator_inertia_kgm2
         if kt is None or inertia is None:  # the recording reader refuses such a file already
@@ -120,6 +118,16 @@ def check_plausible(rec: Recording, axis: DeclaredAxis) -> list[str]:
             f"more than {code}'s maximum {model.max_speed_rpm:g} r/min: wrong actuator declared, "
             "or 'pos' is not the output position in degrees"
         )
+    _check_resolution(pos, q_deg, code, axis.model.output_resolution_ppr, rec.metadata.is_custom)
+    if rec.has_current:
+        _check_current(rec, axis)
+    _check_other_columns(rec, axis, span)
+    return notes
+
+
+def _check_current(rec: Recording, axis: DeclaredAxis) -> None:
+    """The current column must be the motor current of the declared actuator."""
+    code, model = axis.code, axis.model
     cur = rec.current_a
     peak = float(np.max(np.abs(cur)))
     if not rec.metadata.is_custom and peak > 1.5 * model.max_current_a:
@@ -127,7 +135,6 @@ def check_plausible(rec: Recording, axis: DeclaredAxis) -> list[str]:
             f"column 'current' reaches {peak:.3g} A but {code} allows at most {model.max_current_a:g} A: "
             "wrong actuator declared, or 'current' is not the motor current in A"
         )
-    _check_resolution(pos, q_deg, code, axis.model.output_resolution_ppr, rec.metadata.is_custom)
     # Garbage, not a weak signal: a current whose sample-to-sample scatter dominates its spread AND
     # is large against the actuator's current range. A real monitor's noise is a few steps of a
     # 10-bit converter (under 1 % of Imax); a weak but real current (a slow move, a heavy load on a
@@ -148,6 +155,11 @@ def check_plausible(rec: Recording, axis: DeclaredAxis) -> list[str]:
             f"spread of {spread:.3g} A, {100 * scatter / model.max_current_a:.0f} % of {code}'s "
             f"{model.max_current_a:g} A): is it the driver's current monitor?"
         )
+
+
+def _check_other_columns(rec: Recording, axis: DeclaredAxis, span: float) -> None:
+    """load_pos, vel and cmd_pos must be what the format says."""
+    t, pos, model = rec.t_s, rec.pos_deg, axis.model
     load = rec.load_pos_deg
     if load is not None:
         diff = load - pos
@@ -179,7 +191,6 @@ def check_plausible(rec: Recording, axis: DeclaredAxis) -> list[str]:
                 f"column 'cmd_pos' is far from 'pos' (rms {err:.3g} deg over a {span:.3g} deg motion): "
                 "is it the position command in degrees?"
             )
-    return notes
 
 
 def _check_resolution(pos: np.ndarray, q_deg: float, code: str, ppr: int, custom: bool) -> None:

@@ -148,6 +148,9 @@ class Resimulation:
     load_diff_nominal_arcsec: np.ndarray | None = None
     load_diff_updated_arcsec: np.ndarray | None = None
     command: str = "cmd_pos"  # which column drove it ("cmd_pos", or "pos" when no command was recorded)
+    # without a current (closedloop.py): measured - re-simulated position, the following error's gap
+    following_error_rms_nominal_arcsec: float | None = None
+    following_error_rms_updated_arcsec: float | None = None
 
 
 @dataclass
@@ -220,6 +223,8 @@ class ModelCheckResult:
     bandwidth_profile: tuple[BandwidthPoint, ...] = ()  # the bandwidths tried and what each left unexplained
     refused: list[Refused] = field(default_factory=list)  # fitted, not named, and why (consistency.py)
     not_seen: list[str] = field(default_factory=list)  # what this recording cannot show, and what would
+    torque_basis: str = ""  # what the torques in N m rest on, when no torque was measured
+    loop: Any = None  # the closed loop identified from a recording without current (closedloop.Loop)
 
     @property
     def found(self) -> bool:
@@ -243,6 +248,8 @@ class ModelCheckResult:
                 for k, v in e.params.items()
                 if k != p
             )
+            if self.torque_basis and e.units.get(p) == "N m":
+                main += f" ({self.torque_basis})"
             text = f"{e.label} missing: {main}" + (f" ({others})" if others else "")
             if e.alternatives:
                 alts = " or ".join(label_of(a) for a in e.alternatives)
@@ -301,7 +308,16 @@ class ModelCheckResult:
                 for d in self.detection_limits
             )
             lines.append(f"Detection limit (smallest effect this recording could have revealed): {limits}")
-        if self.resimulation is not None:
+        resim = self.resimulation
+        fe_nominal = None if resim is None else resim.following_error_rms_nominal_arcsec
+        if self.resimulation is not None and fe_nominal is not None:
+            r = self.resimulation
+            lines.append(
+                f"Re-simulation of the recorded {r.command}: position against the measured "
+                f"{fmt(fe_nominal)}{to}"
+                f"{fmt(r.following_error_rms_updated_arcsec or 0.0)} arcsec rms (nominal{to}updated model)"
+            )
+        elif self.resimulation is not None:
             r = self.resimulation
             lines.append(
                 f"Re-simulation of the recorded {r.command}: torque {fmt(r.rms_nominal_nm)}{to}"
@@ -397,7 +413,16 @@ class ModelCheckResult:
                 "command": self.resimulation.command,
                 "torque_rms_nominal_nm": self.resimulation.rms_nominal_nm,
                 "torque_rms_updated_nm": self.resimulation.rms_updated_nm,
+                "following_error_rms_nominal_arcsec": self.resimulation.following_error_rms_nominal_arcsec,
+                "following_error_rms_updated_arcsec": self.resimulation.following_error_rms_updated_arcsec,
             },
+            "loop": None if self.loop is None else {
+                "position_gain_per_s": self.loop.position_gain_per_s,
+                "speed_gain_a_s_per_rad": self.loop.speed_gain_a_s_per_rad,
+                "integral_time_s": self.loop.integral_time_s,
+                "feed_forward": self.loop.feed_forward,
+            },
+            "torque_basis": self.torque_basis,
             "not_named": [r.to_json() for r in self.refused],
             "not_seen": list(self.not_seen),
             "notes": list(self.notes),

@@ -143,6 +143,10 @@ def run_modelcheck(
     """
     axis = declared_axis(rec)
     notes = check_plausible(rec, axis)
+    if not rec.has_current:  # a bench capture: entry.run_modelcheck reads it through the closed loop
+        raise ModelCheckError(
+            "the recording has no current column: the torque channel needs the motor current"
+        )
     model = axis.model
     sig, bandwidth, floor_t = _analysis_signals(rec, axis, window)
     if sig.resampled:
