@@ -17,6 +17,7 @@ from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import (
     QComboBox,
     QGridLayout,
+    QHBoxLayout,
     QLabel,
     QLineEdit,
     QPushButton,
@@ -93,36 +94,40 @@ class BenchPanel(QWidget):
         self.start_button.setCheckable(True)
         self.start_button.clicked.connect(self._start_clicked)
         grid.addWidget(self.start_button, 1, 3)
-        grid.addWidget(QLabel("Encoder"), 2, 0)
+        # the roles in one row: the plots get the height
+        roles = QHBoxLayout()
+        roles.addWidget(QLabel("Encoder"))
         self.encoder_edit = QLineEdit("")
         self.encoder_edit.setPlaceholderText("A,B e.g. D0,D1")
         self.encoder_edit.setToolTip("encoder A and B among the channels: counted x4 as they come")
-        grid.addWidget(self.encoder_edit, 2, 1)
-        grid.addWidget(QLabel("Command"), 3, 0)
+        roles.addWidget(self.encoder_edit, 1)
+        roles.addWidget(QLabel("Command"))
         self.command_edit = QLineEdit("")
         self.command_edit.setPlaceholderText("A,B e.g. D2,D3")
         self.command_edit.setToolTip("the command pulse lines into CN2 among the channels (A, and B for "
                                      "two-pulse, the sign or two-phase), decoded by parameters 1, 2, 3 "
                                      "and 4")
-        grid.addWidget(self.command_edit, 3, 1)
-        grid.addWidget(QLabel("IN-POS"), 4, 0)
+        roles.addWidget(self.command_edit, 1)
+        roles.addWidget(QLabel("IN-POS"))
         self.in_position_edit = QLineEdit("")
         self.in_position_edit.setPlaceholderText("e.g. D5 (CN2-33)")
         self.in_position_edit.setToolTip("the drive's in-position output (CN2-33) among the channels: "
                                          "the move's in-position time is taken from it")
-        grid.addWidget(self.in_position_edit, 4, 1)
+        roles.addWidget(self.in_position_edit, 1)
+        grid.addLayout(roles, 2, 0, 1, 4)
         grid.setColumnStretch(1, 1)
         layout.addLayout(grid)
         self.plot = pg.PlotWidget(background="w")
         self.plot.setLabel("bottom", "time", units="s")
-        self.plot.addLegend(offset=(5, 5))
-        layout.addWidget(self.plot, 1)
+        self.plot.addLegend(offset=(5, 5), colCount=3)  # in rows above the lanes
+        layout.addWidget(self.plot, 3)
         self.counts_plot = pg.PlotWidget(background="w")
         self.counts_plot.setLabel("left", "counts")
         self.counts_plot.setXLink(self.plot)
         self.counts_plot.setVisible(False)
+        self.counts_plot.addLegend(offset=(5, 5))
         self._counts_curve = self.counts_plot.plot([], [], pen=pg.mkPen("#333333", width=1))
-        layout.addWidget(self.counts_plot, 1)
+        layout.addWidget(self.counts_plot, 2)
         self.move_label = QLabel("")
         self.move_label.setObjectName("scopeBenchMove")
         self.move_label.setWordWrap(True)
@@ -240,18 +245,18 @@ class BenchPanel(QWidget):
             pen = pg.mkPen(_COLORS[i % len(_COLORS)], width=1)
             self._curves.append(self.plot.plot([], [], pen=pen, name=f"bench {label}"))
         self.plot.enableAutoRange(axis="x", enable=False)
-        lanes = len(self._curves)
-        if all(name in started.logic for name in started.channels):  # lanes only: a fixed height
-            self.plot.enableAutoRange(axis="y", enable=False)
-            self.plot.setYRange(-0.2, 1.2 * lanes, padding=0)
-        else:
-            self.plot.enableAutoRange(axis="y", enable=True)
+        self.plot.enableAutoRange(axis="y", enable=False)  # set per frame: lanes, analog, the legend
         counting = "counts" in started.extra
         self.counts_plot.setVisible(counting)
         self._counts_curve.setData([], [])
         if counting:
             label = started.labels[len(started.channels) + started.extra.index("counts")]
+            # named in the legend (a vertical axis label of this length is cut at this height)
             self.counts_plot.setLabel("left", f"bench {label}")
+            self.counts_plot.getAxis("left").showLabel(False)
+            legend = self.counts_plot.plotItem.legend
+            legend.clear()
+            legend.addItem(self._counts_curve, f"bench {label}")
         self.status_label.setText(f"LIVE from the bench: {started.device} at "
                                   f"{sigrok.rate_text(started.sample_rate_hz)}, "
                                   f"{', '.join(started.labels)}")
@@ -268,11 +273,17 @@ class BenchPanel(QWidget):
         rows = peak_rows(rows, max(200, self.plot.width()))
         end = float(rows[-1, 0])
         self.plot.setXRange(max(0.0, end - WINDOW_S), max(end, WINDOW_S), padding=0)
+        low, high = 0.0, 1.0
         for i, (curve, name) in enumerate(zip(self._curves, started.channels, strict=True)):
             values = rows[:, 1 + i]
             if name in started.logic:  # a logic analyzer's look: one lane per channel
                 values = values * 0.8 + 1.2 * (len(self._curves) - 1 - i)
             curve.setData(rows[:, 0], values)
+            low, high = min(low, float(values.min())), max(high, float(values.max()))
+        # room above the traces for the legend's rows (three names a row), so it covers none
+        legend_rows = 1 + (len(self._curves) - 1) // 3
+        span = high - low
+        self.plot.setYRange(low - 0.05 * span, high + span * 0.28 * legend_rows, padding=0)
         if "counts" in started.extra:
             self._counts_curve.setData(rows[:, 0], rows[:, 1 + len(started.channels)])
         self._measure_move(started, _rows)
