@@ -10,14 +10,11 @@ with the manual's warning until someone says it was put right.
 from __future__ import annotations
 
 import logging
-import time
-from functools import partial
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QObject, Qt, Signal, Slot
+from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import (
-    QCheckBox,
     QComboBox,
     QFileDialog,
     QGroupBox,
@@ -37,12 +34,12 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.gui.link import Call, DriveStatus, LinkInfo, LinkReply, SetInputs
+from fha_studio.gui.link import LinkInfo
 from fha_studio.gui.pages.absolute import AbsolutePage
 from fha_studio.gui.pages.base import BasePage, PageHost, PageId
 from fha_studio.gui.pages.direction import DirectionPage
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
-from fha_studio.hardware.protocol import IoBit
+from fha_studio.gui.pages.procedures.live_panel import LiveCheckPanel
 from fha_studio.logic.procedures import (
     Observation,
     Procedure,
@@ -69,29 +66,6 @@ _STATUS_WORDS = {
 }
 
 
-class _SampleRelay(QObject):
-    """Carries samples of a live check's move from the link thread to the GUI thread."""
-
-    sigSample = Signal(float, int)
-
-
-def _live_check_in_link_thread(step: Step, context, angles: dict, relay: _SampleRelay, memo: dict,
-                               client) -> Observation:
-    """Runs in the link thread (worker CALL). ``memo`` is kept by the page between two presses."""
-    from fha_studio.logic.procedures.live import LiveEnv, run_live_check
-
-    env = LiveEnv(context, angles, on_sample=lambda angle, io: relay.sigSample.emit(angle, io.raw), memo=memo)
-    return run_live_check(client, step, env)
-
-
-#: The sensors a live check's samples report, by I/O bit (docs/protocol.md, IOS).
-_SENSOR_BITS = (
-    (IoBit.LIMIT_SWITCH_1, "limit switch 1"),
-    (IoBit.LIMIT_SWITCH_2, "limit switch 2"),
-    (IoBit.ORIGIN_SENSOR, "origin sensor"),
-)
-
-
 class ProceduresPage(BasePage):
     """Receiving inspection, installation, wiring, sensor set, rotary direction; the report."""
 
@@ -109,19 +83,11 @@ class ProceduresPage(BasePage):
         self.context: dict | None = None
         self.procedures: list[Procedure] = []
         self.run: ProcedureRun | None = None
-        self._live_token: int | None = None
-        self._by_hand_why = ""  # why the drive cannot answer the live step on show
-        self._live_memo: dict = {}  # a live check's state between two presses (the link thread uses it)
-        self._relay = _SampleRelay(self)
         self._build()
-        self.link.sigStatus.connect(self._on_status)
         self.state.sigActuatorChanged.connect(self._axis_changed)
-        self._relay.sigSample.connect(
+        self.live_panel.relay.sigSample.connect(
             lambda angle, bits: self.dog_panel.observe(angle, bits) if self.dog_panel.wizard else None
         )
-        self._relay.sigSample.connect(self._live_progress)
-        self._live_started_s = 0.0
-        self._live_shown_s = 0.0
         self._refresh()
 
     # -- layout -------------------------------------------------------------------------------
@@ -204,42 +170,13 @@ class ProceduresPage(BasePage):
         self.choice_button.clicked.connect(lambda: self.answer(self.choice_combo.currentText()))
         ch.addWidget(self.choice_combo, 1)
         ch.addWidget(self.choice_button)
-        # live
-        live = QWidget()
-        lv = QVBoxLayout(live)
-        row = QHBoxLayout()
-        self.live_button = QPushButton("&Check on the drive")
-        self.live_button.clicked.connect(self.run_live_check)
-        row.addWidget(self.live_button)
-        row.addStretch(1)
-        lv.addLayout(row)
-        # the drive cannot tell: the technician enters what they saw, and that value is recorded
-        self.by_hand_box = QWidget()
-        hb = QHBoxLayout(self.by_hand_box)
-        hb.setContentsMargins(0, 0, 0, 0)
-        self.by_hand_edit = QLineEdit()
-        self.by_hand_edit.setObjectName("by_hand_value")
-        self.by_hand_result = QComboBox()
-        self.by_hand_result.addItems(["as it should be", "NOT as it should be"])
-        self.by_hand_button = QPushButton("Record what I &saw")
-        self.by_hand_button.clicked.connect(self.answer_by_hand)
-        hb.addWidget(QLabel("Seen:"))
-        hb.addWidget(self.by_hand_edit, 1)
-        hb.addWidget(self.by_hand_result)
-        hb.addWidget(self.by_hand_button)
-        self.by_hand_box.setVisible(False)
-        lv.addWidget(self.by_hand_box)
-        # On the simulated drive the trainee switches the brake's 24 V here (INP), as at the machine.
-        self.sim_brake_check = QCheckBox("Simulated drive: brake supply 24 V on")
-        self.sim_brake_check.setObjectName("sim_brake")
-        self.sim_brake_check.toggled.connect(
-            lambda on: self.link.send(SetInputs({"brake_released": on})) if self.link.connected else None
-        )
-        lv.addWidget(self.sim_brake_check)
-        self.live_label = QLabel("")
-        self.live_label.setObjectName("live_result")
-        self.live_label.setWordWrap(True)
-        lv.addWidget(self.live_label)
+        # live: the drive's check, else what the technician saw (its widgets are the page's too)
+        live = self.live_panel = LiveCheckPanel(self.link, self.answer, self._message)
+        live.live_button.clicked.connect(self.run_live_check)
+        live.sigDone.connect(self.sigLiveDone)
+        self.live_button, self.live_label = live.live_button, live.live_label
+        self.by_hand_box, self.by_hand_edit = live.by_hand_box, live.by_hand_edit
+        self.sim_brake_check = live.sim_brake_check
         # sensor angle
         self.dog_panel = SensorDogPanel(self.link)
         self.dog_panel.sigRecord.connect(self.answer)
@@ -412,98 +349,25 @@ class ProceduresPage(BasePage):
         except StepInputError as exc:
             self._message(str(exc))
             return False
-        self._live_memo.clear()  # what a live check kept belongs to the step just answered
+        self.live_panel.answered()  # what a live check kept belongs to the step just answered
         self._message("" if record.passed else "The check failed: the procedure stops here.")
         self.value_edit.clear()
-        self.live_label.setText("")
         self._refresh()
         return True
 
-    def _ask_by_hand(self, step: Step | None, why: str) -> None:
-        """Show the by-hand entry for a live step the drive cannot answer, saying what to enter."""
-        from fha_studio.logic.procedures.live import BY_HAND
-
-        if step is None:
-            return
-        what = BY_HAND.get(step.check or "", "what you saw")
-        self.by_hand_edit.setPlaceholderText(what)
-        self.by_hand_edit.setToolTip(f"Enter {what}")
-        self._by_hand_why = why
-        self.by_hand_box.setVisible(True)
-
     def answer_by_hand(self) -> bool:
         """Record the value the technician entered for a live step the drive cannot answer."""
-        value = self.by_hand_edit.text().strip()
-        if not value:
-            self._message(f"Enter {self.by_hand_edit.placeholderText()} first: it is what the record keeps.")
-            return False
-        passed = self.by_hand_result.currentIndex() == 0
-        why = self._by_hand_why or "the drive cannot tell"
-        observation = Observation(value, passed, f"entered by hand ({why})")
-        if self.answer(observation):
-            self.by_hand_edit.clear()
-            return True
-        return False
+        return self.live_panel.answer_by_hand()
 
     def run_live_check(self) -> None:
         """Ask the drive (in the link thread); the answer is recorded when it comes."""
         step = self.current_step()
-        if step is None or step.kind != "live" or self._live_token is not None:
+        if step is None or step.kind != "live" or self.live_panel.asking or self.context is None:
             return
         if self.axis_mismatch():
             self._message(self.axis_mismatch())
             return
-        if not self.link.connected:
-            self._message("No drive connected: connect first, or enter what you saw.")
-            self._ask_by_hand(step, "no drive is connected")
-            return
-        self.live_label.setText("Asking the drive …")
-        self._live_started_s = time.monotonic()
-        self.live_button.setEnabled(False)
-        function = partial(
-            _live_check_in_link_thread, step, self.context, dict(self.session.sensor_angles_deg), self._relay,
-            self._live_memo
-        )
-        self._live_token = self.link.send(Call(function), self._live_answered)
-
-    @Slot(float, int)
-    def _live_progress(self, angle_deg: float, io_bits: int) -> None:
-        """While a live check moves the axis (the sensor test run takes tens of seconds), say
-        where the output is and which sensors are on, a few times a second."""
-        now = time.monotonic()
-        if self._live_token is None or now - self._live_shown_s < 0.2:
-            return
-        self._live_shown_s = now
-        on = [name for bit, name in _SENSOR_BITS if io_bits >> bit & 1]
-        sensors = f"; on: {', '.join(on)}" if on else "; no sensor on"
-        self.live_label.setText(
-            f"Running on the drive ({now - self._live_started_s:.0f} s): the output is at "
-            f"{angle_deg:+.1f}°{sensors} …"
-        )
-
-    def _live_answered(self, result: LinkReply[Observation]) -> None:
-        self._live_token = None
-        self.live_button.setEnabled(True)
-        if not result.ok:
-            self.live_label.setText(f"The check could not run: {result.error}")
-            self.sigLiveDone.emit(None)
-            return
-        observation = result.answer
-        self.live_label.setText(observation.detail)
-        if observation.available:
-            self.answer(observation)
-            self.live_label.setText(observation.detail)
-        else:
-            self._ask_by_hand(self.current_step(), observation.detail)
-        self.sigLiveDone.emit(observation)
-
-    @Slot(object)
-    def _on_status(self, status: DriveStatus) -> None:
-        released = status.bit(IoBit.BRAKE_RELEASED)
-        if released is not None and self.sim_brake_check.isVisible():
-            self.sim_brake_check.blockSignals(True)
-            self.sim_brake_check.setChecked(released)
-            self.sim_brake_check.blockSignals(False)
+        self.live_panel.run(step, self.context, self.session.sensor_angles_deg)
 
     def retry(self, note: str = "") -> None:
         if self.run is not None and self.run.stopped:
@@ -685,11 +549,9 @@ class ProceduresPage(BasePage):
         self.report_button.setEnabled(has_session)
         self.capture_button.setEnabled(has_session)
         info = self.link.info
-        self.sim_brake_check.setVisible(
-            bool(info and info.is_simulated and self.context and self.context["flags"].get("brake"))
-        )
+        brake = bool(self.context and self.context["flags"].get("brake"))
+        self.live_panel.reset(brake_switch=bool(info and info.is_simulated and brake))
         self.sign_button.setEnabled(has_session)
-        self.by_hand_box.setVisible(False)
         self.step_box.setEnabled(True)
         if run is None:
             selected = self.procedure_list.currentItem()
