@@ -24,7 +24,7 @@ EXIT_NOT_EXCITABLE = 4
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser("tune", help="frequency response, resonance, load inertia and proposed gains",
-                              description="Tuning of the speed loop (issue 25).")
+                              description="Tuning of the speed loop: response, margins, inertia, gains.")
     sub = p.add_subparsers(dest="tune_command", metavar="ACTION", required=True)
     for name, helptext in (("measure", "excite the speed loop and measure its frequency response"),
                            ("propose", "propose tune items for an aim, with predicted figures")):

@@ -1,5 +1,5 @@
 """Tuning: the speed loop's frequency response, the gear's resonance, the load inertia and
-proposed gains (issue 25). No Qt.
+proposed gains. No Qt.
 
 - ``linear``: the loops of the physics model linearised (python-control, discrete time);
 - ``excitation``: the PRBS's amplitude and the angle it may travel, stated before it starts;
