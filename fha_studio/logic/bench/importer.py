@@ -9,6 +9,9 @@ them at :data:`OUTPUT_RATE_HZ` (or the capture's rate if lower):
 - ``cmd_pos`` [deg]: the command pulses through parameters 1, 2, 3, 4, in the same counts;
 - ``vel`` [r/min, output]: SPD-MON by parameter 9, less its offset at standstill, / ratio, the
   mean over each output interval;
+- ``alm_code``: the alarm code lines ALM-A ... ALM-D (roles ``alm_a`` ... ``alm_d``) as the 4-bit
+  code (D C B A, ON = 1; 13 = 1101, the encoder alarms), the summary naming each code that came,
+  when, and the alarms of the HA-655's table it can be;
 - ``in_pos`` (1 = on), ``alarm`` (1 = on) and ``current`` [A] = probe volts x A per V, the mean
   over each interval, only where a probe measured it.
 
@@ -28,6 +31,7 @@ import numpy as np
 
 from fha_studio.hardware.bench.capture import Capture
 from fha_studio.hardware.bench.readers import read_capture
+from fha_studio.hardware.parameters import load_alarm_table
 from fha_studio.logic.bench import decode
 from fha_studio.logic.bench.edges import Lines
 from fha_studio.recording import Recording, RecordingMetadata, make_recording
@@ -41,8 +45,14 @@ ROLES = (
     "command_b",
     "in_position",
     "alarm",
+    "alm_a",
+    "alm_b",
+    "alm_c",
+    "alm_d",
     "current_probe",
 )
+#: The alarm code lines ALM-A ... ALM-D (ON = 1): bit 0 ... bit 3 of the 4-bit code written D C B A.
+ALM_ROLES = ("alm_a", "alm_b", "alm_c", "alm_d")
 #: The recording's rate, when the capture is faster (the scope's and the model check's 1 kHz).
 OUTPUT_RATE_HZ = 1000.0
 #: (mode, number) of the parameter items the decoding reads, and what each is
@@ -279,7 +289,7 @@ def import_bench(
         current_scale_a_per_v,
         output_rate_hz,
         {role: analog(role) for role in ("current_probe",) if role in roles},
-        {role: lines(role) for role in ("in_position", "alarm") if role in roles},
+        {role: lines(role) for role in ("in_position", "alarm", *ALM_ROLES) if role in roles},
     )
 
 
@@ -379,6 +389,9 @@ def _make(
     if "alarm" in logic:
         columns["alarm"] = logic["alarm"].level_at(idx).astype(np.float64)
         sources["alarm"] = f"{src('alarm')}, high = on"
+    alarm_codes: list[dict[str, Any]] = []
+    if any(role in logic for role in ALM_ROLES):
+        columns["alm_code"], sources["alm_code"], alarm_codes = _alarm_code(logic, idx, columns["t"], src)
     if "current_probe" in analog and current_scale is not None:
         columns["current"] = _window_means(analog["current_probe"], idx, n) * current_scale
         sources["current"] = f"{src('current_probe')}, {current_scale:g} A/V"
@@ -393,7 +406,34 @@ def _make(
     )
     recording = make_recording(metadata, **columns)
     summary = _summary(decoded, roles, channel_of, axis, settings, current_scale, sources, len(idx))
+    if alarm_codes or "alm_code" in columns:
+        summary["alarm_codes"] = alarm_codes
     return BenchImport(recording, summary, decoded, notes)
+
+
+def _alarm_code(logic: Mapping[str, Lines], idx: np.ndarray, t: np.ndarray,
+                src: Callable[[str], str]) -> tuple[np.ndarray, str, list[dict[str, Any]]]:
+    """The 4-bit code of ALM-D C B A at each output sample (a line not mapped counts 0), where it
+    says so, and each code that came: when first, written D C B A, and the alarms it can be
+    (the HA-655's table: 1101 is every encoder alarm, 50 ... 57)."""
+    code = np.zeros(idx.size, np.int64)
+    for bit, role in enumerate(ALM_ROLES):
+        if role in logic:
+            code |= logic[role].level_at(idx).astype(np.int64) << bit
+    mapped = [f"ALM-{'ABCD'[bit]} {src(role)}" for bit, role in enumerate(ALM_ROLES) if role in logic]
+    missing = [f"ALM-{'ABCD'[bit]}" for bit, role in enumerate(ALM_ROLES) if role not in logic]
+    source = "D C B A, ON = 1: " + ", ".join(mapped)
+    if missing:
+        source += f" ({', '.join(missing)} not mapped: 0)"
+    table = load_alarm_table("HA-655")
+    seen: list[dict[str, Any]] = []
+    changes = np.flatnonzero(np.diff(code, prepend=0) != 0)
+    for at in changes:
+        value = int(code[at])
+        if value and all(item["alm_code"] != f"{value:04b}" for item in seen):
+            seen.append({"alm_code": f"{value:04b}", "first_s": float(t[at]),
+                         "alarms": [f"{a.code} {a.name}" for a in table if a.alm_bits == value]})
+    return code.astype(np.float64), source, seen
 
 
 def _summary(
