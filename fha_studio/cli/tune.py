@@ -77,7 +77,7 @@ def run_measure(args: argparse.Namespace) -> int:
         try:
             check_excitable(client)
             tuner = tuner_for(client, parameters, model)
-            result = measure_report(client, tuner, time.sleep, args.amplitude_rpm,
+            result = measure_report(client, tuner, time.sleep, time.monotonic, args.amplitude_rpm,
                                     announce=lambda s: print(s, file=sys.stderr))
         except NotExcitable as exc:
             print(f"fha-studio tune measure: {exc}", file=sys.stderr)

@@ -436,7 +436,8 @@ class DriveClient:
     def set_excitation(self, amplitude_rpm: float, travel_limit_deg: float) -> None:
         """The excitation's amplitude (EXA, output r/min) and the angle it may travel (EXL)."""
         self._require(Command.EXA, Command.EXL)
-        self._transact(Command.EXA, _steps(amplitude_rpm, p.SPEED_STEP_RPM, "excitation amplitude", "r/min"))
+        amplitude = _steps(amplitude_rpm, p.EXCITATION_STEP_RPM, "excitation amplitude", "r/min")
+        self._transact(Command.EXA, amplitude)
         self._transact(Command.EXL, _steps(travel_limit_deg, p.ANGLE_STEP_DEG, "travel limit", "deg"))
 
     def excite(self, hold_periods: int) -> None:

@@ -143,7 +143,8 @@ class MonitorItem(IntEnum):
     IO_STATE = 106  # the I/O bits (protocol.IoBit)
     LOAD_POSITION = 107  # external encoder pulses
     OUTPUT_TORQUE = 108  # 0.01 N m
-    SPEED_COMMAND = 109  # 0.01 r/min, the speed loop's reference
+    SPEED_COMMAND = 109  # 0.0001 r/min, the speed loop's reference
+    OUTPUT_SPEED_FINE = 110  # 0.0001 r/min
 
 
 class ParameterModel:

@@ -379,6 +379,8 @@ MONITOR_MASK_ITEMS = 16
 TRACE_MAX_CHANNELS = 4
 TRACE_MAX_SAMPLES = 4096
 TRACE_BLOCK_SAMPLES = 64
+#: EXA's step (r/min): finer than JOG's, a heavy axis is excited by hundredths of a r/min
+EXCITATION_STEP_RPM = 0.0001
 #: The excitation (EXG): shortest and longest shift register of its PRBS, in bits
 EXCITATION_MIN_BITS = 4
 EXCITATION_MAX_BITS = 12

@@ -16,7 +16,7 @@ from fha_studio.hardware.sim.excitation import SimExcitation, prbs_bits
 from fha_studio.logic.tuning.excitation import RPM, plan_excitation
 from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
 from fha_studio.logic.tuning.propose import AIMS, Tuner
-from fha_studio.logic.tuning.response import estimate_response, find_resonance, inertia_from_plant
+from fha_studio.logic.tuning.response import estimate_response, fit_two_mass
 from fha_studio.physics import AxisModel, Effects, ServoAxis
 
 PARAMETERS = load_parameter_model("HA-655")
@@ -59,7 +59,7 @@ def test_linearisation_matches_the_simulated_loop(code: str, load_ratio: float) 
         axis.step(period, excitation.values(period))
         trace = axis.read_trace()
         closed.append((trace["speed_cmd"], trace["vel"]))
-        plant.append((trace["current"], trace["vel"]))
+        plant.append((trace["current"] * model.torque_constant_nm_per_a, trace["vel"]))
     assert np.abs(trace["current"]).max() <= plan.peak_current_a < model.max_current_a
     assert math.degrees(np.ptp(trace["pos"])) <= 2 * plan.travel_bound_deg
     f_max = plan.f_max_hz
@@ -71,12 +71,12 @@ def test_linearisation_matches_the_simulated_loop(code: str, load_ratio: float) 
         assert np.max(np.abs(measured.magnitude_db - mag)[ok]) <= 1.0
         assert np.max(np.abs((measured.phase_deg - phase + 180.0) % 360.0 - 180.0)[ok]) <= 5.0
     measured_plant = estimate_response(plant, RATE, f_max_hz=f_max)
-    found = find_resonance(measured_plant)
+    found = fit_two_mass(measured_plant, RATE)
+    assert found is not None
     predicted = two_mass_prediction(model)
     assert found.resonance_hz == pytest.approx(predicted.resonance_hz, rel=0.1)
     assert found.antiresonance_hz == pytest.approx(predicted.antiresonance_hz, rel=0.1)
-    inertia = inertia_from_plant(measured_plant, model.torque_constant_nm_per_a, found)
-    assert inertia == pytest.approx(model.total_inertia_kgm2, rel=0.1)
+    assert found.total_inertia_kgm2 == pytest.approx(model.total_inertia_kgm2, rel=0.1)
 
 
 @pytest.mark.slow

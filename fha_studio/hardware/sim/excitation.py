@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from fha_studio.hardware.protocol import excitation_register_bits
+from fha_studio.hardware.protocol import EXCITATION_STEP_RPM, excitation_register_bits
 from fha_studio.hardware.sim.reply import rejected
 
 RPM = 2.0 * math.pi / 60.0
@@ -98,11 +98,11 @@ class SimExcitation:
 
 
 def set_amplitude(drive: Any, value: int) -> None:
-    """EXA: the amplitude in 0.01 r/min (output), up to MAX_AMPLITUDE_SHARE of the maximum speed."""
+    """EXA: the amplitude in 0.0001 r/min (output), up to MAX_AMPLITUDE_SHARE of the maximum speed."""
     top = MAX_AMPLITUDE_SHARE * (drive.model.max_speed_rpm or 0.0)
-    if not 0 < value * 0.01 <= top + 1e-9:
-        raise rejected(f"EXA {value * 0.01:g} r/min outside 0 ... {top:g} r/min")
-    drive.excitation.amplitude_rad_s = value * 0.01 * RPM
+    if not 0 < value * EXCITATION_STEP_RPM <= top + 1e-9:
+        raise rejected(f"EXA {value * EXCITATION_STEP_RPM:g} r/min outside 0 ... {top:g} r/min")
+    drive.excitation.amplitude_rad_s = value * EXCITATION_STEP_RPM * RPM
 
 
 def set_travel_limit(drive: Any, value: int) -> None:

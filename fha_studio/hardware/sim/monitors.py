@@ -60,7 +60,9 @@ def monitor_wire(drive: MonitorSource, item: int) -> int:
         return round(drive.output_torque_nm * 100)
     if item == MonitorItem.SPEED_COMMAND:  # the speed loop's reference (command sense)
         axis = drive.axis
-        return round(axis.speed_command_rad_s / RAD_S_PER_RPM * 100) if axis.servo_is_on else 0
+        return round(axis.speed_command_rad_s / RAD_S_PER_RPM * 10000) if axis.servo_is_on else 0
+    if item == MonitorItem.OUTPUT_SPEED_FINE:
+        return round(drive.output_speed_rpm * 10000)
     if item == 0:  # motor speed, r/min
         return round(drive.output_speed_rpm * drive.ratio)
     if item == 1:  # current, % of the maximum

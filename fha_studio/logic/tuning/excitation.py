@@ -22,7 +22,9 @@ from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
 
 RPM = 2.0 * math.pi / 60.0
 #: the excitation's current stays below this share of the maximum current (linear bound)
-CURRENT_SHARE = 0.5
+CURRENT_SHARE = 0.7
+#: the gear's torque stays below this share of T1 (the end of 1-9-2's first, linear slope)
+GEAR_TORQUE_SHARE = 1.0
 #: at most this share of the maximum speed
 SPEED_SHARE = 0.05
 #: the drive's travel limit is the linear bound times this
@@ -41,6 +43,7 @@ class ExcitationPlan:
     travel_limit_deg: float  # where the drive stops it
     peak_current_a: float  # the linear bound of the current
     f_max_hz: float
+    settle_s: float  # before each record: the slowest closed-loop mode decays (6 time constants)
     duration_s: float
 
     def describe(self) -> str:
@@ -62,7 +65,8 @@ def _l1(sys: object, dt: float, duration_s: float = 2.0) -> float:
 def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> ExcitationPlan:
     """The excitation for ``lm``'s axis: bits held so that the PRBS covers ~5 x the predicted
     resonance (or 2 x the speed loop's reach), the largest amplitude within the current and speed
-    shares (or ``requested_rpm`` when lower; a higher request raises ValueError)."""
+    shares and the gear's torque on its first slope (or ``requested_rpm`` when lower; a higher
+    request raises ValueError)."""
     model = lm.model
     rate = lm.settings.servo_rate_hz
     dt = 1.0 / rate
@@ -75,6 +79,9 @@ def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> Excita
     per_a = _l1(loop[3, 0], dt)
     top_rpm = min(CURRENT_SHARE * model.max_current_a / per_a / RPM,
                   SPEED_SHARE * (model.max_speed_rpm or 60.0))
+    if model.stiffness is not None:  # the gear stays on its first slope (K1, 1-9-2): linear
+        per_nm = _l1(loop[4, 0], dt)
+        top_rpm = min(top_rpm, GEAR_TORQUE_SHARE * model.stiffness.t1_nm / per_nm / RPM)
     amplitude = top_rpm if requested_rpm is None else float(requested_rpm)
     if not 0.0 < amplitude <= top_rpm * (1 + 1e-9):
         raise ValueError(f"excitation amplitude {amplitude:g} r/min: allowed 0 ... {top_rpm:.3g} r/min "
@@ -82,10 +89,13 @@ def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> Excita
                          f"speed within {SPEED_SHARE:.0%} of the maximum)")
     travel = math.degrees(amplitude * RPM * _l1(lm.injection_to_position(), dt))
     period = excitation_period_periods(hold)
-    settle = 1.0
+    poles = np.abs(np.concatenate([control.poles(lm.position_closed_loop()), control.poles(loop)]))
+    slowest = float(np.max(poles[poles > 0])) if np.any(poles > 0) else 0.0
+    tau = -dt / math.log(slowest) if 0.0 < slowest < 1.0 else 0.0
+    settle = min(max(12.0 * tau, 0.3), 30.0)
     return ExcitationPlan(
         amplitude_rpm=amplitude, hold_periods=hold, period_samples=period, records=RECORDS,
         travel_bound_deg=travel, travel_limit_deg=TRAVEL_MARGIN * travel + 0.01,
-        peak_current_a=amplitude * RPM * per_a, f_max_hz=0.4 * rate / hold,
-        duration_s=settle + RECORDS * period * dt,
+        peak_current_a=amplitude * RPM * per_a, f_max_hz=0.4 * rate / hold, settle_s=settle,
+        duration_s=RECORDS * (settle + period * dt),
     )

@@ -78,7 +78,7 @@ class LoopModel:
     def _plant(self) -> Any:
         """Current (A) held over a period -> [motor-side speed at the start of the period, mean
         motor-side speed over the period (position change / dt), speed at its end, the current
-        itself]. States: the
+        itself, the gear's torque at K1]. States: the
         speeds and the twist (positions do not act on the dynamics, so no integrator is hidden)."""
         p = kernel_params(self.model, self.settings)
         if p.compliant:
@@ -100,8 +100,11 @@ class LoopModel:
         start = np.zeros((1, n - 1))
         start[0, 0] = 1.0
         mean = phi[[0], :][:, keep] / p.dt
-        c_out = np.vstack([start, mean, ad[[0], :], np.zeros((1, n - 1))])
-        d_out = np.vstack([[[0.0]], gamma[[0], :] / p.dt, bd[[0], :], [[1.0]]])
+        spring = np.zeros((1, n - 1))
+        if p.compliant:
+            spring[0, 1] = p.k1  # the gear's torque at K1 (for the excitation's bound)
+        c_out = np.vstack([start, mean, ad[[0], :], np.zeros((1, n - 1)), spring])
+        d_out = np.vstack([[[0.0]], gamma[[0], :] / p.dt, bd[[0], :], [[1.0]], [[0.0]]])
         return control.ss(ad, bd, c_out, d_out, p.dt)
 
     def _feedback_selector(self) -> Any:
@@ -112,8 +115,8 @@ class LoopModel:
             alpha = p.speed_filter_alpha
             # v_f[k] = v_f[k-1] + alpha (dx[k-1]/dt - v_f[k-1])
             filt = control.ss(control.tf([alpha], [1.0, -(1.0 - alpha)], p.dt))
-            return filt * control.ss([], [], [], [[0.0, 1.0, 0.0, 0.0]], p.dt)
-        return control.ss([], [], [], [[1.0, 0.0, 0.0, 0.0]], p.dt)
+            return filt * control.ss([], [], [], [[0.0, 1.0, 0.0, 0.0, 0.0]], p.dt)
+        return control.ss([], [], [], [[1.0, 0.0, 0.0, 0.0, 0.0]], p.dt)
 
     def speed_controller(self) -> Any:
         """PI: Kv x (1 + (dt/Tv) z/(z - 1)), speed error (rad/s) -> current (A)."""
@@ -132,8 +135,9 @@ class LoopModel:
         return control.feedback(forward, self._feedback_selector())
 
     def plant(self) -> Any:
-        """Current (A) -> output speed (rad/s) as the trace records it (end of the period)."""
-        return self._plant()[2, 0]
+        """Torque (N m, Kt x the commanded current, as monitor 108 reports it) -> output speed
+        (rad/s) as the trace records it (end of the period)."""
+        return self._plant()[2, 0] * (1.0 / self.model.torque_constant_nm_per_a)
 
     def speed_closed_loop(self) -> Any:
         """Speed command (rad/s) -> output speed (rad/s) as the trace records both."""

@@ -2,10 +2,12 @@
 
 The drive adds its PRBS to the speed command (EXA / EXL / EXG, docs/protocol.md) while the
 position loop holds the axis; the drive-side trace records the speed command (monitor 109), the
-output speed (103), the motor current (104) and the position (100) at the servo rate (TDV 1), one
+output speed (110, fine), the torque (108: Kt x the current, finer steps than the current's mA)
+and the position (100) at the servo rate (TDV 1), one
 PRBS period per capture. The excitation is renewed every ``RENEW_S`` like a held JOG (the drive
-stops it without a renewal after 100 ms), stopped when the read-out holds the link, and always
-stopped at the end (also on an error or a STOP: ``should_stop``).
+stops it without a renewal after 100 ms: during a read-out on a real-time line it does, and the
+next record waits for the loop to settle again), and always stopped at the end (also on an error or
+a STOP: ``should_stop``).
 
 ``wait(seconds)`` is the injected clock: ``time.sleep`` on a drive that runs in real time, the
 drive's own ``advance`` on a stepped simulated drive.
@@ -14,6 +16,7 @@ drive's own ``advance`` on a stepped simulated drive.
 from __future__ import annotations
 
 import contextlib
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -21,16 +24,17 @@ from typing import Any
 import numpy as np
 
 from fha_studio.hardware.parameters import MonitorItem
-from fha_studio.hardware.protocol import Command, TraceState
+from fha_studio.hardware.protocol import JOG_HOLD_S, Command, TraceState
 from fha_studio.logic.tuning.excitation import RPM, ExcitationPlan
 
 #: the channels of each capture
-CHANNELS = (MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.MOTOR_CURRENT,
-            MonitorItem.SPEED_COMMAND)
+CHANNELS = (MonitorItem.FEEDBACK_POSITION, MonitorItem.SPEED_COMMAND, MonitorItem.OUTPUT_SPEED_FINE,
+            MonitorItem.OUTPUT_TORQUE)
 NEEDED = frozenset({Command.EXA, Command.EXL, Command.EXG, Command.TCH, Command.TAR, Command.TST,
                     Command.TRB, Command.IOS, Command.ALM, Command.MON})
 RENEW_S = 0.05
-SETTLE_S = 0.5
+#: the drive's excitation watchdog (as JOG's, protocol.JOG_HOLD_S)
+WATCHDOG_S = JOG_HOLD_S
 
 
 class NotExcitable(Exception):
@@ -43,7 +47,7 @@ class Stopped(Exception):
 
 @dataclass(frozen=True)
 class Records:
-    """The captures in SI: per record (speed command rad/s, speed rad/s, current A, position rad)."""
+    """The captures in SI: per record (speed command rad/s, speed rad/s, torque N m, position rad)."""
 
     records: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]
     sample_rate_hz: float
@@ -75,29 +79,35 @@ def check_excitable(client: Any) -> None:
 
 
 def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, wait: Callable[[float], None],
-            should_stop: Callable[[], bool] = lambda: False) -> Records:
-    """Run ``plan`` on the drive and read the captures (see the module docstring)."""
+            now: Callable[[], float], should_stop: Callable[[], bool] = lambda: False,
+            output_ppr: int = 1) -> Records:
+    """Run ``plan`` on the drive and read the captures (see the module docstring). ``now()`` is
+    the drive's time as ``wait`` moves it: a read-out that took longer than the watchdog stopped
+    the excitation, so the next record waits for the loop to settle again."""
     check_excitable(client)
     channels = client.configure_trace(CHANNELS, divider=1)
     client.set_excitation(plan.amplitude_rpm, plan.travel_limit_deg)
     period_s = plan.period_samples / servo_rate_hz
     records = []
+    renewed: float | None = None
     try:
         for _ in range(plan.records):
             client.excite(plan.hold_periods)
-            _hold(client, plan, SETTLE_S, wait, should_stop)
+            if renewed is None or now() - renewed >= WATCHDOG_S:
+                _hold(client, plan, plan.settle_s, wait, should_stop)
             client.arm_trace(plan.period_samples)
             _hold(client, plan, period_s, wait, should_stop)
             while client.trace_status().state is not TraceState.DONE:
                 _hold(client, plan, RENEW_S, wait, should_stop)
-            client.excite(0)  # the read-out holds the link: no renewals, so stop it cleanly
+            renewed = now()
+            # the read-out holds the link: no renewals (on a real-time line the watchdog stops it)
             capture = client.read_trace(should_abort=should_stop)
             cols = {item: np.asarray(capture.column(item), float) for item in channels}
             records.append((
-                cols[MonitorItem.SPEED_COMMAND] * 0.01 * RPM,
-                cols[MonitorItem.OUTPUT_SPEED] * 0.01 * RPM,
-                cols[MonitorItem.MOTOR_CURRENT] * 0.001,
-                cols[MonitorItem.FEEDBACK_POSITION],
+                cols[MonitorItem.SPEED_COMMAND] * 1e-4 * RPM,
+                cols[MonitorItem.OUTPUT_SPEED_FINE] * 1e-4 * RPM,
+                cols[MonitorItem.OUTPUT_TORQUE] * 0.01,
+                cols[MonitorItem.FEEDBACK_POSITION] * (2.0 * math.pi / output_ppr),
             ))
     finally:
         # the link may be gone: the drive's watchdog then stops it within 100 ms

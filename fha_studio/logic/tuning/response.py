@@ -7,8 +7,10 @@
 - ``find_resonance``: on the plant (current -> speed) normalised by the rigid body's 1/s slope,
   the anti-resonance is the dip and the resonance the peak above it (parabolic interpolation
   between the bins).
-- ``inertia_from_plant``: the low-frequency plant gain Kt / (J s), corrected for the two-mass
-  shape when a resonance was found; ``inertia_from_move``: least squares of torque against
+- ``fit_two_mass``: the plant (torque -> speed) fitted with the two-mass shape
+  1/(J s) x (1 + 2 za s/wa + s^2/wa^2)/(1 + 2 zr s/wr + s^2/wr^2): the total inertia from the
+  low-frequency gain 1/(J s) and the resonance and anti-resonance between the bins;
+  ``inertia_from_move``: least squares of torque against
   acceleration (with Coulomb and viscous friction) over a move, as the HA-800A estimates it.
 - ``loop_figures``: gain margin, phase margin, crossover, -3 dB bandwidth (python-control).
 """
@@ -22,7 +24,7 @@ from typing import Any
 
 import control
 import numpy as np
-from scipy import signal
+from scipy import optimize, signal
 
 TWO_PI = 2.0 * math.pi
 #: bins of at least this coherence are trusted
@@ -120,26 +122,59 @@ def find_resonance(plant: FrequencyResponse, min_depth_db: float = 3.0) -> Reson
     return Resonance(_interpolated(f, norm, i_peak), _interpolated(f, norm, i_dip))
 
 
-def inertia_from_plant(plant: FrequencyResponse, torque_constant_nm_per_a: float,
-                       resonance: Resonance) -> float | None:
-    """Total inertia (kg m^2, output side) from the plant gain Kt / (J w) at low frequency; with
-    a resonance found the two-mass shape (1 - (f/fa)^2) / (1 - (f/fr)^2) is taken out, so bins up
-    to half the anti-resonance count."""
+@dataclass(frozen=True)
+class TwoMassFit:
+    """The plant (torque -> speed) fitted with 1/(J s) x (anti-resonance pair)/(resonance pair):
+    the total inertia J (kg m^2) and the two frequencies (Hz; None for a rigid-looking axis)."""
+
+    total_inertia_kgm2: float
+    resonance_hz: float | None
+    antiresonance_hz: float | None
+
+
+def _rigid_factor(w: np.ndarray, dt: float) -> np.ndarray:
+    # the trace's speed at the end of a period of held torque: a sampled integrator's shape
+    x = w * dt / 2.0
+    return np.asarray(np.where(x > 0, x / np.sin(x), 1.0) * np.exp(1j * x))
+
+
+def fit_two_mass(plant: FrequencyResponse, sample_rate_hz: float) -> TwoMassFit | None:
+    """Least squares (scipy.optimize) of the two-mass shape to the trusted bins of ``plant``
+    (torque -> speed), started from the dip and peak ``find_resonance`` finds; a rigid body's
+    1/(J s) when there is no dip. None without trusted bins."""
     ok = plant.trusted()
     f = plant.freq_hz[ok]
-    mag = 10.0 ** (plant.magnitude_db[ok] / 20.0)
-    if resonance.antiresonance_hz is not None:
-        fa = resonance.antiresonance_hz
-        fr = resonance.resonance_hz if resonance.resonance_hz is not None else math.inf
-        use = f <= 0.5 * fa
-        shape = np.abs((1.0 - (f / fa) ** 2) / (1.0 - (f / fr) ** 2))
-    else:
-        use = f <= max(float(f[0]) * 10.0, 20.0) if len(f) else np.zeros(0, bool)
-        shape = np.ones_like(f)
-    if not np.any(use):
+    if len(f) < 3:
         return None
-    estimates = torque_constant_nm_per_a * shape[use] / (TWO_PI * f[use] * mag[use])
-    return float(np.median(estimates))
+    h = plant.complex[ok]
+    w = TWO_PI * f
+    dt = 1.0 / sample_rate_hz
+    rigid = _rigid_factor(w, dt) / (1j * w)
+    guess = find_resonance(plant)
+    j0 = float(np.median(np.abs(rigid[: max(3, len(f) // 10)]) / np.abs(h[: max(3, len(f) // 10)])))
+    if guess.antiresonance_hz is None or guess.resonance_hz is None:
+        use = f <= 0.1 * sample_rate_hz
+        j = float(np.median(np.abs(rigid[use]) / np.abs(h[use]))) if np.any(use) else j0
+        return TwoMassFit(j, None, None)
+    wa0, wr0 = TWO_PI * guess.antiresonance_hz, TWO_PI * guess.resonance_hz
+    use = f <= 3.0 * guess.resonance_hz
+    wu, hu, ru = w[use], h[use], rigid[use]
+
+    def model(x: np.ndarray) -> np.ndarray:
+        j, wa, wr, za, zr = math.exp(x[0]), math.exp(x[1]), math.exp(x[2]), x[3], x[4]
+        num = 1.0 - (wu / wa) ** 2 + 2j * za * wu / wa
+        den = 1.0 - (wu / wr) ** 2 + 2j * zr * wu / wr
+        return np.asarray(ru / j * num / den)
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        r = np.log(hu / model(x))
+        return np.concatenate([r.real, r.imag])
+
+    x0 = np.array([math.log(j0), math.log(wa0), math.log(wr0), 0.05, 0.05])
+    fit = optimize.least_squares(residual, x0, bounds=([-np.inf, -np.inf, -np.inf, 0.0, 0.0],
+                                                       [np.inf, np.inf, np.inf, 1.0, 1.0]))
+    j, wa, wr = (math.exp(v) for v in fit.x[:3])
+    return TwoMassFit(j, wr / TWO_PI, wa / TWO_PI)
 
 
 def inertia_from_move(t_s: np.ndarray, speed_rad_s: np.ndarray, torque_nm: np.ndarray) -> float:

@@ -13,8 +13,7 @@ from fha_studio.logic.tuning.measure import measure
 from fha_studio.logic.tuning.propose import TUNE_KEYS, Tuner
 from fha_studio.logic.tuning.response import (
     estimate_response,
-    find_resonance,
-    inertia_from_plant,
+    fit_two_mass,
     loop_figures,
 )
 from fha_studio.physics import AxisModel, Effects
@@ -43,27 +42,27 @@ def tuner_for(client: Any, parameters: ParameterModel, model: AxisModel,
     return Tuner(model, items, parameters, DEFAULT_SERVO_RATE_HZ, quantised_feedback)
 
 
-def measure_report(client: Any, tuner: Tuner, wait: Callable[[float], None],
+def measure_report(client: Any, tuner: Tuner, wait: Callable[[float], None], now: Callable[[], float],
                    amplitude_rpm: float | None = None, announce: Callable[[str], None] = lambda _s: None,
                    should_stop: Callable[[], bool] = lambda: False) -> dict[str, Any]:
     """Excite, measure and analyse; the JSON of ``tune measure``."""
     lm: LoopModel = tuner.loop({})
     plan = plan_excitation(lm, amplitude_rpm)
     announce(plan.describe())
-    records = measure(client, plan, tuner.servo_rate_hz, wait, should_stop)
+    records = measure(client, plan, tuner.servo_rate_hz, wait, now, should_stop,
+                      output_ppr=tuner.model.output_resolution_ppr)
     closed = estimate_response(records.closed_loop(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
     plant = estimate_response(records.plant(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
-    found = find_resonance(plant)
-    inertia = inertia_from_plant(plant, tuner.model.torque_constant_nm_per_a, found)
+    fit = fit_two_mass(plant, records.sample_rate_hz)
     figures = loop_figures(lm.speed_open_loop(), lm.speed_closed_loop(), 0.49 * tuner.servo_rate_hz)
     predicted = two_mass_prediction(tuner.model)
     own = tuner.model.actuator_inertia_kgm2
     return {
-        "resonance_hz": found.resonance_hz,
-        "antiresonance_hz": found.antiresonance_hz,
+        "resonance_hz": fit.resonance_hz if fit else None,
+        "antiresonance_hz": fit.antiresonance_hz if fit else None,
         "predicted_resonance_hz": predicted.resonance_hz,
         "predicted_antiresonance_hz": predicted.antiresonance_hz,
-        "load_inertia_estimate_kgm2": None if inertia is None else inertia - own,
+        "load_inertia_estimate_kgm2": None if fit is None else fit.total_inertia_kgm2 - own,
         "gain_margin_db": figures.gain_margin_db,
         "phase_margin_deg": figures.phase_margin_deg,
         "crossover_hz": figures.crossover_hz,
