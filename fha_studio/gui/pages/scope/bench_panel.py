@@ -30,6 +30,7 @@ from fha_studio.logic.bench.display import peak_rows
 from fha_studio.logic.bench.importer import DriveSettings
 from fha_studio.logic.bench.move import BenchMoveFigures, bench_move_figures
 
+from . import bench_mappings
 from .bench_source import BenchSettings, BenchSource, BenchStarted
 
 #: Seconds of the newest rows on show.
@@ -78,6 +79,7 @@ class BenchPanel(QWidget):
         self.device_box.setEditable(True)  # a driver with options may be typed: demo:analog_channels=2
         self.device_box.setToolTip("the sigrok driver (and its options) of the instrument")
         grid.addWidget(self.device_box, 0, 1, 1, 2)
+        self.device_box.currentTextChanged.connect(self._offer_mapping)
         self.scan_button = QPushButton("Find")
         self.scan_button.setToolTip("list the instruments sigrok-cli finds")
         self.scan_button.clicked.connect(self.scan)
@@ -165,10 +167,10 @@ class BenchPanel(QWidget):
     def start(self, device: str, channels: str, rate: str = "", encoder: str = "", command: str = "",
               in_position: str = "") -> None:
         """Stream (what the Start button does with the fields' text)."""
+        self.device_box.setEditText(device)  # first: a mapping it offers is then replaced
         self.encoder_edit.setText(encoder)
         self.command_edit.setText(command)
         self.in_position_edit.setText(in_position)
-        self.device_box.setEditText(device)
         self.channels_edit.setText(channels)
         self.rate_edit.setText(rate)
         self.start_button.setChecked(True)
@@ -237,7 +239,26 @@ class BenchPanel(QWidget):
                                       else "sigrok-cli finds no instrument (is it plugged in?)")
         self.sigDevicesListed.emit(len(devices))
 
+    def _fields(self) -> dict[str, str]:
+        return {"channels": self.channels_edit.text(), "rate": self.rate_edit.text(),
+                "encoder": self.encoder_edit.text(), "command": self.command_edit.text(),
+                "in_position": self.in_position_edit.text()}
+
+    def _offer_mapping(self, text: str) -> None:
+        """The channels and roles last used with this instrument, if it was used before."""
+        spec = text.split(" ", 1)[0].strip()
+        fields = bench_mappings.saved(spec)
+        if fields is None or self.source.running:
+            return
+        self.channels_edit.setText(fields["channels"])
+        self.rate_edit.setText(fields["rate"])
+        self.encoder_edit.setText(fields["encoder"])
+        self.command_edit.setText(fields["command"])
+        self.in_position_edit.setText(fields["in_position"])
+        self.status_label.setText(f"Channels and roles as last used with {spec}.")
+
     def _on_started(self, started: BenchStarted) -> None:
+        bench_mappings.save(started.device, self._fields())
         self._started = started
         self.plot.clear()
         self._curves = []
