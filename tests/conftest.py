@@ -13,8 +13,9 @@ import pytest
 from fha_studio import clock
 from tests.support.clock import FakeClock
 
-#: Fixtures every test may take (a client on a scripted drive: pipes, scripted, client_for).
-pytest_plugins = ["tests.support.links"]
+#: Fixtures every test may take: a client on a scripted drive (pipes, scripted, client_for) and
+#: programs in processes of their own (children).
+pytest_plugins = ["tests.support.links", "tests.support.processes"]
 
 # GUI tests run headless; the environment can override (e.g. xcb under xvfb-run).
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")

@@ -17,6 +17,7 @@ from fha_studio.recording import (
     write_recording,
 )
 from tests.support.clock import FakeClock
+from tests.support.processes import Child
 
 GOOD = """\
 # format: fha-recording/1
@@ -215,10 +216,6 @@ def test_rows_reach_the_disk_on_time_when_appends_stop(tmp_path):
 
 def test_a_killed_recording_keeps_its_rows_in_the_partial_file(tmp_path):
     """The process is killed 5 s after its last append: the 7 rows are on the disk, readable."""
-    import signal
-    import subprocess
-    import sys
-
     path = tmp_path / "killed.csv"
     script = (
         "import sys, time\n"
@@ -229,14 +226,10 @@ def test_a_killed_recording_keeps_its_rows_in_the_partial_file(tmp_path):
         "print('appended', flush=True)\n"
         "time.sleep(60)\n"
     )
-    proc = subprocess.Popen([sys.executable, "-c", script, str(path)], stdout=subprocess.PIPE, text=True)
-    try:
-        assert proc.stdout.readline().strip() == "appended"
+    with Child.python("-c", script, path, text=True) as proc:
+        assert proc.first_line("the recording writer") == "appended"
         rec.time.sleep(5.0)
-    finally:
-        proc.send_signal(signal.SIGKILL)
-        proc.wait(timeout=30)
-        proc.stdout.close()
+        proc.kill()
     assert not path.exists()  # never renamed: it does not look complete
     on_disk = read_recording(tmp_path / "killed.csv.partial")
     assert len(on_disk) == 7

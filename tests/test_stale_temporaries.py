@@ -19,6 +19,7 @@ import pytest
 from fha_studio import clock, fileio, temporaries
 from fha_studio.main import main
 from tests.support.clock import FakeClock
+from tests.support.processes import Child
 
 
 def _left_over(folder, name, age_s, middle="abcd1234"):
@@ -90,23 +91,11 @@ def writer_in_the_middle(tmp_path):
         for n in range(2000):
             reg.add_machine(f"cell {n}")
     out = tmp_path / "export.json"
-    proc = subprocess.Popen(
-        [sys.executable, "-c", KILLED_WRITER, "register", "--register", str(register), "export",
-         "-o", str(out)], cwd=ROOT, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    try:
-        assert proc.stdout is not None
-        line = proc.stdout.readline()
-        assert line == b"writing\n", (line, proc.stderr.read() if proc.poll() is not None else "")
+    with Child.python("-c", KILLED_WRITER, "register", "--register", register, "export", "-o", out) as proc:
+        assert proc.first_line("register export") == "writing"
         (tmp,) = tmp_path.glob(".export.json.*.tmp")
         assert tmp.stat().st_size > 0 and not out.exists()
         yield proc, out, tmp
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-        proc.wait(30)
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
 
 
 def _notes():
@@ -128,8 +117,7 @@ def test_a_start_removes_what_a_killed_write_left_and_its_note(writer_in_the_mid
     _age(tmp, 3600)
     _start_fresh()
     assert tmp.exists() and note.exists()
-    proc.send_signal(signal.SIGKILL)
-    proc.wait(30)
+    proc.kill()
     # a start within the minute after the kill leaves it (a write may have touched it just now) ...
     os.utime(tmp)
     _start_fresh()

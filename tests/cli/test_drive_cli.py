@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import select
 import socket
 import subprocess
 import sys
@@ -21,6 +20,7 @@ import pytest
 
 from fha_studio.cli import drive as drive_cli
 from fha_studio.main import main as entry
+from tests.support.processes import Child
 
 pytestmark = pytest.mark.e2e
 
@@ -31,42 +31,17 @@ ACTUATOR = "FHA-25C-50-S248"  # ratio 50, absolute encoder
 POSITION = 3 * 8192 + 1234
 
 
-class Line:
-    def __init__(self, *args: str):
-        self.proc = subprocess.Popen([sys.executable, str(SERVER), *args], cwd=ROOT, env=ENV,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-        assert self.proc.stdout is not None
-        ready, _, _ = select.select([self.proc.stdout], [], [], 30.0)
-        if not ready:
-            self.close()
-            pytest.fail("the line server printed no pty path within 30 s")
-        self.path = self.proc.stdout.readline().decode().strip()
-        assert self.path.startswith("/dev/"), self.path
-
-    def close(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(5)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(5)
-        for stream in (self.proc.stdout, self.proc.stderr):
-            if stream is not None:
-                stream.close()
-
-
 @pytest.fixture
-def line(request):
-    lines: list[Line] = []
+def line(children):
+    """Factory: line(MODE, *options) -> line_server.py in its own process, its pty at ``address``
+    (stopped after the test)."""
 
-    def start(*args: str) -> Line:
-        lines.append(Line(*args))
-        return lines[-1]
+    def start(*args: str) -> Child:
+        server = children(Child.python, SERVER, *args)
+        server.address = server.first_line("the line server", expect="/dev/")
+        return server
 
-    yield start
-    for one in lines:
-        one.close()
+    return start
 
 
 def fha(*args: str, timeout: float = 30.0) -> tuple[int, str, str, float]:
@@ -84,7 +59,7 @@ def one_line(err: str) -> str:
 
 def test_probe_documented_only_drive_servo_off(line):
     server = line("documented")
-    code, out, err, _ = fha("drive", "probe", "--url", server.path, "--actuator", ACTUATOR, "--json")
+    code, out, err, _ = fha("drive", "probe", "--url", server.address, "--actuator", ACTUATOR, "--json")
     assert code == 0, err
     data = json.loads(out)
     assert list(data) == ["link", "driver", "parameter_access", "documented_only", "servo", "encoder",
@@ -98,11 +73,11 @@ def test_probe_documented_only_drive_servo_off(line):
 
 def test_probe_without_actuator_has_no_angle_and_reads_as_text(line):
     server = line("documented")
-    code, out, err, _ = fha("drive", "probe", "--url", server.path, "--json")
+    code, out, err, _ = fha("drive", "probe", "--url", server.address, "--json")
     assert code == 0, err
     data = json.loads(out)
     assert data["position_counts"] == POSITION and data["position_deg"] is None
-    code, out, _, _ = fha("drive", "probe", "--url", server.path)
+    code, out, _, _ = fha("drive", "probe", "--url", server.address)
     assert code == 0
     assert "only the manual's DGR and OWW" in out and "front panel" in out
     assert f"{POSITION} counts (multi-turn 3, single-turn 1234)" in out
@@ -110,14 +85,14 @@ def test_probe_without_actuator_has_no_angle_and_reads_as_text(line):
 
 def test_probe_servo_on_and_incremental(line):
     on = line("documented", "--servo-on")
-    code, out, err, _ = fha("drive", "probe", "--url", on.path, "--actuator", ACTUATOR, "--json")
+    code, out, err, _ = fha("drive", "probe", "--url", on.address, "--actuator", ACTUATOR, "--json")
     assert code == 0, err
     data = json.loads(out)
     assert (data["servo"], data["encoder"], data["position_counts"], data["position_deg"]) == (
         "on", "unknown", None, None)
     assert data["documented_only"] is True and data["parameter_access"] is False
     inc = line("documented", "--incremental")
-    code, out, err, _ = fha("drive", "probe", "--url", inc.path, "--json")
+    code, out, err, _ = fha("drive", "probe", "--url", inc.address, "--json")
     assert code == 0, err
     data = json.loads(out)
     assert (data["servo"], data["encoder"], data["position_counts"]) == ("off", "incremental", None)
@@ -135,7 +110,7 @@ def taken_s(err: str) -> float:
 @pytest.mark.parametrize("mode", ["silent", "flood", "slow", "garbage"])
 def test_probe_exits_3_within_5_s_whatever_the_line_does(line, mode, time_ceiling):
     server = line(mode)
-    code, out, err, elapsed = fha("drive", "probe", "--url", server.path, "--json")
+    code, out, err, elapsed = fha("drive", "probe", "--url", server.address, "--json")
     assert code == 3, (out, err)
     assert out == ""
     one_line(err)
@@ -202,30 +177,30 @@ def test_probe_on_a_missing_port_is_exit_3(tmp_path, time_ceiling):
 
 def test_position_servo_off_servo_on_incremental(line):
     server = line("documented")
-    code, out, err, _ = fha("drive", "position", "--url", server.path, "--actuator", ACTUATOR, "--json")
+    code, out, err, _ = fha("drive", "position", "--url", server.address, "--actuator", ACTUATOR, "--json")
     assert code == 0, err
     assert json.loads(out) == {"position_counts": POSITION,
                                "position_deg": pytest.approx(POSITION * 360 / (8192 * 50))}
     on = line("documented", "--servo-on")
-    code, out, err, _ = fha("drive", "position", "--url", on.path, "--actuator", ACTUATOR)
+    code, out, err, _ = fha("drive", "position", "--url", on.address, "--actuator", ACTUATOR)
     assert code == 4 and out == ""
     assert "servo on (controller)" in one_line(err)
     inc = line("documented", "--incremental")
-    code, out, err, _ = fha("drive", "position", "--url", inc.path, "--actuator", ACTUATOR)
+    code, out, err, _ = fha("drive", "position", "--url", inc.address, "--actuator", ACTUATOR)
     assert code == 4 and "incremental" in one_line(err)
 
 
 def test_position_needs_an_actuator_and_a_valid_code(line):
     server = line("documented")
-    code, _, err, _ = fha("drive", "position", "--url", server.path)
+    code, _, err, _ = fha("drive", "position", "--url", server.address)
     assert code == 2 and "--actuator" in err
-    code, _, err, _ = fha("drive", "position", "--url", server.path, "--actuator", "FHA-99C-50-S248")
+    code, _, err, _ = fha("drive", "position", "--url", server.address, "--actuator", "FHA-99C-50-S248")
     assert code == 2 and "--actuator FHA-99C-50-S248" in one_line(err)
 
 
 def test_origin_clears_the_multi_turn_data_and_reads_back(line):
     server = line("documented", "--oww-s", "1.0")
-    code, out, err, elapsed = fha("drive", "origin", "--url", server.path, "--actuator", ACTUATOR,
+    code, out, err, elapsed = fha("drive", "origin", "--url", server.address, "--actuator", ACTUATOR,
                                   "--yes", "--json")
     assert code == 0, err
     data = json.loads(out)
@@ -234,28 +209,28 @@ def test_origin_clears_the_multi_turn_data_and_reads_back(line):
     assert data["position_deg"] == pytest.approx(1234 * 360 / (8192 * 50))
     assert data["oww_s"] >= 0.9 and elapsed >= 1.0
     # the drive now says turn 0
-    code, out, _, _ = fha("drive", "position", "--url", server.path, "--actuator", ACTUATOR, "--json")
+    code, out, _, _ = fha("drive", "position", "--url", server.address, "--actuator", ACTUATOR, "--json")
     assert json.loads(out)["position_counts"] == 1234
 
 
 def test_origin_with_a_5_s_acknowledgement_as_the_manual_says(line):
     server = line("documented", "--oww-s", "5.0")
-    code, out, err, _ = fha("drive", "origin", "--url", server.path, "--actuator", ACTUATOR, "--yes")
+    code, out, err, _ = fha("drive", "origin", "--url", server.address, "--actuator", ACTUATOR, "--yes")
     assert code == 0, err
     assert "position read back: 1234 counts (multi-turn 0, single-turn 1234)" in out
 
 
 def test_origin_refuses_servo_on_and_incremental_and_asks_without_yes(line):
     on = line("documented", "--servo-on")
-    code, out, err, _ = fha("drive", "origin", "--url", on.path, "--actuator", ACTUATOR, "--yes")
+    code, out, err, _ = fha("drive", "origin", "--url", on.address, "--actuator", ACTUATOR, "--yes")
     assert code == 4 and "servo on" in one_line(err) and out == ""
     inc = line("documented", "--incremental")
-    code, out, err, _ = fha("drive", "origin", "--url", inc.path, "--actuator", ACTUATOR, "--yes")
+    code, out, err, _ = fha("drive", "origin", "--url", inc.address, "--actuator", ACTUATOR, "--yes")
     assert code == 4 and "incremental" in one_line(err)
     server = line("documented")
-    code, _, err, _ = fha("drive", "origin", "--url", server.path, "--actuator", ACTUATOR)
+    code, _, err, _ = fha("drive", "origin", "--url", server.address, "--actuator", ACTUATOR)
     assert code == 2 and "--yes" in one_line(err)
-    code, out, _, _ = fha("drive", "position", "--url", server.path, "--actuator", ACTUATOR, "--json")
+    code, out, _, _ = fha("drive", "position", "--url", server.address, "--actuator", ACTUATOR, "--json")
     assert json.loads(out)["position_counts"] == POSITION  # nothing was cleared
 
 
@@ -264,7 +239,7 @@ def test_origin_refuses_servo_on_and_incremental_and_asks_without_yes(line):
 def test_params_on_a_documented_only_drive_say_front_panel(line, action, tmp_path):
     server = line("documented")
     args = [a.replace("x.toml", str(tmp_path / "x.toml")) for a in action]
-    code, out, err, _ = fha("drive", "params", args[0], "--url", server.path, *args[1:])
+    code, out, err, _ = fha("drive", "params", args[0], "--url", server.address, *args[1:])
     assert code == 4 and out == ""
     assert "front panel" in one_line(err)
     assert not (tmp_path / "x.toml").exists()

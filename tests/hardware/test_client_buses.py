@@ -16,14 +16,9 @@ machine lets the drive's 100 ms watchdog stop the axis, and the next JOG starts 
 
 from __future__ import annotations
 
-import os
 import re
-import select
-import subprocess
-import sys
 import time
 from collections.abc import Callable, Iterator
-from pathlib import Path
 
 import pytest
 
@@ -41,42 +36,14 @@ from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import Mode, MonitorItem
 from fha_studio.hardware.protocol import Command, rejected_text, servo_on_text
 from tests.gui.fake_drive import SIMULATED_COMMANDS, FakeDriveClient
+from tests.support.processes import Child
 
-ROOT = Path(__file__).resolve().parents[2]
 #: An absolute-encoder actuator, so that DGR answers a position.
 ACTUATOR = "FHA-25C-50-S248"
 #: Only a hang takes this long: the output reaches the jog speed within some 0.1 s.
 HELD_JOG_LIMIT_S = 15.0
 E2E = pytest.mark.e2e
 BUSES = ["sim", pytest.param("tcp", marks=E2E), pytest.param("pty", marks=E2E), "fake"]
-
-
-def _start(tmp: Path, where: str) -> tuple[subprocess.Popen[bytes], str]:
-    """``fha-studio sim`` in its own process; returns it and the address it printed (within 30 s)."""
-    cmd = [sys.executable, "-m", "fha_studio", "sim", *where.split(), "--unpaced",
-           "--actuator", ACTUATOR, "--eeprom", str(tmp / "eeprom.json")]
-    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            env={**os.environ, "PYTHONPATH": str(ROOT)})
-    assert proc.stdout is not None
-    ready, _, _ = select.select([proc.stdout], [], [], 30.0)
-    address = proc.stdout.readline().decode().strip() if ready else ""
-    if not address:
-        _stop(proc)
-        pytest.fail(f"fha-studio sim {where} printed no address within 30 s")
-    return proc, address
-
-
-def _stop(proc: subprocess.Popen[bytes]) -> None:
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(10)
-    for stream in (proc.stdout, proc.stderr):
-        if stream is not None:
-            stream.close()
 
 
 @pytest.fixture(scope="module", params=BUSES)
@@ -89,10 +56,10 @@ def bus(request, tmp_path_factory) -> Iterator[str]:
     if request.param == "sim":
         yield f"sim://{ACTUATOR}?paced=0&eeprom={tmp / 'eeprom.json'}"
         return
-    proc, address = _start(tmp, "--tcp 0" if request.param == "tcp" else "--pty")
-    yield address
-    _stop(proc)
-    assert proc.returncode == 0, "SIGTERM ends the simulated drive cleanly"
+    where = ("--tcp", "0") if request.param == "tcp" else ("--pty",)
+    with Child.sim(tmp / "eeprom.json", *where, "--actuator", ACTUATOR) as process:
+        yield process.address
+    assert process.returncode == 0, "SIGTERM ends the simulated drive cleanly"
 
 
 @pytest.fixture

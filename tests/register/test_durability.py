@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import signal
 import sqlite3
-import subprocess
-import sys
 import textwrap
 
 import pytest
@@ -15,6 +13,7 @@ import pytest
 from fha_studio.logic.register import Register, RegisterError
 from fha_studio.logic.register import store as register_store
 from fha_studio.logic.register.schema import MIGRATIONS
+from tests.support.processes import Child
 
 
 def _write_v1_register(path):
@@ -107,32 +106,19 @@ _WRITER = textwrap.dedent(
 )
 
 
-def _start_writer(path, axis, tag, count):
-    return subprocess.Popen(
-        [sys.executable, "-c", _WRITER, str(path), axis, tag, str(count)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+def _writer(path, axis, tag, count) -> Child:
+    return Child.python("-c", _WRITER, path, axis, tag, str(count), text=True)
 
 
-def test_a_process_killed_mid_write_loses_nothing_committed(tmp_path):
+def test_a_process_killed_mid_write_loses_nothing_committed(tmp_path, children):
     path = tmp_path / "crash.sqlite"
-    writer = _start_writer(path, "rotary", "writer", -1)
+    writer = children(_writer, path, "rotary", "writer", -1)
     committed = []
-    try:
-        while len(committed) < 40:
-            line = writer.stdout.readline()
-            assert line, f"the writer ended early: {writer.stderr.read()}"
-            committed.append(int(line))
-        writer.send_signal(signal.SIGKILL)  # while it is in the middle of its next snapshot
-        writer.wait(timeout=30)
-    finally:
-        if writer.poll() is None:
-            writer.kill()
-            writer.wait(timeout=30)
-        writer.stdout.close()
-        writer.stderr.close()
+    while len(committed) < 40:
+        line = writer.stdout.readline()
+        assert line, f"the writer ended early: {writer.stderr.read()}"
+        committed.append(int(line))
+    writer.kill()  # while it is in the middle of its next snapshot
     assert writer.returncode == -signal.SIGKILL
     assert (tmp_path / "crash.sqlite-wal").exists()  # the log the next opener recovers from
     with Register(path) as reg:
@@ -144,13 +130,13 @@ def test_a_process_killed_mid_write_loses_nothing_committed(tmp_path):
         assert len(writes) >= len(committed)
 
 
-def test_two_processes_writing_one_register_do_not_corrupt_it(tmp_path):
+def test_two_processes_writing_one_register_do_not_corrupt_it(tmp_path, children):
     path = tmp_path / "shared.sqlite"
     # both add the same machine and the axis "shared" at the start: one of each results
-    writers = [_start_writer(path, "shared", tag, 60) for tag in ("window A", "window B")]
+    writers = [children(_writer, path, "shared", tag, 60) for tag in ("window A", "window B")]
     outputs = []
     for writer in writers:
-        out, err = writer.communicate(timeout=240)
+        out, err = writer.communicate(240)
         assert writer.returncode == 0, err
         outputs.append([int(n) for n in out.split()])
     assert all(len(numbers) == 60 for numbers in outputs)

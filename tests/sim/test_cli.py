@@ -2,20 +2,14 @@
 
 from __future__ import annotations
 
-import os
-import select
-import subprocess
-import sys
 import time
-from pathlib import Path
 
 import pytest
 import serial
 
 from fha_studio.cli import main as cli_main
 from fha_studio.recording import read_recording
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.support.processes import Child
 
 
 def test_bad_actuator_is_one_line_and_exit_2(capsys, tmp_path):
@@ -43,26 +37,15 @@ def test_corrupt_eeprom_is_named(capsys, tmp_path):
 @pytest.mark.e2e
 def test_serves_tcp_and_records(tmp_path):
     record = tmp_path / "run.csv"
-    cmd = [sys.executable, "-m", "fha_studio", "sim", "--tcp", "0", "--unpaced", "--actuator",
-           "FHA-17C-50-US250", "--eeprom", str(tmp_path / "e.json"), "--record", str(record)]
-    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            env={**os.environ, "PYTHONPATH": str(ROOT)})
-    try:
-        ready, _, _ = select.select([proc.stdout], [], [], 30.0)
-        assert ready, "no address printed"
-        address = proc.stdout.readline().decode().strip()
-        assert address.startswith("socket://127.0.0.1:")
-        with serial.serial_for_url(address, timeout=2.0) as port:
+    with Child.sim(tmp_path / "e.json", "--tcp", "0", "--actuator", "FHA-17C-50-US250",
+                   "--record", str(record)) as sim:
+        assert sim.address.startswith("socket://127.0.0.1:")
+        with serial.serial_for_url(sim.address, timeout=2.0) as port:
             port.write(b"IDN+00000\r")
             assert port.read_until(b"q\r").startswith(b"HA-655-2-200\rFHA-17C-50-US250\r")
             port.write(b"SVO+00001\rJOG+01000\r")
             assert port.read(4) == b"q\rq\r"
-    finally:
-        proc.terminate()
-        proc.wait(10)
-        proc.stdout.close()
-        proc.stderr.close()
-    assert proc.returncode == 0
+    assert sim.returncode == 0
     recording = read_recording(record)
     assert recording.metadata.actuator == "FHA-17C-50-US250"
     assert len(recording) > 10 and recording.metadata.sample_rate_hz == 1000
@@ -76,32 +59,19 @@ def test_a_sim_in_another_process_offers_packed_trace_blocks_unless_told_not_to(
     from fha_studio.hardware import protocol as p
     from fha_studio.hardware.client import DriveClient
 
-    cmd = [sys.executable, "-m", "fha_studio", "sim", "--tcp", "0", "--unpaced", "--eeprom",
-           str(tmp_path / "e.json"), *flags]
-    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            env={**os.environ, "PYTHONPATH": str(ROOT)})
-    try:
-        ready, _, _ = select.select([proc.stdout], [], [], 30.0)
-        assert ready, "no address printed"
-        address = proc.stdout.readline().decode().strip()
-        with DriveClient.open(address) as client:
-            assert client.trace_encoding == encoding
-            assert ("TRP" in {c.value for c in client.capabilities.commands}) == (encoding == "packed")
-            client.servo(True)
-            client.jog(20.0)
-            client.configure_trace([100, 103], divider=5)
-            client.arm_trace(200)
-            deadline = time.monotonic() + 20
-            while client.trace_status().state is not p.TraceState.DONE:
-                assert time.monotonic() < deadline, "the capture did not finish"
-                client.jog(20.0)  # held: JOG again on every look at the capture
-            seen = []
-            capture = client.read_trace(progress=lambda done, total: seen.append((done, total)))
-        assert len(capture.samples) == 200 and seen[0] == (0, 200) and seen[-1] == (200, 200)
-        positions = capture.column(100)
-        assert positions[-1] > positions[0] and positions == sorted(positions)
-    finally:
-        proc.terminate()
-        proc.wait(10)
-        proc.stdout.close()
-        proc.stderr.close()
+    with Child.sim(tmp_path / "e.json", "--tcp", "0", *flags) as sim, DriveClient.open(sim.address) as client:
+        assert client.trace_encoding == encoding
+        assert ("TRP" in {c.value for c in client.capabilities.commands}) == (encoding == "packed")
+        client.servo(True)
+        client.jog(20.0)
+        client.configure_trace([100, 103], divider=5)
+        client.arm_trace(200)
+        deadline = time.monotonic() + 20
+        while client.trace_status().state is not p.TraceState.DONE:
+            assert time.monotonic() < deadline, "the capture did not finish"
+            client.jog(20.0)  # held: JOG again on every look at the capture
+        seen = []
+        capture = client.read_trace(progress=lambda done, total: seen.append((done, total)))
+    assert len(capture.samples) == 200 and seen[0] == (0, 200) and seen[-1] == (200, 200)
+    positions = capture.column(100)
+    assert positions[-1] > positions[0] and positions == sorted(positions)

@@ -21,6 +21,7 @@ from fha_studio.hardware.errors import ServoOnRefused
 from fha_studio.hardware.protocol import EXTENSION_COMMANDS
 from fha_studio.hardware.sim import SimConfigError, SimDrive, config_from_url
 from tests.sim.conftest import ask, responder
+from tests.support.processes import Child
 
 ROOT = Path(__file__).resolve().parents[2]
 COUNTS_PER_DEG_50 = 8192 * 50 / 360  # DGR counts per output degree at ratio 50
@@ -116,7 +117,7 @@ def test_the_client_sees_a_drive_of_the_manual(tmp_path):
         assert isinstance(client.absolute_position(), int)
 
 
-def said_by(proc: subprocess.Popen, words: bytes, limit_s: float = 30.0) -> None:
+def said_by(proc: Child, words: bytes, limit_s: float = 30.0) -> None:
     """Wait until ``proc`` says ``words`` on its stderr; fail naming what it said when it ends
     first or stays silent ``limit_s``."""
     said = b""
@@ -128,7 +129,7 @@ def said_by(proc: subprocess.Popen, words: bytes, limit_s: float = 30.0) -> None
                         f"it said {said.decode()!r}")
         chunk = os.read(proc.stderr.fileno(), 4096)  # the pipe's bytes, no buffer select cannot see
         if not chunk:
-            pytest.fail(f"the sim ended (exit code {proc.wait(10)}) before it said {words.decode()!r}; "
+            pytest.fail(f"the sim ended (exit code {proc.proc.wait(10)}) before it said {words.decode()!r}; "
                         f"it said {said.decode()!r}")
         said += chunk
 
@@ -137,14 +138,9 @@ def said_by(proc: subprocess.Popen, words: bytes, limit_s: float = 30.0) -> None
 def test_probe_a_documented_sim_in_another_process_and_switch_its_servo(tmp_path):
     """``fha-studio sim --profile documented --panel`` over a pty; servo-ON typed on its stdin."""
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    sim = subprocess.Popen(
-        [sys.executable, "-m", "fha_studio", "sim", "--pty", "--unpaced", "--profile", "documented",
-         "--panel", "--actuator", "FHA-25C-50-S248", "--eeprom", str(tmp_path / "e.json")],
-        cwd=ROOT, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    try:
-        ready, _, _ = select.select([sim.stdout], [], [], 30.0)
-        assert ready, "the sim printed no pty path"
-        path = sim.stdout.readline().decode().strip()
+    with Child.sim(tmp_path / "e.json", "--pty", "--profile", "documented", "--panel",
+                   "--actuator", "FHA-25C-50-S248", stdin=True) as sim:
+        path = sim.address
 
         def fha(*args: str) -> subprocess.CompletedProcess:
             return subprocess.run([sys.executable, "-m", "fha_studio", "drive", *args, "--url", path],
@@ -160,7 +156,4 @@ def test_probe_a_documented_sim_in_another_process_and_switch_its_servo(tmp_path
         assert done.returncode == 4 and "servo on (controller)" in done.stderr
         with pytest.raises(ServoOnRefused), DriveClient.open(path) as client:
             client.absolute_position()
-    finally:
-        sim.terminate()
-        sim.communicate(timeout=10)
     assert sim.returncode == 0

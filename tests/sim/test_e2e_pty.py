@@ -7,65 +7,25 @@ watchdog stop the axis, and the next JOG starts it again. Only a hang takes LIMI
 
 from __future__ import annotations
 
-import os
-import select
-import subprocess
-import sys
 import time
-from pathlib import Path
 
 import pytest
 
 from fha_studio.hardware.client import DriveClient, LinkSettings
 from fha_studio.hardware.errors import CommandRejected, LinkLost, LinkTimeout
 from fha_studio.hardware.parameters import Mode
+from tests.support.processes import Child
 
 pytestmark = pytest.mark.e2e
-
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def start_sim(tmp_path: Path, *extra: str) -> tuple[subprocess.Popen, str]:
-    """Start the sim in a process; returns it and the pty path it printed (within 30 s)."""
-    cmd = [sys.executable, "-m", "fha_studio", "sim", "--pty", "--unpaced",
-           "--eeprom", str(tmp_path / "eeprom.json"), *extra]
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
-    assert proc.stdout is not None
-    ready, _, _ = select.select([proc.stdout], [], [], 30.0)
-    if not ready:
-        proc.kill()
-        proc.wait(5)
-        pytest.fail("the sim printed no pty path within 30 s")
-    line = proc.stdout.readline().decode().strip()
-    if not line.startswith("/dev/"):
-        proc.kill()
-        _, err = proc.communicate(timeout=5)
-        pytest.fail(f"the sim did not start: {line!r} {err.decode()!r}")
-    return proc, line
-
-
-def stop_sim(proc: subprocess.Popen) -> None:
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(5)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(5)
-    for stream in (proc.stdout, proc.stderr):
-        if stream is not None:
-            stream.close()
 
 
 @pytest.fixture(scope="module")
 def sim(tmp_path_factory):
-    proc, path = start_sim(tmp_path_factory.mktemp("sim"))
-    client = DriveClient.open(path)
-    yield client
-    client.close()
-    stop_sim(proc)
-    assert proc.returncode == 0  # SIGTERM ends it cleanly (EEPROM saved, threads stopped)
+    with Child.sim(tmp_path_factory.mktemp("sim") / "eeprom.json", "--pty") as process:
+        client = DriveClient.open(process.address)
+        yield client
+        client.close()
+    assert process.returncode == 0  # SIGTERM ends it cleanly (EEPROM saved, threads stopped)
 
 
 #: Only a hang takes this long (a jog turns the output 1000 pulses in some 0.1 s).
@@ -135,12 +95,11 @@ def test_raises_and_clears_an_alarm(sim):
 
 
 def test_killing_the_sim_gives_a_clean_link_error(tmp_path, time_ceiling):
-    proc, path = start_sim(tmp_path)
-    client = DriveClient.open(path, LinkSettings(response_timeout_s=0.3, retries=1))
+    process = Child.sim(tmp_path / "eeprom.json", "--pty")
+    client = DriveClient.open(process.address, LinkSettings(response_timeout_s=0.3, retries=1))
     try:
         assert sim_alive(client)
-        proc.kill()
-        proc.wait(5)
+        process.kill()
         started = time.monotonic()
         with pytest.raises((LinkLost, LinkTimeout)):
             for _ in range(5):
@@ -148,7 +107,7 @@ def test_killing_the_sim_gives_a_clean_link_error(tmp_path, time_ceiling):
         time_ceiling("a link error after the sim is killed", time.monotonic() - started, 10.0)
     finally:
         client.close()
-        stop_sim(proc)
+        process.stop()
 
 
 def sim_alive(client: DriveClient) -> bool:

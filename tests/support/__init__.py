@@ -4,6 +4,8 @@
 - ``documented``: ``DocumentedDrive``, the one drive of the manual's DGR and OWW (a handler).
 - ``links``: the fixtures ``pipes``, ``scripted`` and ``client_for`` (a client on a scripted
   drive), offered to every test.
+- ``processes``: ``Child``, a program in a process of its own (``Child.sim``: ``fha-studio sim``
+  and its address), ended the one way (``stop``); the fixture ``children``.
 - ``clock``: ``FakeClock``, the one injected clock (the calendar and a count of seconds, moved
   together).
 - ``read_only``: ``ReadOnlyPlace``, files the program really cannot write (as uid 65534 where the
