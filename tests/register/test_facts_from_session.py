@@ -149,3 +149,14 @@ def test_a_fact_the_register_cannot_take_raises_its_error(line3):
 
     with pytest.raises(RegisterError):
         f.record_fact(line3, "Line 3 positioner/none", f.OriginFact("x", "ana"))
+
+
+def test_every_kind_of_history_entry_has_its_word_and_its_place():
+    """A new kind of register fact is told in the register dialog and ``fha-studio register
+    history`` by its word, and facts of one moment in a fixed order: neither may be missing."""
+    from fha_studio.logic.register.history import HISTORY_ORDER
+    from fha_studio.logic.register.records import EventKind
+    from fha_studio.logic.register.words import KIND_WORDS
+
+    assert set(KIND_WORDS) == set(EventKind)
+    assert sorted(HISTORY_ORDER) == sorted(EventKind)
