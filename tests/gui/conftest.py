@@ -3,11 +3,10 @@ window is built by a factory that tears it down without leaking widgets or threa
 
 from __future__ import annotations
 
-import gc
-
 import pytest
 from PySide6.QtCore import QCoreApplication, QSettings, QStandardPaths
-from PySide6.QtWidgets import QApplication
+
+from tests.support.windows import torn_down
 
 
 @pytest.fixture(autouse=True)
@@ -31,14 +30,11 @@ def make_window(qtbot):
 
     `open_client(url, baud)` replaces the real DriveClient.open (a fake drive); by default the
     real client (and the embedded simulated drive for sim:// URLs) is used. On teardown the link
-    thread is ended, the window closed and deleted, and no top-level widget may be left.
+    thread is ended, the window closed and deleted, and no top-level widget may be left
+    (tests/support/windows.py).
     """
     from fha_studio.gui.link import LinkController
     from fha_studio.gui.main_window import MainWindow
-
-    app = QApplication.instance()
-    before = set(app.topLevelWidgets())
-    windows = []
 
     def factory(open_client=None, connect: str | None = None, show: bool = True):
         link = LinkController(open_client=open_client)
@@ -53,22 +49,8 @@ def make_window(qtbot):
                 window.connect_to(connect)
         return window
 
-    yield factory
-
-    for window in windows:
-        window._closing_confirmed = True
-        window.shutdown()
-        assert not window.link._thread.isRunning(), "the link thread is still running"
-        window.close()
-        window.deleteLater()
-    QApplication.processEvents()
-    QCoreApplication.sendPostedEvents(None, 0)  # DeferredDelete
-    QApplication.processEvents()
-    gc.collect()
-    leaked = [w for w in app.topLevelWidgets() if w not in before and w.isVisible()]
-    for w in leaked:
-        w.close()
-    assert not leaked, f"top-level widgets left open: {[type(w).__name__ for w in leaked]}"
+    with torn_down(lambda window: [window.link]) as windows:
+        yield factory
 
 
 @pytest.fixture(scope="session")

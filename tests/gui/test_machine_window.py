@@ -5,14 +5,11 @@ axes are commissioned (history, a diff against the twin, a find)."""
 
 from __future__ import annotations
 
-import gc
 import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import QCoreApplication
-from PySide6.QtWidgets import QApplication
 
 from fha_studio.gui.link import ClearAlarm, Servo, Stop
 from fha_studio.logic.machine import MachineProject
@@ -20,6 +17,7 @@ from fha_studio.logic.register import Register
 from fha_studio.logic.register.words import value_text
 from tests.gui.procedure_answers import answer_by_hand
 from tests.support.read_only import ReadOnlyPlace
+from tests.support.windows import torn_down
 
 MACHINE = "Line 3 positioner"
 TABLE = "FHA-25C-50-US250"
@@ -34,34 +32,14 @@ def make_machine(qtbot):
     make_window (every link thread ended, no window left open)."""
     from fha_studio.gui.machine_window import MachineWindow
 
-    app = QApplication.instance()
-    before = set(app.topLevelWidgets())
-    windows = []
-
     def factory(project, register):
         window = MachineWindow(project, register)
         window.show()
         windows.append(window)
         return window
 
-    yield factory
-
-    for window in windows:
-        window._closing_confirmed = True
-        window.shutdown()
-        assert not any(w.link._thread.isRunning() for w in window.axis_windows), (
-            "a link thread is still running"
-        )
-        window.close()
-        window.deleteLater()
-    QApplication.processEvents()
-    QCoreApplication.sendPostedEvents(None, 0)
-    QApplication.processEvents()
-    gc.collect()
-    leaked = [w for w in app.topLevelWidgets() if w not in before and w.isVisible()]
-    for w in leaked:
-        w.close()
-    assert not leaked, f"top-level widgets left open: {[type(w).__name__ for w in leaked]}"
+    with torn_down(lambda window: [axis.link for axis in window.axis_windows]) as windows:
+        yield factory
 
 
 def _walk(page, qtbot, procedure_id, limit=80):

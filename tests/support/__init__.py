@@ -6,6 +6,7 @@
   drive), offered to every test.
 - ``processes``: ``Child``, a program in a process of its own (``Child.sim``: ``fha-studio sim``
   and its address), ended the one way (``stop``); the fixture ``children``.
+- ``windows`` (Qt): ``torn_down``, the one teardown of the GUI tests' window factories.
 - ``clock``: ``FakeClock``, the one injected clock (the calendar and a count of seconds, moved
   together).
 - ``read_only``: ``ReadOnlyPlace``, files the program really cannot write (as uid 65534 where the
