@@ -217,6 +217,11 @@ CHECK_TITLES = {
     "rotary_direction": "Rotary direction (1-10)",
     "sensor_dog": "Sensor dog angle (4-7-2, 4-7-3)",
     "absolute_origin": "Absolute origin (OWW)",
+    # a move under the controller seen on CN2 (the Scope's Bench tab): servo on, CN3 silent
+    "bench_encoder": "Encoder outputs follow the command (CN2, bench)",
+    "bench_direction": "Rotary direction (1-10) as the encoder outputs count it (CN2, bench)",
+    "bench_in_position": "IN-POS after a move (CN2-33, bench)",
+    "bench_alarm": "ALARM during a move (CN2, bench)",
 }
 
 

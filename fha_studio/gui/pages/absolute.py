@@ -421,6 +421,12 @@ class AbsolutePage(BasePage):
         self.sigRecorded.emit(record)
         return record
 
+    def record_bench_checks(self, checks: list) -> None:
+        """Checks of a move taken from CN2 on a bench instrument (the Scope's Bench tab, servo on),
+        recorded beside the DGR checks with where their figures came from."""
+        for check in checks:
+            self._record(check.check, dict(check.values), check.passed, check.detail)
+
     def _save(self, record: ab.DgrCheckRecord) -> None:
         folder = data_dir() / "checks"
         folder.mkdir(parents=True, exist_ok=True)

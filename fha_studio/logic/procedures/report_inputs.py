@@ -85,7 +85,8 @@ def dgr_check_notes(records: Sequence[DgrCheckRecord]) -> list[tuple[str, str]]:
     notes = []
     for record in records:
         verdict = {True: "pass", False: "FAIL", None: "recorded"}[record.passed]
-        how = ", entered by hand" if record.by_hand else ", with DGR"
+        how = ", entered by hand" if record.by_hand else (
+            ", from CN2 on a bench instrument" if record.check.startswith("bench_") else ", with DGR")
         title = CHECK_TITLES.get(record.check, record.check)
         notes.append((f"{title} ({record.at}{how}): {verdict}: {record.detail}", record.who))
     return notes

@@ -15,7 +15,9 @@ from PySide6.QtCore import QSettings
 #: The settings key: one JSON object, instrument spec -> fields.
 SETTINGS_KEY = "bench/mappings"
 #: The fields of a mapping (the Bench tab's line edits).
-FIELDS = ("channels", "rate", "encoder", "command", "in_position")
+FIELDS = ("channels", "rate", "encoder", "command", "in_position", "alarm")
+#: Fields kept only when given (a mapping of an older version has none).
+OPTIONAL = ("alarm",)
 #: Instruments remembered at most (the least recently used go first).
 MAX_INSTRUMENTS = 50
 
@@ -43,7 +45,7 @@ def save(spec: str, fields: dict[str, str]) -> None:
         return
     data = _all()
     data.pop(spec, None)
-    data[spec] = {k: fields.get(k, "") for k in FIELDS}
+    data[spec] = {k: fields.get(k, "") for k in FIELDS if k not in OPTIONAL or fields.get(k)}
     while len(data) > MAX_INSTRUMENTS:
         data.pop(next(iter(data)))
     QSettings().setValue(SETTINGS_KEY, json.dumps(data))

@@ -26,6 +26,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.hardware.bench import sigrok
+from fha_studio.logic.bench.checks import BenchCheck, bench_checks
 from fha_studio.logic.bench.display import peak_rows
 from fha_studio.logic.bench.importer import DriveSettings
 from fha_studio.logic.bench.move import BenchMoveFigures, bench_move_figures
@@ -39,6 +40,10 @@ WINDOW_S = 2.0
 MOVE_SETTLED_S = 0.5
 #: A command standing still this long before a change marks where a move began [s].
 MOVE_GAP_S = 0.2
+#: The checks as the move's line names them.
+CHECK_WORDS = {"bench_encoder": "encoder outputs follow the command", "bench_direction": "direction",
+               "bench_in_position": "IN-POS", "bench_alarm": "ALARM"}
+VERDICT = {True: "pass", False: "FAIL", None: "recorded"}
 _COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#e07000", "#9467bd", "#8c564b", "#e377c2", "#008b8b")
 
 
@@ -59,6 +64,7 @@ class BenchPanel(QWidget):
     """Instrument, channels and rate; Start/Stop; a plot of the stream."""
 
     sigDevicesListed = Signal(int)  # in the GUI thread: how many instruments the scan found
+    sigChecks = Signal(object)  # list of BenchCheck: a move's DGR checks from CN2, once it settled
 
     def __init__(self, parent: QWidget | None = None):
         super().__init__(parent)
@@ -116,6 +122,12 @@ class BenchPanel(QWidget):
         self.in_position_edit.setToolTip("the drive's in-position output (CN2-33) among the channels: "
                                          "the move's in-position time is taken from it")
         roles.addWidget(self.in_position_edit, 1)
+        roles.addWidget(QLabel("ALARM"))
+        self.alarm_edit = QLineEdit("")
+        self.alarm_edit.setPlaceholderText("e.g. D6")
+        self.alarm_edit.setToolTip("the drive's ALARM output among the channels: the checks of a move say "
+                                   "whether it came on")
+        roles.addWidget(self.alarm_edit, 1)
         grid.addLayout(roles, 2, 0, 1, 4)
         grid.setColumnStretch(1, 1)
         layout.addLayout(grid)
@@ -136,6 +148,8 @@ class BenchPanel(QWidget):
         self.move_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         layout.addWidget(self.move_label)
         self.move_figures: BenchMoveFigures | None = None
+        self.checks: list[BenchCheck] = []
+        self.parameter_8: int | None = None  # rotary direction, as the drive or its panel gave it
         self._move_seen_at: float | None = None
         self._last_command_change: float | None = None
         self.drive = DriveSettings(0, 4, 1, 1, 3000.0)
@@ -165,9 +179,10 @@ class BenchPanel(QWidget):
         self.drive = drive
 
     def start(self, device: str, channels: str, rate: str = "", encoder: str = "", command: str = "",
-              in_position: str = "") -> None:
+              in_position: str = "", alarm: str = "") -> None:
         """Stream (what the Start button does with the fields' text)."""
         self.device_box.setEditText(device)  # first: a mapping it offers is then replaced
+        self.alarm_edit.setText(alarm)
         self.encoder_edit.setText(encoder)
         self.command_edit.setText(command)
         self.in_position_edit.setText(in_position)
@@ -212,7 +227,12 @@ class BenchPanel(QWidget):
         if in_position and in_position not in names:
             self._refuse(f"IN-POS {in_position}: it must be among the channels ({', '.join(names)}).")
             return
+        alarm_name = self.alarm_edit.text().strip()
+        if alarm_name and alarm_name not in names:
+            self._refuse(f"ALARM {alarm_name}: it must be among the channels ({', '.join(names)}).")
+            return
         self.move_figures = None
+        self.checks = []
         self._move_seen_at = None
         self._last_command_change = None
         self.move_label.setText("")
@@ -242,7 +262,7 @@ class BenchPanel(QWidget):
     def _fields(self) -> dict[str, str]:
         return {"channels": self.channels_edit.text(), "rate": self.rate_edit.text(),
                 "encoder": self.encoder_edit.text(), "command": self.command_edit.text(),
-                "in_position": self.in_position_edit.text()}
+                "in_position": self.in_position_edit.text(), "alarm": self.alarm_edit.text()}
 
     def _offer_mapping(self, text: str) -> None:
         """The channels and roles last used with this instrument, if it was used before."""
@@ -250,11 +270,12 @@ class BenchPanel(QWidget):
         fields = bench_mappings.saved(spec)
         if fields is None or self.source.running:
             return
-        self.channels_edit.setText(fields["channels"])
-        self.rate_edit.setText(fields["rate"])
-        self.encoder_edit.setText(fields["encoder"])
-        self.command_edit.setText(fields["command"])
-        self.in_position_edit.setText(fields["in_position"])
+        self.channels_edit.setText(fields.get("channels", ""))
+        self.rate_edit.setText(fields.get("rate", ""))
+        self.encoder_edit.setText(fields.get("encoder", ""))
+        self.command_edit.setText(fields.get("command", ""))
+        self.in_position_edit.setText(fields.get("in_position", ""))
+        self.alarm_edit.setText(fields.get("alarm", ""))
         self.status_label.setText(f"Channels and roles as last used with {spec}.")
 
     def _on_started(self, started: BenchStarted) -> None:
@@ -345,6 +366,15 @@ class BenchPanel(QWidget):
         except ValueError:
             return
         self.move_figures = figures
+        alarm_name = self.alarm_edit.text().strip()
+        alarm = (rows[start:, 1 + started.channels.index(alarm_name)]
+                 if alarm_name in started.channels else None)
+        wired = [f"encoder {self.encoder_edit.text().strip()}", f"command {self.command_edit.text().strip()}"]
+        wired += [f"{what} {name}" for what, name in (("IN-POS", in_position), ("ALARM", alarm_name)) if name]
+        self.checks = bench_checks(t[start:], cmd[start:], enc[start:], in_position=in_pos, alarm=alarm,
+                                   in_position_time_s=figures.in_position_time_s,
+                                   parameter_8=self.parameter_8,
+                                   source=f"the bench instrument {started.device} ({', '.join(wired)})")
         m = figures.metrics
 
         def ms(value: float | None) -> str:
@@ -356,7 +386,9 @@ class BenchPanel(QWidget):
             f"({m.overshoot:.4f} deg); settling time {ms(m.settling_time_s)} "
             f"(band ±{m.settling_band:.3g} deg); in-position (IN-POS) {inpos} after the command ended; "
             f"following error (command − encoder) at most {figures.following_error_peak_counts:.0f} "
-            f"counts, {figures.following_error_end_counts:.0f} counts at the end")
+            f"counts, {figures.following_error_end_counts:.0f} counts at the end\n"
+            + "; ".join(f"{CHECK_WORDS[c.check]}: {VERDICT[c.passed]}" for c in self.checks))
+        self.sigChecks.emit(list(self.checks))
 
     def _on_stopped(self, why: str) -> None:
         self.start_button.setChecked(False)

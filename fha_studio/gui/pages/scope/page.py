@@ -52,6 +52,8 @@ class ScopePage(BasePage):
         # a bench instrument on CN2 beside CN3 polling (a real drive's CN3 is silent in motion)
         self.bench = BenchPanel()
         self.view.plots.addTab(self.bench, "Bench")
+        self._host = main_window
+        self.bench.sigChecks.connect(self._bench_checks)
         self._bench_axis()
         # the axis's actuator, driver and load decide the scaling and what is recorded, at every moment
         state = self.state
@@ -91,6 +93,19 @@ class ScopePage(BasePage):
             values[(mode, number)] = value if value is not None else fallback[number]
         counts = state.output_resolution_ppr if state.actuator_code else 0
         self.bench.set_axis(int(counts or 0), DriveSettings.from_values(values))
+        direction = state.value_of("system", 8)  # rotary direction, read or entered from the panel
+        self.bench.parameter_8 = int(direction) if direction is not None else None
+
+    def _bench_checks(self, checks: list) -> None:
+        """A move's checks from CN2 go to the DGR checks page's record (and so into the report)."""
+        from fha_studio.gui.pages.absolute import AbsolutePage
+        from fha_studio.gui.pages.base import PageId
+
+        if self._host is None or not checks:
+            return
+        page = self._host.page(PageId.ABSOLUTE)
+        if isinstance(page, AbsolutePage):
+            page.record_bench_checks(checks)
 
     def _load_inertia_edited(self, value_kgm2: float) -> None:
         self.state.set_load_inertia(value_kgm2)

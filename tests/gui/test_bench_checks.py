@@ -1,0 +1,64 @@
+"""DGR checks of a moving axis from CN2 on the documented profile (CN3 silent while the servo is
+on): the controller's 10 deg FWD move seen on the sim-cn2 instrument gives the encoder check, the
+direction as the encoder outputs count it, IN-POS and ALARM; they are recorded on the DGR checks
+page, with where their figures came from, and go into the report's notes."""
+
+from __future__ import annotations
+
+import pytest
+
+from fha_studio.gui.link import SimPanelRequest
+from fha_studio.gui.pages.base import PageId
+from fha_studio.logic.procedures.report_inputs import dgr_check_notes
+
+CODE = "FHA-25C-50-US250"
+URL = f"sim://{CODE}?paced=0&profile=documented"
+
+
+def _panel_done(window, qtbot, action) -> None:
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
+                          timeout=10000) as done:
+        action()
+    assert done.args[0].ok, done.args[0].error
+
+
+@pytest.fixture
+def window(make_window, qtbot):
+    w = make_window(connect=URL)
+    w.state.set_actuator(CODE, acknowledged=True)
+    return w
+
+
+def test_a_controller_move_on_cn2_is_checked_and_recorded_with_its_source(window, qtbot):
+    bench = window.show_page("scope").bench
+    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
+        bench.scan()
+    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
+        bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,ALARM", "250k",
+                    "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS", "ALARM")
+    _panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
+    qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
+    qtbot.wait(300)  # standing under servo: what the move starts from
+    window.sim_panel.command_spin.setValue(10.0)
+    with qtbot.waitSignal(bench.sigChecks, timeout=30000) as checked:
+        _panel_done(window, qtbot, window.sim_panel.fwd_button.click)
+    checks = {c.check: c for c in checked.args[0]}
+    assert {name: c.passed for name, c in checks.items()} == {
+        "bench_encoder": True, "bench_direction": True, "bench_in_position": True, "bench_alarm": True}
+    source = "from the bench instrument sim-cn2 (encoder ENC_A,ENC_B, command CMD_A,CMD_B, IN-POS IN_POS, " \
+        "ALARM ALARM)"
+    assert all(source in c.detail for c in checks.values())
+    assert "a FWD command (+13889 counts) turned the axis FWD" in checks["bench_direction"].detail
+    assert "encoder outputs follow the command: pass" in bench.move_label.text()
+
+    page = window.page(PageId.ABSOLUTE)
+    recorded = [r for r in page.records if r.check.startswith("bench_")]
+    assert [r.check for r in recorded] == ["bench_encoder", "bench_direction", "bench_in_position",
+                                           "bench_alarm"]
+    assert all(r.passed and not r.by_hand for r in recorded)
+    notes = [text for text, _who in dgr_check_notes(recorded)]
+    assert notes[0].startswith("Encoder outputs follow the command (CN2, bench) (")
+    assert ", from CN2 on a bench instrument): pass: the encoder outputs counted +13889 for " \
+        "+13889" in notes[0]
+    with qtbot.waitSignal(bench.source.sigStopped, timeout=10000):
+        bench.start_button.click()
