@@ -3,7 +3,8 @@
 Run from the checkout: PYTHONPATH=. python benchmarks/modelcheck_speed.py
 Generates recordings with the shared physics (closed loop, monitor quantisation and noise), writes
 them as fha-recording/1 files, and times reading + run_modelcheck (with and without re-simulation)
-for a torque-only recording and one with load_pos, 20 s at 1 kHz. The target: under 1 s of CPU with
+for a torque-only recording, one with load_pos and one without current (a bench capture, read through
+the closed loop), 20 s at 1 kHz. The target: under 1 s of CPU with
 the re-simulation. Then the cost against the recording's length (5 to 80 s: it should grow linearly)
 and the peak memory the analysis allocates (tracemalloc, numpy included; the re-simulation keeps one
 chunk of servo periods, and covers at most the first RESIM_MAX_S seconds). Wall time and the
@@ -28,7 +29,7 @@ from modelcheck_gen import record, standard_moves, trapezoid_moves
 from fha_studio.logic.modelcheck import run_modelcheck
 from fha_studio.logic.modelcheck.workflow import RESIM_MAX_S
 from fha_studio.physics import AxisModel, Effects
-from fha_studio.recording import read_recording, write_recording
+from fha_studio.recording import Recording, read_recording, write_recording
 
 CODE = "FHA-25C-50-US250"
 
@@ -76,6 +77,18 @@ def main() -> None:
                     f"check {t2 - t1:5.2f} s  (cpu {c2 - c0:5.2f} s)  "
                     f"bandwidth {result.bandwidth_hz:5.1f} Hz  named: {named}"
                 )
+
+    # a bench capture: no current column, read through the closed loop identified from the recording
+    without = record(model, friction.with_effect("gravity_load", amplitude_nm=12.0, phase_deg=30.0), t, cmd,
+                     actuator_code=CODE).recording
+    bench = Recording(without.metadata, {k: v for k, v in without.channels.items() if k != "current"})
+    for resim in (True, False):
+        c0 = time.process_time()
+        result = run_modelcheck(bench, resimulate=resim)
+        cpu = time.process_time() - c0
+        named = ", ".join(e.id for e in result.effects) or "none"
+        on = "on " if resim else "off"
+        print(f"  {'no current: closed loop':30s} resim={on}  (cpu {cpu:5.2f} s)  named: {named}")
 
     print(f"cost against length (torque + friction, re-simulation on; it covers at most {RESIM_MAX_S:g} s):")
     for duration in (5.0, 10.0, 20.0, 40.0, 80.0):

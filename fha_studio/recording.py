@@ -25,7 +25,8 @@ Metadata (units are in the key names; values are plain numbers):
 
 Columns: ``t`` [s], ``pos`` [deg, output side from the motor encoder] and ``current`` [A, the
 driver's current monitor] are required; ``cmd_pos`` [deg], ``load_pos`` [deg, external encoder on
-the output] and ``vel`` [r/min, output] are optional; further columns are extra channels (the
+the output], ``vel`` [r/min, output] and ``torque`` [N m, a torque sensor on the output flange,
+positive = the flange driving the load CW] are optional; further columns are extra channels (the
 writer's own signals) and are kept by name in :attr:`Recording.channels`.
 
 **fha-recording/2** is the same file with ``# format: fha-recording/2``, in which ``current`` and
@@ -70,11 +71,11 @@ FORMATS = (FORMAT_ID, FORMAT_V2)
 REQUIRED_COLUMNS = ("t", "pos", "current")
 #: what a ``fha-recording/2`` file must have
 REQUIRED_COLUMNS_V2 = ("t", "pos")
-OPTIONAL_COLUMNS = ("cmd_pos", "load_pos", "vel", "in_pos")
+OPTIONAL_COLUMNS = ("cmd_pos", "load_pos", "vel", "in_pos", "torque")
 CONTRACT_COLUMNS = ("t", "pos", "current", *OPTIONAL_COLUMNS)
 #: unit of each contract column, as the format defines it (in_pos: 1 = the drive's IN-POS output on)
 COLUMN_UNITS = {"t": "s", "pos": "deg", "current": "A", "cmd_pos": "deg", "load_pos": "deg", "vel": "r/min",
-                "in_pos": "1 = on, 0 = off"}
+                "in_pos": "1 = on, 0 = off", "torque": "N m"}
 
 # Numeric metadata keys (unit in the name) and the unit text a writer may append to the value.
 _NUMERIC_KEYS = {

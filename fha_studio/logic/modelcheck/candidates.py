@@ -34,7 +34,8 @@ from fha_studio.logic.wording import with_unit
 
 TORQUE = "torque"
 POSITION = "position"
-CHANNEL_UNITS = {TORQUE: "N m", POSITION: "arcsec"}
+# the torque channel split by an output torque sensor: the gear's part and the load's (workflow.py)
+CHANNEL_UNITS = {TORQUE: "N m", POSITION: "arcsec", "gear torque": "N m", "load torque": "N m"}
 
 
 @dataclass

@@ -236,7 +236,19 @@ def decode_loop(beta: np.ndarray, tv_s: float, kt_nm_per_a: float, panel: ServoS
     )
 
 
-def not_identifiable_lines(axis: DeclaredAxis) -> list[str]:
+def not_identifiable_lines(axis: DeclaredAxis, sensor: bool = False) -> list[str]:
+    """What a recording without current cannot show; ``sensor``: it has an output torque sensor,
+    which measures the load's side (then only the gear is read through the loop)."""
+    if sensor:
+        j_gear = axis.nominal_inertia_kgm2 - axis.model.load_inertia_kgm2
+        return [
+            "Without a current the gear is read through the closed loop, the load on the torque sensor: "
+            "a constant drag in the gear and the part of its friction that differs by direction are held "
+            "by the speed loop's integral and leave no trace in the following error; viscous friction "
+            "trades off against the speed loop's gain and feed-forward. Record the current to see them.",
+            f"The gear's torques, in N m, rest on the declared actuator inertia ({j_gear:.4g} kg m^2); "
+            "the load's are measured.",
+        ]
     return [
         "Without a torque measurement (no current, no torque column) these cannot be seen: a constant "
         "load torque and the part of friction that differs by direction are held by the speed loop's "

@@ -248,7 +248,7 @@ class ModelCheckResult:
                 for k, v in e.params.items()
                 if k != p
             )
-            if self.torque_basis and e.units.get(p) == "N m":
+            if self.torque_basis and e.units.get(p) == "N m" and not e.label.endswith(" at the load"):
                 main += f" ({self.torque_basis})"
             text = f"{e.label} missing: {main}" + (f" ({others})" if others else "")
             if e.alternatives:

@@ -48,11 +48,19 @@ def run_without_current(
     index = np.arange(0, n, step)
     floor_t = max(wf.TORQUE_FLOOR_MIN_NM, wf.TORQUE_FLOOR_FRACTION_OF_MAX * (model.max_torque_nm or 0.0))
     j = axis.nominal_inertia_kgm2
-    y = -(j * sig.accel_rad_s2)
+    # with a torque sensor on the output flange the loop fights the gear alone: the load's torque
+    # is measured, and judged on its own channel (workflow.sensor_steps)
+    sensor = wf.sensor_torque_nm(rec, sig)
+    j_gear = j - model.load_inertia_kgm2
+    y = -(j * sig.accel_rad_s2) if sensor is None else -(j_gear * sig.accel_rad_s2 + sensor)
     cols = loop_columns(sig)
     ctx = ChannelContext(sig, TORQUE, nominal_inertia_kgm2=j)
     excitation = excitation_of(sig)
-    candidates = tuple(c for c in CANDIDATES_WITHOUT_CURRENT if c.id not in excitation.excluded())
+    candidates = tuple(
+        c
+        for c in CANDIDATES_WITHOUT_CURRENT
+        if c.id not in excitation.excluded() and (sensor is None or c.motor_side)
+    )
     tv = best_integral_time(cols, y[index], index, friction_proxies(ctx, index))
     sel = ChannelSelector(
         ctx, y[index], candidates, index, floor_t, CHANNEL_UNITS[TORQUE], base=cols.base(tv, index)
@@ -83,8 +91,9 @@ def run_without_current(
         "pos_rad": sig.pos_rad,
         "following_error_rad": cols.eps,
     }
+    name = TORQUE if sensor is None else wf.GEAR
     channel = wf.ChannelStep(
-        TORQUE,
+        name,
         ctx,
         y,
         candidates,
@@ -96,7 +105,7 @@ def run_without_current(
         max_torque_nm=max_torque,
         actuator=axis.code,
     )
-    report = ChannelReport(TORQUE, "N m", floor_t, steps, settled.ar_order, len(index))
+    report = ChannelReport(name, "N m", floor_t, steps, settled.ar_order, len(index))
     total = max(float(np.mean(sel.y**2)), 1e-300)
     cancelled = [
         Structure(
@@ -127,13 +136,18 @@ def run_without_current(
         )
     ]
     status = {
-        TORQUE: ChannelStatus(TORQUE, CHECKED, "", float(np.max(np.abs(loop_torque))), "N m"),
+        name: ChannelStatus(name, CHECKED, "", float(np.max(np.abs(loop_torque))), "N m"),
         "current": ChannelStatus(
             "current",
             ABSENT,
             "is absent: the torque is read through the closed loop from the following error and the speed",
         ),
     }
+    if sensor is not None:
+        load = wf.sensor_steps(wf._torque_step(sig, axis, y, floor_t, index, excitation), sensor, model, sig,
+                               gear=False)[0]
+        chosen.append(wf._select(load, index))
+        status[load.channel] = ChannelStatus(load.channel, CHECKED, "", float(np.max(np.abs(load.y))), "N m")
     status[POSITION], position = wf._position_step(sig, model, ctx, settled.fitted, residual, index)
     if position is not None:
         chosen.append(wf._select(position, index))
@@ -188,8 +202,9 @@ def run_without_current(
         channel_status=status,
         window_reason="fixed without a current: the acceleration sets what the loop's torque can show",
         refused=found.refused,
-        not_seen=[*not_identifiable_lines(axis), *excitation.lines()],
-        torque_basis=f"on the declared inertia {axis.nominal_inertia_kgm2:.4g} kg m^2",
+        not_seen=[*not_identifiable_lines(axis, sensor is not None), *excitation.lines()],
+        torque_basis=f"on the declared {'' if sensor is None else 'actuator '}inertia "
+        f"{(j if sensor is None else j_gear):.4g} kg m^2",
         loop=loop,
     )
 

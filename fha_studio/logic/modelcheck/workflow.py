@@ -9,7 +9,7 @@ types and their summary are result.py.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -175,7 +175,12 @@ def run_modelcheck(
     torque = _torque_step(sig, axis, residual["torque_residual_nm"], floor_t, index, excitation)
     chosen: list[Selected] = []
     delay_ms = 0.0
-    if status[TORQUE].checked:
+    sensor = sensor_torque_nm(rec, sig)
+    if status[TORQUE].checked and sensor is not None:  # the gear and the load, each on its own
+        for part in sensor_steps(torque, sensor, model, sig):
+            chosen.append(_select(part, index))
+            status[part.channel] = ChannelStatus(part.channel, CHECKED, "", _shows(part.y), "N m")
+    elif status[TORQUE].checked:
         chosen.append(_select(torque, index))
         delay_ms = -1000.0 * float(chosen[0].base_beta[0])
         if abs(delay_ms) > 0.05:
@@ -292,6 +297,47 @@ def _torque_step(
     )
 
 
+GEAR, LOAD = "gear torque", "load torque"
+SIDE_WORDS = {GEAR: " in the gear", LOAD: " at the load"}
+
+
+def sensor_torque_nm(rec: Recording, sig: Signals) -> np.ndarray | None:
+    """The output torque sensor's column (N m), smoothed like the analysis, or None."""
+    raw = rec.channels.get("torque")
+    if raw is None:
+        return None
+    if sig.resampled:
+        raw = np.interp(sig.raw_t_s, rec.t_s, raw)
+    return sig.filt.apply(raw)
+
+
+def sensor_steps(
+    torque: ChannelStep, sensor_nm: np.ndarray, model: AxisModel, sig: Signals, gear: bool = True
+) -> list[ChannelStep]:
+    """With a torque sensor on the output flange the torque channel splits in two: the gear's
+    (Kt x current - the flange's torque - the actuator's inertia x acceleration: friction, ripple)
+    and the load's (the flange's torque - the load's inertia x acceleration: gravity, a load torque,
+    an inertia error). ``gear``: False without a current (the load judged alone)."""
+    j_load = model.load_inertia_kgm2
+    j_gear = model.total_inertia_kgm2 - j_load
+    y_load = sensor_nm - j_load * sig.accel_rad_s2
+    steps = [
+        replace(
+            torque,
+            channel=LOAD,
+            y=y_load,
+            candidates=tuple(c for c in torque.candidates if not c.motor_side and not c.only_as_alternative),
+            torque_nm=sensor_nm,
+            torque_is_cause=True,
+        )
+    ]
+    if gear:
+        y_gear = sig.torque_f_nm - sensor_nm - j_gear * sig.accel_rad_s2
+        gear_candidates = tuple(c for c in torque.candidates if c.motor_side)
+        steps.insert(0, replace(torque, channel=GEAR, y=y_gear, candidates=gear_candidates, nominal_first=()))
+    return steps
+
+
 def _position_step(
     sig: Signals,
     model: AxisModel,
@@ -373,7 +419,10 @@ def _name(s: Selected, sig: Signals, index: np.ndarray, step: int, found: Findin
         found.ambiguities.append(Ambiguity(ch, a, b, dbic, separating_test(a, b), alt_params))
     for ft in s.fitted:
         alternatives = [amb.alternative for amb in found.ambiguities if ft.id in amb.chosen.split(" + ")]
-        found.effects.append(_effect(ft, alternatives, found.ambiguities))
+        effect = _effect(ft, alternatives, found.ambiguities)
+        if ch in SIDE_WORDS:  # an output torque sensor told the gear and the load apart
+            effect.label += SIDE_WORDS[ch]
+        found.effects.append(effect)
     chosen = {t.id for t in terms}
     for cand in sel.candidates:
         if cand.id in chosen or any(a.alternative == cand.id for a in found.ambiguities):

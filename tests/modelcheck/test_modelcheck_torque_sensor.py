@@ -1,0 +1,66 @@
+"""An output torque sensor (the optional ``torque`` column, N m on the output flange): with the current
+it tells what happens in the gear (Kt x current minus the flange's torque) from what the load does;
+without the current the load is judged on the sensor alone and the gear through the closed loop."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from modelcheck_gen import moves_for, record, trapezoid_moves
+
+from fha_studio.logic.modelcheck import run_modelcheck
+from fha_studio.physics import AxisModel, Effects
+from fha_studio.recording import Recording
+
+CODE = "FHA-25C-50-US250"
+
+
+@pytest.fixture(scope="module")
+def with_sensor():
+    """Coulomb friction 5 N m in the gear, a 20 N m unbalance at the load. The sensor reads the load's
+    inertia times the encoder's acceleration plus the unbalance, with 0.05 N m of noise."""
+    model = AxisModel.from_code(CODE, load_inertia_kgm2=1.5)
+    t, cmd = trapezoid_moves(moves_for(model), 1000.0)
+    effects = Effects().with_effect("coulomb_friction", torque_nm=5.0)
+    effects = effects.with_effect("gravity_load", amplitude_nm=20.0, phase_deg=30.0)
+    gen = record(model, effects, t, cmd, actuator_code=CODE)
+    channels = dict(gen.recording.channels)
+    p = np.radians(channels["pos"])
+    acc = np.zeros_like(p)
+    acc[1:-1] = (p[2:] - 2.0 * p[1:-1] + p[:-2]) / 1e-6
+    noise = np.random.default_rng(1).normal(0.0, 0.05, len(p))
+    channels["torque"] = model.load_inertia_kgm2 * acc + 20.0 * np.sin(p + math.radians(30.0)) + noise
+    return gen.recording.metadata, channels
+
+
+def _found(result) -> dict[str, tuple[str, dict[str, float]]]:
+    return {e.id: (e.label, e.params) for e in result.effects}
+
+
+@pytest.mark.slow
+def test_with_the_current_the_gear_and_the_load_are_told_apart(with_sensor):
+    meta, channels = with_sensor
+    result = run_modelcheck(Recording(meta, channels, "sensor"), resimulate=False)
+    found = _found(result)
+    assert set(found) == {"coulomb_friction", "gravity_load"}, result.summary_lines()
+    assert found["coulomb_friction"][0].endswith("in the gear")
+    assert found["gravity_load"][0].endswith("at the load")
+    assert found["coulomb_friction"][1]["torque_nm"] == pytest.approx(5.0, rel=0.05)
+    assert found["gravity_load"][1]["amplitude_nm"] == pytest.approx(20.0, rel=0.05)
+    assert {"gear torque", "load torque"} <= set(result.channel_status)
+
+
+@pytest.mark.slow
+def test_without_the_current_the_load_is_judged_on_the_sensor_alone(with_sensor):
+    meta, channels = with_sensor
+    channels = {k: v for k, v in channels.items() if k != "current"}
+    result = run_modelcheck(Recording(meta, channels, "sensor"), resimulate=False)
+    found = _found(result)
+    assert set(found) == {"coulomb_friction", "gravity_load"}, result.summary_lines()
+    assert found["gravity_load"][0].endswith("at the load")
+    assert found["gravity_load"][1]["amplitude_nm"] == pytest.approx(20.0, rel=0.05)  # measured
+    assert found["coulomb_friction"][1]["torque_nm"] == pytest.approx(5.0, rel=0.35)  # through the loop
+    text = "\n".join(result.summary_lines())
+    assert "the load on the torque sensor" in text and "the load's are measured" in text
