@@ -12,6 +12,7 @@ import pytest
 from corpus_readers import READERS
 
 from fha_studio.main import main as cli_main
+from tests.support.processes import Child
 
 CORPUS = Path(__file__).parent / "corpus"
 MANIFEST = tomllib.loads((CORPUS / "expected.toml").read_text(encoding="utf-8"))
@@ -82,9 +83,7 @@ sys.exit(main(sys.argv[1:]))
 
 
 @pytest.mark.parametrize("case", MANIFEST["killed"], ids=[c["output"] for c in MANIFEST["killed"]])
-def test_what_a_killed_write_left_is_gone_after_the_next_start(case, tmp_path):
-    import select
-    import signal
+def test_what_a_killed_write_left_is_gone_after_the_next_start(case, tmp_path, children):
     import subprocess
     import sys
 
@@ -94,16 +93,13 @@ def test_what_a_killed_write_left_is_gone_after_the_next_start(case, tmp_path):
         register.add_machine("M")
     args = [a.format(tmp=tmp_path) for a in case["args"]]
     env = {**os.environ, "PYTHONPATH": str(CORPUS.parents[1])}
-    writer = subprocess.Popen([sys.executable, "-c", KILLED_WRITER, *args], cwd=tmp_path,
-                              env={**env, "HOLD": case["output"]},
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    writer = children(Child.python, "-c", KILLED_WRITER, *args, cwd=tmp_path, env={"HOLD": case["output"]},
+                      text=True)
     try:
-        ready, _, _ = select.select([writer.stdout], [], [], 120)
-        assert ready and writer.stdout.readline() == "writing\n", writer.stderr.read()
+        assert writer.first_line("the killed writer", within_s=120) == "writing"
         (temporary,) = tmp_path.glob(f".{case['output']}.*.tmp")
     finally:
-        writer.send_signal(signal.SIGKILL)
-        writer.communicate(timeout=60)
+        writer.kill()
     assert not (tmp_path / case["output"]).exists()
     then = temporary.stat().st_mtime - 120  # the minute a start leaves a temporary for
     os.utime(temporary, (then, then))

@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import os
 import sqlite3
-import subprocess
-import sys
 import textwrap
 
 import pytest
@@ -16,6 +14,7 @@ import pytest
 from fha_studio.logic.register import Register, RegisterError
 from fha_studio.logic.register.check import check_register
 from fha_studio.main import main
+from tests.support.processes import Child
 from tests.support.read_only import ReadOnlyPlace
 
 
@@ -153,21 +152,18 @@ def test_a_damaged_register_takes_no_write_even_beside_the_damage(tmp_path):
     assert main(["register", "--register", str(path), "add-machine", "Press 8"]) == 2
 
 
-def test_a_locked_register_says_who_holds_it(tmp_path):
+def test_a_locked_register_says_who_holds_it(tmp_path, children):
     path = _filled(tmp_path / "r.sqlite")
-    holder = subprocess.Popen(
-        [sys.executable, "-c", textwrap.dedent("""
+    holder = children(Child.python, "-c", textwrap.dedent("""
             import sqlite3, sys
             db = sqlite3.connect(sys.argv[1], isolation_level=None)
             db.execute("BEGIN IMMEDIATE")
             db.execute("INSERT INTO machine (name, site, notes, created_utc) VALUES ('x', '', '', '')")
             print("holding", flush=True)
             sys.stdin.read()
-        """), str(path)],
-        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-    )
+        """), path, stdin=True, text=True)
     try:
-        assert holder.stdout.readline() == "holding\n"
+        assert holder.first_line("the register's holder") == "holding"
         with Register(path, busy_timeout_s=0.2) as reg, pytest.raises(RegisterError) as err:
             reg.add_machine("Press 8")
         message = str(err.value)
@@ -175,7 +171,7 @@ def test_a_locked_register_says_who_holds_it(tmp_path):
         assert f"(pid {holder.pid})" in message
         assert message.endswith("for more than 0.2 s: nothing was changed; try again when it is done")
     finally:
-        holder.communicate("")
+        holder.communicate(60, "")
     with Register(path) as reg:
         assert [m.name for m in reg.machines()] == ["Press 7"]
 

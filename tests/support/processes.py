@@ -15,8 +15,9 @@ import select
 import signal
 import subprocess
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -27,10 +28,12 @@ FIRST_LINE_S = 30.0
 
 
 class Child:
-    def __init__(self, *args: str | os.PathLike[str], stdin: bool = False, text: bool = False):
+    def __init__(self, *args: str | os.PathLike[str], stdin: bool = False, text: bool = False,
+                 cwd: Path = ROOT, env: Mapping[str, str] | None = None):
+        """Start ``args`` in ``cwd`` (the checkout) with the environment and ``env`` on top."""
         self.args = [str(a) for a in args]
         self.proc = subprocess.Popen(
-            self.args, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)},
+            self.args, cwd=cwd, env={**os.environ, "PYTHONPATH": str(ROOT), **(env or {})},
             stdin=subprocess.PIPE if stdin else None, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
             text=text,
         )
@@ -38,14 +41,14 @@ class Child:
         self.address = ""
 
     @classmethod
-    def fha(cls, *args: str | os.PathLike[str], stdin: bool = False, text: bool = False) -> Child:
-        """``fha-studio ARGS`` (``python -m fha_studio``)."""
-        return cls(sys.executable, "-m", "fha_studio", *args, stdin=stdin, text=text)
+    def fha(cls, *args: str | os.PathLike[str], **how: Any) -> Child:
+        """``fha-studio ARGS`` (``python -m fha_studio``); ``how``: as for ``Child``."""
+        return cls(sys.executable, "-m", "fha_studio", *args, **how)
 
     @classmethod
-    def python(cls, *args: str | os.PathLike[str], stdin: bool = False, text: bool = False) -> Child:
-        """``python ARGS``: a script, or ``-c`` and its program."""
-        return cls(sys.executable, *args, stdin=stdin, text=text)
+    def python(cls, *args: str | os.PathLike[str], **how: Any) -> Child:
+        """``python ARGS``: a script, or ``-c`` and its program; ``how``: as for ``Child``."""
+        return cls(sys.executable, *args, **how)
 
     @classmethod
     def sim(cls, eeprom: Path, *options: str, stdin: bool = False) -> Child:
@@ -97,9 +100,12 @@ class Child:
             printed = "ended without a line" if ended else f"printed nothing within {within_s:g} s"
         pytest.fail(f"{what} {printed} (exit code {self.proc.returncode}); on stderr: {said!r}")
 
-    def communicate(self, timeout: float) -> tuple[str | bytes, str | bytes]:
-        """Everything it prints until it ends by itself (within ``timeout``), stdout and stderr."""
-        return self.proc.communicate(timeout=timeout)
+    def communicate(
+        self, timeout: float, stdin: str | bytes | None = None
+    ) -> tuple[str | bytes, str | bytes]:
+        """Everything it prints until it ends by itself (within ``timeout``; ``stdin`` given to it
+        first, its stdin then closed), stdout and stderr."""
+        return self.proc.communicate(stdin, timeout=timeout)
 
     def kill(self) -> int:
         """SIGKILL (as a crash, a pulled plug) and wait; its pipes stay open until ``stop``."""
