@@ -40,6 +40,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             q.set_defaults(func=run_measure)
         else:
             q.add_argument("--aim", choices=("stiff", "standard", "soft"), default="standard")
+            q.add_argument("--apply", action="store_true",
+                           help="back the drive's items up, write the proposed tune items (verified), "
+                           "then measure again and move 90 deg")
+            q.add_argument("--backup", metavar="PATH",
+                           help="where --apply saves the backup "
+                           "(default: fha-tune-backup-<UTC time>.toml here)")
             q.set_defaults(func=run_propose)
 
 
@@ -100,18 +106,63 @@ def run_measure(args: argparse.Namespace) -> int:
 def run_propose(args: argparse.Namespace) -> int:
     from fha_studio.hardware.client import DriveClient
     from fha_studio.hardware.parameters import load_parameter_model
+    from fha_studio.logic.tuning.measure import NotExcitable, check_excitable
     from fha_studio.logic.tuning.session import tuner_for
 
     model = _model(args)
     parameters = load_parameter_model("HA-655")
     with DriveClient.open(args.url) as client:
+        if args.apply:
+            try:
+                check_excitable(client)
+            except NotExcitable as exc:
+                print(f"fha-studio tune propose: {exc}", file=sys.stderr)
+                return EXIT_NOT_EXCITABLE
         tuner = tuner_for(client, parameters, model)
-    proposal = tuner.propose(args.aim)
-    result: dict[str, Any] = {"aim": proposal.aim, "used_aim": proposal.used_aim, "warning": proposal.warning,
-                              "present": proposal.present.to_dict(), "proposed": proposal.proposed.to_dict()}
-    if proposal.warning:
-        print(f"warning: {proposal.warning}", file=sys.stderr)
+        proposal = tuner.propose(args.aim)
+        result: dict[str, Any] = {"aim": proposal.aim, "used_aim": proposal.used_aim,
+                                  "warning": proposal.warning, "present": proposal.present.to_dict(),
+                                  "proposed": proposal.proposed.to_dict()}
+        if proposal.warning:
+            print(f"warning: {proposal.warning}", file=sys.stderr)
+        if args.apply:
+            result["measured"] = _apply(args, client, parameters, tuner, proposal)
     items = ", ".join(f"{k} {v}" for k, v in proposal.proposed.items.items())
     _emit(args, result, f"proposed ({proposal.used_aim}): {items}; gain margin "
           f"{proposal.proposed.gain_margin_db}, phase margin {proposal.proposed.phase_margin_deg}")
     return 0
+
+
+def _apply(args: argparse.Namespace, client: Any, parameters: Any, tuner: Any,
+           proposal: Any) -> dict[str, Any]:
+    """Backup, verified writes, then the same figures measured: margins from a new frequency
+    response, overshoot and settling from a 90 deg move."""
+    from pathlib import Path
+
+    from fha_studio import clock
+    from fha_studio.logic.tuning.move import MoveAlarm
+    from fha_studio.logic.tuning.session import (
+        backup_parameters,
+        measure_report,
+        tuner_for,
+        verify_move,
+        write_tune_items,
+    )
+
+    stamp = clock.now_utc().strftime("%Y%m%dT%H%M%SZ")
+    path = Path(args.backup) if args.backup else Path(f"fha-tune-backup-{stamp}.toml")
+    try:
+        backup_parameters(client, parameters, args.actuator, path)
+        print(f"backup of the drive's items: {path}", file=sys.stderr)
+        write_tune_items(client, parameters, proposal.proposed.items)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    after = tuner_for(client, parameters, tuner.model)
+    report = measure_report(client, after, time.sleep, time.monotonic)
+    measured: dict[str, Any] = {**proposal.proposed.items, "gain_margin_db": report["gain_margin_db"],
+                                "phase_margin_deg": report["phase_margin_deg"], "backup": str(path)}
+    try:
+        measured.update(verify_move(client, parameters, after, time.sleep).to_dict())
+    except MoveAlarm as exc:
+        measured.update({"overshoot_pct": None, "settling_ms": None, "alarm": exc.code})
+    return measured

@@ -23,6 +23,7 @@ sqrt(K1 / J_load) and resonance sqrt(K1 x (1/J_motor + 1/J_load)), in Hz.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -63,6 +64,41 @@ def _ss(a: Any, b: Any, c: Any, d: Any, dt: float) -> Any:
     return control.ss(np.atleast_2d(a), np.atleast_2d(b), np.atleast_2d(c), np.atleast_2d(d), dt)
 
 
+@functools.lru_cache(maxsize=64)
+def _discrete_plant(model: AxisModel, servo_rate_hz: float) -> Any:
+    """Current (A) held over a period -> [motor-side speed at the start of the period, mean
+    motor-side speed over the period (position change / dt), speed at its end, the current
+    itself, the gear's torque at K1]. States: the
+    speeds and the twist (positions do not act on the dynamics, so no integrator is hidden)."""
+    # the plant does not depend on the gains: ServoSettings' defaults at this rate
+    p = kernel_params(model, ServoSettings(servo_rate_hz=servo_rate_hz))
+    if p.compliant:
+        jm, jl, k, c = p.jm, p.jl, p.k1, p.damping
+        # states [xm, vm, twist, vl]; xm only to read its change over the period
+        a = np.array([[0, 1, 0, 0],
+                      [0, -c / jm, -k / jm, c / jm],
+                      [0, 1, 0, -1],
+                      [0, c / jl, k / jl, -c / jl]], float)
+        b = np.array([[0], [p.kt / jm], [0], [0]], float)
+    else:
+        a = np.array([[0, 1], [0, 0]], float)
+        b = np.array([[0], [p.kt / p.j_total]], float)
+    n = a.shape[0]
+    disc = control.c2d(control.ss(a, b, np.eye(n), np.zeros((n, 1))), p.dt, method="zoh")
+    phi, gamma = np.asarray(disc.A), np.asarray(disc.B)
+    keep = list(range(1, n))  # the speed states (and twist)
+    ad, bd = phi[np.ix_(keep, keep)], gamma[keep, :]
+    start = np.zeros((1, n - 1))
+    start[0, 0] = 1.0
+    mean = phi[[0], :][:, keep] / p.dt
+    spring = np.zeros((1, n - 1))
+    if p.compliant:
+        spring[0, 1] = p.k1  # the gear's torque at K1 (for the excitation's bound)
+    c_out = np.vstack([start, mean, ad[[0], :], np.zeros((1, n - 1)), spring])
+    d_out = np.vstack([[[0.0]], gamma[[0], :] / p.dt, bd[[0], :], [[1.0]], [[0.0]]])
+    return control.ss(ad, bd, c_out, d_out, p.dt)
+
+
 @dataclass(frozen=True)
 class LoopModel:
     """The linearised loops of one axis at one set of servo settings (discrete, servo period)."""
@@ -76,36 +112,9 @@ class LoopModel:
 
     # ----- building blocks ----------------------------------------------------------------------
     def _plant(self) -> Any:
-        """Current (A) held over a period -> [motor-side speed at the start of the period, mean
-        motor-side speed over the period (position change / dt), speed at its end, the current
-        itself, the gear's torque at K1]. States: the
-        speeds and the twist (positions do not act on the dynamics, so no integrator is hidden)."""
-        p = kernel_params(self.model, self.settings)
-        if p.compliant:
-            jm, jl, k, c = p.jm, p.jl, p.k1, p.damping
-            # states [xm, vm, twist, vl]; xm only to read its change over the period
-            a = np.array([[0, 1, 0, 0],
-                          [0, -c / jm, -k / jm, c / jm],
-                          [0, 1, 0, -1],
-                          [0, c / jl, k / jl, -c / jl]], float)
-            b = np.array([[0], [p.kt / jm], [0], [0]], float)
-        else:
-            a = np.array([[0, 1], [0, 0]], float)
-            b = np.array([[0], [p.kt / p.j_total]], float)
-        n = a.shape[0]
-        disc = control.c2d(control.ss(a, b, np.eye(n), np.zeros((n, 1))), p.dt, method="zoh")
-        phi, gamma = np.asarray(disc.A), np.asarray(disc.B)
-        keep = list(range(1, n))  # the speed states (and twist)
-        ad, bd = phi[np.ix_(keep, keep)], gamma[keep, :]
-        start = np.zeros((1, n - 1))
-        start[0, 0] = 1.0
-        mean = phi[[0], :][:, keep] / p.dt
-        spring = np.zeros((1, n - 1))
-        if p.compliant:
-            spring[0, 1] = p.k1  # the gear's torque at K1 (for the excitation's bound)
-        c_out = np.vstack([start, mean, ad[[0], :], np.zeros((1, n - 1)), spring])
-        d_out = np.vstack([[[0.0]], gamma[[0], :] / p.dt, bd[[0], :], [[1.0]], [[0.0]]])
-        return control.ss(ad, bd, c_out, d_out, p.dt)
+        return _discrete_plant(self.model, self.settings.servo_rate_hz)
+
+
 
     def _feedback_selector(self) -> Any:
         """Plant outputs -> the speed the loop sees: the speed at the start of the period, or with
@@ -173,6 +182,22 @@ class LoopModel:
         resp = control.frequency_response(sys, TWO_PI * np.asarray(freq_hz, float))
         h = np.asarray(resp.complex).reshape(-1)
         return 20.0 * np.log10(np.abs(h)), np.degrees(np.unwrap(np.angle(h)))
+
+    def quantisation_current_noise_a(self) -> float:
+        """Standard deviation of the current that the encoder's quantisation makes through the
+        speed loop (A): the pulse difference per period has the variance q^2/6 of two uniform
+        rounding errors, the speed filter passes alpha/(2 - alpha) of it, Kv amplifies it. 0 with
+        ideal feedback."""
+        p = kernel_params(self.model, self.settings)
+        if p.pulse_rad <= 0.0:
+            return 0.0
+        alpha = p.speed_filter_alpha
+        return p.kv * p.pulse_rad / p.dt * math.sqrt(alpha / (2.0 - alpha) / 6.0)
+
+    def current_per_position_pulse_a(self) -> float:
+        """Current (A) one encoder pulse of position error asks for (Kv x Kp x pulse)."""
+        p = kernel_params(self.model, self.settings)
+        return p.kv * p.kp * self.model.output_pulse_rad
 
     def stable(self) -> bool:
         """True when the closed speed and position loops are stable."""

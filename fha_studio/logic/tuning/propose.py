@@ -5,10 +5,12 @@ Hz), speed loop integral compensation (Tv, ms), position loop gain (Kp, 1/s), fe
 (%). Their meaning in SI is the simulated drive's mapping (``hardware.sim.axis.servo_settings``);
 the proposal searches integer panel values:
 
-1. Kv and Tv: the highest speed loop gain whose loop meets the aim's gain and phase margin, for
+1. Kv and Tv: the highest speed loop gain whose loop meets the aim's gain and phase margin and
+   whose current from the encoder's quantisation stays within ``NOISE_SHARE``, for
    Tv at 1, 2 or 4 x the conventional 4 / (2 pi f) (the present Tv is tried as well);
 2. Kp: of a few position loop gains from a quarter of the present one up to the item's maximum,
-   the one whose position step settles soonest while overshooting at most ``MAX_OVERSHOOT_PCT``;
+   the one whose position step settles soonest while overshooting at most ``MAX_OVERSHOOT_PCT``
+   and asking at most ``PULSE_CURRENT_SHARE`` of the current for one pulse of position error;
 3. feed-forward stays as it is.
 
 Beyond FHA-C manual 2-1's allowance (a load inertia of more than ``ALLOWED_LOAD_RATIO`` times the
@@ -36,11 +38,17 @@ TUNE_KEYS = ("speed_loop_gain", "speed_loop_integral_compensation", "position_lo
 ALLOWED_LOAD_RATIO = 3.0
 #: gain margin (dB), phase margin (deg) by aim; "standard" are common targets of servo tuning
 AIMS: dict[str, tuple[float, float]] = {"stiff": (6.0, 35.0), "standard": (8.0, 45.0), "soft": (12.0, 60.0)}
+#: the encoder's quantisation may make a current of at most this share of the maximum (standard
+#: deviation): a speed loop gain above it turns the encoder's steps into a current that saturates
+NOISE_SHARE = 0.25
+#: one encoder pulse of position error may ask for at most this share of the maximum current
+#: (Kv x Kp x pulse): above it the axis dithers between pulses instead of settling
+PULSE_CURRENT_SHARE = 0.05
 #: the most a proposed position step may overshoot (%)
 MAX_OVERSHOOT_PCT = 5.0
 #: 2 % band for the settling time
 SETTLING_BAND = 0.02
-STEP_DURATION_S = 1.0
+STEP_DURATION_S = 0.6
 
 
 @dataclass(frozen=True)
@@ -153,9 +161,10 @@ class Tuner:
 
             def ok(f: int, tv_for: object = tv_for) -> bool:
                 tv = tv_for(f)  # type: ignore[operator]
-                _lm, figs, stable = self.speed_figures({"speed_loop_gain": f,
-                                                        "speed_loop_integral_compensation": tv})
-                return bool(stable and figs is not None and figs.phase_margin_deg is not None
+                lm, figs, stable = self.speed_figures({"speed_loop_gain": f,
+                                                       "speed_loop_integral_compensation": tv})
+                noise = lm.quantisation_current_noise_a() <= NOISE_SHARE * self.model.max_current_a
+                return bool(stable and figs is not None and noise and figs.phase_margin_deg is not None
                             and figs.phase_margin_deg >= pm
                             and (figs.gain_margin_db is None or figs.gain_margin_db >= gm))
 
@@ -173,6 +182,8 @@ class Tuner:
         kp, best_settling = present_kp, math.inf
         for candidate in candidates:
             lm = self.loop({**speed, "position_loop_gain": candidate})
+            if lm.current_per_position_pulse_a() > PULSE_CURRENT_SHARE * self.model.max_current_a:
+                continue
             try:
                 if not lm.stable():
                     continue

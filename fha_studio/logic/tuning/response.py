@@ -216,3 +216,23 @@ def loop_figures(open_loop: Any, closed_loop: Any, f_max_hz: float, f_min_hz: fl
         crossover_hz=float(wp) / TWO_PI if wp is not None and math.isfinite(wp) and wp > 0 else None,
         bandwidth_hz=bw_hz,
     )
+
+
+def measured_loop_figures(open_loop: Any, plant_model: Any, plant: FrequencyResponse) -> LoopFigures:
+    """Margins and crossover of the loop with the plant as measured: the model's loop gain times
+    measured / modelled plant at the trusted bins (the controller and the feedback are the drive's
+    own, known parts), then python-control's margins on that frequency response."""
+    ok = plant.trusted()
+    w = TWO_PI * plant.freq_hz[ok]
+    if len(w) < 3:
+        return LoopFigures(None, None, None, None)
+    model_l = np.asarray(control.frequency_response(control.tf(open_loop), w).complex).reshape(-1)
+    model_p = np.asarray(control.frequency_response(control.tf(plant_model), w).complex).reshape(-1)
+    measured = model_l * plant.complex[ok] / model_p
+    gm, pm, _sm, _wg, wp, _ws = control.stability_margins(control.frd(measured, w))
+    return LoopFigures(
+        gain_margin_db=20.0 * math.log10(gm) if gm is not None and math.isfinite(gm) and gm > 0 else None,
+        phase_margin_deg=float(pm) if pm is not None and math.isfinite(pm) else None,
+        crossover_hz=float(wp) / TWO_PI if wp is not None and math.isfinite(wp) and wp > 0 else None,
+        bandwidth_hz=None,
+    )

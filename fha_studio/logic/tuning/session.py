@@ -2,21 +2,30 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from fha_studio.hardware.parameters import Mode, ParameterModel
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
-from fha_studio.logic.tuning.excitation import plan_excitation
+from fha_studio.logic.drive_session import WriteEntry, read_parameters, write_parameters
+from fha_studio.logic.paramfile import dump_parameter_file
+from fha_studio.logic.tuning.excitation import RPM, plan_excitation
 from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
 from fha_studio.logic.tuning.measure import measure
+from fha_studio.logic.tuning.move import MoveFigures, measure_move
 from fha_studio.logic.tuning.propose import TUNE_KEYS, Tuner
 from fha_studio.logic.tuning.response import (
     estimate_response,
     fit_two_mass,
     loop_figures,
+    measured_loop_figures,
 )
 from fha_studio.physics import AxisModel, Effects
+
+#: the verification move of a tuning (issue 25: "settle a 90 deg move")
+VERIFY_MOVE_DEG = 90.0
 
 
 def declared_model(actuator: str, load_inertia_kgm2: float) -> AxisModel:
@@ -55,6 +64,7 @@ def measure_report(client: Any, tuner: Tuner, wait: Callable[[float], None], now
     plant = estimate_response(records.plant(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
     fit = fit_two_mass(plant, records.sample_rate_hz)
     figures = loop_figures(lm.speed_open_loop(), lm.speed_closed_loop(), 0.49 * tuner.servo_rate_hz)
+    measured = measured_loop_figures(lm.speed_open_loop(), lm.plant(), plant)
     predicted = two_mass_prediction(tuner.model)
     own = tuner.model.actuator_inertia_kgm2
     return {
@@ -63,10 +73,12 @@ def measure_report(client: Any, tuner: Tuner, wait: Callable[[float], None], now
         "predicted_resonance_hz": predicted.resonance_hz,
         "predicted_antiresonance_hz": predicted.antiresonance_hz,
         "load_inertia_estimate_kgm2": None if fit is None else fit.total_inertia_kgm2 - own,
-        "gain_margin_db": figures.gain_margin_db,
-        "phase_margin_deg": figures.phase_margin_deg,
-        "crossover_hz": figures.crossover_hz,
-        "bandwidth_hz": figures.bandwidth_hz,
+        "gain_margin_db": measured.gain_margin_db,
+        "phase_margin_deg": measured.phase_margin_deg,
+        "crossover_hz": measured.crossover_hz,
+        "predicted": {"gain_margin_db": figures.gain_margin_db, "phase_margin_deg": figures.phase_margin_deg,
+                      "crossover_hz": figures.crossover_hz, "bandwidth_hz": figures.bandwidth_hz},
+        "bandwidth_hz": _bandwidth(closed),
         "excitation": {"amplitude_rpm": plan.amplitude_rpm, "travel_bound_deg": plan.travel_bound_deg,
                        "travel_limit_deg": plan.travel_limit_deg, "hold_periods": plan.hold_periods,
                        "records": plan.records},
@@ -76,13 +88,60 @@ def measure_report(client: Any, tuner: Tuner, wait: Callable[[float], None], now
     }
 
 
-def write_items(client: Any, parameters: ParameterModel, items: dict[str, int]) -> None:
-    """Write tune items and read each back (a verified write)."""
-    for key, value in items.items():
+def _bandwidth(closed: Any) -> float | None:
+    """The -3 dB frequency of the measured closed loop (first trusted bin below it)."""
+    mag, f, ok = closed.magnitude_db, closed.freq_hz, closed.trusted()
+    below = [i for i in range(len(f)) if ok[i] and mag[i] < mag[0] - 3.0103]
+    return float(f[below[0]]) if below else None
+
+
+def backup_parameters(client: Any, parameters: ParameterModel, actuator: str, path: Path) -> Path:
+    """Read every writable tune and parameter-mode item and save them as a parameter file (the
+    backup every write is preceded by). Raises ValueError when an item cannot be read."""
+    keys = [(item.mode, item.number) for item in parameters
+            if item.mode in (Mode.TUNE, Mode.SYSTEM) and item.writable]
+    readout = read_parameters(client, keys)
+    if readout.errors:
+        (mode, number), why = next(iter(readout.errors.items()))
+        raise ValueError(f"backup: {mode} item {number} could not be read ({why}): nothing written")
+    identity = client.identify()
+    driver = identity.driver_model if identity is not None else parameters.driver
+    text = dump_parameter_file(parameters, dict(readout.values.items()), actuator, driver)
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def write_tune_items(client: Any, parameters: ParameterModel, items: dict[str, int]) -> list[WriteEntry]:
+    """Write the tune items, each verified by read-back (the parameter write path); ValueError
+    naming the first that did not verify."""
+    writes = []
+    for key in TUNE_KEYS:
         item = parameters.by_key(key)
-        if item.mode is not Mode.TUNE:
-            continue
-        client.write_parameter(item.mode, item.number, int(value))
-        back = int(client.read_parameter(item.mode, item.number))
-        if back != int(value):
-            raise ValueError(f"tune item {key}: wrote {value}, the drive reads back {back}")
+        writes.append((item.mode, item.number, int(items[key])))
+    entries = write_parameters(client, writes)
+    for entry in entries:
+        if not entry.get("verified"):
+            item = parameters.item(entry["mode"], entry["number"])
+            raise ValueError(f"tune item {item.key}: {entry.get('error') or 'not verified'}")
+    return entries
+
+
+def verify_move(client: Any, parameters: ParameterModel, tuner: Tuner, wait: Callable[[float], None],
+                angle_deg: float = VERIFY_MOVE_DEG) -> MoveFigures:
+    """A 90 deg move at half the maximum speed, measured through the trace, at an acceleration
+    the axis can follow: at most half the torque-limited TM / (J_A + J_L) (FHA-C manual 2-4-4),
+    the test item "JOG acceleration" lowered for the move and put back after it (a faster profile
+    than the motor's torque makes every tuning overshoot: that is the profile, not the loop)."""
+    speed = 0.5 * (tuner.model.max_speed_rpm or 10.0)
+    accel_item = parameters.by_key("jog_acceleration")
+    present = int(client.read_parameter(accel_item.mode, accel_item.number))
+    followable = max(accel_item.minimum, math.floor(0.5 * tuner.model.max_acceleration_rad_s2() / RPM))
+    lowered = followable < present
+    if lowered:
+        client.write_parameter(accel_item.mode, accel_item.number, followable)
+    try:
+        return measure_move(client, angle_deg, speed, tuner.servo_rate_hz, tuner.model.output_resolution_ppr,
+                            tuner.items["in_position_range"], wait)
+    finally:
+        if lowered:
+            client.write_parameter(accel_item.mode, accel_item.number, present)
