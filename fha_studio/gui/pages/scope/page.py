@@ -54,6 +54,9 @@ class ScopePage(BasePage):
         self.view.plots.addTab(self.bench, "Bench")
         self._host = main_window
         self.bench.sigChecks.connect(self._bench_checks)
+        # its stream on the Time plot too, beside the CN3 channels
+        self.bench.source.sigRows.connect(self._bench_on_time_plot)
+        self.bench.source.sigStarted.connect(lambda _s: self.view.time_plot.set_bench_curves({}))
         self._bench_axis()
         # the axis's actuator, driver and load decide the scaling and what is recorded, at every moment
         state = self.state
@@ -95,6 +98,19 @@ class ScopePage(BasePage):
         self.bench.set_axis(int(counts or 0), DriveSettings.from_values(values))
         direction = state.value_of("system", 8)  # rotary direction, read or entered from the panel
         self.bench.parameter_8 = int(direction) if direction is not None else None
+
+    def _bench_on_time_plot(self, _rows) -> None:
+        """The newest bench rows on the Time plot while its live view runs (time before now)."""
+        from .bench_overlay import COLORS, bench_traces
+
+        started = self.bench.source.started
+        plot = self.view.time_plot
+        if started is None or not plot.live:
+            return
+        span = self.view.toolbar.time_base_s()
+        rows = started.ring.window(int(span * started.row_rate_hz))
+        plot.set_bench_curves(bench_traces(started, rows, self.bench.counts_per_output_turn,
+                                           max(200, plot.plot.width())), COLORS)
 
     def _bench_checks(self, checks: list) -> None:
         """A move's checks from CN2 go to the DGR checks page's record (and so into the report)."""

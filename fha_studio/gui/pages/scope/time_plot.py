@@ -87,6 +87,12 @@ class TimePlot(QWidget):
         self._live_span: float | None = None
         self.autoscale = True
         self._legend_entries: list[str] = []  # the shown channels, as rich text
+        self._note = ""
+        self._shown: tuple | None = None  # what set_curves was given last
+        # a bench instrument's traces beside CN3's (label -> curve, its plot), their units and legend
+        self._bench: dict[str, tuple[pg.PlotDataItem, pg.PlotItem]] = {}
+        self._bench_units: list[str] = []
+        self._bench_entries: list[str] = []
         self._still_grid = False
         self._set_units([""])
 
@@ -173,12 +179,13 @@ class TimePlot(QWidget):
         """One curve per visible channel, in the plot of its unit, named in the legend with its
         unit and scale; ``live`` switches the time axis to "before now" and the y range to
         ``autoscale`` with hysteresis. ``note`` goes after the legend (what is shown, and why)."""
+        self._shown = (channels, visible, scale, color, live, note)
         live_changed = live != self._live
         if live_changed:
             self._live = live
             self._x_offset, self._live_span = 0.0, None
         shown = [c for c in channels if visible.get(c.key, True)]
-        units = list(dict.fromkeys(c.unit for c in shown)) or [""]
+        units = list(dict.fromkeys([c.unit for c in shown] + self._bench_units)) or [""]
         for plot in self._plots:
             for key in plot.keys:
                 curve = self._curves.get(key)
@@ -214,7 +221,8 @@ class TimePlot(QWidget):
 
     def set_note(self, note: str) -> None:
         """The line under the legend: what the plots show, and why."""
-        entries = self._legend_entries
+        self._note = note
+        entries = self._legend_entries + self._bench_entries
         text = " &nbsp; ".join(entries) if entries else "No channel ticked: tick one in the table."
         if note:
             text += f"<br><span style='color:#555'>{html.escape(note)}</span>"
@@ -378,6 +386,42 @@ class TimePlot(QWidget):
     @property
     def live(self) -> bool:
         return self._live
+
+    def set_bench_curves(self, traces: Mapping[str, tuple[str, np.ndarray, np.ndarray]],
+                         colors: Sequence[str] = ("#555555",)) -> None:
+        """A bench instrument's traces beside CN3's: label (with its source) -> (unit, time
+        before now [s], values), each on the plot of its unit (one is added for a unit no CN3
+        channel has), drawn as the live view draws (time before now). Empty: none."""
+        units = list(dict.fromkeys(unit for unit, _t, _v in traces.values()))
+        if units != self._bench_units:
+            self._bench_units = units
+            if self._shown is not None:  # CN3's curves again, in the plots of both
+                channels, visible, scale, color, live, _note = self._shown
+                self.set_curves(channels, visible, scale, color, live, self._note)
+            else:
+                self._set_units(units or [""])
+        items = {p.unit: p for p in self._plots}
+        current = {p.item for p in self._plots}
+        for label in [k for k, (_c, item) in self._bench.items() if k not in traces or item not in current]:
+            curve, item = self._bench.pop(label)
+            if item in current:
+                item.removeItem(curve)
+        entries = []
+        for i, (label, (unit, t, values)) in enumerate(traces.items()):
+            plot = items[unit]
+            color = colors[i % len(colors)]
+            known = self._bench.get(label)
+            if known is None or known[1] is not plot.item:
+                curve = plot.item.plot(pen=pg.mkPen(color, width=1, style=Qt.PenStyle.DashLine))
+                self._bench[label] = (curve, plot.item)
+            self._bench[label][0].setData(t, values)
+            if len(values) and not plot.keys and self.autoscale:  # a plot of bench traces only
+                self._follow_y(plot, float(np.min(values)), float(np.max(values)))
+            entries.append(f"<span style='color:{color}; font-weight:bold'>╌╌</span>&nbsp;"
+                           f"{html.escape(label)}")
+        if entries != self._bench_entries:
+            self._bench_entries = entries
+            self.set_note(self._note)
 
     def cursor_times(self) -> tuple[float, float]:
         """The cursors' times in the data's own time [s]."""

@@ -1,0 +1,44 @@
+"""A bench instrument's stream on the scope's Time plot beside the CN3 channels, each trace named
+with its source: on the documented profile the sim-cn2 encoder counts in output degrees share the
+plot of CN3's positions while the CN3 live view runs."""
+
+from __future__ import annotations
+
+import pytest
+
+CODE = "FHA-25C-50-S248"  # absolute: CN3 gives the position (DGR) while the servo is off
+URL = f"sim://{CODE}?paced=0&profile=documented"
+
+
+@pytest.fixture
+def window(make_window, qtbot):
+    w = make_window(connect=URL)
+    w.state.set_actuator(CODE, acknowledged=True)
+    return w
+
+
+def test_bench_traces_are_drawn_beside_cn3s_named_with_their_source(window, qtbot):
+    page = window.show_page("scope")
+    view, bench = page.view, page.bench
+    view.start_live()
+    qtbot.waitUntil(lambda: view.time_plot.live, timeout=10000)
+    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
+        bench.scan()
+    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
+        bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,IN_POS,SPD_MON", "100k", "ENC_A,ENC_B")
+    label = "bench sim-cn2: ENC_A/ENC_B position (output) [deg]"
+    plot = view.time_plot
+    qtbot.waitUntil(lambda: label in plot._bench and plot._bench[label][0].getData()[0] is not None,
+                    timeout=10000)
+    curve, item = plot._bench[label]
+    t, _y = curve.getData()
+    assert len(t) > 10 and t[-1] == 0.0 and t[0] < 0  # time before now, as the live view draws
+    units = {p.unit: p.item for p in plot._plots}
+    assert item is units["deg"]
+    assert next(p.keys for p in plot._plots if p.unit == "deg")  # CN3's position on the same plot
+    assert {"bench sim-cn2: SPD_MON [V]", "bench sim-cn2: IN_POS [bit]"} <= set(plot._bench)
+    assert "V" in units and "bench sim-cn2: SPD_MON [V]" in plot.legend.text()
+    assert label in plot.legend.text()
+    with qtbot.waitSignal(bench.source.sigStopped, timeout=10000):
+        bench.start_button.click()
+    view.stop_live()
