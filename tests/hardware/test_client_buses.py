@@ -207,3 +207,26 @@ def test_refusals_say_what_was_refused_in_the_same_words_on_every_bus(drive):
 def test_arguments_are_refused_before_anything_is_sent_in_the_same_words(drive, call, said):
     with pytest.raises(ValueError, match=exactly(said)):
         call(drive)
+
+
+def test_every_item_of_a_mode_is_read_at_once(drive):
+    values = drive.read_all_parameters(Mode.TUNE)
+    assert set(values) == {item.number for item in drive.model.in_mode(Mode.TUNE)}
+    assert all(isinstance(v, int) for v in values.values())
+
+
+def test_the_multi_turn_data_is_not_cleared_with_the_servo_on(drive):
+    drive.servo(True)
+    with pytest.raises(CommandRejected, match=exactly(rejected_text(Command.OWW))):
+        drive.clear_multiturn()
+    drive.servo(False)
+    with pytest.raises(CommandRejected, match=exactly(rejected_text(Command.MOV))):
+        drive.move_by(5.0)  # and no move with it off
+
+
+def test_the_sensors_of_an_actuator_without_option_l_stay_where_they_are(drive):
+    angles = drive.sensor_angles()
+    assert set(angles) == {"origin", "ls1", "ls2"}
+    with pytest.raises(CommandRejected, match=exactly(rejected_text(Command.SNO))):
+        drive.set_sensor_angle("origin", 10.0)
+    assert drive.sensor_angles() == angles
