@@ -157,3 +157,22 @@ def test_probe_a_documented_sim_in_another_process_and_switch_its_servo(tmp_path
         with pytest.raises(ServoOnRefused), DriveClient.open(path) as client:
             client.absolute_position()
     assert sim.returncode == 0
+
+
+def test_the_tests_drive_of_the_manual_answers_as_this_profile_does(make_drive):
+    """tests/support's DocumentedDrive (no axis behind it) and this profile give the same answer
+    to every command, with the servo off and on; a reply that comes later is "later"."""
+    from fha_studio.hardware.protocol import decode_request
+    from tests.support.documented import DocumentedDrive
+
+    drive = make_drive("FHA-25C-50-S248", profile="documented")
+    stand_in = DocumentedDrive()
+    commands = ["DGR", "OWW", "OWW", *sorted(EXTENSION_COMMANDS), "ZZZ"]
+    for servo_on in (False, True):
+        drive.set_servo(servo_on)
+        stand_in.servo_on = servo_on
+        for command in commands:
+            _, request = decode_request(f"{command}+00000\r".encode())
+            ours, its = responder(drive).respond(request), stand_in.answer(request, 0.0)
+            answers = (ours.terminal if ours else "later", its.status if its else "later")
+            assert answers[0] == answers[1], (command, f"servo {'on' if servo_on else 'off'}", answers)
