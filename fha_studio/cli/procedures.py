@@ -53,7 +53,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     report = sub.add_parser("report", help="write the commissioning report of a session as HTML")
     report.add_argument("session", type=Path)
     report.add_argument("-o", "--output", type=output_path, help="HTML file (default: beside the session)")
-    report.add_argument("--sign", metavar="NAME", type=text, help="sign it (refused while checks are open)")
+    report.add_argument("--sign", metavar="NAME", type=text, help="sign it (refused while checks are open): "
+                        "with NAME's key when the register has one (fha-studio register keys add)")
+    report.add_argument("--key-file", type=Path, metavar="PATH",
+                        help="the signer's private key (default: NAME's in the user data directory)")
+    report.add_argument("--register", metavar="FILE", help="the register that keeps the signers' keys "
+                        "(default: as for fha-studio register)")
     report.set_defaults(func=_report)
 
 
@@ -241,15 +246,49 @@ def _report(args) -> int:
     from fha_studio.logic.procedures.report import SignError, build_report, render_html, sign
 
     session = _load_session(args.session)
-    if args.sign:
-        try:
-            sign(session, args.sign)
-        except SignError as exc:
-            raise CliError(str(exc)) from None
-    report = build_report(session)
     output = Path(args.output) if args.output else args.session.with_suffix(".html")
-    fileio.write_text(output, render_html(report))
+    if args.key_file and not args.sign:
+        raise CliError("--key-file signs a report: give --sign NAME too")
+    if args.sign and _sign_with_key(args, session, output):
+        report = build_report(session)
+    else:
+        if args.sign:
+            try:
+                sign(session, args.sign)
+            except SignError as exc:
+                raise CliError(str(exc)) from None
+            print(f"note: signed by name only: {args.sign} has no signing key in the register "
+                  "(fha-studio register keys add --name NAME makes one)", file=sys.stderr)
+        report = build_report(session)
+        fileio.write_text(output, render_html(report))
     print(f"{output}  ({len(report.warnings)} open warning(s))")
     for warning in report.warnings:
         print(f"  - {warning}", file=sys.stderr)
     return 0
+
+
+def _sign_with_key(args, session, output: Path) -> bool:
+    """Sign and write the report with the signer's key; False when the signer has none (then the
+    report is signed by name only). Everything that can be refused is refused before a write."""
+    from fha_studio.cli._register_signing import passphrase
+    from fha_studio.logic.procedures.report import SignError
+    from fha_studio.logic.register import Register, RegisterError, default_register_path
+    from fha_studio.logic.register.report_signing import private_key_file_for, sign_report_file
+    from fha_studio.logic.register.signing import SigningError, key_file_encrypted, load_private_key
+
+    path = default_register_path(args.register)
+    if not args.key_file and not path.exists():
+        return False
+    try:
+        with Register(path, create=False) as reg:
+            key_file = args.key_file.expanduser() if args.key_file else private_key_file_for(reg, args.sign)
+            if key_file is None:
+                return False
+            secret = passphrase(f"Passphrase of {key_file}: ") if key_file_encrypted(key_file) else ""
+            key = load_private_key(key_file, secret)
+            signed = sign_report_file(reg, session, args.sign, key, output)
+    except (RegisterError, SigningError, SignError) as exc:
+        raise CliError(str(exc)) from None
+    print(f"signed by {signed.signer} with key {signed.key_id} (SHA-256 {signed.sha256}); "
+          f"check it: fha-studio register verify {output}", file=sys.stderr)
+    return True

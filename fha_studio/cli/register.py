@@ -11,6 +11,8 @@
 - ``export [--machine M] [-o FILE]``: everything as JSON.
 - ``check``: SQLite's integrity check, and what a damaged register still holds.
 - ``add-machine NAME``, ``add-axis MACHINE/AXIS``, ``import FILE... --machine M``: fill it.
+- ``keys add --name PERSON [--key-file PATH]``, ``keys list``: each person's signing key;
+  ``verify REPORT``: is the report the one that was signed, and by whom (exit 0, else 5).
 
 Every action takes ``--json``. The register is ``--register FILE``, else ``$FHA_STUDIO_REGISTER``,
 else ``register.sqlite`` in the user data directory: the GUI's rule and option
@@ -30,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import fileio, plausible
-from fha_studio.cli import CliError
+from fha_studio.cli import CliError, _register_signing
 from fha_studio.cli._values import in_range
 from fha_studio.logic.register.words import (
     KIND_WORDS,
@@ -166,6 +168,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument("--axis", metavar="AXIS", help="the axis (needed for a parameter file)")
     s.add_argument("--operator", default="", help="who imports it (for parameter files)")
     s.set_defaults(func=_import)
+    _register_signing.add_actions(sub, common, _open_register)
 
 
 # -- plumbing -------------------------------------------------------------------------------------------
@@ -177,7 +180,7 @@ def _open_register(args):
 
     # a question asked of a register that is not there is a mistake (a typed path), not an empty
     # answer; adding or importing creates it
-    create = args.action in ("add-machine", "add-axis", "import")
+    create = args.action in ("add-machine", "add-axis", "import") or getattr(args, "writes", False)
     # a question changes nothing in the file (the report records itself: it writes)
     question = not create and args.action != "report"
     try:

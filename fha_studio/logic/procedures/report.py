@@ -204,15 +204,23 @@ def build_report(session: ProcedureSession, context: Mapping[str, Any] | None = 
     )
 
 
-def sign(session: ProcedureSession, who: str, context: Mapping[str, Any] | None = None) -> None:
-    """Sign the session's report; refused (SignError listing what is open) while anything is open."""
+def sign(
+    session: ProcedureSession, who: str, context: Mapping[str, Any] | None = None, key_id: str = "",
+    save: bool = True,
+) -> None:
+    """Sign the session's report; refused (SignError listing what is open) while anything is open.
+    ``key_id``: the signer's key the report file is signed with (the register's
+    ``sign_report_file`` signs it); without one the report is signed by name only. ``save``:
+    the session file is saved (False: the caller saves it once the signed file is written)."""
     if not who.strip():
         raise SignError("a report is signed with a name")
     report = build_report(session, context)
     if report.warnings:
         raise SignError("cannot sign while these are open: " + " | ".join(report.warnings))
     session.signature = {"who": who.strip(), "at_utc": utc_now()}
-    if session.path is not None:
+    if key_id:
+        session.signature["key_id"] = key_id
+    if save and session.path is not None:
         session.save()
 
 
@@ -390,6 +398,21 @@ def render_html(report: CommissioningReport) -> str:
     out.append("<h2>Signature</h2>")
     if report.signature:
         out.append(f"<p>Signed by {_e(report.signature['who'])} at {_e(report.signature['at_utc'])} UTC.</p>")
+        key_id = report.signature.get("key_id", "")
+        if key_id:
+            out.append(
+                f"<p>Signed with {_e(report.signature['who'])}'s own key (Ed25519, key {_e(key_id)}): the "
+                "signature covers every byte of the HTML report file and says who signed it and when. "
+                "To check that a copy is the one that was signed, and by whom, run "
+                "<b>fha-studio register verify REPORT</b> (REPORT: the HTML file, or its PDF) where the "
+                "plant's register is; a changed byte fails it.</p>"
+            )
+        else:
+            out.append(
+                "<p class='note'>Signed by name only: there is no key behind this signature, so nothing "
+                "shows whether this file is the one that was signed (a key of one's own: "
+                "fha-studio register keys add --name NAME).</p>"
+            )
     else:
         out.append("<p class='warn'>Not signed.</p>")
     out.append("</body></html>")

@@ -95,7 +95,7 @@ class ProcedureSession:
     )  # {"file": path, "values": {key: value}, "read_utc": ...}
     plots: list[dict[str, str]] = field(default_factory=list)  # {"title": ..., "path": PNG}
     notes: list[dict[str, str]] = field(default_factory=list)  # {"who", "at_utc", "text"}
-    signature: dict[str, str] = field(default_factory=dict)  # {"who", "at_utc"}
+    signature: dict[str, str] = field(default_factory=dict)  # {"who", "at_utc"[, "key_id"]}
     path: Path | None = field(default=None, compare=False, repr=False)
 
     def run(self, procedure_id: str) -> RunState:
@@ -236,7 +236,7 @@ def _session_from_json(data: dict[str, Any]) -> ProcedureSession:
     if "driver" in data:
         values["driver"] = _texts(data["driver"], "driver")
     if "signature" in data:
-        values["signature"] = _texts(data["signature"], "signature", ("who", "at_utc"))
+        values["signature"] = _texts(data["signature"], "signature", ("who", "at_utc", "key_id"))
     for key, fields in (("notes", ("who", "at_utc", "text")), ("plots", ("title", "path"))):
         if key in data:
             values[key] = [_texts(v, f"{key}[{i}]", fields)

@@ -230,6 +230,9 @@ TABLE_WORDS = {
     "report": "reports",
     "recording": "recordings",
     "model_check": "model checks",
+    "signing_key": "signing keys",
+    "key_revocation": "key revocations",
+    "report_signature": "report signatures",
 }
 
 

@@ -165,8 +165,38 @@ _V2 = [
     "CREATE INDEX parameter_write_by_key ON parameter_write (key, axis_id)",
 ]
 
+# v3: the people's public signing keys (Ed25519) and the signatures made with them. Append-only:
+# a key is never replaced (a new key is a new row, a revoked key a row of key_revocation), a
+# signature is a row of its own; ids are the key's fingerprint and the signature itself, the same
+# in every register a fact travels to.
+_V3 = [
+    """CREATE TABLE signing_key (
+        key_id TEXT PRIMARY KEY,
+        person TEXT NOT NULL,
+        public_key TEXT NOT NULL UNIQUE,
+        created_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT ''
+    )""",
+    """CREATE TABLE key_revocation (
+        key_id TEXT PRIMARY KEY REFERENCES signing_key(key_id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        reason TEXT NOT NULL DEFAULT ''
+    )""",
+    """CREATE TABLE report_signature (
+        signature TEXT PRIMARY KEY,
+        key_id TEXT NOT NULL REFERENCES signing_key(key_id),
+        signer TEXT NOT NULL,
+        signed_utc TEXT NOT NULL,
+        sha256 TEXT NOT NULL,
+        file TEXT NOT NULL DEFAULT ''
+    )""",
+    "CREATE INDEX signing_key_by_person ON signing_key (person, created_utc)",
+    "CREATE INDEX report_signature_by_sha256 ON report_signature (sha256)",
+]
+
 #: MIGRATIONS[n] takes a file from user_version n to n + 1.
-MIGRATIONS: tuple[tuple[str, ...], ...] = (tuple(_V1), tuple(_V2))
+MIGRATIONS: tuple[tuple[str, ...], ...] = (tuple(_V1), tuple(_V2), tuple(_V3))
 
 #: The version this program writes.
 SCHEMA_VERSION = len(MIGRATIONS)

@@ -25,7 +25,7 @@ from fha_studio import fileio
 from fha_studio.logic.register import guard
 from fha_studio.logic.register.connection import ENV_REGISTER, REGISTER_FILE_NAME, default_register_path
 from fha_studio.logic.register.guard import RegisterError
-from fha_studio.logic.register.history import History
+from fha_studio.logic.register.keys import Keys
 from fha_studio.logic.register.records import (
     SOURCES,
     Axis,
@@ -44,7 +44,7 @@ from fha_studio.logic.register.schema import MIGRATIONS, SCHEMA_VERSION
 
 
 @guard.in_words
-class Register(History):
+class Register(Keys):
     """One register file, open. Use as a context manager or call :meth:`close`.
 
     Every public method turns SQLite's errors into one :class:`RegisterError` line naming the
