@@ -42,3 +42,35 @@ def test_bench_traces_are_drawn_beside_cn3s_named_with_their_source(window, qtbo
     with qtbot.waitSignal(bench.source.sigStopped, timeout=10000):
         bench.start_button.click()
     view.stop_live()
+
+
+def test_the_scopes_recording_takes_the_bench_stream_beside_its_cn3_channels(make_window, qtbot, tmp_path):
+    from fha_studio.recording import read_recording
+
+    code = "FHA-25C-50-US250"
+    window = make_window(connect=f"sim://{code}?paced=0")  # every CN3 channel the recording needs
+    window.state.set_actuator(code, acknowledged=True)
+    page = window.show_page("scope")
+    view, bench = page.view, page.bench
+    view.start_live()
+    qtbot.waitUntil(lambda: view.time_plot.live, timeout=10000)
+    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
+        bench.scan()
+    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
+        bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,SPD_MON", "100k", "ENC_A,ENC_B")
+    qtbot.waitUntil(lambda: len(bench.source.started.ring) > 100, timeout=10000)
+    path = tmp_path / "live.csv"
+    view.start_recording(path)
+    qtbot.waitUntil(lambda: view._recorder is not None and view._recorder.rows_written > 20, timeout=20000)
+    view.stop_recording()
+    with qtbot.waitSignal(bench.source.sigStopped, timeout=10000):
+        bench.start_button.click()
+    view.stop_live()
+    recording = read_recording(path)
+    channels = recording.channels
+    assert {"pos", "current", "bench_enc_a", "bench_enc_b", "bench_spd_mon", "bench_pos"} <= set(channels)
+    extra = recording.metadata.extra
+    assert extra["source_bench_pos"] == ("bench sim-cn2: ENC_A/ENC_B counts x 360 / 500000 counts per "
+                                         "output turn [deg]")
+    assert extra["source_bench_spd_mon"].startswith("bench sim-cn2: SPD_MON (V,")
+    assert set(channels["bench_enc_a"]) <= {0.0, 1.0}

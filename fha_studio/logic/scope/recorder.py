@@ -9,7 +9,8 @@ flushes at least once per second, so a crash loses at most a second of data.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -26,11 +27,23 @@ CONTRACT_SOURCES = {
 }
 
 
+@dataclass(frozen=True)
+class BesideColumns:
+    """Columns recorded beside the scope's channels (a bench instrument's stream): their names,
+    where each came from (the recording's ``source_<column>``), and their values at the scope's
+    sample times (``sample(t_s)`` -> ``(len(t_s), len(columns))``)."""
+
+    columns: tuple[str, ...]
+    sources: Mapping[str, str]
+    sample: Callable[[np.ndarray], np.ndarray]
+
+
 class ScopeRecorder:
-    """Writes rows of ``[t_s, channel values...]`` (the scope's sample layout) to a recording."""
+    """Writes rows of ``[t_s, channel values...]`` (the scope's sample layout) to a recording;
+    ``beside``: columns of another source at the same times, after the channels."""
 
     def __init__(self, path: str | os.PathLike[str], metadata: RecordingMetadata,
-                 channels: Sequence[ScopeChannel]):
+                 channels: Sequence[ScopeChannel], beside: BesideColumns | None = None):
         keys = [c.key for c in channels]
         for column in ("pos", "current"):
             if CONTRACT_SOURCES[column] not in keys:
@@ -54,6 +67,11 @@ class ScopeRecorder:
         index[0] = 0
         self._index = np.asarray(index)
         self._t0: float | None = None
+        self._beside = beside
+        if beside is not None:
+            columns += list(beside.columns)
+            metadata = replace(metadata, extra={**metadata.extra, **{
+                f"source_{name}": text for name, text in beside.sources.items()}})
         self._writer = RecordingWriter(path, metadata, columns)
 
     @property
@@ -72,6 +90,8 @@ class ScopeRecorder:
         if self._t0 is None:
             self._t0 = float(block[0, 0])
         rows = block[:, self._index]
+        if self._beside is not None:
+            rows = np.column_stack([rows, self._beside.sample(block[:, 0])])
         rows[:, 0] -= self._t0
         self._writer.append_rows(rows)
 

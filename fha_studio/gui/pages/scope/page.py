@@ -57,6 +57,7 @@ class ScopePage(BasePage):
         # its stream on the Time plot too, beside the CN3 channels
         self.bench.source.sigRows.connect(self._bench_on_time_plot)
         self.bench.source.sigStarted.connect(lambda _s: self.view.time_plot.set_bench_curves({}))
+        self.view.beside_recording = self._bench_beside  # and in the recording, beside them
         self._bench_axis()
         # the axis's actuator, driver and load decide the scaling and what is recorded, at every moment
         state = self.state
@@ -111,6 +112,15 @@ class ScopePage(BasePage):
         rows = started.ring.window(int(span * started.row_rate_hz))
         plot.set_bench_curves(bench_traces(started, rows, self.bench.counts_per_output_turn,
                                            max(200, plot.plot.width())), COLORS)
+
+    def _bench_beside(self, live_t0: float):
+        """The bench stream's columns for a recording started now (None: no stream runs)."""
+        from .bench_overlay import recorder_columns
+
+        started = self.bench.source.started
+        if started is None or not self.bench.source.running:
+            return None
+        return recorder_columns(started, live_t0, self.bench.counts_per_output_turn)
 
     def _bench_checks(self, checks: list) -> None:
         """A move's checks from CN2 go to the DGR checks page's record (and so into the report)."""

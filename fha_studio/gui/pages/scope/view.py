@@ -45,7 +45,7 @@ from fha_studio.logic.scope.channels import ScopeChannel, scope_channels
 from fha_studio.logic.scope.files import csv_text, recording_rows
 from fha_studio.logic.scope.indicator import IndicatorKind, live_indicator
 from fha_studio.logic.scope.levels import MinMaxLevels
-from fha_studio.logic.scope.recorder import ScopeRecorder
+from fha_studio.logic.scope.recorder import BesideColumns, ScopeRecorder
 from fha_studio.recording import RecordingMetadata, read_recording
 
 from .channel_table import ChannelTable
@@ -114,6 +114,7 @@ class ScopeView(QWidget):
         self._static: _Static | None = None
         self._paused = False
         self._recorder: ScopeRecorder | None = None
+        self.beside_recording: Callable[[float], BesideColumns | None] | None = None  # by live t0
         self.frames = 0
         self._last_text_update = 0.0
         self.last_test: MoveTestResult | None = None
@@ -546,7 +547,8 @@ class ScopeView(QWidget):
         if self._levels is not None:
             self._levels.append(self._live.ring.drain())
         self._recorder = ScopeRecorder(path, self._metadata(None, {
-            "source": "fha-studio scope, polled monitor items (host time stamps)"}), self._live.channels)
+            "source": "fha-studio scope, polled monitor items (host time stamps)"}), self._live.channels,
+            self.beside_recording(self._live.t0) if self.beside_recording is not None else None)
         self.toolbar.set_recording(True)
 
     def stop_recording(self) -> Path | None:
