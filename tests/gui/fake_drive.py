@@ -18,6 +18,7 @@ import math
 import time
 from collections.abc import Callable, Iterable
 
+from fha_studio.catalog.actuator import get_actuator
 from fha_studio.catalog.model_code import parse_model_code
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.api import (
@@ -86,7 +87,8 @@ class FakeDriveClient:
         self.alarm_table = load_alarm_table(self.model.driver)
         code = parse_model_code(actuator)
         self.actuator = actuator
-        self.driver_model = next(d for d in _compatible_drivers(actuator) if d.startswith(self.model.driver))
+        drivers = get_actuator(actuator).compatible_drivers
+        self.driver_model = next(d for d in drivers if d.startswith(self.model.driver))
         self.absolute_encoder = absolute_encoder
         self.has_sensors = "L" in code.options
         self.values: dict[tuple[str, int], int] = {
@@ -457,9 +459,3 @@ class FakeDriveClient:
             if progress is not None:
                 progress(len(rows), status.count)
         return TraceCapture(channels, tuple(rows))
-
-
-def _compatible_drivers(actuator: str) -> tuple[str, ...]:
-    from fha_studio.catalog.actuator import get_actuator
-
-    return tuple(get_actuator(actuator).compatible_drivers)
