@@ -88,10 +88,11 @@ def test_each_page_id_is_typed_as_the_class_of_the_page_it_gives(make_window):
     from fha_studio.gui.pages.procedures.page import ProceduresPage
     from fha_studio.gui.pages.scope.page import ScopePage
     from fha_studio.gui.pages.sizing import SizingPage
+    from fha_studio.gui.pages.tuning import TuningPage
 
     names = {**vars(lookup), **{c.__name__: c for c in (
         AbsolutePage, AlarmsPage, ConnectionPage, DirectionPage, JogPage, ModelCheckPage, ParametersPage,
-        ProceduresPage, ScopePage, SizingPage)}}
+        ProceduresPage, ScopePage, SizingPage, TuningPage)}}
     for method in (lookup.PageLookup.page, lookup.PageLookup.built_page):
         typed = {}
         for overload in typing.get_overloads(method):

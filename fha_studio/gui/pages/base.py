@@ -30,6 +30,7 @@ class PageId(StrEnum):
     SCOPE = "scope"
     PROCEDURES = "procedures"
     MODELCHECK = "modelcheck"
+    TUNING = "tuning"
 
 
 @runtime_checkable

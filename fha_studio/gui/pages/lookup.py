@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from fha_studio.gui.pages.procedures.page import ProceduresPage
     from fha_studio.gui.pages.scope.page import ScopePage
     from fha_studio.gui.pages.sizing import SizingPage
+    from fha_studio.gui.pages.tuning import TuningPage
 
 
 class PageLookup:
@@ -59,6 +60,8 @@ class PageLookup:
     @overload
     def page(self, name: Literal[PageId.MODELCHECK]) -> ModelCheckPage: ...
     @overload
+    def page(self, name: Literal[PageId.TUNING]) -> TuningPage: ...
+    @overload
     def page(self, name: PageId | str) -> Page: ...
 
     def page(self, name: PageId | str) -> Page:
@@ -88,6 +91,8 @@ class PageLookup:
     def built_page(self, name: Literal[PageId.PROCEDURES]) -> ProceduresPage | None: ...
     @overload
     def built_page(self, name: Literal[PageId.MODELCHECK]) -> ModelCheckPage | None: ...
+    @overload
+    def built_page(self, name: Literal[PageId.TUNING]) -> TuningPage | None: ...
     @overload
     def built_page(self, name: PageId) -> Page | None: ...
 

@@ -73,6 +73,12 @@ def _modelcheck(session: Session, window: PageHost) -> Page:
     return ModelCheckPage(session, window)
 
 
+def _tuning(session: Session, window: PageHost) -> Page:
+    from fha_studio.gui.pages.tuning import TuningPage
+
+    return TuningPage(session, window)
+
+
 #: Every page, in tab order.
 PAGES: tuple[PageEntry, ...] = (
     PageEntry(PageId.CONNECTION, "Connection", "o", ConnectionPage),
@@ -85,4 +91,5 @@ PAGES: tuple[PageEntry, ...] = (
     PageEntry(PageId.SCOPE, "Scope", "S", _scope, lazy=True),
     PageEntry(PageId.PROCEDURES, "Procedures", "u", _procedures, lazy=True),
     PageEntry(PageId.MODELCHECK, "Model check", "k", _modelcheck, lazy=True),
+    PageEntry(PageId.TUNING, "Tuning", "T", _tuning, lazy=True),
 )

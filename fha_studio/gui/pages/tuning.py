@@ -1,0 +1,377 @@
+"""The Tuning page: the speed loop's frequency response with the gear's resonance marked, the
+load inertia from it, margins with the present gains, and proposed tune items (issue 25).
+
+The work is the logic's (``logic/tuning``); it runs in the link thread (``Call``), STOP ends it
+(``link.abort_event``). The excitation is shown before it starts, and it starts only after a
+countdown the person can cancel. Applying the proposal goes through the session's write path
+(backup before the first write, each write verified), then the response is measured again. A drive
+that cannot be excited (the manual's commands only) gets the proposal as a front-panel worksheet.
+"""
+
+from __future__ import annotations
+
+import time
+from functools import partial
+from typing import Any
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6.QtCore import QTimer, Signal
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QPlainTextEdit,
+    QPushButton,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+)
+
+from fha_studio.gui.link_requests import Call, LinkInfo, LinkReply
+from fha_studio.gui.pages.base import BasePage
+from fha_studio.hardware.parameters import Mode
+from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
+from fha_studio.logic.tuning.excitation import plan_excitation
+from fha_studio.logic.tuning.measure import NEEDED
+from fha_studio.logic.tuning.propose import AIMS, TUNE_KEYS, Proposal, Tuner
+from fha_studio.logic.tuning.session import declared_model, measure_report, tuner_for
+
+COUNTDOWN_S = 3
+FIGURE_ROWS = ("gain_margin_db", "phase_margin_deg", "overshoot_pct", "settling_ms")
+
+
+class TuningPage(BasePage):
+    """See the module docstring."""
+
+    sigMeasured = Signal(object)  # the measurement's dict (tune measure's JSON)
+    sigProposed = Signal(object)  # Proposal
+    sigApplied = Signal(object)  # the measurement after the writes
+
+    def __init__(self, session: Any, main_window: Any = None) -> None:
+        super().__init__()
+        self.session = session
+        self.link = session.link
+        self.result: dict[str, Any] | None = None
+        self.proposal: Proposal | None = None
+        self._countdown = 0
+        self._timer = QTimer(self)
+        self._timer.setInterval(1000)
+        self._timer.timeout.connect(self._tick)
+        self._excitable = False
+
+        form = QFormLayout()
+        self.actuator_edit = QLineEdit(session.state.actuator_code or "")
+        self.actuator_edit.setPlaceholderText("model code, e.g. FHA-25C-50-US250")
+        form.addRow("Actuator", self.actuator_edit)
+        self.load_spin = QDoubleSpinBox()
+        self.load_spin.setRange(0.0, 1.0e5)
+        self.load_spin.setDecimals(4)
+        self.load_spin.setSuffix(" kg·m²")
+        self.load_spin.setValue(float(session.state.load_inertia_kgm2))
+        form.addRow("Declared load inertia", self.load_spin)
+        self.aim_combo = QComboBox()
+        self.aim_combo.addItems(list(AIMS))
+        self.aim_combo.setCurrentText("standard")
+        form.addRow("Aim", self.aim_combo)
+        self.amplitude_spin = QDoubleSpinBox()
+        self.amplitude_spin.setRange(0.0, 100.0)
+        self.amplitude_spin.setDecimals(4)
+        self.amplitude_spin.setSpecialValueText("the largest the axis allows")
+        self.amplitude_spin.setSuffix(" r/min")
+        form.addRow("Excitation amplitude", self.amplitude_spin)
+
+        buttons = QHBoxLayout()
+        self.plan_button = QPushButton("Show the excitation")
+        self.start_button = QPushButton(f"Start measuring ({COUNTDOWN_S} s countdown)")
+        self.cancel_button = QPushButton("Cancel")
+        self.propose_button = QPushButton("Propose gains")
+        self.apply_button = QPushButton("Apply proposed gains")
+        for b in (self.plan_button, self.start_button, self.cancel_button, self.propose_button,
+                  self.apply_button):
+            buttons.addWidget(b)
+        self.start_button.setEnabled(False)
+        self.cancel_button.setEnabled(False)
+        self.apply_button.setEnabled(False)
+        self.plan_button.clicked.connect(self.show_plan)
+        self.start_button.clicked.connect(self.start_countdown)
+        self.cancel_button.clicked.connect(self.cancel_countdown)
+        self.propose_button.clicked.connect(self.propose)
+        self.apply_button.clicked.connect(self.apply)
+
+        self.plan_label = QLabel("Connect a drive, then show the excitation before it starts.")
+        self.plan_label.setWordWrap(True)
+        self.status_label = QLabel("")
+        self.status_label.setWordWrap(True)
+        self.warning_label = QLabel("")
+        self.warning_label.setWordWrap(True)
+        self.warning_label.setStyleSheet("color: #b00000; font-weight: bold")
+
+        self.plots = pg.GraphicsLayoutWidget()
+        self.plots.setBackground("w")
+        self.mag_plot = self.plots.addPlot(row=0, col=0, title="Magnitude (dB)")
+        self.phase_plot = self.plots.addPlot(row=1, col=0, title="Phase (deg)")
+        self.coh_plot = self.plots.addPlot(row=2, col=0, title="Coherence")
+        for plot in (self.mag_plot, self.phase_plot, self.coh_plot):
+            plot.setLogMode(x=True, y=False)
+            plot.showGrid(x=True, y=True, alpha=0.3)
+        self.phase_plot.setXLink(self.mag_plot)
+        self.coh_plot.setXLink(self.mag_plot)
+        self.coh_plot.setLabel("bottom", "frequency", units="Hz")
+        self.coh_plot.setYRange(0.0, 1.05)
+        self.mag_plot.addLegend(offset=(-10, 10))
+        self.curves = {
+            "closed": (self.mag_plot.plot(pen=pg.mkPen("#1f4e9c", width=2), name="speed loop (closed)"),
+                       self.phase_plot.plot(pen=pg.mkPen("#1f4e9c", width=2)),
+                       self.coh_plot.plot(pen=pg.mkPen("#1f4e9c", width=2))),
+            "plant": (self.mag_plot.plot(pen=pg.mkPen("#c05000", width=2), name="plant (speed per torque)"),
+                      self.phase_plot.plot(pen=pg.mkPen("#c05000", width=2)),
+                      self.coh_plot.plot(pen=pg.mkPen("#c05000", width=2))),
+        }
+        self.markers: list[Any] = []
+
+        self.table = QTableWidget(len(TUNE_KEYS) + len(FIGURE_ROWS), 3)
+        self.table.setHorizontalHeaderLabels(["present", "proposed", "measured after"])
+        self.table.setVerticalHeaderLabels([*TUNE_KEYS, *FIGURE_ROWS])
+        self.worksheet = QPlainTextEdit()
+        self.worksheet.setReadOnly(True)
+        self.worksheet.setPlaceholderText("The front-panel worksheet appears here for a drive without "
+                                          "parameter access over CN3.")
+        self.worksheet.setMaximumHeight(110)
+
+        layout = QVBoxLayout(self)
+        layout.addLayout(form)
+        layout.addLayout(buttons)
+        layout.addWidget(self.plan_label)
+        layout.addWidget(self.warning_label)
+        layout.addWidget(self.status_label)
+        layout.addWidget(self.plots, 3)
+        layout.addWidget(self.table, 1)
+        layout.addWidget(self.worksheet)
+
+    # ----- the link ------------------------------------------------------------------------------
+    def link_connected(self, info: LinkInfo) -> None:
+        code = info.adjusted_for or self.session.state.actuator_code
+        if code:
+            self.actuator_edit.setText(code)
+        self._excitable = not info.documented_only and info.can_move
+        if not self._excitable:
+            self.plan_label.setText("This drive answers only its manual's commands: it cannot be excited "
+                                    "over CN3. Propose gains for the front-panel worksheet, or measure on "
+                                    "the bench (SPD-CMD from a DAQ's output, SPD-MON recorded).")
+
+    def link_disconnected(self, reason: str, lost: bool) -> None:
+        self.cancel_countdown()
+        self.start_button.setEnabled(False)
+        self.apply_button.setEnabled(False)
+
+    def shutdown(self) -> None:
+        self._timer.stop()
+
+    def release_held(self) -> None:
+        self.cancel_countdown()
+
+    # ----- excitation, countdown, measurement ----------------------------------------------------
+    def _code(self) -> str:
+        return self.actuator_edit.text().strip()
+
+    def _amplitude(self) -> float | None:
+        value = self.amplitude_spin.value()
+        return value if value > 0 else None
+
+    def show_plan(self) -> None:
+        """Compute and show the excitation (in the link thread: it reads the drive's items)."""
+        code, load, amplitude = self._code(), self.load_spin.value(), self._amplitude()
+
+        def plan(client: Any) -> Any:
+            if NEEDED - set(client.capabilities.commands):
+                return None
+            tuner = tuner_for(client, self.session.parameter_model, declared_model(code, load))
+            return plan_excitation(tuner.loop({}), amplitude)
+
+        self.link.send(Call(plan), self._planned)
+
+    def _planned(self, reply: LinkReply[Any]) -> None:
+        if not reply.ok:
+            self.plan_label.setText(f"No excitation: {reply.error}")
+            return
+        if reply.value is None:
+            self.plan_label.setText("This drive has no excitation over CN3: the proposal is a front-panel "
+                                    "worksheet.")
+            return
+        self.plan = reply.value
+        self.plan_label.setText(reply.value.describe() + ". Servo on, the axis free to move that far; "
+                                "STOP ends it at once.")
+        self.start_button.setEnabled(True)
+
+    def start_countdown(self) -> None:
+        self._countdown = COUNTDOWN_S
+        self.cancel_button.setEnabled(True)
+        self.start_button.setEnabled(False)
+        self.status_label.setText(f"The excitation starts in {self._countdown} s (Cancel stops it) …")
+        self._timer.start()
+
+    def cancel_countdown(self) -> None:
+        if self._timer.isActive():
+            self._timer.stop()
+            self.status_label.setText("Cancelled: nothing moved.")
+            self.start_button.setEnabled(True)
+        self.cancel_button.setEnabled(False)
+
+    def _tick(self) -> None:
+        self._countdown -= 1
+        if self._countdown > 0:
+            self.status_label.setText(f"The excitation starts in {self._countdown} s (Cancel stops it) …")
+            return
+        self._timer.stop()
+        self.cancel_button.setEnabled(False)
+        self.measure()
+
+    def measure(self, then: Any = None) -> None:
+        code, load, amplitude = self._code(), self.load_spin.value(), self._amplitude()
+        stop = self.link.abort_event.is_set
+        self.status_label.setText("Measuring: the axis is excited …")
+
+        def run(client: Any) -> dict[str, Any]:
+            tuner = tuner_for(client, self.session.parameter_model, declared_model(code, load))
+            return measure_report(client, tuner, time.sleep, time.monotonic, amplitude, should_stop=stop)
+
+        self.link.send(Call(run), partial(self._measured, then))
+
+    def _measured(self, then: Any, reply: LinkReply[dict[str, Any]]) -> None:
+        self.start_button.setEnabled(True)
+        if not reply.ok or reply.value is None:
+            self.status_label.setText(f"Measurement not done: {reply.error}")
+            return
+        self.show_result(reply.value)
+        if then is not None:
+            then(reply.value)
+        else:
+            self.sigMeasured.emit(reply.value)
+
+    def show_result(self, result: dict[str, Any]) -> None:
+        """Plot a measurement (tune measure's dict) and mark the resonances."""
+        self.result = result
+        for key, name in (("closed", "frequency_response"), ("plant", "plant_response")):
+            data = result[name]
+            f = np.asarray(data["freq_hz"], float)
+            mag, phase, coh = (self.curves[key][i] for i in range(3))
+            mag.setData(f, np.asarray(data["magnitude_db"], float))
+            phase.setData(f, np.asarray(data["phase_deg"], float))
+            coh.setData(f, np.asarray(data["coherence"], float))
+        for marker in self.markers:
+            self.mag_plot.removeItem(marker)
+        self.markers = []
+        for key, colour, style, label in (
+            ("resonance_hz", "#008000", None, "resonance"),
+            ("antiresonance_hz", "#800080", None, "anti-resonance"),
+            ("predicted_resonance_hz", "#008000", pg.QtCore.Qt.PenStyle.DashLine, "predicted"),
+            ("predicted_antiresonance_hz", "#800080", pg.QtCore.Qt.PenStyle.DashLine, "predicted"),
+        ):
+            value = result.get(key)
+            if value:
+                pen = pg.mkPen(colour, width=2, style=style) if style else pg.mkPen(colour, width=2)
+                line = pg.InfiniteLine(pos=np.log10(value), angle=90, pen=pen,
+                                       label=f"{label} {value:.1f} Hz", labelOpts={"position": 0.9})
+                self.mag_plot.addItem(line)
+                self.markers.append(line)
+
+        def fmt(key: str, unit: str) -> str:
+            v = result.get(key)
+            return "—" if v is None else f"{v:.3g} {unit}"
+
+        self.status_label.setText(
+            f"Resonance {fmt('resonance_hz', 'Hz')} (predicted {fmt('predicted_resonance_hz', 'Hz')}), "
+            f"anti-resonance {fmt('antiresonance_hz', 'Hz')}; load inertia estimate "
+            f"{fmt('load_inertia_estimate_kgm2', 'kg·m²')}; gain margin {fmt('gain_margin_db', 'dB')}, "
+            f"phase margin {fmt('phase_margin_deg', 'deg')}, crossover {fmt('crossover_hz', 'Hz')}, "
+            f"bandwidth {fmt('bandwidth_hz', 'Hz')}")
+
+    # ----- proposal, apply, worksheet ------------------------------------------------------------
+    def _offline_items(self) -> dict[str, int]:
+        model = self.session.parameter_model
+        items = {it.key: int(it.default) for it in model if it.mode in (Mode.TUNE, Mode.SYSTEM)
+                 and it.default is not None}
+        for it in model:
+            known = self.session.state.value_of(str(it.mode), it.number)
+            if known is not None:
+                items[it.key] = int(known)
+        return items
+
+    def propose(self) -> None:
+        code, load, aim = self._code(), self.load_spin.value(), self.aim_combo.currentText()
+        parameters = self.session.parameter_model
+        if not self._excitable:
+            try:
+                tuner = Tuner(declared_model(code, load), self._offline_items(), parameters,
+                              DEFAULT_SERVO_RATE_HZ)
+                proposal = tuner.propose(aim)
+            except ValueError as exc:
+                self.status_label.setText(f"No proposal: {exc}")
+                return
+            self._proposed(None, direct=proposal)
+            return
+
+        def run(client: Any) -> Proposal:
+            return tuner_for(client, parameters, declared_model(code, load)).propose(aim)
+
+        self.status_label.setText("Proposing gains …")
+        self.link.send(Call(run), self._proposed)
+
+    def _proposed(self, reply: Any, direct: Proposal | None = None) -> None:
+        if direct is None:
+            if not reply.ok:
+                self.status_label.setText(f"No proposal: {reply.error}")
+                return
+            direct = reply.value
+        proposal: Proposal = direct
+        self.proposal = proposal
+        self.warning_label.setText(f"Warning: {proposal.warning}" if proposal.warning else "")
+        for col, figs in ((0, proposal.present), (1, proposal.proposed)):
+            values = figs.to_dict()
+            for row, key in enumerate((*TUNE_KEYS, *FIGURE_ROWS)):
+                value = values.get(key)
+                self.table.setItem(row, col, QTableWidgetItem("—" if value is None else f"{value:g}"))
+        self.apply_button.setEnabled(self._excitable)
+        self.worksheet.setPlainText(self.worksheet_text(proposal))
+        self.status_label.setText(f"Proposed for the aim {proposal.used_aim}.")
+        self.sigProposed.emit(proposal)
+
+    def worksheet_text(self, proposal: Proposal) -> str:
+        """The proposal as front-panel entries (tune mode items), for a drive without CN3 access."""
+        model = self.session.parameter_model
+        lines = ["Front-panel worksheet (tune mode): set, then verify with a move."]
+        for key in TUNE_KEYS:
+            item = model.by_key(key)
+            lines.append(f"  tune item {item.number} {item.name}: {proposal.present.items.get(key)} -> "
+                         f"{proposal.proposed.items[key]} {item.unit}")
+        return "\n".join(lines)
+
+    def apply(self) -> None:
+        """Write the proposed tune items (the session's path: backup first, verified), then
+        measure again."""
+        if self.proposal is None:
+            return
+        model = self.session.parameter_model
+        writes = [(Mode.TUNE, model.by_key(k).number, int(v))
+                  for k, v in self.proposal.proposed.items.items()]
+        self.session.sigWritesDone.connect(self._written)
+        self.status_label.setText("Writing the proposed gains (backup first) …")
+        self.session.write(writes)
+
+    def _written(self, entries: list[Any]) -> None:
+        self.session.sigWritesDone.disconnect(self._written)
+        if not entries or not all(e.get("verified") for e in entries):
+            self.status_label.setText("The proposed gains were not all written and verified: "
+                                      "nothing measured.")
+            return
+        self.measure(then=self._measured_after)
+
+    def _measured_after(self, result: dict[str, Any]) -> None:
+        for row, key in enumerate((*TUNE_KEYS, *FIGURE_ROWS)):
+            value = self.proposal.proposed.items.get(key) if key in TUNE_KEYS else result.get(key)
+            self.table.setItem(row, 2, QTableWidgetItem("—" if value is None else f"{value:g}"))
+        self.sigApplied.emit(result)

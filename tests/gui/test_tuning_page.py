@@ -1,0 +1,64 @@
+"""The Tuning page end to end on the embedded simulated drive (real client, protocol and trace):
+the excitation is shown before it starts, the countdown can be cancelled (nothing moves), the
+measured response is plotted with the gear's resonance marked, the proposal is applied through the
+session's write path (backup first) and measured again; a drive of the manual's commands gets a
+front-panel worksheet."""
+
+from __future__ import annotations
+
+import pytest
+
+from fha_studio.gui.pages.base import PageId
+
+CODE = "FHA-25C-50-US250"
+URL = f"sim://{CODE}?load_inertia=0.81&effects=torsional_compliance&paced=0"
+
+
+def _servo_on(window, qtbot) -> None:
+    window.servo_action.trigger()
+    qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
+
+
+@pytest.mark.slow
+def test_measure_propose_apply_end_to_end(make_window, qtbot):
+    window = make_window(connect=URL)
+    page = window.show_page(PageId.TUNING)
+    page.load_spin.setValue(0.81)
+    _servo_on(window, qtbot)
+    with qtbot.waitSignal(window.link.sigResult, timeout=20000):
+        page.plan_button.click()
+    qtbot.waitUntil(page.start_button.isEnabled, timeout=10000)
+    assert "r/min" in page.plan_label.text() and "deg" in page.plan_label.text()
+    drive = window.link._worker._client.transaction.transport.inner.sim_drive
+    before = drive.axis.output_pos_rad
+    page.start_countdown()
+    page.cancel_countdown()
+    assert "nothing moved" in page.status_label.text()
+    assert drive.axis.output_pos_rad == pytest.approx(before, abs=1e-6)
+    with qtbot.waitSignal(page.sigMeasured, timeout=120000) as measured:
+        page.start_countdown()
+    result = measured.args[0]
+    assert result["resonance_hz"] == pytest.approx(result["predicted_resonance_hz"], rel=0.1)
+    assert len(page.markers) == 4  # resonance, anti-resonance, and their predictions
+    assert "Resonance" in page.status_label.text()
+    with qtbot.waitSignal(page.sigProposed, timeout=120000):
+        page.propose_button.click()
+    assert page.table.item(0, 1) is not None
+    assert page.apply_button.isEnabled()
+    with qtbot.waitSignal(page.sigApplied, timeout=180000) as applied:
+        page.apply_button.click()
+    assert window.session.state.backup_path is not None and window.session.state.backup_path.exists()
+    assert applied.args[0]["items"]["speed_loop_gain"] == page.proposal.proposed.items["speed_loop_gain"]
+    assert page.table.item(len(page.proposal.proposed.items), 2) is not None
+
+
+def test_documented_drive_gets_a_front_panel_worksheet(make_window, qtbot):
+    window = make_window(connect=f"sim://{CODE}?paced=0&profile=documented")
+    page = window.show_page(PageId.TUNING)
+    assert "cannot be excited" in page.plan_label.text()
+    page.actuator_edit.setText(CODE)  # the manual's commands do not say which actuator
+    with qtbot.waitSignal(page.sigProposed, timeout=60000):
+        page.propose_button.click()
+    text = page.worksheet.toPlainText()
+    assert "tune item 0" in text and "->" in text
+    assert not page.apply_button.isEnabled()
