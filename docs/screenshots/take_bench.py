@@ -28,7 +28,7 @@ from PySide6.QtCore import QCoreApplication  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
 
 OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
-CODE = "FHA-25C-50-US250"
+CODE = "FHA-25C-50-S248"  # absolute: CN3 gives the position (DGR) while the servo is off
 URL = f"sim://{CODE}?paced=0&profile=documented"
 
 
@@ -78,8 +78,10 @@ def main() -> int:
     bench.sigDevicesListed.connect(listed.append)
     bench.scan()
     wait_until(lambda: listed, "the instrument list")
-    bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,SPD_MON", "250k",
-                "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS")
+    scope.view.start_live()  # CN3 beside: silent while the servo is on
+    wait_until(lambda: scope.view.time_plot.live, "the CN3 live view")
+    bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,ALARM,SPD_MON", "250k",
+                "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS", "ALARM")
     wait_until(lambda: bench.source.started is not None, "the sim-cn2 stream")
     window.sim_panel.servo_check.setChecked(True)
     wait_until(lambda: window.link.status is not None and window.link.status.servo_on, "servo-ON")
@@ -89,10 +91,15 @@ def main() -> int:
     wait_until(lambda: bench.move_figures is not None, "the move's figures")
     settle(0.6)
     shot("bench-move")
+    scope.view.plots.setCurrentWidget(scope.view.time_plot)  # the same stream beside CN3's channels
+    settle(1.0)
+    shot("scope-bench-time")
+    scope.view.plots.setCurrentWidget(bench)
     bench.start_button.click()
     wait_until(lambda: not bench.source.running, "the stream's end")
     window.sim_panel.servo_check.setChecked(False)
     wait_until(lambda: window.link.status is not None and not window.link.status.servo_on, "servo-OFF")
+    scope.view.stop_live()
 
     # any instrument sigrok-cli drives: its demo at 10 kHz (every sample drawn), D0/D1 counted as an encoder
     bench.start("demo", "D0,D1,D2,D3", "10k", "D0,D1")

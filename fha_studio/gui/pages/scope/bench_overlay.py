@@ -3,7 +3,8 @@
 The Bench tab's rows (``[t_s, channels..., counts, command]``) become traces named with their
 source, ``bench sim-cn2: ENC_A/ENC_B position (output) [deg]``: the encoder and command counts
 in output degrees (the axis's counts per output turn), so they share the plot of CN3's positions;
-logic channels as bits, analog ones in volts. Drawn as the live view draws, time before now.
+other logic channels as bits (not the lines decoded into those counts), analog ones in volts. Drawn
+as the live view draws, time before now.
 The scope's recording takes the same stream as columns beside its CN3 channels
 (:func:`recorder_columns`: ``bench_pos``, ``bench_cmd_pos`` [deg], ``bench_<channel>``).
 """
@@ -31,6 +32,8 @@ def bench_traces(started: BenchStarted, rows: np.ndarray, counts_per_output_turn
     device = started.device.split(":", 1)[0]
     traces: dict[str, tuple[str, np.ndarray, np.ndarray]] = {}
     for i, name in enumerate(started.channels):
+        if name in _decoded_lines(started):
+            continue  # the encoder's and the command's lines: their position is drawn instead
         unit = "bit" if name in started.logic else "V"
         traces[f"bench {device}: {name} [{unit}]"] = (unit, t, rows[:, 1 + i])
     first = 1 + len(started.channels)
@@ -45,6 +48,14 @@ def bench_traces(started: BenchStarted, rows: np.ndarray, counts_per_output_turn
         else:
             traces[f"bench {device}: {label} [counts]"] = ("counts", t, values)
     return traces
+
+
+def _decoded_lines(started: BenchStarted) -> set[str]:
+    """The channels decoded into counts (named in the counts' labels: "sim-cn2:ENC_A/ENC_B counts")."""
+    lines: set[str] = set()
+    for label in started.labels[len(started.channels):]:
+        lines.update(label.split(":", 1)[1].split(" ", 1)[0].split("/"))
+    return lines
 
 
 def _column_name(text: str) -> str:

@@ -93,6 +93,7 @@ class TimePlot(QWidget):
         self._bench: dict[str, tuple[pg.PlotDataItem, pg.PlotItem]] = {}
         self._bench_units: list[str] = []
         self._bench_entries: list[str] = []
+        self._bench_ranges: dict[str, tuple[float, float]] = {}  # unit -> the bench traces' extent
         self._still_grid = False
         self._set_units([""])
 
@@ -256,6 +257,8 @@ class TimePlot(QWidget):
         if self.autoscale:
             for plot in self._plots:
                 lo, hi = ranges.get(plot.unit, (np.inf, -np.inf))
+                b_lo, b_hi = self._bench_ranges.get(plot.unit, (np.inf, -np.inf))  # bench traces beside
+                lo, hi = min(lo, b_lo), max(hi, b_hi)
                 if lo <= hi:
                     self._follow_y(plot, lo, hi)
         if self._cursors_on:
@@ -407,6 +410,7 @@ class TimePlot(QWidget):
             if item in current:
                 item.removeItem(curve)
         entries = []
+        self._bench_ranges = {}
         for i, (label, (unit, t, values)) in enumerate(traces.items()):
             plot = items[unit]
             color = colors[i % len(colors)]
@@ -415,10 +419,14 @@ class TimePlot(QWidget):
                 curve = plot.item.plot(pen=pg.mkPen(color, width=1, style=Qt.PenStyle.DashLine))
                 self._bench[label] = (curve, plot.item)
             self._bench[label][0].setData(t, values)
-            if len(values) and not plot.keys and self.autoscale:  # a plot of bench traces only
-                self._follow_y(plot, float(np.min(values)), float(np.max(values)))
+            if len(values):
+                lo, hi = self._bench_ranges.get(unit, (np.inf, -np.inf))
+                self._bench_ranges[unit] = min(lo, float(np.min(values))), max(hi, float(np.max(values)))
             entries.append(f"<span style='color:{color}; font-weight:bold'>╌╌</span>&nbsp;"
                            f"{html.escape(label)}")
+        for plot in self._plots:  # a plot of bench traces only follows them here (CN3's: each frame)
+            if not plot.keys and self.autoscale and plot.unit in self._bench_ranges:
+                self._follow_y(plot, *self._bench_ranges[plot.unit])
         if entries != self._bench_entries:
             self._bench_entries = entries
             self.set_note(self._note)
