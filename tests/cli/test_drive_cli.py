@@ -98,6 +98,10 @@ def test_probe_servo_on_and_incremental(line):
     assert (data["servo"], data["encoder"], data["position_counts"]) == ("off", "incremental", None)
 
 
+#: what ``drive probe`` promises on a line that never answers usefully
+PROMISE_S = 5.0
+
+
 def taken_s(err: str) -> float:
     """The time the command says it took, from its own start (Python's start-up counted) to where
     it gave up: the figure the 5 s promise is about, which a loaded machine cannot stretch in the
@@ -115,8 +119,11 @@ def test_probe_exits_3_within_5_s_whatever_the_line_does(line, mode, time_ceilin
     assert out == ""
     one_line(err)
     # one deadline for the whole probe, from the process's start: 4.0 s, the rest of 4.5 s is
-    # closing and exiting; attempts and retries each with their own timeouts came to 5.2-5.4 s
-    assert taken_s(err) <= drive_cli.CONNECT_S + 0.1 <= drive_cli.PROBE_S, err
+    # closing and exiting; attempts and retries each with their own timeouts came to 5.2-5.4 s.
+    # The figure is held to the 5 s promise: on a machine loaded well past its cores the
+    # process is woken some tenths after its deadline (4.4 s seen at a load of 7.5 on 2 cores)
+    assert drive_cli.CONNECT_S < drive_cli.PROBE_S < PROMISE_S
+    assert taken_s(err) <= PROMISE_S, err
     time_ceiling(f"drive probe on a {mode} line", elapsed, 30.0)
     if mode == "silent":
         assert "nothing arrived" in err
@@ -156,12 +163,12 @@ def listener():
 
 
 @pytest.mark.parametrize("full", [False, True], ids=["connected-silent", "connect-unanswered"])
-def test_probe_on_a_listener_that_never_accepts_ends_within_4_5_s(listener, full, time_ceiling):
+def test_probe_on_a_listener_that_never_accepts_ends_within_5_s(listener, full, time_ceiling):
     url = listener(full)
     code, out, err, elapsed = fha("drive", "probe", "--url", url, "--json")
     assert code == 3 and out == "", (out, err)
     one_line(err)
-    assert taken_s(err) <= drive_cli.CONNECT_S + 0.1, err
+    assert taken_s(err) <= PROMISE_S, err  # the process gives up at 4.0 s, woken late under load
     time_ceiling("drive probe on a listener that never accepts", elapsed, 30.0)
     if full:
         assert "nothing accepted the connection" in err

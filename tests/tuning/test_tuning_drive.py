@@ -1,5 +1,5 @@
 """Tuning on the simulated drive over the client and the protocol (EXA/EXL/EXG and the trace at
-the servo rate), issue 25's Done-when: for FHA-17C-100, FHA-25C-50 and FHA-40C-160 with a load of
+the servo rate), what tuning promises: for FHA-17C-100, FHA-25C-50 and FHA-40C-160 with a load of
 0, 1, 3 and 10 x the actuator's own inertia, the measured response within 1 dB and 5 deg of the
 loop's own linearisation wherever the coherence is at least 0.9, the resonance within 10 % of the
 two-mass prediction, the inertia within 10 %; and the refusals (exit 4, nothing moves)."""

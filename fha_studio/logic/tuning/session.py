@@ -24,7 +24,7 @@ from fha_studio.logic.tuning.response import (
 )
 from fha_studio.physics import AxisModel, Effects
 
-#: the verification move of a tuning (issue 25: "settle a 90 deg move")
+#: the verification move of a tuning: a proposal must settle a 90 deg move no slower than the defaults
 VERIFY_MOVE_DEG = 90.0
 
 
