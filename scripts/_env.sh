@@ -21,6 +21,9 @@ find_python() {
 # Debian package names of the shared libraries Qt needs; see shared/reference/qt-stack-notes.md.
 # sigrok-cli (a command) streams the bench instruments: logic analyzers, oscilloscopes, DAQs.
 BENCH_PACKAGES="sigrok-cli"
+# The tests start a throw-away PostgreSQL server of their own (the plant's register on a server;
+# tests/support/postgres.py); scripts/start stays on the SQLite file and does not need it.
+SERVER_PACKAGES="postgresql"
 QT_OFFSCREEN_PACKAGES="libglib2.0-0 libegl1 libgl1 libdbus-1-3 libfontconfig1 libxkbcommon0"
 QT_XCB_PACKAGES="libxcb-cursor0 libxcb-icccm4 libxcb-keysyms1 libxcb-shape0 libxcb-xkb1 libxkbcommon-x11-0"
 
@@ -47,6 +50,9 @@ missing_libraries() {
                 continue ;;
             sigrok-cli)  # a command: the acquisition engine of the bench instruments
                 command -v sigrok-cli >/dev/null || echo -n "$pkg "
+                continue ;;
+            postgresql)  # the server's programs, not on PATH (Debian keeps them per version)
+                ls /usr/lib/postgresql/*/bin/initdb >/dev/null 2>&1 || echo -n "$pkg "
                 continue ;;
             *) lib="$pkg" ;;
         esac

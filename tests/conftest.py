@@ -13,9 +13,10 @@ import pytest
 from fha_studio import clock
 from tests.support.clock import FakeClock
 
-#: Fixtures every test may take: a client on a scripted drive (pipes, scripted, client_for) and
-#: programs in processes of their own (children).
-pytest_plugins = ["tests.support.links", "tests.support.processes"]
+#: Fixtures every test may take: a client on a scripted drive (pipes, scripted, client_for),
+#: programs in processes of their own (children) and a throw-away PostgreSQL server
+#: (postgres_cluster, started once per session by the first test that asks).
+pytest_plugins = ["tests.support.links", "tests.support.processes", "tests.support.postgres"]
 
 # GUI tests run headless; the environment can override (e.g. xcb under xvfb-run).
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")

@@ -1,4 +1,4 @@
-"""``fha-studio register [--register FILE] ACTION ...``: the questions a plant asks of the register.
+"""``fha-studio register [--register FILE_OR_URL] ACTION ...``: the questions a plant asks of the register.
 
 - ``machines``: the machines, their sites, how many axes and open items.
 - ``axes [MACHINE]``: every axis with actuator, driver, port, checks passed/failed, report.
@@ -14,9 +14,10 @@
 - ``keys add --name PERSON [--key-file PATH]``, ``keys list``: each person's signing key;
   ``verify REPORT``: is the report the one that was signed, and by whom (exit 0, else 5).
 
-Every action takes ``--json``. The register is ``--register FILE``, else ``$FHA_STUDIO_REGISTER``,
-else ``register.sqlite`` in the user data directory: the GUI's rule and option
-(``default_register_path``). ``--db FILE`` is the old name of ``--register``, still taken.
+Every action takes ``--json``. The register is ``--register FILE`` (or a plant's register on a
+PostgreSQL server: ``--register postgresql://USER:PASSWORD@HOST/DB``), else
+``$FHA_STUDIO_REGISTER``, else ``register.sqlite`` in the user data directory: the GUI's rule and
+option (``register_location``). ``--db FILE`` is the old name of ``--register``, still taken.
 """
 
 from __future__ import annotations
@@ -60,22 +61,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "register",
         help="the register of machines and axes: history, differences, find, open items",
         description="The register keeps every commissioning fact of every axis (parameter snapshots, "
-        "verified writes, checks, alarms, reports, recordings, model checks) in one SQLite file.",
+        "verified writes, checks, alarms, reports, recordings, model checks) in one SQLite file, or for a "
+        "plant in a database on a PostgreSQL server (--register postgresql://...).",
     )
     p.add_argument(
         "--register",
-        type=Path,
-        metavar="FILE",
-        help="the register file (default: $FHA_STUDIO_REGISTER, "
-        "else register.sqlite in the user data directory), as for the GUI",
+        metavar="FILE_OR_URL",
+        help="the register: a file, or postgresql://USER:PASSWORD@HOST/DB for a plant's register on a "
+        "server (default: $FHA_STUDIO_REGISTER, else register.sqlite in the user data directory), "
+        "as for the GUI",
     )
-    p.add_argument("--db", type=Path, dest="register", action=_OldName, help=argparse.SUPPRESS)
+    p.add_argument("--db", dest="register", action=_OldName, help=argparse.SUPPRESS)
     p.add_argument("--json", action="store_true", help="print JSON")
     common = argparse.ArgumentParser(add_help=False, allow_abbrev=False)
     # also accepted after the action; SUPPRESS keeps the action from resetting what came before it
     hidden = argparse.SUPPRESS
-    common.add_argument("--register", type=Path, metavar="FILE", default=hidden, help=hidden)
-    common.add_argument("--db", type=Path, dest="register", action=_OldName, default=hidden, help=hidden)
+    common.add_argument("--register", metavar="FILE_OR_URL", default=hidden, help=hidden)
+    common.add_argument("--db", dest="register", action=_OldName, default=hidden, help=hidden)
     common.add_argument("--json", action="store_true", default=argparse.SUPPRESS, help="print JSON")
     sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
 
@@ -176,7 +178,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 @contextmanager
 def _open_register(args):
-    from fha_studio.logic.register import Register, RegisterError, default_register_path
+    from fha_studio.logic.register import Register, RegisterError, register_location
 
     # a question asked of a register that is not there is a mistake (a typed path), not an empty
     # answer; adding or importing creates it
@@ -184,7 +186,7 @@ def _open_register(args):
     # a question changes nothing in the file (the report records itself: it writes)
     question = not create and args.action != "report"
     try:
-        reg = Register(default_register_path(args.register), create=create, read_only=question)
+        reg = Register(register_location(args.register), create=create, read_only=question)
     except RegisterError as exc:
         none = "there is no register" in str(exc)
         hint = " (start one: fha-studio register add-machine NAME)" if none else ""
@@ -490,10 +492,14 @@ def _report(args) -> int:
 
 
 def _check(args) -> int:
-    from fha_studio.logic.register import RegisterError, default_register_path
+    from fha_studio.logic.register import RegisterError, register_location
     from fha_studio.logic.register.check import check_register
+    from fha_studio.logic.register.server import shown_url
 
-    path = default_register_path(args.register)
+    path = register_location(args.register)
+    if isinstance(path, str):
+        raise CliError(f"register check reads a register file; the register {shown_url(path)} is on a "
+                       "server, which keeps its own pages and constraints")
     try:
         result = check_register(path)
     except RegisterError as exc:

@@ -89,9 +89,10 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--register",
-        metavar="FILE",
-        help="the register file (default: $FHA_STUDIO_REGISTER, else register.sqlite in the user data "
-        "directory), as for fha-studio register",
+        metavar="FILE_OR_URL",
+        help="the register: a file, or postgresql://USER:PASSWORD@HOST/DB for a plant's register on a "
+        "server (default: $FHA_STUDIO_REGISTER, else register.sqlite in the user data directory), as "
+        "for fha-studio register",
     )
     parser.add_argument(
         "--training",
@@ -109,14 +110,14 @@ def _machine_window(args):
         return None
     from fha_studio.gui.machine_window import MachineWindow
     from fha_studio.logic.machine import MachineError, MachineProject
-    from fha_studio.logic.register import Register, RegisterError, default_register_path
+    from fha_studio.logic.register import Register, RegisterError, register_location
 
     try:
         # a machine file is read (and refused) before the register is opened: a refused file
         # leaves no new register behind; it is put into the register (made when missing), while
         # a machine by name must be there
         project = MachineProject.load(args.machine_file) if args.machine_file else None
-        register = Register(default_register_path(args.register), create=bool(args.machine_file))
+        register = Register(register_location(args.register), create=bool(args.machine_file))
         try:
             if project is None:
                 project = MachineProject.from_register(register, args.machine)

@@ -1,4 +1,6 @@
-"""Register fixtures: a register file in the test's temporary directory, never the user's."""
+"""Register fixtures: a register file in the test's temporary directory, never the user's, and
+the same register on a throw-away PostgreSQL server (a database of its own for each test): a
+test that takes ``register`` (or ``line3``) runs on both stores."""
 
 from __future__ import annotations
 
@@ -7,8 +9,24 @@ import pytest
 from fha_studio.logic.register import Register
 
 
+@pytest.fixture(params=["sqlite", "postgresql"])
+def register_target(request, tmp_path):
+    """Where the test's register is: a file, or a ``postgresql://`` URL of a new database."""
+    if request.param == "sqlite":
+        return tmp_path / "register.sqlite"
+    return request.getfixturevalue("postgres_cluster").new_database()
+
+
 @pytest.fixture
-def register(tmp_path):
+def register(register_target):
+    reg = Register(register_target)
+    yield reg
+    reg.close()
+
+
+@pytest.fixture
+def register_file(tmp_path):
+    """A register in an SQLite file only (what only a file has: WAL, its path)."""
     reg = Register(tmp_path / "register.sqlite")
     yield reg
     reg.close()

@@ -13,9 +13,13 @@ from fha_studio.cli import main
 from fha_studio.logic.register import Register
 
 
-@pytest.fixture
-def db(tmp_path, capsys):
-    path = tmp_path / "plant.sqlite"
+@pytest.fixture(params=["sqlite", "postgresql"])
+def db(request, tmp_path, capsys):
+    """A register (a file, or a database on the throw-away server) with Line 3's two axes."""
+    if request.param == "sqlite":
+        path = tmp_path / "plant.sqlite"
+    else:
+        path = request.getfixturevalue("postgres_cluster").new_database()
     assert main(["register", "--register", str(path), "add-machine", "Line 3", "--site", "Plant A"]) == 0
     for axis, port in (("table", "/dev/ttyUSB0"), ("table twin", "/dev/ttyUSB1")):
         args = ["register", "--register", str(path), "add-axis", f"Line 3/{axis}",

@@ -20,7 +20,8 @@ DELIVERY = [
 ]
 
 
-def test_a_new_register_is_wal_at_the_current_version(register):
+def test_a_new_register_is_wal_at_the_current_version(register_file):
+    register = register_file
     assert register.version == SCHEMA_VERSION
     assert register.journal_mode == "wal"
     assert register.integrity_check() == "ok"

@@ -29,6 +29,7 @@ from fha_studio.logic.register.store import (
     RegisterError,
     default_register_path,
     file_sha256,
+    register_location,
     utc_stamp,
 )
 
@@ -52,5 +53,6 @@ __all__ = [
     "import_parameter_file",
     "import_session_file",
     "record_session",
+    "register_location",
     "utc_stamp",
 ]

@@ -1,6 +1,7 @@
-"""The register file's connection: WAL, one write transaction at a time (or a batch of them),
-SQLite's errors in words; which file the register is (one rule for the GUI and the command line).
-The layers of :class:`~fha_studio.logic.register.store.Register` build on :class:`Connection`."""
+"""The register's connection: to an SQLite file (WAL, one write transaction at a time, or a batch
+of them) or to a PostgreSQL server (:mod:`.server` speaks the register's SQL there); their errors
+in words; which register it is (one rule for the GUI and the command line). The layers of
+:class:`~fha_studio.logic.register.store.Register` build on :class:`Connection`."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import sqlite3
 import time
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Self
+from typing import Any, Self
 
 from fha_studio.logic.register import guard
 from fha_studio.logic.register.guard import RegisterError
@@ -19,6 +20,15 @@ from fha_studio.paths import user_data_dir
 #: A site chooses its register file with this environment variable (e.g. on a shared drive).
 ENV_REGISTER = "FHA_STUDIO_REGISTER"
 REGISTER_FILE_NAME = "register.sqlite"
+
+
+def register_location(chosen: str | Path | None = None) -> Path | str:
+    """The register by the rule of :func:`default_register_path`: a ``postgresql://`` URL (a
+    register on a server) as it is, else the file's path."""
+    from fha_studio.logic.register.server import is_server_url
+
+    text = str(chosen or "").strip() or os.environ.get(ENV_REGISTER, "").strip()
+    return text if is_server_url(text) else default_register_path(chosen)
 
 
 def default_register_path(chosen: str | Path | None = None) -> Path:
@@ -33,11 +43,15 @@ def default_register_path(chosen: str | Path | None = None) -> Path:
 class Connection:
     """An open register file (opened by :class:`~fha_studio.logic.register.store.Register`)."""
 
-    path: Path
+    #: the file, or for a register on a server its URL without the password
+    path: Path | str
     busy_timeout_s: float
     read_only: bool
     journal_mode: str
-    _db: sqlite3.Connection
+    #: an ``sqlite3.Connection``, or a :class:`~.server.ServerDatabase` that takes the same SQL
+    _db: Any
+    #: the server's URL (with its password) for a register on a server, else ""
+    _url = ""
     #: SQLite's quick check found the file sound at this connection's first write (it is run
     #: once: 0.27 s for a register of 46 MB, measured under load)
     _checked_sound = False
@@ -76,30 +90,43 @@ class Connection:
         try:
             self._db.execute("BEGIN IMMEDIATE")
             if not self._checked_sound:  # the first write of this connection: is the file sound?
-                if not guard.sound(self._db):
-                    failure = guard.damaged(self.path, self._db)
+                if not self._url and not guard.sound(self._db):  # a server checks its own pages
+                    failure = guard.damaged(Path(self.path), self._db)
                     self._db.execute("ROLLBACK")
                     raise failure
                 self._checked_sound = True
-        except sqlite3.Error as exc:
-            with contextlib.suppress(sqlite3.Error):
-                self._db.execute("ROLLBACK")
+        except Exception as exc:
+            if not guard.is_db_error(exc):
+                raise
+            self._rollback()
             raise self._problem(exc) from None
         try:
             yield self._db
         except BaseException:
-            with contextlib.suppress(sqlite3.Error):  # the error that ended it is the one to tell
-                self._db.execute("ROLLBACK")
+            self._rollback()  # the error that ended it is the one to tell
             raise
         try:
             self._db.execute("COMMIT")
-        except sqlite3.Error as exc:
-            with contextlib.suppress(sqlite3.Error):
-                self._db.execute("ROLLBACK")
+        except Exception as exc:
+            if not guard.is_db_error(exc):
+                raise
+            self._rollback()
             raise self._problem(exc) from None
 
-    def _problem(self, exc: sqlite3.Error) -> RegisterError:
-        """SQLite's error as one line naming this register and what to do."""
+    def _rollback(self) -> None:
+        try:
+            self._db.execute("ROLLBACK")
+        except Exception as exc:
+            if not guard.is_db_error(exc):
+                raise
+
+    def _problem(self, exc: BaseException) -> RegisterError:
+        """SQLite's (or the server's) error as one line naming this register and what to do."""
+        if self._url:
+            from fha_studio.logic.register import server
+
+            return server.problem(self._url, exc)
+        assert isinstance(exc, sqlite3.Error) and isinstance(self.path, Path)
         return guard.problem(self.path, exc, self._db, self.busy_timeout_s)
 
     def close(self) -> None:
@@ -112,5 +139,8 @@ class Connection:
         self.close()
 
     def integrity_check(self) -> str:
-        """SQLite's verdict on the file: ``"ok"`` or what is wrong."""
+        """SQLite's verdict on the file: ``"ok"`` or what is wrong (on a server: "ok" when it
+        answers; it keeps its pages and constraints itself)."""
+        if self._url:
+            return "ok" if self._db.execute("SELECT 1").fetchone() is not None else "no answer"
         return "; ".join(str(r[0]) for r in self._db.execute("PRAGMA integrity_check"))

@@ -168,7 +168,7 @@ _Class = TypeVar("_Class", bound=type)
 
 
 def in_words(cls: _Class) -> _Class:
-    """Class decorator: every public method of ``cls`` raises SQLite's errors as
+    """Class decorator: every public method of ``cls`` raises SQLite's (and the server's) errors as
     ``self._problem(exc)`` (a :class:`RegisterError` line) instead of ``sqlite3.Error``."""
     for name, member in list(vars(cls).items()):
         if name.startswith("_") or not callable(member) or isinstance(member, staticmethod | classmethod):
@@ -177,12 +177,20 @@ def in_words(cls: _Class) -> _Class:
     return cls
 
 
+def is_db_error(exc: BaseException) -> bool:
+    """An error of the register's store: SQLite's, or psycopg's (the server's or the connection's
+    to it; psycopg is imported only by a register on a server)."""
+    return isinstance(exc, sqlite3.Error) or type(exc).__module__.split(".")[0] == "psycopg"
+
+
 def _translating(method: Callable[..., Any]) -> Callable[..., Any]:
     @functools.wraps(method)
     def call(self: Any, *args: Any, **kwargs: Any) -> Any:
         try:
             return method(self, *args, **kwargs)
-        except sqlite3.Error as exc:
+        except Exception as exc:
+            if not is_db_error(exc):
+                raise
             raise self._problem(exc) from None
 
     return call

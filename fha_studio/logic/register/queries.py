@@ -121,13 +121,17 @@ class Queries(Facts):
         has a value for it when ``value`` is None). Latest known: as in :meth:`current_values`."""
         axes = {a.id: a for a in self.axes(machine)}
         latest: dict[int, ParameterValue] = {}
-        # SQLite takes the other columns of an aggregate query from the row with the MAX
+        # the latest row of each axis (the newest time, then the highest number)
         queries = (
-            "SELECT s.axis_id, v.mode, v.number, v.key, v.value, MAX(s.at_utc), s.source, s.id"
-            " FROM snapshot_value v JOIN snapshot s ON s.id = v.snapshot_id"
-            " WHERE v.key = ? GROUP BY s.axis_id",
-            "SELECT axis_id, mode, number, key, COALESCE(read_back, new), MAX(at_utc), 'write', id"
-            " FROM parameter_write WHERE key = ? AND verified = 1 GROUP BY axis_id",
+            "SELECT axis_id, mode, number, key, value, at_utc, source, id FROM (SELECT s.axis_id, v.mode,"
+            " v.number, v.key, v.value, s.at_utc, s.source, s.id, ROW_NUMBER() OVER (PARTITION BY s.axis_id"
+            " ORDER BY s.at_utc DESC, s.id DESC) AS latest"
+            " FROM snapshot_value v JOIN snapshot s ON s.id = v.snapshot_id WHERE v.key = ?) AS known"
+            " WHERE latest = 1",
+            "SELECT axis_id, mode, number, key, value, at_utc, 'write', id FROM (SELECT axis_id, mode,"
+            " number, key, COALESCE(read_back, new) AS value, at_utc, id, ROW_NUMBER() OVER"
+            " (PARTITION BY axis_id ORDER BY at_utc DESC, id DESC) AS latest"
+            " FROM parameter_write WHERE key = ? AND verified = 1) AS known WHERE latest = 1",
         )
         for query in queries:
             for row in self._db.execute(query, (key,)):
@@ -156,7 +160,11 @@ class Queries(Facts):
 
     def procedure_status(self, axis: Axis | str | int) -> list[dict[str, Any]]:
         current = self.axis(axis)
-        rows = self._db.execute("SELECT * FROM procedure_run WHERE axis_id = ? ORDER BY rowid", (current.id,))
+        rows = self._db.execute(
+            "SELECT axis_id, procedure_id, title, section, status, updated_utc, session_file"
+            " FROM procedure_run WHERE axis_id = ? ORDER BY rowid",
+            (current.id,),
+        )
         return [dict(r) for r in rows]
 
     def session_file(self, axis: Axis | str | int) -> str:

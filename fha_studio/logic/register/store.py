@@ -1,4 +1,6 @@
-"""The register: every commissioning fact of every axis of every machine, in one SQLite file.
+"""The register: every commissioning fact of every axis of every machine, in one SQLite file or
+in a database on a PostgreSQL server (a ``postgresql://`` URL; :mod:`.server`), the same tables
+and migrations in both.
 
 Machines have axes; an axis has a history of parameter snapshots (read over the link, entered
 from the front panel or taken from a parameter file), verified writes, procedure checks, alarms,
@@ -23,7 +25,12 @@ from typing import Any
 
 from fha_studio import fileio
 from fha_studio.logic.register import guard
-from fha_studio.logic.register.connection import ENV_REGISTER, REGISTER_FILE_NAME, default_register_path
+from fha_studio.logic.register.connection import (
+    ENV_REGISTER,
+    REGISTER_FILE_NAME,
+    default_register_path,
+    register_location,
+)
 from fha_studio.logic.register.guard import RegisterError
 from fha_studio.logic.register.keys import Keys
 from fha_studio.logic.register.records import (
@@ -60,12 +67,17 @@ class Register(Keys):
         create: bool = True,
         read_only: bool = False,
     ):
-        """Opens the register at ``path`` (default: :func:`default_register_path`), created when
+        """Opens the register at ``path`` (default: :func:`default_register_path`; a
+        ``postgresql://`` URL: the register in that database on the server), created when
         missing unless ``create`` is False (then RegisterError says there is none). ``read_only``:
         for questions only; the file is not changed (a register this user may not write is
         opened so anyway)."""
-        self.path = Path(path) if path is not None else default_register_path()
         self.busy_timeout_s = busy_timeout_s
+        target = register_location(path)
+        if isinstance(target, str):
+            self._open_on_server(target, create, read_only)
+            return
+        self.path = Path(target)
         # a device, a FIFO or a file that is no database is refused before SQLite opens it
         cannot_write = guard.check_before_opening(self.path, create and not read_only)
         if read_only and not cannot_write:
@@ -102,6 +114,37 @@ class Register(Keys):
             raise failure from None
         except RegisterError:
             self._db.close()
+            raise
+
+    def _open_on_server(self, url: str, create: bool, read_only: bool) -> None:
+        from fha_studio.logic.register import server
+
+        self._url, self.path = url, server.shown_url(url)
+        self.journal_mode, self._checked_sound = "server", True
+        try:
+            self._db = server.ServerDatabase(url, connect_timeout_s=min(self.busy_timeout_s, 10.0))
+        except Exception as exc:
+            if not guard.is_db_error(exc):
+                raise
+            raise server.problem(url, exc, opening=True) from None
+        try:
+            if not self._db.prepare_register(create and not read_only):
+                raise RegisterError(f"there is no register at {guard.shown_path(self.path)}")
+            self.read_only = read_only
+            if read_only and self.version < SCHEMA_VERSION:
+                self.read_only = False  # an older register is brought up to date before it is read
+            if self.read_only:
+                if self.version != SCHEMA_VERSION:
+                    raise RegisterError(
+                        f"the register {guard.shown_path(self.path)} was written by another FHA Studio "
+                        f"(schema {self.version}; this one reads {SCHEMA_VERSION})")
+            else:
+                self._migrate()
+            self.read_only = read_only
+        except Exception as exc:
+            self._db.close()
+            if guard.is_db_error(exc):
+                raise server.problem(url, exc, opening=True) from None
             raise
 
     def _migrate(self, target: int = SCHEMA_VERSION) -> None:
@@ -174,5 +217,6 @@ __all__ = [
     "RegisterError",
     "default_register_path",
     "file_sha256",
+    "register_location",
     "utc_stamp",
 ]
