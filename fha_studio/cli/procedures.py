@@ -243,7 +243,7 @@ def _answer_in_terminal(step, client, context, session):
 
 
 def _report(args) -> int:
-    from fha_studio.logic.procedures.report import SignError, build_report, render_html, sign
+    from fha_studio.logic.procedures.report import SignError, build_report, sign
 
     session = _load_session(args.session)
     output = Path(args.output) if args.output else args.session.with_suffix(".html")
@@ -260,7 +260,9 @@ def _report(args) -> int:
             print(f"note: signed by name only: {args.sign} has no signing key in the register "
                   "(fha-studio register keys add --name NAME makes one)", file=sys.stderr)
         report = build_report(session)
-        fileio.write_text(output, render_html(report))
+        from fha_studio.logic.register.report_signing import report_file_bytes
+
+        fileio.write_bytes(output, report_file_bytes(session))  # a key signature the session keeps
     print(f"{output}  ({len(report.warnings)} open warning(s))")
     for warning in report.warnings:
         print(f"  - {warning}", file=sys.stderr)

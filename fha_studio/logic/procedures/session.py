@@ -29,6 +29,11 @@ class SessionError(ValueError):
     """A session file cannot be read or does not fit (says which file and what)."""
 
 
+#: What a session's signature holds: who and when; with a key also its id, the report's SHA-256
+#: and the signature (hex).
+SIGNATURE_FIELDS = ("who", "at_utc", "key_id", "sha256", "ed25519")
+
+
 def utc_now() -> str:
     """Now, UTC, ISO 8601 to the second."""
     return clock.utc_iso()
@@ -95,7 +100,8 @@ class ProcedureSession:
     )  # {"file": path, "values": {key: value}, "read_utc": ...}
     plots: list[dict[str, str]] = field(default_factory=list)  # {"title": ..., "path": PNG}
     notes: list[dict[str, str]] = field(default_factory=list)  # {"who", "at_utc", "text"}
-    signature: dict[str, str] = field(default_factory=dict)  # {"who", "at_utc"[, "key_id"]}
+    # {"who", "at_utc"}, and with a key: "key_id", "sha256" of the report, "ed25519" (its signature)
+    signature: dict[str, str] = field(default_factory=dict)
     path: Path | None = field(default=None, compare=False, repr=False)
 
     def run(self, procedure_id: str) -> RunState:
@@ -205,13 +211,16 @@ def _list(value: Any, where: str, what: str) -> list[Any]:
     return value
 
 
-def _texts(value: Any, where: str, keys: tuple[str, ...] | None = None) -> dict[str, str]:
+def _texts(value: Any, where: str, keys: tuple[str, ...] | None = None,
+           optional: tuple[str, ...] = ()) -> dict[str, str]:
+    """A table of texts; ``keys`` (said in the refusal) and ``optional`` the ones it may hold."""
     what = "texts" if keys is None else f"texts ({', '.join(keys)})"
     table = _table(value, where, what)
     if keys is not None:
-        unknown = sorted(set(table) - set(keys))
+        allowed = keys + optional
+        unknown = sorted(set(table) - set(allowed))
         if unknown:
-            raise _ShapeError(f"{where}.{unknown[0]}", f"unknown; allowed: {', '.join(keys)}")
+            raise _ShapeError(f"{where}.{unknown[0]}", f"unknown; allowed: {', '.join(allowed)}")
     return {k: _text(v, f"{where}.{k}") for k, v in table.items()}
 
 
@@ -236,7 +245,8 @@ def _session_from_json(data: dict[str, Any]) -> ProcedureSession:
     if "driver" in data:
         values["driver"] = _texts(data["driver"], "driver")
     if "signature" in data:
-        values["signature"] = _texts(data["signature"], "signature", ("who", "at_utc", "key_id"))
+        signature = data["signature"]
+        values["signature"] = _texts(signature, "signature", SIGNATURE_FIELDS[:2], SIGNATURE_FIELDS[2:])
     for key, fields in (("notes", ("who", "at_utc", "text")), ("plots", ("title", "path"))):
         if key in data:
             values[key] = [_texts(v, f"{key}[{i}]", fields)

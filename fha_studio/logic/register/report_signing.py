@@ -1,9 +1,11 @@
 """Signing a commissioning report with a person's key: the HTML file carries its signature, the
 register records it (the PDF, which cannot carry one, is found in the register by its hash).
 
-Nothing is half-done: the key is loaded and checked against the register before anything is
-written; the register's record comes before the file, and the session file is saved last (a
-failure on the way leaves the session unsigned, as it was)."""
+The report's HTML is reproducible from the session, so the signature is made once, when the
+person signs, and kept in the session file; every report written from that session carries it.
+Nothing is half-done: the key is checked against the register before anything is written; the
+register's record comes before the session file (a failure on the way leaves the session
+unsigned, as it was)."""
 
 from __future__ import annotations
 
@@ -59,6 +61,49 @@ def private_key_file_for(register: Keys, person: str) -> Path | None:
                        "give its key file")
 
 
+def sign_session(
+    register: Keys,
+    session: ProcedureSession,
+    who: str,
+    key: Ed25519PrivateKey,
+    context: Mapping[str, Any] | None = None,
+) -> Signed:
+    """Sign the session's report as ``who`` with ``key``: the signature covers the report's HTML
+    as :func:`report_file_bytes` writes it, is recorded in the register and kept in the session
+    (saved). SignError while checks are open; RegisterError when the key is not ``who``'s usable
+    key in the register; on either the session is as it was."""
+    known = usable_key(register, key, who)
+    before = dict(session.signature)
+    try:
+        sign(session, who, context, key_id=known.key_id, save=False)
+        content = render_html(build_report(session, context)).encode("utf-8")
+        signed = sign_bytes(key, content, known.person, session.signature["at_utc"])
+        register.record_signature(signed)
+        session.signature.update(sha256=signed.sha256, ed25519=signed.signature)
+        if session.path is not None:
+            session.save()
+    except BaseException:
+        session.signature = before
+        raise
+    return signed
+
+
+def carried_signature(session: ProcedureSession) -> Signed | None:
+    """The key signature the session keeps (None: unsigned, or signed by name only)."""
+    s = session.signature
+    if not all(s.get(k) for k in ("who", "at_utc", "key_id", "sha256", "ed25519")):
+        return None
+    return Signed(s["sha256"], s["who"], s["key_id"], s["at_utc"], s["ed25519"])
+
+
+def report_file_bytes(session: ProcedureSession, context: Mapping[str, Any] | None = None) -> bytes:
+    """The report's HTML file: its canonical bytes, and its signature as the last line when the
+    session is signed with a key (a session changed after signing no longer verifies)."""
+    content = render_html(build_report(session, context)).encode("utf-8")
+    signed = carried_signature(session)
+    return with_block(content, signed) if signed is not None else content
+
+
 def sign_report_file(
     register: Keys,
     session: ProcedureSession,
@@ -67,23 +112,11 @@ def sign_report_file(
     output: str | Path,
     context: Mapping[str, Any] | None = None,
 ) -> Signed:
-    """Sign the session's report as ``who`` with ``key`` and write it to ``output`` (HTML, its
-    signature the last line); the signature is recorded in the register. SignError while checks
-    are open; RegisterError when the key is not ``who``'s usable key in the register."""
-    known = usable_key(register, key, who)
+    """:func:`sign_session`, then the signed report written to ``output`` (whole or not at all;
+    a target that cannot be written is refused before anything is signed)."""
     target = fileio.check_output_path(output)
-    before = dict(session.signature)
-    try:
-        sign(session, who, context, key_id=known.key_id, save=False)
-        content = render_html(build_report(session, context)).encode("utf-8")
-        signed = sign_bytes(key, content, known.person, session.signature["at_utc"])
-        register.record_signature(signed, target)
-        fileio.write_bytes(target, with_block(content, signed))
-    except BaseException:
-        session.signature = before
-        raise
-    if session.path is not None:
-        session.save()
+    signed = sign_session(register, session, who, key, context)
+    fileio.write_bytes(target, report_file_bytes(session, context))
     return signed
 
 

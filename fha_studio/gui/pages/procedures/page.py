@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
     QFileDialog,
     QGroupBox,
     QHBoxLayout,
+    QInputDialog,
     QLabel,
     QLineEdit,
     QListWidget,
@@ -40,6 +41,7 @@ from fha_studio.gui.pages.base import BasePage, PageHost, PageId
 from fha_studio.gui.pages.direction import DirectionPage
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
 from fha_studio.gui.pages.procedures.live_panel import LiveCheckPanel
+from fha_studio.gui.pages.procedures.signer import ReportSigner
 from fha_studio.logic.procedures import (
     Observation,
     Procedure,
@@ -51,8 +53,9 @@ from fha_studio.logic.procedures import (
     StepInputError,
     load_all,
 )
-from fha_studio.logic.procedures.report import SignError, build_report, sign, value_text
+from fha_studio.logic.procedures.report import build_report, value_text
 from fha_studio.logic.procedures.report_inputs import ReportInputs, collect_for_report
+from fha_studio.logic.register.report_signing import report_file_bytes
 from fha_studio.logic.register.words import when_text
 
 log = logging.getLogger(__name__)
@@ -83,6 +86,7 @@ class ProceduresPage(BasePage):
         self.context: dict | None = None
         self.procedures: list[Procedure] = []
         self.run: ProcedureRun | None = None
+        self.signer = ReportSigner()  # the sign step's key (the register's, the user's keys folder)
         self._build()
         self.state.sigActuatorChanged.connect(self._axis_changed)
         self.live_panel.relay.sigSample.connect(
@@ -282,6 +286,7 @@ class ProceduresPage(BasePage):
         self._use(session, context)
 
     def _use(self, session: ProcedureSession, context: dict) -> None:
+        self.signer.forget()
         self.session, self.context = session, context
         self.procedures = load_all(context)
         self.run = None
@@ -440,22 +445,33 @@ class ProceduresPage(BasePage):
         if self.session is None:
             raise SessionError("no session: nothing to report")
         self._collect_for_report()
-        html, pdf = write_report(build_report(self.session, self.context), html_path, pdf_path)
+        html_file = report_file_bytes(self.session, self.context)  # with its signature line when signed
+        html, pdf = write_report(build_report(self.session, self.context), html_path, pdf_path, html_file)
+        if pdf is not None:
+            self.signer.sign_pdf(self.session, pdf)
         self.sigReportWritten.emit(html, pdf)
         return html, pdf
 
-    def sign(self, who: str = "") -> bool:
+    def sign(self, who: str = "", passphrase: str | None = None) -> bool:
+        """Sign the report as ``who`` (else the operator), with their key when the register keeps
+        one (``passphrase``: its passphrase; None asks for it when the key is encrypted)."""
         if self.session is None:
             return False
         self._collect_for_report()
+        ask = self._ask_passphrase if passphrase is None else (lambda _path: passphrase)
         try:
-            sign(self.session, who or self.who, self.context)
-        except SignError as exc:
+            said = self.signer.sign(self.session, who or self.who, self.context, ask)
+        except ValueError as exc:  # open checks, a key that cannot be used, a wrong passphrase
             self._message(str(exc))
             return False
-        self._message(f"Signed by {self.session.signature['who']}.")
+        self._message(said)
         self._refresh()
         return True
+
+    def _ask_passphrase(self, key_file: Path) -> str | None:
+        text, ok = QInputDialog.getText(self, "Sign the report", f"Passphrase of the key {key_file.name}:",
+                                        QLineEdit.EchoMode.Password)
+        return text if ok else None
 
     # -- dialogs ------------------------------------------------------------------------------
     def _new_clicked(self) -> None:

@@ -227,10 +227,12 @@ def write_pdf(
 
 
 def write_report(
-    report: CommissioningReport, html_path: str | Path, pdf_path: str | Path | None = None
+    report: CommissioningReport, html_path: str | Path, pdf_path: str | Path | None = None,
+    html_file: bytes | None = None,
 ) -> tuple[Path, Path | None]:
     """Write the report as HTML and (when ``pdf_path`` is given) as PDF; returns both paths.
-    The HTML appears after the PDF is complete, each whole or not at all (:mod:`fha_studio.fileio`)."""
+    The HTML appears after the PDF is complete, each whole or not at all (:mod:`fha_studio.fileio`).
+    ``html_file``: the HTML file's bytes when they are more than the rendering (its signature line)."""
     html = render_html(report)
     html_path = Path(html_path)
     if not os.path.lexists(html_path.parent):
@@ -239,5 +241,5 @@ def write_report(
         if target is not None:
             fileio.check_output_path(target)  # before the work: a target that cannot be written
     pdf = write_pdf(html, pdf_path, report.title, html_path.parent) if pdf_path is not None else None
-    fileio.write_text(html_path, html)  # whole or not at all
+    fileio.write_bytes(html_path, html_file if html_file is not None else html.encode("utf-8"))
     return html_path, pdf
