@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import pytest
 
+from fha_studio.gui.pages.base import PageId
+
 CODE = "FHA-25C-50-S248"  # absolute: CN3 gives the position (DGR) while the servo is off
 URL = f"sim://{CODE}?paced=0&profile=documented"
 
@@ -17,7 +19,7 @@ def window(make_window, qtbot):
     return w
 
 
-def test_bench_traces_are_drawn_beside_cn3s_named_with_their_source(window, qtbot):
+def test_bench_traces_are_drawn_beside_cn3s_named_with_their_source(window, qtbot, tmp_path):
     page = window.show_page("scope")
     view, bench = page.view, page.bench
     view.start_live()
@@ -39,6 +41,13 @@ def test_bench_traces_are_drawn_beside_cn3s_named_with_their_source(window, qtbo
     assert {"bench sim-cn2: SPD_MON [V]", "bench sim-cn2: IN_POS [bit]"} <= set(plot._bench)
     assert "V" in units and "bench sim-cn2: SPD_MON [V]" in plot.legend.text()
     assert label in plot.legend.text()
+    # a plot of it saved for the report says where its bench traces came from
+    procedures = window.page(PageId.PROCEDURES)
+    procedures.new_session(tmp_path / "session.json", CODE, "T. Trainee")
+    saved = procedures.capture_scope_plot()
+    assert saved is not None and saved.is_file()
+    assert procedures.session.plots[-1]["title"].startswith(
+        "Scope plot 1 (with bench sim-cn2 at 100 kHz: sim-cn2:ENC_A, sim-cn2:ENC_B, sim-cn2:IN_POS")
     with qtbot.waitSignal(bench.source.sigStopped, timeout=10000):
         bench.start_button.click()
     view.stop_live()

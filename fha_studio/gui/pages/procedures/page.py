@@ -434,7 +434,8 @@ class ProceduresPage(BasePage):
         from fha_studio.gui.paper import save_for_paper
 
         save_for_paper(path)  # printed in the report: a light background, the legend readable
-        self.add_plot(title or f"Scope plot {number}", path)
+        # a bench stream drawn beside CN3's channels: the plot says where its traces came from
+        self.add_plot(title or f"Scope plot {number}{scope.bench_source_text()}", path)
         self._message(f"Plot saved for the report: {path}")
         return path
 

@@ -113,6 +113,17 @@ class ScopePage(BasePage):
         plot.set_bench_curves(bench_traces(started, rows, self.bench.counts_per_output_turn,
                                            max(200, plot.plot.width())), COLORS)
 
+    def bench_source_text(self) -> str:
+        """`` (with bench sim-cn2 at 250 kHz: sim-cn2:ENC_A, ...)`` while a bench stream is drawn on
+        the Time plot beside CN3's channels, else ""."""
+        from fha_studio.hardware.bench.sigrok import rate_text
+
+        started = self.bench.source.started
+        if started is None or not self.view.time_plot.has_bench_curves:
+            return ""
+        return (f" (with bench {started.device} at {rate_text(started.sample_rate_hz)}: "
+                f"{', '.join(started.labels)})")
+
     def _bench_beside(self, live_t0: float):
         """The bench stream's columns for a recording started now (None: no stream runs)."""
         from .bench_overlay import recorder_columns

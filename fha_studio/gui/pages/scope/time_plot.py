@@ -390,6 +390,10 @@ class TimePlot(QWidget):
     def live(self) -> bool:
         return self._live
 
+    @property
+    def has_bench_curves(self) -> bool:
+        return bool(self._bench)
+
     def set_bench_curves(self, traces: Mapping[str, tuple[str, np.ndarray, np.ndarray]],
                          colors: Sequence[str] = ("#555555",)) -> None:
         """A bench instrument's traces beside CN3's: label (with its source) -> (unit, time
