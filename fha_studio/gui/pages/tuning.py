@@ -1,5 +1,5 @@
 """The Tuning page: the speed loop's frequency response with the gear's resonance marked, the
-load inertia from it, margins with the present gains, and proposed tune items (issue 25).
+load inertia from it, margins with the present gains, and proposed tune items.
 
 The work is the logic's (``logic/tuning``); it runs in the link thread (``Call``), STOP ends it
 (``link.abort_event``). The excitation is shown before it starts, and it starts only after a
