@@ -57,8 +57,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "with NAME's key when the register has one (fha-studio register keys add)")
     report.add_argument("--key-file", type=Path, metavar="PATH",
                         help="the signer's private key (default: NAME's in the user data directory)")
-    report.add_argument("--register", metavar="FILE", help="the register that keeps the signers' keys "
-                        "(default: as for fha-studio register)")
+    report.add_argument("--register", metavar="FILE_OR_URL", help="the register that keeps the signers' "
+                        "keys (default: as for fha-studio register)")
     report.set_defaults(func=_report)
 
 
@@ -274,15 +274,15 @@ def _sign_with_key(args, session, output: Path) -> bool:
     report is signed by name only). Everything that can be refused is refused before a write."""
     from fha_studio.cli._register_signing import passphrase
     from fha_studio.logic.procedures.report import SignError
-    from fha_studio.logic.register import Register, RegisterError, default_register_path
+    from fha_studio.logic.register import Register, RegisterError, register_location
     from fha_studio.logic.register.report_signing import private_key_file_for, sign_report_file
     from fha_studio.logic.register.signing import SigningError, key_file_encrypted, load_private_key
 
-    path = default_register_path(args.register)
-    if not args.key_file and not path.exists():
+    where = register_location(args.register)
+    if not args.key_file and isinstance(where, Path) and not where.exists():
         return False
     try:
-        with Register(path, create=False) as reg:
+        with Register(where, create=False) as reg:
             key_file = args.key_file.expanduser() if args.key_file else private_key_file_for(reg, args.sign)
             if key_file is None:
                 return False

@@ -33,9 +33,10 @@ def finished(tmp_path):
 
 
 @pytest.fixture
-def reg_path(tmp_path, monkeypatch):
+def reg_path(register_target, monkeypatch):
+    """The register, a file or a database on the tests' PostgreSQL server (each test runs on both)."""
     monkeypatch.setenv("FHA_STUDIO_KEY_PASSPHRASE", "correct horse")
-    return tmp_path / "register.sqlite"
+    return register_target
 
 
 def _add_key(reg_path, name, *extra):
@@ -169,10 +170,10 @@ def test_bad_keys_and_passphrases_are_one_line_and_write_nothing(
     assert [k["person"] for k in keys] == ["A. Reviewer"]
 
 
-def test_keys_are_kept_across_an_upgrade_and_never_replaced(tmp_path):
+def test_a_key_is_never_replaced_and_a_revocation_is_a_fact_of_its_own(register_target):
     from fha_studio.logic.register.signing import key_id_of, new_key, public_raw
 
-    with Register(tmp_path / "r.sqlite") as reg:
+    with Register(register_target) as reg:
         key = new_key()
         key_id = key_id_of(public_raw(key))
         reg.add_key("A. Reviewer", public_raw(key).hex(), key_id)

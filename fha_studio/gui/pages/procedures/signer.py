@@ -13,7 +13,7 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from fha_studio.logic.procedures import ProcedureSession
 from fha_studio.logic.procedures.report import SignError, sign
-from fha_studio.logic.register import Register, default_register_path
+from fha_studio.logic.register import Register, register_location
 from fha_studio.logic.register.report_signing import (
     carried_signature,
     private_key_file_for,
@@ -29,25 +29,26 @@ AskPassphrase = Callable[[Path], "str | None"]
 class ReportSigner:
     """Signs a session's report with the signer's key when the register has one."""
 
-    def __init__(self, register_path: Path | None = None) -> None:
-        #: the register with the keys (None: the one of --register / $FHA_STUDIO_REGISTER / default)
-        self.register_path = register_path
+    def __init__(self, register: Path | str | None = None) -> None:
+        #: the register with the keys, a file or a server's URL (None: $FHA_STUDIO_REGISTER, else
+        #: the user's register file)
+        self.register = register
         self._key: Ed25519PrivateKey | None = None
         self._who = ""
 
-    def _path(self) -> Path:
-        return self.register_path or default_register_path()
+    def _where(self) -> Path | str:
+        return register_location(self.register)
 
     def sign(self, session: ProcedureSession, who: str, context: Mapping[str, Any] | None,
              ask: AskPassphrase) -> str:
         """Sign; returns what the message line says. SignError, RegisterError or SigningError
         (one line) when it is refused; the session is then as it was."""
         self.forget()
-        path = self._path()
-        if not path.exists():
+        where = self._where()
+        if isinstance(where, Path) and not where.exists():
             sign(session, who, context)
             return f"Signed by {who.strip()} by name only (no register keeps a key of theirs)."
-        with Register(path, create=False) as reg:
+        with Register(where, create=False) as reg:
             key_file = private_key_file_for(reg, who)
             if key_file is None:
                 sign(session, who, context)
@@ -70,7 +71,7 @@ class ReportSigner:
         signed = carried_signature(session)
         if self._key is None or signed is None or signed.signer != self._who:
             return False
-        with Register(self._path(), create=False) as reg:
+        with Register(self._where(), create=False) as reg:
             sign_other_file(reg, self._key, self._who, pdf)
         return True
 
