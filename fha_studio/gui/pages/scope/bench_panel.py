@@ -9,6 +9,7 @@ CN3 channel. Where sigrok-cli is missing the tab says how to install it.
 
 from __future__ import annotations
 
+import math
 import shutil
 
 import numpy as np
@@ -36,6 +37,8 @@ from .bench_source import BenchSettings, BenchSource, BenchStarted
 
 #: Seconds of the newest rows on show.
 WINDOW_S = 2.0
+#: The time axis moves on in steps of this [s].
+STEP_S = 0.5
 #: A move's figures are taken once its command has stood this long [s] (the axis settles first).
 MOVE_SETTLED_S = 0.5
 #: A command standing still this long before a change marks where a move began [s].
@@ -141,6 +144,11 @@ class BenchPanel(QWidget):
         self.counts_plot.setVisible(False)
         self.counts_plot.addLegend(offset=(5, 5))
         self._counts_curve = self.counts_plot.plot([], [], pen=pg.mkPen("#333333", width=1))
+        self._counts_curve.setSkipFiniteCheck(True)
+        self.counts_plot.enableAutoRange(enable=False)  # ranges set per frame, not from the data's bounds
+        self._y_range: tuple[float, float] | None = None
+        self._x_range: tuple[float, float] | None = None
+        self._counts_range: tuple[float, float] | None = None
         layout.addWidget(self.counts_plot, 2)
         self.move_label = QLabel("")
         self.move_label.setObjectName("scopeBenchMove")
@@ -285,8 +293,11 @@ class BenchPanel(QWidget):
         self._curves = []
         for i, label in enumerate(started.labels[: len(started.channels)]):
             pen = pg.mkPen(_COLORS[i % len(_COLORS)], width=1)
-            self._curves.append(self.plot.plot([], [], pen=pen, name=f"bench {label}"))
+            curve = self.plot.plot([], [], pen=pen, name=f"bench {label}")
+            curve.setSkipFiniteCheck(True)  # display rows are finite, and already one or two a pixel
+            self._curves.append(curve)
         self.plot.enableAutoRange(axis="x", enable=False)
+        self._y_range = self._counts_range = self._x_range = None
         self.plot.enableAutoRange(axis="y", enable=False)  # set per frame: lanes, analog, the legend
         counting = "counts" in started.extra
         self.counts_plot.setVisible(counting)
@@ -307,14 +318,19 @@ class BenchPanel(QWidget):
         started = self._started
         if started is None:
             return
-        rows = started.ring.window(int(WINDOW_S * started.row_rate_hz))
+        rows = started.ring.window(int((WINDOW_S + STEP_S) * started.row_rate_hz))
         if not len(rows):
             return
         # drawn as the plot's pixels show it (each pixel's least and largest value), over a fixed
         # window: a redraw neither walks every row nor looks for the data's bounds
         rows = peak_rows(rows, max(200, self.plot.width()))
-        end = float(rows[-1, 0])
-        self.plot.setXRange(max(0.0, end - WINDOW_S), max(end, WINDOW_S), padding=0)
+        # the time axis steps on every STEP_S instead of scrolling each frame (a new range lays
+        # its ticks out again, which costs more than the traces): the newest WINDOW_S always shows
+        right = (math.floor(float(rows[-1, 0]) / STEP_S) + 1) * STEP_S
+        x_range = (max(0.0, right - WINDOW_S - STEP_S), max(right, WINDOW_S + STEP_S))
+        if x_range != self._x_range:
+            self._x_range = x_range
+            self.plot.setXRange(*x_range, padding=0)
         low, high = 0.0, 1.0
         for i, (curve, name) in enumerate(zip(self._curves, started.channels, strict=True)):
             values = rows[:, 1 + i]
@@ -325,9 +341,20 @@ class BenchPanel(QWidget):
         # room above the traces for the legend's rows (three names a row), so it covers none
         legend_rows = 1 + (len(self._curves) - 1) // 3
         span = high - low
-        self.plot.setYRange(low - 0.05 * span, high + span * 0.28 * legend_rows, padding=0)
+        y_range = (low - 0.05 * span, high + span * 0.28 * legend_rows)
+        if y_range != self._y_range:  # set only when it changes: a new range lays the axis out again
+            self._y_range = y_range
+            self.plot.setYRange(*y_range, padding=0)
         if "counts" in started.extra:
-            self._counts_curve.setData(rows[:, 0], rows[:, 1 + len(started.channels)])
+            counts = rows[:, 1 + len(started.channels)]
+            self._counts_curve.setData(rows[:, 0], counts)
+            lo, hi = float(counts.min()), float(counts.max())
+            shown = self._counts_range
+            # the counts' range moves only when they leave it or fill less than half of it
+            if shown is None or lo < shown[0] or hi > shown[1] or (hi - lo) < 0.5 * (shown[1] - shown[0]):
+                pad = 0.1 * (hi - lo) if hi > lo else 1.0
+                self._counts_range = (lo - pad, hi + pad)
+                self.counts_plot.setYRange(*self._counts_range, padding=0)
         self._measure_move(started, _rows)
 
     def _measure_move(self, started: BenchStarted, new_rows: np.ndarray) -> None:
