@@ -1,7 +1,7 @@
 """The model check of a recording without current (a bench capture of an HA-655: command, encoder,
 no current monitor): the torque is read through the closed loop identified from the recording.
 
-Recordings of the simulated drive with one hidden effect each (two actuators, two loads), the
+Recordings of the simulated drive with hidden effects alone and in a pair (three actuators and loads), the
 current column dropped. Asserted: the hidden effect named within 35 %, nothing else named; the
 effects such a recording cannot show (inertia, a constant load torque) named nowhere and said to be
 not identifiable; the loop found near the panel's values it ran with.
@@ -24,6 +24,11 @@ CASES = [
     ("FHA-40C-50-S248", 6.0, {"coulomb_friction": {"torque_nm": 5.0}}),
     ("FHA-25C-50-US250", 1.5, {"load_torque_offset": {"torque_nm": 5.0}}),
     ("FHA-17C-50-US250", 0.3, {"inertia_error": {"inertia_kgm2": 0.1}}),
+    (
+        "FHA-40C-50-S248",
+        6.0,
+        {"coulomb_friction": {"torque_nm": 5.0}, "gravity_load": {"amplitude_nm": 20.0, "phase_deg": 30.0}},
+    ),
 ]
 NOT_VISIBLE = {"load_torque_offset", "inertia_error"}
 

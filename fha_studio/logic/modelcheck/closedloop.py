@@ -92,8 +92,8 @@ class Loop:
             return [
                 "The closed loop is not pinned down by this recording (the fit gives Kp "
                 f"{self.position_gain_per_s:.3g} 1/s, Tv {1000.0 * self.integral_time_s:.3g} ms, "
-                f"feed-forward {self.feed_forward:.2f}, no loop a drive runs): record moves with more "
-                "acceleration."
+                f"feed-forward {self.feed_forward:.2f}, no loop a drive runs): record moves with clear "
+                "accelerations that keep the current within its limit."
             ]
         text = (
             f"Closed loop identified from the recording: Kp {self.position_gain_per_s:.3g} 1/s, "

@@ -142,6 +142,9 @@ class ChannelSelector:
         self.candidates = [c for c in candidates if not (c.needs_ratio and ctx.sig.ratio is None)]
         self.n = len(y)
         self._cols_cache: dict[tuple[str, tuple[float, ...]], np.ndarray] = {}
+        # detection limits by (candidate, the terms beside it with their shapes): substitutes() and
+        # the report ask for the same ones
+        self._limit_cache: dict[tuple[object, ...], tuple[float, tuple[float, ...]]] = {}
 
     # --- columns
     def cols(self, cand: Candidate, shape: tuple[float, ...]) -> np.ndarray:
@@ -181,6 +184,14 @@ class ChannelSelector:
     def best_shape(self, cand: Candidate, terms: list[Term]) -> tuple[float, ...]:
         if len(cand.shape_grid) == 1 and not cand.shape_refine:
             return cand.shape_grid[0]
+        # the same candidate beside the same terms (shapes included) is asked for again by the
+        # look-alike and detection-limit steps: one search each
+        key = ("shape", cand.id, *((t.id, t.shape) for t in terms))
+        if key not in self._limit_cache:
+            self._limit_cache[key] = (0.0, self._best_shape(cand, terms))
+        return self._limit_cache[key][1]
+
+    def _best_shape(self, cand: Candidate, terms: list[Term]) -> tuple[float, ...]:
         x0 = self.design(terms)
         # shapes by contiguous-block CV: honest for shapes of different dimension (wind-up regions),
         # and it does not weigh the highest frequencies as whitening does
@@ -521,6 +532,12 @@ class ChannelSelector:
         the whitened-BIC gate's own threshold sqrt(BIC_MIN + k ln n), never below the floor. A shape
         that is not a searched frequency (a Stribeck speed) is the one that fits best next to terms.
         """
+        key = (cand.id, *((t.id, t.shape) for t in terms))
+        if key not in self._limit_cache:
+            self._limit_cache[key] = self._detection_limit(terms, cand)
+        return self._limit_cache[key]
+
+    def _detection_limit(self, terms: list[Term], cand: Candidate) -> tuple[float, tuple[float, ...]]:
         shape = (
             self.best_shape(cand, terms)
             if cand.shape_refine and not cand.look_elsewhere

@@ -144,8 +144,9 @@ def run_without_current(
         ),
     }
     if sensor is not None:
-        load = wf.sensor_steps(wf._torque_step(sig, axis, y, floor_t, index, excitation), sensor, model, sig,
-                               gear=False)[0]
+        load = wf.sensor_steps(
+            wf._torque_step(sig, axis, y, floor_t, index, excitation), sensor, model, sig, gear=False
+        )[0]
         chosen.append(wf._select(load, index))
         status[load.channel] = ChannelStatus(load.channel, CHECKED, "", float(np.max(np.abs(load.y))), "N m")
     status[POSITION], position = wf._position_step(sig, model, ctx, settled.fitted, residual, index)
@@ -179,6 +180,8 @@ def run_without_current(
                 f"({fe_nominal:.3g} -> {fe_updated:.3g} arcsec rms of following error)",
             )
     wf._hold_to_the_set(found, None, floor_t)
+    if found.effects and not loop.plausible:
+        _refuse(found, "the closed loop is not pinned down by this recording")
     updated = wf._updated_model(model, found.effects)
     filt = sig.filt
     return ModelCheckResult(
@@ -202,11 +205,34 @@ def run_without_current(
         channel_status=status,
         window_reason="fixed without a current: the acceleration sets what the loop's torque can show",
         refused=found.refused,
-        not_seen=[*not_identifiable_lines(axis, sensor is not None), *excitation.lines()],
+        not_seen=[
+            *not_identifiable_lines(axis, sensor is not None),
+            *_saturation(sig, axis),
+            *excitation.lines(),
+        ],
         torque_basis=f"on the declared {'' if sensor is None else 'actuator '}inertia "
         f"{(j if sensor is None else j_gear):.4g} kg m^2",
         loop=loop,
     )
+
+
+#: the loop is linear only while the current stays within its limit
+SATURATION_SHARE = 0.9
+
+
+def _saturation(sig, axis: DeclaredAxis) -> list[str]:
+    """A line when the motion asked for (nearly) the actuator's peak torque: the current was then at
+    its limit, the loop not linear, and the loop columns do not hold there."""
+    peak = axis.model.peak_torque_nm
+    demand = np.abs(axis.nominal_inertia_kgm2 * sig.accel_rad_s2)
+    if not len(demand) or float(np.max(demand)) < SATURATION_SHARE * peak:
+        return []
+    at = float(sig.t_s[int(np.argmax(demand))])
+    return [
+        f"The loop cannot be read where the current was at its limit: the motion needs up to "
+        f"{float(np.max(demand)):.3g} N m (inertia x acceleration, at t = {at:.2f} s) against the actuator's "
+        f"{peak:.3g} N m peak. Record moves with less acceleration."
+    ]
 
 
 def _refuse(found: wf.Findings, why: str) -> None:
