@@ -1,4 +1,4 @@
-"""``fha-studio register keys add|list`` and ``fha-studio register verify REPORT``: each person's
+"""``fha-studio register keys add|list|revoke`` and ``fha-studio register verify REPORT``: each person's
 signing key and whether a report file is the one that was signed (exit 0 yes, 5 no).
 
 A passphrase comes from ``$FHA_STUDIO_KEY_PASSPHRASE`` when set (scripts), else it is asked on
@@ -25,7 +25,7 @@ ENV_PASSPHRASE = "FHA_STUDIO_KEY_PASSPHRASE"
 def add_actions(sub: argparse._SubParsersAction, common: argparse.ArgumentParser, opener) -> None:
     """The ``keys`` and ``verify`` actions of ``fha-studio register``; ``opener(args)`` opens the
     register the command names (a context manager)."""
-    keys = sub.add_parser("keys", parents=[common], help="each person's signing key (add, list)")
+    keys = sub.add_parser("keys", parents=[common], help="each person's signing key (add, list, revoke)")
     actions = keys.add_subparsers(dest="keys_action", metavar="KEYS_ACTION", required=True)
     add = actions.add_parser("add", parents=[common], help="make a person's key pair; the register keeps "
                              "the public key, the private key stays on this computer")
@@ -34,6 +34,11 @@ def add_actions(sub: argparse._SubParsersAction, common: argparse.ArgumentParser
     add.add_argument("--key-file", type=Path, metavar="PATH",
                      help="where the private key goes (default: keys/KEY_ID.pem in the user data directory)")
     add.set_defaults(func=_keys_add, writes=True, open_register=opener)
+    revoke = actions.add_parser("revoke", parents=[common], help="a key signs nothing from now on (a lost "
+                                "laptop); what it signed before still verifies")
+    revoke.add_argument("key_id", metavar="KEY_ID")
+    revoke.add_argument("--reason", default="", help="why, for the register")
+    revoke.set_defaults(func=_keys_revoke, writes=True, open_register=opener)
     ls = actions.add_parser("list", parents=[common], help="the public keys in the register")
     ls.set_defaults(func=_keys_list, open_register=opener)
     verify = sub.add_parser(
@@ -92,6 +97,19 @@ def _keys_add(args) -> int:
     else:
         protected = "encrypted with the passphrase" if secret else "not encrypted: readable by this user only"
         print(f"key {added.key_id} for {added.person}; private key {path} ({protected})")
+    return 0
+
+
+def _keys_revoke(args) -> int:
+    with args.open_register(args) as reg:
+        reg.revoke_key(args.key_id.strip(), args.reason)
+        key = reg.signing_key(args.key_id.strip())
+    assert key is not None
+    if args.json:
+        print(json.dumps({"key_id": key.key_id, "person": key.person, "revoked_utc": key.revoked_utc,
+                          "reason": key.revoked_reason}, indent=2, ensure_ascii=False))
+    else:
+        print(f"key {key.key_id} of {key.person} revoked at {key.revoked_utc[:19].replace('T', ' ')} UTC")
     return 0
 
 

@@ -200,6 +200,7 @@ class MachineWindow(QMainWindow):
         link.sigStopped.connect(lambda _reply, i=index: self._refresh_axis(i))
         window.state.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
         if self.register is not None:
+            window.signing_register = self.register.location  # the sign step finds the keys there
             self.recorders.append(
                 AxisRecorder(
                     self.register,

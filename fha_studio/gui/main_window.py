@@ -4,6 +4,7 @@ status bar with link, servo, alarm and what the drive supports."""
 from __future__ import annotations
 
 import logging
+from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
 from PySide6.QtCore import QSettings, Qt, Slot
@@ -85,6 +86,9 @@ class MainWindow(QMainWindow, PageLookup):
         from fha_studio.gui.training import TrainingController
 
         self.training = TrainingController(self)
+        #: the register where the Procedures page's sign step finds the signer's key (the
+        #: machine window's; None: the user's register by the usual rule)
+        self.signing_register: Path | str | None = None
         self._closing_confirmed = False
         self._shut_down = False
         self._status_note = ""

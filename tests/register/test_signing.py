@@ -182,3 +182,23 @@ def test_a_key_is_never_replaced_and_a_revocation_is_a_fact_of_its_own(register_
         reg.revoke_key(key_id, "laptop lost")
         [kept] = reg.signing_keys("A. Reviewer")
         assert kept.revoked_reason == "laptop lost" and kept.person == "A. Reviewer"
+
+
+def test_a_revoked_key_signs_nothing_more_and_what_it_signed_still_verifies(
+        finished, reg_path, tmp_path, capsys):
+    assert _add_key(reg_path, "A. Reviewer", "--json") == 0
+    key_id = json.loads(capsys.readouterr().out)["key_id"]
+    report = tmp_path / "r.html"
+    assert main(["procedures", "report", str(finished), "-o", str(report), "--sign", "A. Reviewer",
+                 "--register", str(reg_path)]) == 0
+    revoke = ["register", "--register", str(reg_path), "keys", "revoke"]
+    assert main([*revoke, key_id, "--reason", "laptop lost"]) == 0
+    assert "revoked" in capsys.readouterr().out
+    assert _verify(reg_path, report, capsys)[0] == 0  # signed before the revocation
+    assert main([*revoke, key_id]) == 2
+    assert main([*revoke, "0000000000000000"]) == 2
+    again = tmp_path / "again.html"
+    capsys.readouterr()
+    assert main(["procedures", "report", str(finished), "-o", str(again), "--sign", "A. Reviewer",
+                 "--register", str(reg_path)]) == 0  # no usable key left: by name only, said so
+    assert "signed by name only" in capsys.readouterr().err

@@ -53,6 +53,12 @@ class Verdict:
 class Keys(History):
     """Signing keys and signatures."""
 
+    @property
+    def location(self) -> Path | str:
+        """Where this register is, as :class:`~.store.Register` takes it: the file, or the
+        server's URL."""
+        return self._url or self.path
+
     def add_key(self, person: str, public_key_hex: str, key_id: str, who: str = "",
                 at_utc: str | None = None) -> SigningKey:
         """A person's new public key (never replacing one: a key id already there is refused)."""
@@ -154,7 +160,7 @@ class Keys(History):
         if digest != signed.sha256:
             return fails(f"changed since it was signed: its SHA-256 is {digest}, "
                          f"the signed one {signed.sha256}")
-        if key.revoked_utc and key.revoked_utc <= signed.signed_utc:
+        if key.revoked_utc and key.revoked_utc <= _stamp_or_text(signed.signed_utc):
             return fails(f"signed at {signed.signed_utc} with key {key.key_id}, revoked at {key.revoked_utc}")
         return Verdict(True, shown, digest, "", signed.signer, signed.key_id, signed.signed_utc)
 
@@ -162,3 +168,12 @@ class Keys(History):
 def _looks_like_report(data: bytes) -> bool:
     head = data[:4096]
     return (b"<html" in head and b"Commissioning report" in head) or head.startswith(b"%PDF-")
+
+
+def _stamp_or_text(when: str) -> str:
+    """A signature's time as the register stamps times (comparable as text); as it is when it
+    is no time (then the signature does not hold anyway)."""
+    try:
+        return utc_stamp(when)
+    except RegisterError:
+        return when

@@ -54,3 +54,29 @@ def test_the_page_signs_with_the_key_and_both_files_verify(make_window, tmp_path
     pdf.write_bytes(bytes(data))
     code, verdict = _verify(pdf, capsys)
     assert code == 5 and "no signature" in verdict["reason"]
+
+
+def test_an_axis_of_a_machine_signs_with_a_key_of_the_machine_windows_register(qtbot, tmp_path, monkeypatch):
+    from fha_studio.gui.machine_window import MachineWindow
+    from fha_studio.logic.machine import MachineProject
+    from fha_studio.logic.register import Register
+    from tests.support.windows import torn_down
+
+    plant = tmp_path / "plant.sqlite"  # not the user's register: the machine window's
+    monkeypatch.setenv("FHA_STUDIO_KEY_PASSPHRASE", "")
+    assert main(["register", "--register", str(plant), "keys", "add", "--name", "A. Reviewer"]) == 0
+    project = MachineProject("Line 3", site="Plant A")
+    project.add_axis("table", CODE, port_url=f"sim://{CODE}?paced=0")
+    _finished_session(tmp_path / "axis1.json")
+    register = Register(plant)
+    with torn_down(lambda window: [axis.link for axis in window.axis_windows]) as windows:
+        window = MachineWindow(project, register)
+        windows.append(window)
+        window.show()
+        page = window.axis_windows[0].show_page("procedures")
+        page.open_session(tmp_path / "axis1.json")
+        assert page.sign("A. Reviewer"), page.message_label.text()  # a key without a passphrase
+        assert "with key" in page.message_label.text()
+        html, _pdf = page.write_report(tmp_path / "report.html")
+    register.close()
+    assert main(["register", "--register", str(plant), "verify", str(html)]) == 0

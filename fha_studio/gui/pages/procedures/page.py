@@ -86,7 +86,9 @@ class ProceduresPage(BasePage):
         self.context: dict | None = None
         self.procedures: list[Procedure] = []
         self.run: ProcedureRun | None = None
-        self.signer = ReportSigner()  # the sign step's key (the register's, the user's keys folder)
+        # the sign step's key: in the machine window's register (else the user's), its private
+        # key in the user's keys folder
+        self.signer = ReportSigner(lambda: getattr(self.main_window, "signing_register", None))
         self._build()
         self.state.sigActuatorChanged.connect(self._axis_changed)
         self.live_panel.relay.sigSample.connect(

@@ -29,15 +29,15 @@ AskPassphrase = Callable[[Path], "str | None"]
 class ReportSigner:
     """Signs a session's report with the signer's key when the register has one."""
 
-    def __init__(self, register: Path | str | None = None) -> None:
-        #: the register with the keys, a file or a server's URL (None: $FHA_STUDIO_REGISTER, else
-        #: the user's register file)
+    def __init__(self, register: Callable[[], Path | str | None] = lambda: None) -> None:
+        #: the register with the keys, a file or a server's URL: the machine window's; None:
+        #: $FHA_STUDIO_REGISTER, else the user's register file
         self.register = register
         self._key: Ed25519PrivateKey | None = None
         self._who = ""
 
     def _where(self) -> Path | str:
-        return register_location(self.register)
+        return register_location(self.register())
 
     def sign(self, session: ProcedureSession, who: str, context: Mapping[str, Any] | None,
              ask: AskPassphrase) -> str:
