@@ -84,22 +84,23 @@ def quadrature(a: np.ndarray, b: np.ndarray) -> QuadratureResult:
     return quadrature_lines(Lines.from_levels(a, b))
 
 
-def quadrature_lines(lines: Lines) -> QuadratureResult:
+def quadrature_lines(lines: Lines, glitches: bool = True) -> QuadratureResult:
     """Count A (line 0) / B (line 1) x4 from the samples where they change: each change's step
-    from a 16-entry table of (code before, code after)."""
+    from a 16-entry table of (code before, code after). ``glitches`` False: not counted (0; a
+    live stream's counts do not need them)."""
     at = lines.at
     key = _transitions(lines, 3)
     illegal = int(np.count_nonzero(_ILLEGAL16[key]))
     steps = _STEP16[key]
     # a glitch: a step undone by the next one within GLITCH_SAMPLES samples
-    glitches = 0
-    if at.size > 1:
+    undone_count = 0
+    if glitches and at.size > 1:
         undone = (steps[1:] == -steps[:-1]) & (steps[1:] != 0) & (np.diff(at) <= GLITCH_SAMPLES)
-        glitches = int(np.count_nonzero(undone))
+        undone_count = int(np.count_nonzero(undone))
     counted = steps != 0
     edges = at[counted]
     counts = Steps(lines.n, edges, np.cumsum(steps[counted], dtype=np.int64))
-    return QuadratureResult(counts, int(at.size), glitches, illegal, edges)
+    return QuadratureResult(counts, int(at.size), undone_count, illegal, edges)
 
 
 def _transitions(lines: Lines, mask: int) -> np.ndarray:

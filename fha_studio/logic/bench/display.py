@@ -111,7 +111,7 @@ class LiveQuadrature:
         lines = _with_last(self, logic, bit_a, bit_b)
         if lines is None:
             return Steps(0, np.zeros(0, np.int64), np.zeros(0, np.int64), self.counts)
-        result = decode.quadrature_lines(lines)
+        result = decode.quadrature_lines(lines, glitches=False)
         counts = _shifted(result.steps, self.counts)
         self.counts = int(counts.final)
         self.illegal_transitions += result.illegal_transitions

@@ -15,10 +15,21 @@ decoders therefore find the samples where the packed logic word changes once (on
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+
+
+@functools.lru_cache(maxsize=64)
+def _code_table(bits: tuple[int, ...]) -> np.ndarray:
+    """Byte -> the code of its bits ``bits`` (bit j of the code = bit ``bits[j]`` of the byte)."""
+    byte = np.arange(256)
+    code = np.zeros(256, np.uint8)
+    for j, bit in enumerate(bits):
+        code |= (((byte >> bit) & 1) << j).astype(np.uint8)
+    return code
 
 
 def changes(values: np.ndarray) -> np.ndarray:
@@ -107,11 +118,14 @@ class Lines:
         at = changes(masked)
         n = int(packed.shape[0])
         words = masked[at]
-        codes = np.zeros(at.size, np.uint8)
         first = 0
         for j, bit in enumerate(bits):
-            codes |= ((words >> packed.dtype.type(bit)) & 1).astype(np.uint8) << np.uint8(j)
             first |= (int(masked[0]) >> bit & 1) << j if n else 0
+        if packed.dtype == np.uint8:  # one byte a sample: the code of each word by a table
+            return cls(n, first, at, _code_table(tuple(bits))[words])
+        codes = np.zeros(at.size, np.uint8)
+        for j, bit in enumerate(bits):
+            codes |= ((words >> packed.dtype.type(bit)) & 1).astype(np.uint8) << np.uint8(j)
         return cls(n, first, at, codes)
 
     @classmethod
