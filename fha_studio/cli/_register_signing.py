@@ -79,8 +79,8 @@ def _keys_add(args) -> int:
     path = args.key_file.expanduser() if args.key_file else default_key_path(key_id)
     if os.path.lexists(path):
         raise CliError(f"key file {path}: already exists (a key is never replaced; choose another path)")
+    secret = passphrase(f"Passphrase for {person}'s new key (empty: none): ", confirm=True)
     with args.open_register(args) as reg:
-        secret = passphrase(f"Passphrase for {person}'s new key (empty: none): ", confirm=True)
         try:
             write_private_key(key, path, secret)
         except SigningError as exc:

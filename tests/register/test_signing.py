@@ -202,3 +202,18 @@ def test_a_revoked_key_signs_nothing_more_and_what_it_signed_still_verifies(
     assert main(["procedures", "report", str(finished), "-o", str(again), "--sign", "A. Reviewer",
                  "--register", str(reg_path)]) == 0  # no usable key left: by name only, said so
     assert "signed by name only" in capsys.readouterr().err
+
+
+def test_the_passphrase_is_asked_twice_on_a_terminal(reg_path, tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("FHA_STUDIO_KEY_PASSPHRASE")
+    monkeypatch.setattr("sys.stdin.isatty", lambda: True)
+    answers = iter(["one", "two", "same", "same"])
+    monkeypatch.setattr("getpass.getpass", lambda prompt="": next(answers))
+    key_file = tmp_path / "k.pem"
+    assert _add_key(reg_path, "A. Reviewer", "--key-file", str(key_file)) == 2
+    assert "the two passphrases differ" in capsys.readouterr().err and not key_file.exists()
+    assert isinstance(reg_path, str) or not reg_path.exists()  # no register made for it either
+    assert _add_key(reg_path, "A. Reviewer", "--key-file", str(key_file)) == 0
+    assert "encrypted with the passphrase" in capsys.readouterr().out
+    assert main(["register", "--register", str(reg_path), "keys", "list", "--json"]) == 0
+    assert len(json.loads(capsys.readouterr().out)) == 1  # the refused one left nothing
