@@ -294,10 +294,14 @@ class ModelCheckPage(BasePage):
         declared = self.state.load_inertia_kgm2
         optional = {"cmd_pos": recording.cmd_pos_deg, "load_pos": recording.load_pos_deg,
                     "vel": recording.vel_rpm}
-        columns = ", ".join(["t", "pos", "current"] + [c for c, v in optional.items() if v is not None])
+        columns = ", ".join(["t", "pos"] + (["current"] if recording.has_current else [])
+                            + [c for c, v in optional.items() if v is not None])
+        # a bench capture (fha-studio bench import / record) says where its position came from
+        bench = m.extra.get("source_pos", "")
         self.source_label.setText(
             f"Recording: {label} — {m.actuator}, {len(recording)} samples over {recording.duration_s:.2f} s, "
-            f"columns {columns}. "
+            f"columns {columns}. " + (f"Position from {bench}. " if bench else "")
+            + ("" if recording.has_current else "No current column (no current probe on the bench). ")
             + ("No load inertia declared in it." if m.load_inertia_kgm2 is None
                else f"Declared load inertia {m.load_inertia_kgm2:g} kg·m².")
             + ("" if m.load_inertia_kgm2 is not None and abs(declared - m.load_inertia_kgm2) <= 1e-12 else
@@ -306,7 +310,7 @@ class ModelCheckPage(BasePage):
 
     def _open_clicked(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self, "Open a recording", "",
-                                              "fha-recording/1 (*.csv);;All (*)")
+                                              "fha-recording (*.csv);;All (*)")
         if path:
             try:
                 self.load_recording(path)

@@ -1,0 +1,43 @@
+"""The Model check page takes a recording made from a bench capture (``fha-studio bench import``
+of the simulated drive's CN2): it says which columns it has (no current: no probe on the bench)
+and where its position came from."""
+
+from __future__ import annotations
+
+import math
+
+from fha_studio.catalog import get_actuator
+from fha_studio.gui.pages.base import PageId
+from fha_studio.hardware.sim.cn2 import Cn2Settings, VirtualBenchInstrument
+from fha_studio.logic.bench.importer import AxisFacts, DriveSettings, SignalSpec, import_bench
+from fha_studio.physics import AxisModel, ServoAxis
+from fha_studio.recording import write_recording
+
+CODE = "FHA-25C-50-US250"
+RPM = 2 * math.pi / 60
+
+
+def test_a_bench_recording_opens_on_the_model_check_page_with_its_source(make_window, tmp_path):
+    axis = ServoAxis(AxisModel.from_actuator(get_actuator(CODE), load_inertia_kgm2=0.3))
+    axis.servo_on()
+    instrument = VirtualBenchInstrument(axis, 200e3, Cn2Settings(pulse_form=0))
+    instrument.record(0.03)
+    axis.move_by_pulses(9000, speed_rad_s=8 * RPM)
+    instrument.record(0.4)
+    capture = tmp_path / "capture.sr"
+    instrument.write(capture, "sr")
+    roles = {"encoder_a": "ENC_A", "encoder_b": "ENC_B", "command_a": "CMD_A", "command_b": "CMD_B",
+             "speed_monitor": "SPD_MON", "in_position": "IN_POS"}
+    result = import_bench([SignalSpec(r, str(capture), c) for r, c in roles.items()],
+                          AxisFacts.for_actuator(CODE), DriveSettings(0, 4, 1, 1, 3000.0))
+    path = tmp_path / "bench.csv"
+    write_recording(path, result.recording)
+
+    window = make_window()
+    page = window.page(PageId.MODELCHECK)
+    recording = page.load_recording(path)
+    assert not recording.has_current
+    text = page.source_label.text()
+    assert "columns t, pos, cmd_pos, vel." in text and "current" not in text.split("columns")[1].split(".")[0]
+    assert f"Position from {capture}#ENC_A and {capture}#ENC_B, x4" in text
+    assert "No current column (no current probe on the bench)." in text
