@@ -308,8 +308,11 @@ class ScopeView(QWidget):
 
     def _on_live_started(self, started: LiveStarted) -> None:
         self._live = started
-        self._levels = MinMaxLevels(len(started.channels), started.ring.capacity)
-        self._levels.append(started.ring.drain())  # what came before this view learnt of it
+        # no channel to poll (a drive that answers neither status nor DGR): nothing to draw
+        self._levels = None
+        if started.channels:
+            self._levels = MinMaxLevels(len(started.channels), started.ring.capacity)
+            self._levels.append(started.ring.drain())  # what came before this view learnt of it
         self._static = None
         self._status = None
         self.time_plot.show_grid_for_still_data(False)
