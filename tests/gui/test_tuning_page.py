@@ -40,7 +40,7 @@ def test_measure_propose_apply_end_to_end(make_window, qtbot):
     result = measured.args[0]
     assert result["resonance_hz"] == pytest.approx(result["predicted_resonance_hz"], rel=0.1)
     assert len(page.markers) == 4  # resonance, anti-resonance, and their predictions
-    assert "Resonance" in page.status_label.text()
+    assert "Resonance" in page.result_label.text()
     with qtbot.waitSignal(page.sigProposed, timeout=120000):
         page.propose_button.click()
     assert page.table.item(0, 1) is not None

@@ -106,6 +106,8 @@ class TuningPage(BasePage):
         self.plan_label.setWordWrap(True)
         self.status_label = QLabel("")
         self.status_label.setWordWrap(True)
+        self.result_label = QLabel("")
+        self.result_label.setWordWrap(True)
         self.warning_label = QLabel("")
         self.warning_label.setWordWrap(True)
         self.warning_label.setStyleSheet("color: #b00000; font-weight: bold")
@@ -140,7 +142,8 @@ class TuningPage(BasePage):
         self.worksheet.setReadOnly(True)
         self.worksheet.setPlaceholderText("The front-panel worksheet appears here for a drive without "
                                           "parameter access over CN3.")
-        self.worksheet.setMaximumHeight(110)
+        self.table.setMaximumHeight(250)
+        self.worksheet.setMaximumHeight(250)
 
         layout = QVBoxLayout(self)
         layout.addLayout(form)
@@ -148,9 +151,12 @@ class TuningPage(BasePage):
         layout.addWidget(self.plan_label)
         layout.addWidget(self.warning_label)
         layout.addWidget(self.status_label)
-        layout.addWidget(self.plots, 3)
-        layout.addWidget(self.table, 1)
-        layout.addWidget(self.worksheet)
+        layout.addWidget(self.result_label)
+        layout.addWidget(self.plots, 4)
+        lower = QHBoxLayout()
+        lower.addWidget(self.table, 1)
+        lower.addWidget(self.worksheet, 1)
+        layout.addLayout(lower, 1)
 
     # ----- the link ------------------------------------------------------------------------------
     def link_connected(self, info: LinkInfo) -> None:
@@ -265,17 +271,18 @@ class TuningPage(BasePage):
         for marker in self.markers:
             self.mag_plot.removeItem(marker)
         self.markers = []
-        for key, colour, style, label in (
-            ("resonance_hz", "#008000", None, "resonance"),
-            ("antiresonance_hz", "#800080", None, "anti-resonance"),
-            ("predicted_resonance_hz", "#008000", pg.QtCore.Qt.PenStyle.DashLine, "predicted"),
-            ("predicted_antiresonance_hz", "#800080", pg.QtCore.Qt.PenStyle.DashLine, "predicted"),
+        for key, colour, style, label, where in (
+            ("resonance_hz", "#008000", None, "resonance", 0.95),
+            ("antiresonance_hz", "#800080", None, "anti-resonance", 0.95),
+            ("predicted_resonance_hz", "#008000", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.12),
+            ("predicted_antiresonance_hz", "#800080", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.12),
         ):
             value = result.get(key)
             if value:
                 pen = pg.mkPen(colour, width=2, style=style) if style else pg.mkPen(colour, width=2)
                 line = pg.InfiniteLine(pos=np.log10(value), angle=90, pen=pen,
-                                       label=f"{label} {value:.1f} Hz", labelOpts={"position": 0.9})
+                                       label=f"{label} {value:.1f} Hz",
+                                       labelOpts={"position": where, "color": colour})
                 self.mag_plot.addItem(line)
                 self.markers.append(line)
 
@@ -283,7 +290,8 @@ class TuningPage(BasePage):
             v = result.get(key)
             return "—" if v is None else f"{v:.3g} {unit}"
 
-        self.status_label.setText(
+        self.status_label.setText("Measured.")
+        self.result_label.setText(
             f"Resonance {fmt('resonance_hz', 'Hz')} (predicted {fmt('predicted_resonance_hz', 'Hz')}), "
             f"anti-resonance {fmt('antiresonance_hz', 'Hz')}; load inertia estimate "
             f"{fmt('load_inertia_estimate_kgm2', 'kg·m²')}; gain margin {fmt('gain_margin_db', 'dB')}, "
