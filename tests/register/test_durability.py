@@ -48,7 +48,7 @@ def test_a_v1_register_is_upgraded_with_its_data(tmp_path):
     path = tmp_path / "v1.sqlite"
     _write_v1_register(path)
     with Register(path) as reg:
-        assert reg.version == 3
+        assert reg.version == 4
         feed = reg.axis("Press 7/feed")
         assert (feed.actuator_code, feed.port_url, feed.serial_number) == ("FHA-17C-50-US250", "COM3", "")
         assert [f.axis.name for f in reg.find("rotary_direction", 1)] == ["feed"]
@@ -64,7 +64,7 @@ def test_a_v1_register_is_upgraded_with_its_data(tmp_path):
         assert "snapshot_value_by_key" in " ".join(str(tuple(r)) for r in plan)
         assert reg.integrity_check() == "ok"
     with Register(path) as again:  # opening an up-to-date file changes nothing
-        assert again.version == 3 and len(again.snapshots("Press 7/feed")) == 1
+        assert again.version == 4 and len(again.snapshots("Press 7/feed")) == 1
 
 
 def test_a_failing_migration_leaves_the_file_at_its_version(tmp_path, monkeypatch):
@@ -82,7 +82,7 @@ def test_a_failing_migration_leaves_the_file_at_its_version(tmp_path, monkeypatc
     db.close()
     monkeypatch.undo()
     with Register(path) as reg:
-        assert reg.version == 3
+        assert reg.version == 4
 
 
 _WRITER = textwrap.dedent(

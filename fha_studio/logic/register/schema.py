@@ -195,8 +195,15 @@ _V3 = [
     "CREATE INDEX report_signature_by_sha256 ON report_signature (sha256)",
 ]
 
+# v4: "which axes have this parameter value" over a plant's register (a thousand axes, ten years of
+# writes each) looks up each axis's latest write of the parameter in this index, not every write.
+_V4 = [
+    "CREATE INDEX parameter_write_latest ON parameter_write (axis_id, key, at_utc, id)",
+    "CREATE INDEX snapshot_latest ON snapshot (axis_id, at_utc, id)",
+]
+
 #: MIGRATIONS[n] takes a file from user_version n to n + 1.
-MIGRATIONS: tuple[tuple[str, ...], ...] = (tuple(_V1), tuple(_V2), tuple(_V3))
+MIGRATIONS: tuple[tuple[str, ...], ...] = (tuple(_V1), tuple(_V2), tuple(_V3), tuple(_V4))
 
 #: The version this program writes.
 SCHEMA_VERSION = len(MIGRATIONS)

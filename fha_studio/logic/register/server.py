@@ -153,6 +153,8 @@ class ServerDatabase:
         self.url = url
         self._conn = psycopg.connect(url, autocommit=True, connect_timeout=max(1, round(connect_timeout_s)))
         self._conn.row_factory = _row_factory
+        # the register's questions are small: compiling them costs more than it saves (20 ms)
+        self._conn.execute("SET jit = off")
         self.total_changes = 0
 
     @property
