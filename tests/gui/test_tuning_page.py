@@ -50,6 +50,8 @@ def test_measure_propose_apply_end_to_end(make_window, qtbot):
     assert window.session.state.backup_path is not None and window.session.state.backup_path.exists()
     assert applied.args[0]["items"]["speed_loop_gain"] == page.proposal.proposed.items["speed_loop_gain"]
     assert page.table.item(len(page.proposal.proposed.items), 2) is not None
+    ((note, _who),) = page.report_notes()  # the commissioning report's before / after
+    assert "Applied" in note and "resonance" in note
 
 
 def test_documented_drive_gets_a_front_panel_worksheet(make_window, qtbot):

@@ -11,6 +11,7 @@ that cannot be excited (the manual's commands only) gets the proposal as a front
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from functools import partial
 from typing import Any
 
@@ -31,6 +32,7 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
 )
 
+from fha_studio import clock
 from fha_studio.gui.link_requests import Call, LinkInfo, LinkReply
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.hardware.parameters import Mode
@@ -38,6 +40,7 @@ from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
 from fha_studio.logic.tuning.excitation import plan_excitation
 from fha_studio.logic.tuning.measure import NEEDED
 from fha_studio.logic.tuning.propose import AIMS, TUNE_KEYS, Proposal, Tuner
+from fha_studio.logic.tuning.record import TuningRecord, tuning_notes
 from fha_studio.logic.tuning.session import declared_model, measure_report, tuner_for
 
 COUNTDOWN_S = 3
@@ -57,6 +60,7 @@ class TuningPage(BasePage):
         self.link = session.link
         self.result: dict[str, Any] | None = None
         self.proposal: Proposal | None = None
+        self.records: list[TuningRecord] = []
         self._countdown = 0
         self._timer = QTimer(self)
         self._timer.setInterval(1000)
@@ -253,6 +257,9 @@ class TuningPage(BasePage):
             self.status_label.setText(f"Measurement not done: {reply.error}")
             return
         self.show_result(reply.value)
+        if then is None:
+            stamp = clock.now_utc().strftime("%Y-%m-%d %H:%M:%S UTC")
+            self.records.append(TuningRecord(at=stamp, who="", before=reply.value))
         if then is not None:
             then(reply.value)
         else:
@@ -378,7 +385,15 @@ class TuningPage(BasePage):
             return
         self.measure(then=self._measured_after)
 
+    def report_notes(self) -> list[tuple[str, str]]:
+        """What the commissioning report says of the tunings of this session (before / after)."""
+        return tuning_notes(self.records)
+
     def _measured_after(self, result: dict[str, Any]) -> None:
+        if self.records and self.proposal is not None:
+            self.records[-1] = replace(self.records[-1], items=dict(self.proposal.proposed.items),
+                                       aim=self.proposal.used_aim, warning=self.proposal.warning,
+                                       after=result)
         for row, key in enumerate((*TUNE_KEYS, *FIGURE_ROWS)):
             value = self.proposal.proposed.items.get(key) if key in TUNE_KEYS else result.get(key)
             self.table.setItem(row, 2, QTableWidgetItem("—" if value is None else f"{value:g}"))

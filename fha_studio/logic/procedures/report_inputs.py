@@ -47,7 +47,8 @@ class ReportInputs:
     front panel); ``read``: which of them were read from the drive; ``front_panel``: who entered
     each value from the panel, and when. ``parameter_file_text``: the parameter file of those
     values. ``direction_check``: the last check of the Rotary direction page. ``dgr_checks``: the
-    DGR checks page's records. ``who``: the operator, for a direction check without a name."""
+    DGR checks page's records. ``tuning_notes``: the Tuning page's before / after (text, who).
+    ``who``: the operator, for a direction check without a name."""
 
     who: str
     parameter_model: ParameterModel
@@ -58,6 +59,8 @@ class ReportInputs:
     parameter_file_text: str = ""
     direction_check: DirectionCheck | None = None
     dgr_checks: Sequence[DgrCheckRecord] = ()
+    #: the Tuning page's measurements before and after, as notes (text, who)
+    tuning_notes: Sequence[tuple[str, str]] = ()
 
 
 def collect_for_report(session: ProcedureSession, inputs: ReportInputs) -> bool:
@@ -71,7 +74,7 @@ def collect_for_report(session: ProcedureSession, inputs: ReportInputs) -> bool:
         session.driver = dict(inputs.driver)
     if inputs.values:
         session.parameters = _parameters(session, inputs)
-    for text, who in dgr_check_notes(inputs.dgr_checks):
+    for text, who in [*dgr_check_notes(inputs.dgr_checks), *inputs.tuning_notes]:
         if text not in {n.get("text", "") for n in session.notes}:
             session.add_note(text, who=who)
     if session.path:

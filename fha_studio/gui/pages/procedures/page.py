@@ -403,6 +403,13 @@ class ProceduresPage(BasePage):
         window = self.main_window
         direction = window.built_page(PageId.DIRECTION) if window is not None else None
         checks = window.built_page(PageId.ABSOLUTE) if window is not None else None
+        tuning = window.built_page(PageId.TUNING) if window is not None else None
+        notes: list[tuple[str, str]] = []
+        if tuning is not None:
+            from fha_studio.gui.pages.tuning import TuningPage  # plots: imported once it is built
+
+            if isinstance(tuning, TuningPage):
+                notes = [(text, who or self.who) for text, who in tuning.report_notes()]
         # another page is a Page to this one: what it is, isinstance says
         return ReportInputs(
             who=self.who,
@@ -414,6 +421,7 @@ class ProceduresPage(BasePage):
             parameter_file_text=self.gui_session.parameter_file_text(values) if values else "",
             direction_check=direction.last_check if isinstance(direction, DirectionPage) else None,
             dgr_checks=list(checks.records) if isinstance(checks, AbsolutePage) else [],
+            tuning_notes=notes,
         )
 
     def add_plot(self, title: str, png_path: str | Path) -> None:

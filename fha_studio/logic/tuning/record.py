@@ -1,0 +1,48 @@
+"""What a tuning did, for the commissioning report: before and after, figures, who, when."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+FIGURES = (("resonance_hz", "resonance", "Hz"), ("antiresonance_hz", "anti-resonance", "Hz"),
+           ("load_inertia_estimate_kgm2", "load inertia estimate", "kg·m²"),
+           ("gain_margin_db", "gain margin", "dB"), ("phase_margin_deg", "phase margin", "deg"),
+           ("crossover_hz", "crossover", "Hz"), ("bandwidth_hz", "bandwidth", "Hz"))
+
+
+@dataclass(frozen=True)
+class TuningRecord:
+    """One measurement (``before``), the proposal applied (``items``, its ``aim``), and the
+    measurement after writing them (``after``, None when nothing was applied)."""
+
+    at: str
+    who: str
+    before: Mapping[str, Any]
+    items: Mapping[str, int] = field(default_factory=dict)
+    aim: str = ""
+    warning: str | None = None
+    after: Mapping[str, Any] | None = None
+
+
+def _figures(result: Mapping[str, Any]) -> str:
+    parts = []
+    for key, words, unit in FIGURES:
+        value = result.get(key)
+        parts.append(f"{words} {'none found' if value is None else f'{value:.3g} {unit}'}")
+    return ", ".join(parts)
+
+
+def tuning_notes(records: Sequence[TuningRecord]) -> list[tuple[str, str]]:
+    """The records as the report's notes: (text, who)."""
+    notes = []
+    for r in records:
+        items = dict(r.before.get("items", {}))
+        text = f"Tuning ({r.at}): measured with the items {items}: {_figures(r.before)}"
+        if r.after is not None:
+            text += (f". Applied ({r.aim}) {dict(r.items)}, measured again: {_figures(r.after)}")
+        if r.warning:
+            text += f". Warning: {r.warning}"
+        notes.append((text, r.who))
+    return notes
