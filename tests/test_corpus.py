@@ -51,6 +51,7 @@ def scratch(tmp_path):
 def test_a_malformed_command_line_is_refused_with_one_line(case, scratch, capsys):
     values = {"corpus": str(CORPUS), "tmp": str(scratch), "long": "n" * 300}
     args = [a.format(**values) for a in case["args"]]
+    before = _corpus_bytes()
     try:
         code = cli_main(args)
     except SystemExit as exc:  # argparse refuses an option value
@@ -64,6 +65,13 @@ def test_a_malformed_command_line_is_refused_with_one_line(case, scratch, capsys
     # nothing half-written (a register file may have been opened: it is the input, not an output)
     # (and SQLite's -wal and -shm files beside it)
     assert sorted(p.name for p in scratch.iterdir() if not p.name.startswith("r.sqlite")) == ["afile", "fifo"]
+    # and a refused input is left as it was: a question on a damaged register of an older schema
+    # was upgraded first (WAL switched on, the file changed) before the damage was found
+    assert _corpus_bytes() == before
+
+
+def _corpus_bytes() -> dict[str, bytes]:
+    return {str(p.relative_to(CORPUS)): p.read_bytes() for p in CORPUS.rglob("*") if p.is_file()}
 
 
 #: The real command, stopped in its write of $HOLD (fsync: after the data, before the rename) to be

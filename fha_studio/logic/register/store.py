@@ -190,10 +190,14 @@ class Register(Keys):
 
 
 def _upgrade_if_older(path: Path, busy_timeout_s: float) -> None:
-    """A register of an older schema is brought up to date before it is read (its data kept)."""
+    """A register of an older schema is brought up to date before it is read (its data kept);
+    a damaged one is refused as it is: an upgrade would write into it (WAL, the new tables) before
+    a question is asked, and `register check` is to find the file as it was left."""
     try:
         with contextlib.closing(sqlite3.connect(guard.connect_uri(path, True, False), uri=True)) as db:
             older = int(db.execute("PRAGMA user_version").fetchone()[0]) < SCHEMA_VERSION
+            if older and not guard.sound(db):
+                raise guard.damaged(path, db)
     except sqlite3.Error:
         return  # opening it read-only says what is wrong
     if older:
