@@ -132,12 +132,14 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
         rec: tuple[list, ...] = ([], [], [], [], [], [], [])
         _kernel.run(p, state, cmd_servo, m, True, rec, 1)
         ts = np.concatenate(([last_t], t_servo))
-        cur = np.asarray(rec[5])
+        # the lists to arrays with their dtype stated: numpy then skips its type discovery per item
+        recorded = [np.array(r, dtype=float) for r in rec[1:]]
+        cur = recorded[4]
         charge = last_charge + np.concatenate(([0.0], np.cumsum(cur) * dt))
         stop = int(np.searchsorted(t, t[0] + ts[-1], side="right")) if k0 + m < n else len(t)
         rel = t[done:stop] - t[0]
         for j, key in enumerate(keys):
-            out[key][done:stop] = np.interp(rel, ts, np.concatenate(([last[j]], rec[j + 1])))
+            out[key][done:stop] = np.interp(rel, ts, np.concatenate(([last[j]], recorded[j])))
         charge_at[done:stop] = np.interp(rel, ts, charge)
         done = stop
         last_t = float(ts[-1])

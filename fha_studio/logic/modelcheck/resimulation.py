@@ -40,8 +40,12 @@ def resimulate(
     if n_raw < len(sig.raw_t_s):
         command += f", its first {max_s:g} s"
     kt = axis.kt_nm_per_a
-    out = {}
+    out: dict[str, dict[str, np.ndarray]] = {}
     for name, m in (("nominal", nominal), ("updated", updated)):
+        if name == "updated" and updated == nominal:
+            # the same model through the same servo: simulate() is deterministic, run it once
+            out[name] = out["nominal"]
+            continue
         try:
             r = simulate(m, servo, t, cmd)
         except ValueError as exc:
