@@ -41,6 +41,8 @@ def test_measure_propose_apply_end_to_end(make_window, qtbot):
     assert result["resonance_hz"] == pytest.approx(result["predicted_resonance_hz"], rel=0.1)
     assert len(page.markers) == 4  # resonance, anti-resonance, and their predictions
     assert "Resonance" in page.result_label.text()
+    page.use_inertia_button.click()  # the estimate offered to the commissioning state
+    assert window.session.state.load_inertia_kgm2 == pytest.approx(0.81, rel=0.1)
     with qtbot.waitSignal(page.sigProposed, timeout=120000):
         page.propose_button.click()
     assert page.table.item(0, 1) is not None

@@ -92,3 +92,19 @@ def test_proposal_meets_its_margins(load_ratio: float, softer: bool) -> None:
     if softer:
         assert "2-1" in (proposal.warning or "")
         assert proposal.proposed.meets(*AIMS["soft"])
+
+
+@pytest.mark.parametrize("load_ratio", [0.0, 3.0])
+def test_inertia_from_a_move(load_ratio: float) -> None:
+    from fha_studio.logic.tuning.response import inertia_from_move
+
+    model = _model("FHA-25C-50-US250", load_ratio)
+    axis = ServoAxis(model, servo_settings(model, DEFAULTS, RATE, quantised_feedback=False))
+    axis.servo_on()
+    axis.start_trace(5)
+    axis.move_by(math.radians(90.0), speed_rad_s=0.5 * model.max_speed_rad_s,
+                 accel_rad_s2=0.5 * model.max_acceleration_rad_s2())
+    axis.advance(1.5)
+    trace = axis.read_trace()
+    estimate = inertia_from_move(trace["t"], trace["vel"], trace["current"] * model.torque_constant_nm_per_a)
+    assert estimate == pytest.approx(model.total_inertia_kgm2, rel=0.1)

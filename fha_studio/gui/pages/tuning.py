@@ -94,8 +94,11 @@ class TuningPage(BasePage):
         self.cancel_button = QPushButton("Cancel")
         self.propose_button = QPushButton("Propose gains")
         self.apply_button = QPushButton("Apply proposed gains")
+        self.use_inertia_button = QPushButton("Use the estimate as the load inertia")
+        self.use_inertia_button.setEnabled(False)
+        self.use_inertia_button.clicked.connect(self.use_inertia_estimate)
         for b in (self.plan_button, self.start_button, self.cancel_button, self.propose_button,
-                  self.apply_button):
+                  self.apply_button, self.use_inertia_button):
             buttons.addWidget(b)
         self.start_button.setEnabled(False)
         self.cancel_button.setEnabled(False)
@@ -298,6 +301,7 @@ class TuningPage(BasePage):
             return "—" if v is None else f"{v:.3g} {unit}"
 
         self.status_label.setText("Measured.")
+        self.use_inertia_button.setEnabled(result.get("load_inertia_estimate_kgm2") is not None)
         self.result_label.setText(
             f"Resonance {fmt('resonance_hz', 'Hz')} (predicted {fmt('predicted_resonance_hz', 'Hz')}), "
             f"anti-resonance {fmt('antiresonance_hz', 'Hz')}; load inertia estimate "
@@ -384,6 +388,16 @@ class TuningPage(BasePage):
                                       "nothing measured.")
             return
         self.measure(then=self._measured_after)
+
+    def use_inertia_estimate(self) -> None:
+        """Offer the measured load inertia to the commissioning state (the declared load)."""
+        estimate = (self.result or {}).get("load_inertia_estimate_kgm2")
+        if estimate is None:
+            return
+        value = max(0.0, float(estimate))
+        self.session.state.set_load_inertia(value)
+        self.load_spin.setValue(value)
+        self.status_label.setText(f"The declared load inertia is now {value:.4g} kg·m² (measured).")
 
     def report_notes(self) -> list[tuple[str, str]]:
         """What the commissioning report says of the tunings of this session (before / after)."""
