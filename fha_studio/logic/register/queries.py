@@ -124,11 +124,13 @@ class Queries(Facts):
         # each axis's latest row (the newest time, then the highest number), found by its own index
         # entries (a thousand axes with ten years of writes each: milliseconds, on either store);
         # the CTE is made first, then joined (never planned as a join over every snapshot), and
-        # ``key || ''`` keeps both planners on the snapshot's own values, not on every value of the key
+        # ``key || ''`` keeps both planners on the snapshot's own values, not on every value of the key;
+        # a key no snapshot holds (written only) is seen at once, not after every snapshot of every axis
         queries = (
             "WITH latest AS MATERIALIZED (SELECT (SELECT t.id FROM snapshot t WHERE t.axis_id = a.id"
             " AND EXISTS (SELECT 1 FROM snapshot_value u WHERE u.snapshot_id = t.id AND u.key || '' = ?)"
-            " ORDER BY t.at_utc DESC, t.id DESC LIMIT 1) AS id FROM axis a)"
+            " ORDER BY t.at_utc DESC, t.id DESC LIMIT 1) AS id FROM axis a"
+            " WHERE EXISTS (SELECT 1 FROM snapshot_value k WHERE k.key = ?))"
             " SELECT s.axis_id, v.mode, v.number, v.key, v.value, s.at_utc, s.source, s.id FROM latest"
             " JOIN snapshot s ON s.id = latest.id"
             " JOIN snapshot_value v ON v.snapshot_id = s.id AND v.key || '' = ?",
