@@ -36,7 +36,7 @@ def main() -> int:
     from fha_studio.gui.main_window import MainWindow
 
     window = MainWindow()
-    window.resize(1366, 900)
+    window.resize(int(os.environ.get("FHA_SHOT_WIDTH", 1366)), int(os.environ.get("FHA_SHOT_HEIGHT", 740)))
     window.show()
     window.connect_to(URL)
 

@@ -17,24 +17,28 @@ from typing import Any
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import QTimer, Signal
+from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
     QFormLayout,
     QHBoxLayout,
+    QHeaderView,
     QLabel,
     QLineEdit,
     QPlainTextEdit,
     QPushButton,
+    QSplitter,
     QTableWidget,
     QTableWidgetItem,
     QVBoxLayout,
+    QWidget,
 )
 
 from fha_studio import clock
 from fha_studio.gui.link_requests import Call, LinkInfo, LinkReply
 from fha_studio.gui.pages.base import BasePage
+from fha_studio.gui.widgets import scrolling
 from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
 from fha_studio.logic.tuning.excitation import plan_excitation
@@ -45,6 +49,27 @@ from fha_studio.logic.tuning.session import declared_model, measure_report, tune
 
 COUNTDOWN_S = 3
 FIGURE_ROWS = ("gain_margin_db", "phase_margin_deg", "overshoot_pct", "settling_ms")
+#: the table's words for the figures beside the tune items
+FIGURE_WORDS = {"gain_margin_db": "Gain margin [dB]", "phase_margin_deg": "Phase margin [deg]",
+                "overshoot_pct": "Overshoot of a move [%]", "settling_ms": "Settling time of a move [ms]"}
+
+
+def _item_words(item: Any) -> str:
+    """A tune item as the front panel knows it (tune mode): its number, name and unit."""
+    return f"{item.number} {item.name}" + (f" [{item.unit}]" if item.unit else "")
+
+
+class FrequencyAxis(pg.AxisItem):
+    """A logarithmic frequency axis labelled 1, 2, 5 per decade in plain numbers (pyqtgraph labels
+    every minor tick as 2·10¹, 3·10¹, ..., which run into each other)."""
+
+    def logTickStrings(self, values, scale, spacing):  # pyqtgraph calls it by this name
+        words = []
+        for v in values:
+            f = 10.0 ** float(v)
+            lead = f / 10.0 ** np.floor(np.log10(f) + 1e-9)
+            words.append(f"{f:g}" if any(abs(lead - d) < 1e-6 for d in (1.0, 2.0, 5.0)) else "")
+        return words
 
 
 class TuningPage(BasePage):
@@ -121,9 +146,12 @@ class TuningPage(BasePage):
 
         self.plots = pg.GraphicsLayoutWidget()
         self.plots.setBackground("w")
-        self.mag_plot = self.plots.addPlot(row=0, col=0, title="Magnitude (dB)")
-        self.phase_plot = self.plots.addPlot(row=1, col=0, title="Phase (deg)")
-        self.coh_plot = self.plots.addPlot(row=2, col=0, title="Coherence")
+        self.mag_plot = self.plots.addPlot(row=0, col=0, title="Magnitude [dB]",
+                                           axisItems={"bottom": FrequencyAxis("bottom")})
+        self.phase_plot = self.plots.addPlot(row=1, col=0, title="Phase [deg]",
+                                             axisItems={"bottom": FrequencyAxis("bottom")})
+        self.coh_plot = self.plots.addPlot(row=2, col=0, title="Coherence",
+                                           axisItems={"bottom": FrequencyAxis("bottom")})
         for plot in (self.mag_plot, self.phase_plot, self.coh_plot):
             plot.setLogMode(x=True, y=False)
             plot.showGrid(x=True, y=True, alpha=0.3)
@@ -144,26 +172,44 @@ class TuningPage(BasePage):
 
         self.table = QTableWidget(len(TUNE_KEYS) + len(FIGURE_ROWS), 3)
         self.table.setHorizontalHeaderLabels(["present", "proposed", "measured after"])
-        self.table.setVerticalHeaderLabels([*TUNE_KEYS, *FIGURE_ROWS])
+        self.table.setToolTip("Tune mode items of the front panel, and the figures they give")
+        model = session.parameter_model
+        self.table.setVerticalHeaderLabels(
+            [*(_item_words(model.by_key(k)) for k in TUNE_KEYS), *(FIGURE_WORDS[k] for k in FIGURE_ROWS)])
         self.worksheet = QPlainTextEdit()
         self.worksheet.setReadOnly(True)
         self.worksheet.setPlaceholderText("The front-panel worksheet appears here for a drive without "
                                           "parameter access over CN3.")
-        self.table.setMaximumHeight(250)
-        self.worksheet.setMaximumHeight(250)
+        # the plots take the width, the figures and the worksheet a column beside them; below
+        # these heights the page scrolls instead of squeezing three plots into one line each
+        self.plots.setMinimumHeight(420)
+        self.table.setMinimumHeight(230)
+        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        self.table.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        side = QWidget()
+        side_layout = QVBoxLayout(side)
+        side_layout.setContentsMargins(0, 0, 0, 0)
+        side_layout.addWidget(self.table, 3)
+        side_layout.addWidget(self.worksheet, 2)
+        lower = QSplitter(Qt.Orientation.Horizontal)
+        lower.addWidget(self.plots)
+        lower.addWidget(side)
+        lower.setStretchFactor(0, 1)
+        lower.setStretchFactor(1, 1)
+        lower.setSizes([760, 560])
 
-        layout = QVBoxLayout(self)
+        panel = QWidget()
+        layout = QVBoxLayout(panel)
         layout.addLayout(form)
         layout.addLayout(buttons)
         layout.addWidget(self.plan_label)
         layout.addWidget(self.warning_label)
         layout.addWidget(self.status_label)
         layout.addWidget(self.result_label)
-        layout.addWidget(self.plots, 4)
-        lower = QHBoxLayout()
-        lower.addWidget(self.table, 1)
-        lower.addWidget(self.worksheet, 1)
-        layout.addLayout(lower, 1)
+        layout.addWidget(lower, 1)
+        outer = QVBoxLayout(self)
+        outer.setContentsMargins(0, 0, 0, 0)
+        outer.addWidget(scrolling(panel))
 
     # ----- the link ------------------------------------------------------------------------------
     def link_connected(self, info: LinkInfo) -> None:
@@ -282,9 +328,10 @@ class TuningPage(BasePage):
             self.mag_plot.removeItem(marker)
         self.markers = []
         for key, colour, style, label, where in (
+            # each label at a height of its own: the two frequencies are often close on the axis
             ("resonance_hz", "#008000", None, "resonance", 0.95),
-            ("antiresonance_hz", "#800080", None, "anti-resonance", 0.95),
-            ("predicted_resonance_hz", "#008000", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.12),
+            ("antiresonance_hz", "#800080", None, "anti-resonance", 0.78),
+            ("predicted_resonance_hz", "#008000", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.29),
             ("predicted_antiresonance_hz", "#800080", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.12),
         ):
             value = result.get(key)
