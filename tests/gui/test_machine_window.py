@@ -428,7 +428,7 @@ window.close()
 """
 
 
-def _register_nobody_may_write(place):
+def _register_the_program_cannot_write(place):
     path = place.folder / "plant.sqlite"
     with Register(path) as register:
         register.add_machine("Press 7")
@@ -438,7 +438,7 @@ def _register_nobody_may_write(place):
 
 def test_a_read_only_register_is_a_message_in_the_machine_window():
     with ReadOnlyPlace() as place:
-        path, before = _register_nobody_may_write(place)
+        path, before = _register_the_program_cannot_write(place)
         done = place.run("-c", MACHINE_WINDOW_ON, str(path))
         assert done.returncode == 0, done.stderr
         assert "Traceback" not in done.stderr
@@ -451,7 +451,7 @@ def test_a_read_only_register_is_a_message_in_the_machine_window():
 
 def test_the_gui_on_a_read_only_register_opens_a_new_machine_file():
     with ReadOnlyPlace() as place:
-        path, before = _register_nobody_may_write(place)
+        path, before = _register_the_program_cannot_write(place)
         project = MachineProject("Press 9")
         project.add_axis("feed", "FHA-17C-50-US250", port_url="sim://FHA-17C-50-US250?paced=0")
         machine_file = project.save(place.folder / "press9.json")
