@@ -83,6 +83,13 @@ def estimate_response(records: Sequence[tuple[np.ndarray, np.ndarray]], sample_r
                              np.clip(coh, 0.0, 1.0))
 
 
+def bandwidth_hz(closed: FrequencyResponse) -> float | None:
+    """The -3 dB frequency of a measured closed loop: the first trusted bin 3 dB below the first."""
+    mag, f, ok = closed.magnitude_db, closed.freq_hz, closed.trusted()
+    below = [i for i in range(len(f)) if ok[i] and mag[i] < mag[0] - 3.0103]
+    return float(f[below[0]]) if below else None
+
+
 @dataclass(frozen=True)
 class Resonance:
     resonance_hz: float | None

@@ -17,6 +17,8 @@ from fha_studio.logic.tuning.measure import measure
 from fha_studio.logic.tuning.move import MoveFigures, measure_move
 from fha_studio.logic.tuning.propose import TUNE_KEYS, Tuner
 from fha_studio.logic.tuning.response import (
+    FrequencyResponse,
+    bandwidth_hz,
     estimate_response,
     fit_two_mass,
     loop_figures,
@@ -62,7 +64,21 @@ def measure_report(client: Any, tuner: Tuner, wait: Callable[[float], None], now
                       output_ppr=tuner.model.output_resolution_ppr)
     closed = estimate_response(records.closed_loop(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
     plant = estimate_response(records.plant(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
-    fit = fit_two_mass(plant, records.sample_rate_hz)
+    return {
+        **response_figures(tuner, lm, closed, plant, records.sample_rate_hz),
+        "excitation": {"amplitude_rpm": plan.amplitude_rpm, "travel_bound_deg": plan.travel_bound_deg,
+                       "travel_limit_deg": plan.travel_limit_deg, "hold_periods": plan.hold_periods,
+                       "records": plan.records},
+    }
+
+
+def response_figures(tuner: Tuner, lm: LoopModel, closed: FrequencyResponse, plant: FrequencyResponse,
+                     sample_rate_hz: float) -> dict[str, Any]:
+    """The figures of a measured closed loop and plant (torque -> speed, as ``lm.plant()``), as
+    ``tune measure``'s JSON: the two-mass fit (resonance, anti-resonance, inertia), the margins
+    with the plant as measured, the bandwidth, and what the declared model predicts. One path for
+    every measurement: over CN3 and from the bench."""
+    fit = fit_two_mass(plant, sample_rate_hz)
     figures = loop_figures(lm.speed_open_loop(), lm.speed_closed_loop(), 0.49 * tuner.servo_rate_hz)
     measured = measured_loop_figures(lm.speed_open_loop(), lm.plant(), plant)
     predicted = two_mass_prediction(tuner.model)
@@ -78,21 +94,11 @@ def measure_report(client: Any, tuner: Tuner, wait: Callable[[float], None], now
         "crossover_hz": measured.crossover_hz,
         "predicted": {"gain_margin_db": figures.gain_margin_db, "phase_margin_deg": figures.phase_margin_deg,
                       "crossover_hz": figures.crossover_hz, "bandwidth_hz": figures.bandwidth_hz},
-        "bandwidth_hz": _bandwidth(closed),
-        "excitation": {"amplitude_rpm": plan.amplitude_rpm, "travel_bound_deg": plan.travel_bound_deg,
-                       "travel_limit_deg": plan.travel_limit_deg, "hold_periods": plan.hold_periods,
-                       "records": plan.records},
+        "bandwidth_hz": bandwidth_hz(closed),
         "items": {k: v for k, v in tuner.items.items() if k in TUNE_KEYS},
         "frequency_response": closed.to_dict(),
         "plant_response": plant.to_dict(),
     }
-
-
-def _bandwidth(closed: Any) -> float | None:
-    """The -3 dB frequency of the measured closed loop (first trusted bin below it)."""
-    mag, f, ok = closed.magnitude_db, closed.freq_hz, closed.trusted()
-    below = [i for i in range(len(f)) if ok[i] and mag[i] < mag[0] - 3.0103]
-    return float(f[below[0]]) if below else None
 
 
 def backup_parameters(client: Any, parameters: ParameterModel, actuator: str, path: Path) -> Path:
