@@ -67,8 +67,8 @@ from PySide6.QtCore import QCoreApplication
 from PySide6.QtWidgets import QApplication
 app = QApplication([])
 QCoreApplication.setOrganizationName("FHA Studio Tests")
-from fha_studio.gui.main_window import MainWindow
-window = MainWindow()
+from fha_studio.gui.app import parse_arguments, single_axis_window
+window = single_axis_window(parse_arguments(["--no-connect"]))  # as fha-studio makes it
 window.show()
 app.processEvents()
 heavy = sorted({m.split('.')[0] if not m.startswith('fha_studio') else m for m in sys.modules

@@ -80,7 +80,15 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--machine",
         metavar="NAME",
-        help="open the machine NAME of the register: its axes beside the pages, each connected to its port",
+        help="open the machine NAME of the register: its axes beside the pages, each connected to its "
+        "port; with --axis, the single-axis window records under that machine",
+    )
+    parser.add_argument(
+        "--axis",
+        metavar="NAME",
+        help="the single-axis window records what it learns in the register under this axis (of "
+        "--machine, else of this computer's bench); without it, under an axis named after the "
+        "actuator or the connection (the status bar's Register line names and changes it)",
     )
     parser.add_argument(
         "--machine-file",
@@ -106,6 +114,12 @@ def _parser() -> argparse.ArgumentParser:
 def _machine_window(args):
     """The machine window for --machine / --machine-file, or None; SystemExit(2) with one line
     when the machine or the register cannot be opened."""
+    if args.axis is not None:
+        if args.machine_file:
+            print("fha-studio: --axis names the single-axis window's axis; a machine file opens the "
+                  "machine window, whose axes are named by the file", file=sys.stderr)
+            raise SystemExit(2)
+        return None
     if not (args.machine or args.machine_file):
         return None
     from fha_studio.gui.machine_window import MachineWindow
@@ -137,6 +151,29 @@ def _machine_window(args):
     return MachineWindow(project, register)
 
 
+def single_axis_window(args: argparse.Namespace):
+    """The single-axis window, recording into the register (``--register``) under ``--machine`` /
+    ``--axis`` or the default names; SystemExit(2) with one line for a name the register refuses."""
+    from fha_studio.gui.main_window import MainWindow
+    from fha_studio.gui.window_register import WindowRegister
+    from fha_studio.logic.register.window_axis import check_names
+    from fha_studio.names import NameProblem
+
+    try:
+        machine, axis = check_names(args.machine or "", args.axis or "")
+    except NameProblem as exc:
+        print(f"fha-studio: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
+    window = MainWindow()
+    WindowRegister(window, args.register, machine, axis)
+    return window
+
+
+def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:
+    """The GUI's options (SystemExit(2) with one line for a refused one)."""
+    return _parser().parse_args(list(argv))
+
+
 def make_application(argv: Sequence[str] = ()):
     """The QApplication (created once), with the names QSettings uses, in a process whose GIL
     switches fast enough for the link thread (``GIL_SWITCH_INTERVAL_S``)."""
@@ -159,7 +196,7 @@ def make_application(argv: Sequence[str] = ()):
 def run(argv: Sequence[str] = ()) -> int:
     """Starts the GUI; returns the exit code."""
     started = time.perf_counter()
-    args = _parser().parse_args(list(argv))
+    args = parse_arguments(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     scenario = None
     if args.training:
@@ -174,7 +211,6 @@ def run(argv: Sequence[str] = ()) -> int:
     from PySide6.QtCore import QCoreApplication, QEvent, QTimer
     from PySide6.QtGui import QIcon
 
-    from fha_studio.gui.main_window import MainWindow
     from fha_studio.paths import resources_dir
 
     icon = resources_dir() / "icons" / "fha-studio.png"
@@ -190,7 +226,7 @@ def run(argv: Sequence[str] = ()) -> int:
         if not args.no_connect:
             machine.connect_all()
     else:
-        window = MainWindow()
+        window = single_axis_window(args)
         if args.page:
             window.show_page(args.page)
         window.show()

@@ -1,4 +1,5 @@
-"""What happens on one axis of a machine goes into the register as it happens.
+"""What happens on one axis goes into the register as it happens: an axis of a machine (the
+machine window) or the single-axis window's (``gui/window_register.py`` names its axis).
 
 :class:`AxisRecorder` hears the axis's link (parameter reads, verified writes, alarms, the driver
 it names) and its pages (procedure checks and reports, recordings, model checks, the DGR checks,
@@ -8,11 +9,12 @@ in :mod:`fha_studio.logic.register.facts_from_session`.
 
 from __future__ import annotations
 
+import getpass
 import logging
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, TypeGuard, TypeVar
+from typing import TYPE_CHECKING, Any, TypeGuard, TypeVar
 
 from PySide6.QtCore import QObject, Slot
 
@@ -45,6 +47,18 @@ log = logging.getLogger(__name__)
 
 _P = TypeVar("_P")
 
+#: QSettings key of the operator's name (the machine window's *Operator* field, the single-axis
+#: window's register line): who the register records.
+OPERATOR_KEY = "machine/operator"
+
+
+def login_name() -> str:
+    """The computer's login name ("" when the environment and the password database have none)."""
+    try:
+        return getpass.getuser()
+    except (KeyError, OSError):
+        return ""
+
 
 class AxisRecorder(QObject):
     """Writes one axis's commissioning facts into the register as they happen.
@@ -53,11 +67,23 @@ class AxisRecorder(QObject):
     disk) is said in the axis's message area; the commissioning goes on."""
 
     def __init__(
-        self, register: Register, axis_ref: str, window: MainWindow, who: Callable[[], str], site: str = ""
+        self,
+        register: Register,
+        axis_ref: str | Callable[[], str],
+        window: MainWindow,
+        who: Callable[[], str],
+        site: str = "",
+        axis_fields: Callable[[str], Mapping[str, Any]] | None = None,
     ):
+        """``axis_ref``: the axis (``MACHINE/AXIS``), or a function saying it at each fact (the
+        single-axis window's, which a person may rename). ``axis_fields``: for an axis that may not
+        be in the register yet, its fields (actuator, load); it is added before its first fact."""
         super().__init__(window)
         self.register = register
-        self.axis_ref = axis_ref
+        self._axis_ref = axis_ref
+        self._axis_fields = axis_fields
+        self._axes_there: set[str] = set()
+        self._stopped = False
         self.site = site
         self.window = window
         self._who = who
@@ -94,20 +120,54 @@ class AxisRecorder(QObject):
         self._hooked.add(id(page))
         return True
 
+    @property
+    def axis_ref(self) -> str:
+        """The axis the next fact goes to (``MACHINE/AXIS``)."""
+        return self._axis_ref() if callable(self._axis_ref) else self._axis_ref
+
+    def stop(self) -> None:
+        """Records nothing more (the window is closing and its register is closed)."""
+        self._stopped = True
+
+    def recorded_axes(self) -> set[str]:
+        """The axes this recorder added or found in the register (``MACHINE/AXIS``)."""
+        return set(self._axes_there)
+
     # -- writing, never failing the GUI ---------------------------------------------------------------
     def _record(self, facts: Iterable[Fact]) -> None:
+        facts = list(facts)
+        if not facts or self._stopped:
+            return
+        axis = self.axis_ref
+        if not self._axis_there(axis, facts[0].what):
+            return
         for fact in facts:
-            self._record_action(fact.what, partial(record_fact, self.register, self.axis_ref, fact))
+            self._record_action(fact.what, partial(record_fact, self.register, axis, fact), axis)
 
-    def _record_action(self, what: str, action: Callable[[], object]) -> None:
+    def _axis_there(self, axis: str, what: str) -> bool:
+        """The axis is in the register (added now when the recorder may add it); False, said in
+        the message area, when it could not be added."""
+        if self._axis_fields is None or axis in self._axes_there:
+            return True
+        machine, name = axis.split("/", 1)
+        fields = dict(self._axis_fields(axis))
+        if self._record_action(what, lambda: self.register.ensure_axis(machine, name, **fields), axis):
+            self._axes_there.add(axis)
+            return True
+        return False
+
+    def _record_action(self, what: str, action: Callable[[], object], axis: str = "") -> bool:
+        """Runs one write; True when it was done. A refusal is said, never raised."""
         try:
             action()
+            return True
         except (RegisterError, OSError, ValueError) as exc:
-            log.warning("register: %s of %s not recorded: %s", what, self.axis_ref, exc)
+            log.warning("register: %s of %s not recorded: %s", what, axis or self.axis_ref, exc)
             self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
         except Exception as exc:  # sqlite3 errors (a locked or damaged file): said, not raised
-            log.exception("register: %s of %s not recorded", what, self.axis_ref)
+            log.exception("register: %s of %s not recorded", what, axis or self.axis_ref)
             self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
+        return False
 
     @property
     def who(self) -> str:
@@ -161,16 +221,21 @@ class AxisRecorder(QObject):
     # -- from the pages -------------------------------------------------------------------------------
     def _on_procedures(self, page: ProceduresPage) -> None:
         session = page.session
-        if session is None:
+        if session is None or self._stopped:
             return
-        axis_name = self.axis_ref.split("/", 1)[1]
+        axis_ref = self.axis_ref
+        if not self._axis_there(axis_ref, "procedure check"):
+            return
+        axis_name = axis_ref.split("/", 1)[1]
         if session.axis != axis_name and not any(s.records for s in session.runs.values()):
             # a session started on this axis's pages is this axis's, on this machine's site
             session.axis = axis_name
             session.site = session.site or self.site
             if session.path is not None:
                 self._record_action("session file", session.save)
-        self._record_action("procedure check", lambda: record_session(self.register, self.axis_ref, session))
+        self._record_action(
+            "procedure check", lambda: record_session(self.register, axis_ref, session), axis_ref
+        )
 
     def _on_report(self, page: ProceduresPage, html: Path, pdf: Path | None) -> None:
         self._record(report_facts(page.session, page.context, html, pdf, self.who))

@@ -13,7 +13,6 @@ results. An axis is added through ``gui/axis_dialog.py``.
 
 from __future__ import annotations
 
-import getpass
 import logging
 from pathlib import Path
 
@@ -36,7 +35,7 @@ from PySide6.QtWidgets import (
 
 from fha_studio import fileio
 from fha_studio.gui.axis_dialog import AxisDialog
-from fha_studio.gui.axis_recorder import AxisRecorder
+from fha_studio.gui.axis_recorder import OPERATOR_KEY, AxisRecorder, login_name
 from fha_studio.gui.link import LinkController, OpenClient
 from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
@@ -51,13 +50,6 @@ log = logging.getLogger(__name__)
 
 #: Width of the axis list [px].
 AXIS_LIST_WIDTH_PX = 230
-
-
-def _login_name() -> str:
-    try:
-        return getpass.getuser()
-    except (KeyError, OSError):  # no login name in the environment or the password database
-        return ""
 
 
 class MachineWindow(QMainWindow):
@@ -128,16 +120,16 @@ class MachineWindow(QMainWindow):
         bar.addAction(self.register_action)
         bar.addSeparator()
         bar.addWidget(QLabel("Operator: "))
-        self.operator_edit = QLineEdit(str(QSettings().value("machine/operator", "")))
+        self.operator_edit = QLineEdit(str(QSettings().value(OPERATOR_KEY, "")))
         self.operator_edit.setObjectName("operator")
-        login = _login_name()
+        login = login_name()
         self.operator_edit.setPlaceholderText(
             f"your name (the register records it; else the login name {login})" if login
             else "your name (the register records it)"
         )
         self.operator_edit.setMaximumWidth(200)
         self.operator_edit.editingFinished.connect(
-            lambda: QSettings().setValue("machine/operator", self.operator_edit.text().strip())
+            lambda: QSettings().setValue(OPERATOR_KEY, self.operator_edit.text().strip())
         )
         bar.addWidget(self.operator_edit)
         spacer = QWidget()
@@ -253,7 +245,7 @@ class MachineWindow(QMainWindow):
     @property
     def operator(self) -> str:
         """Who the register records: the name typed, else the computer's login name."""
-        return self.operator_edit.text().strip() or _login_name()
+        return self.operator_edit.text().strip() or login_name()
 
     @property
     def current_index(self) -> int:

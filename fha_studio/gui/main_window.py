@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 from pathlib import Path
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, Protocol, cast
 
 from PySide6.QtCore import QSettings, Qt, Slot
 from PySide6.QtGui import QAction, QKeySequence, QShortcut
@@ -65,6 +65,13 @@ CAPS_WIDTH_PX = 420
 CAPS_WIDTH_SHARE = 0.25
 
 
+class WindowPart(Protocol):
+    """A part a window of its own has beside its pages (``gui/window_register.py``'s register
+    line), ended with the window."""
+
+    def shutdown(self) -> None: ...
+
+
 class MainWindow(QMainWindow, PageLookup):
     """FHA Studio's main window (its pages by id: :class:`PageLookup`)."""
 
@@ -89,6 +96,9 @@ class MainWindow(QMainWindow, PageLookup):
         #: the register where the Procedures page's sign step finds the signer's key (the
         #: machine window's; None: the user's register by the usual rule)
         self.signing_register: Path | str | None = None
+        #: the register this window records into when it is a window of its own (a
+        #: ``WindowRegister``; a machine window's axes are recorded by the machine window)
+        self.window_register: WindowPart | None = None
         self._closing_confirmed = False
         self._shut_down = False
         self._status_note = ""
@@ -139,7 +149,8 @@ class MainWindow(QMainWindow, PageLookup):
         spacer.setSizePolicy(
             spacer.sizePolicy().horizontalPolicy().Expanding, spacer.sizePolicy().verticalPolicy().Preferred
         )
-        bar.addWidget(spacer)
+        self._spacer_action = bar.addWidget(spacer)
+        self.axis_toolbar = bar
         self.alarm_banner = QPushButton("")
         self.alarm_banner.setObjectName("alarmBanner")
         self.alarm_banner.setToolTip("Show the alarm, its cause and remedy on the Alarms page")
@@ -159,6 +170,12 @@ class MainWindow(QMainWindow, PageLookup):
         self.sim_panel.sigMessage.connect(self.show_message)
         self.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
         self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.sim_panel)
+
+    def add_axis_line(self, widget: QWidget) -> None:
+        """A line about the axis in the toolbar, after the servo (a window of its own shows there
+        where the register records it)."""
+        self.axis_toolbar.insertSeparator(self._spacer_action)
+        self.axis_toolbar.insertWidget(self._spacer_action, widget)
 
     def _build_pages(self) -> None:
         self.tabs = QTabWidget(self)
@@ -518,6 +535,8 @@ class MainWindow(QMainWindow, PageLookup):
             page.shutdown()
         self.link.shutdown()
         self.training.shutdown()
+        if self.window_register is not None:
+            self.window_register.shutdown()
 
 
 class LazyPage(QWidget):
