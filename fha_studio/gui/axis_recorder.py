@@ -10,9 +10,7 @@ in :mod:`fha_studio.logic.register.facts_from_session`.
 from __future__ import annotations
 
 import getpass
-import logging
 from collections.abc import Callable, Iterable, Mapping
-from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeGuard, TypeVar
 
@@ -22,19 +20,22 @@ from fha_studio.gui.link import DriveStatus, LinkInfo, LinkReply, ParameterReado
 from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
+from fha_studio.gui.register_writer import DirectWriter, RegisterWriter
 from fha_studio.logic.absolute import DgrCheckRecord
-from fha_studio.logic.register import Register, RegisterError, record_session
+from fha_studio.logic.register import Register
 from fha_studio.logic.register.facts_from_session import (
+    ActuatorFact,
     DriverFact,
     Fact,
     RecordingFact,
     alarm_facts,
+    axis_fact,
     facts_from_dgr_check,
     front_panel_facts,
     model_check_facts,
     read_facts,
-    record_fact,
     report_facts,
+    session_fact,
     write_fact,
 )
 
@@ -42,8 +43,6 @@ if TYPE_CHECKING:
     from fha_studio.gui.pages.modelcheck.page import ModelCheckPage
     from fha_studio.gui.pages.procedures.page import ProceduresPage
     from fha_studio.logic.modelcheck import ModelCheckResult
-
-log = logging.getLogger(__name__)
 
 _P = TypeVar("_P")
 
@@ -68,21 +67,24 @@ class AxisRecorder(QObject):
 
     def __init__(
         self,
-        register: Register,
+        register: Register | RegisterWriter,
         axis_ref: str | Callable[[], str],
         window: MainWindow,
         who: Callable[[], str],
         site: str = "",
         axis_fields: Callable[[str], Mapping[str, Any]] | None = None,
     ):
-        """``axis_ref``: the axis (``MACHINE/AXIS``), or a function saying it at each fact (the
-        single-axis window's, which a person may rename). ``axis_fields``: for an axis that may not
-        be in the register yet, its fields (actuator, load); it is added before its first fact."""
+        """``register``: an open register (written on the GUI thread) or a writer (a server's, in
+        its own thread). ``axis_ref``: the axis (``MACHINE/AXIS``), or a function saying it at each
+        fact (the single-axis window's, which a person may rename). ``axis_fields``: for an axis
+        that may not be in the register yet, what a new one is given (actuator, load); the axis
+        is added before its facts."""
         super().__init__(window)
-        self.register = register
+        self.writer = register if isinstance(register, RegisterWriter) else DirectWriter(register, self)
+        self.writer.sigNotRecorded.connect(self._on_not_recorded)
         self._axis_ref = axis_ref
         self._axis_fields = axis_fields
-        self._axes_there: set[str] = set()
+        self._axes_sent: set[str] = set()
         self._stopped = False
         self.site = site
         self.window = window
@@ -130,62 +132,47 @@ class AxisRecorder(QObject):
         self._stopped = True
 
     def recorded_axes(self) -> set[str]:
-        """The axes this recorder added or found in the register (``MACHINE/AXIS``)."""
-        return set(self._axes_there)
+        """The axes facts were sent to (``MACHINE/AXIS``)."""
+        return set(self._axes_sent)
 
     # -- writing, never failing the GUI ---------------------------------------------------------------
-    def _record(self, facts: Iterable[Fact]) -> None:
+    def record(self, facts: Iterable[Fact]) -> None:
+        """Hands ``facts`` of the axis to the register (after the axis itself, when the recorder
+        may add it: ``axis_fields``)."""
         facts = list(facts)
         if not facts or self._stopped:
             return
         axis = self.axis_ref
-        if not self._axis_there(axis, facts[0].what):
-            return
-        for fact in facts:
-            self._record_action(fact.what, partial(record_fact, self.register, axis, fact), axis)
+        if self._axis_fields is not None:
+            facts.insert(0, axis_fact(self._axis_fields(axis), self.who))
+        self._axes_sent.add(axis)
+        self.writer.record(axis, facts)
 
-    def _axis_there(self, axis: str, what: str) -> bool:
-        """The axis is in the register (added now when the recorder may add it); False, said in
-        the message area, when it could not be added."""
-        if self._axis_fields is None or axis in self._axes_there:
-            return True
-        machine, name = axis.split("/", 1)
-        fields = dict(self._axis_fields(axis))
-        if self._record_action(what, lambda: self.register.ensure_axis(machine, name, **fields), axis):
-            self._axes_there.add(axis)
-            return True
-        return False
-
-    def _record_action(self, what: str, action: Callable[[], object], axis: str = "") -> bool:
-        """Runs one write; True when it was done. A refusal is said, never raised."""
-        try:
-            action()
-            return True
-        except (RegisterError, OSError, ValueError) as exc:
-            log.warning("register: %s of %s not recorded: %s", what, axis or self.axis_ref, exc)
-            self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
-        except Exception as exc:  # sqlite3 errors (a locked or damaged file): said, not raised
-            log.exception("register: %s of %s not recorded", what, axis or self.axis_ref)
-            self.window.show_message(f"Register: the {what} was not recorded ({exc}).", Level.WARNING)
-        return False
+    @Slot(str, str)
+    def _on_not_recorded(self, what: str, why: str) -> None:
+        self.window.show_message(f"Register: the {what} was not recorded ({why}).", Level.WARNING)
 
     @property
     def who(self) -> str:
         return self._who()
+
+    def record_actuator(self, code: str) -> None:
+        """The actuator declared on the axis (its register record says it)."""
+        self.record([ActuatorFact(code, self.who)])
 
     # -- from the link --------------------------------------------------------------------------------
     @Slot(object)
     def _on_connected(self, info: LinkInfo) -> None:
         self._alarm_code = 0
         if info.driver_model:
-            self._record([DriverFact(info.driver_model, self.who)])
+            self.record([DriverFact(info.driver_model, self.who)])
 
     @Slot(object)
     def _on_read(self, result: LinkReply[ParameterReadout]) -> None:
         if not result.ok or not result.answer.values:
             return
         info = self.window.link.info
-        self._record(
+        self.record(
             read_facts(
                 self.window.session.parameter_model,
                 {(str(mode), number): value for (mode, number), value in result.answer.values.items()},
@@ -196,7 +183,7 @@ class AxisRecorder(QObject):
 
     @Slot(object)
     def _on_write(self, entry: dict) -> None:
-        self._record([write_fact(self.window.session.parameter_model, entry, self.who)])
+        self.record([write_fact(self.window.session.parameter_model, entry, self.who)])
 
     @Slot(object)
     def _on_status(self, status: DriveStatus) -> None:
@@ -204,13 +191,13 @@ class AxisRecorder(QObject):
         if code is None or code == self._alarm_code:
             return
         self._alarm_code = code
-        self._record(alarm_facts(code, self.window.session.driver, self.who))
+        self.record(alarm_facts(code, self.window.session.driver, self.who))
 
     @Slot()
     def _on_front_panel(self) -> None:
         """Values read off the drive's front panel by a person: a front-panel snapshot per
         entry time and person (an entry already recorded is not recorded again)."""
-        self._record(
+        self.record(
             front_panel_facts(
                 self.window.session.parameter_model,
                 self.window.state.front_panel.values(),
@@ -223,33 +210,31 @@ class AxisRecorder(QObject):
         session = page.session
         if session is None or self._stopped:
             return
-        axis_ref = self.axis_ref
-        if not self._axis_there(axis_ref, "procedure check"):
-            return
-        axis_name = axis_ref.split("/", 1)[1]
+        axis_name = self.axis_ref.split("/", 1)[1]
         if session.axis != axis_name and not any(s.records for s in session.runs.values()):
             # a session started on this axis's pages is this axis's, on this machine's site
             session.axis = axis_name
             session.site = session.site or self.site
             if session.path is not None:
-                self._record_action("session file", session.save)
-        self._record_action(
-            "procedure check", lambda: record_session(self.register, axis_ref, session), axis_ref
-        )
+                try:
+                    session.save()
+                except (OSError, ValueError) as exc:
+                    self._on_not_recorded("session file", str(exc))
+        self.record([session_fact(session)])
 
     def _on_report(self, page: ProceduresPage, html: Path, pdf: Path | None) -> None:
-        self._record(report_facts(page.session, page.context, html, pdf, self.who))
+        self.record(report_facts(page.session, page.context, html, pdf, self.who))
 
     @Slot(object, str)
     def _on_recording(self, path: Path, what: str) -> None:
-        self._record([RecordingFact(path, what, self.who)])
+        self.record([RecordingFact(path, what, self.who)])
 
     @Slot(object)
     def _on_dgr_check(self, record: DgrCheckRecord) -> None:
         """A check of the DGR checks page (what it becomes: ``facts_from_dgr_check``)."""
-        self._record(facts_from_dgr_check(record))
+        self.record(facts_from_dgr_check(record))
 
     def _on_model_check(self, page: ModelCheckPage, result: ModelCheckResult) -> None:
-        self._record(
+        self.record(
             model_check_facts(result.summary_lines(manual_units=True), page.recording_path or "", self.who)
         )

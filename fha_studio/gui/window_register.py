@@ -136,9 +136,9 @@ class WindowRegister(QObject):
         return self.axis.ref
 
     def _axis_fields(self, _axis_ref: str) -> dict[str, Any]:
-        """What a new axis is given: its actuator and declared load, and who added it."""
+        """What a new axis is given: its actuator and declared load."""
         state = self.window.state
-        fields: dict[str, Any] = {"actuator_code": state.actuator_code, "who": self.operator()}
+        fields: dict[str, Any] = {"actuator_code": state.actuator_code}
         if state.load_inertia_kgm2 > 0:
             fields["load_inertia_kgm2"] = state.load_inertia_kgm2
         return fields
@@ -183,15 +183,8 @@ class WindowRegister(QObject):
     def _on_actuator(self, code: str) -> None:
         """The actuator declared: the axis's record says it (once its axis is in the register)."""
         self._refresh()
-        if self.register is None or self.recorder is None or not code:
-            return
-        axis = self.axis.ref
-        if axis not in self.recorder.recorded_axes():
-            return
-        try:
-            self.register.update_axis(axis, who=self.operator(), actuator_code=code)
-        except (RegisterError, OSError, ValueError) as exc:
-            self.window.show_message(f"Register: the actuator was not recorded ({exc}).", Level.WARNING)
+        if self.recorder is not None and code and self.axis.ref in self.recorder.recorded_axes():
+            self.recorder.record_actuator(code)
 
     # -- showing it -----------------------------------------------------------------------------------
     def _refresh(self) -> None:

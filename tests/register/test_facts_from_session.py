@@ -144,6 +144,24 @@ def test_a_model_check_is_its_first_three_summary_lines(line3):
     assert any(e.kind == "model_check" for e in line3.history(AXIS))
 
 
+def test_a_windows_axis_is_added_once_with_its_actuator_and_a_session_as_it_stood(register_file):
+    """The single-axis window's facts: its axis (machine too) added before them and found after,
+    the actuator declared later in its record, a session recorded as it was when handed over."""
+    bench = "laptop-07 bench/FHA-25C-50-US250"
+    axis = f.axis_fact({"actuator_code": "", "load_inertia_kgm2": None}, "ana")
+    assert axis == f.AxisFact((), "ana")
+    session = ProcedureSession(actuator_code="FHA-25C-50-US250", operator="ana")
+    handed_over = f.session_fact(session)
+    session.run("receiving-inspection").status = "completed"  # the page goes on with its own
+    for fact in (axis, axis, f.ActuatorFact("FHA-25C-50-US250", "ben"), handed_over):
+        f.record_fact(register_file, bench, fact)
+    assert [a.name for a in register_file.axes("laptop-07 bench")] == ["FHA-25C-50-US250"]
+    texts = [e.text for e in register_file.history(bench) if e.kind == "axis"]
+    assert texts == ["axis added", "actuator: not given → FHA-25C-50-US250"]
+    status = {r["procedure_id"]: r["status"] for r in register_file.procedure_status(bench)}
+    assert status["receiving-inspection"] == "not_started"
+
+
 def test_a_fact_the_register_cannot_take_raises_its_error(line3):
     from fha_studio.logic.register import RegisterError
 

@@ -14,6 +14,7 @@ the procedure session itself goes in through :func:`~fha_studio.logic.register.i
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping, Sequence
+from copy import deepcopy
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -22,6 +23,7 @@ from fha_studio.hardware.parameters import ParameterModel, load_alarm_table
 from fha_studio.logic.absolute import CHECK_TITLES, DgrCheckRecord
 from fha_studio.logic.procedures.report import build_report
 from fha_studio.logic.procedures.session import ProcedureSession
+from fha_studio.logic.register.importers import record_session
 from fha_studio.logic.register.store import Register
 
 #: A parameter of a snapshot as the register takes it: (mode, number, key, wire value).
@@ -29,6 +31,35 @@ ParameterRow = tuple[str, int, str, int]
 
 #: The procedure the DGR checks page's checks are filed under.
 DGR_PROCEDURE_ID = "dgr-checks"
+
+
+@dataclass(frozen=True)
+class AxisFact:
+    """The axis the facts after it go to, added (with its machine) when the register lacks it:
+    the single-axis window's axis, named by a person or by default. ``fields``: what a new axis is
+    given (its actuator, its declared load); an axis already there gets those it lacks."""
+
+    fields: tuple[tuple[str, Any], ...]
+    who: str
+    what: str = "axis"
+
+
+@dataclass(frozen=True)
+class ActuatorFact:
+    """The actuator declared on the axis (the model code from its label)."""
+
+    actuator_code: str
+    who: str
+    what: str = "actuator"
+
+
+@dataclass(frozen=True, eq=False)
+class SessionFact:
+    """A procedure session as it stood when a step was answered: its checks, where each procedure
+    stands, its parameter values (a copy, :func:`session_fact`: the page goes on with its own)."""
+
+    session: ProcedureSession
+    what: str = "procedure check"
 
 
 @dataclass(frozen=True)
@@ -155,7 +186,10 @@ class ModelCheckFact:
 
 
 Fact = (
-    DriverFact
+    AxisFact
+    | ActuatorFact
+    | SessionFact
+    | DriverFact
     | SnapshotFact
     | WriteFact
     | AlarmFact
@@ -169,6 +203,18 @@ Fact = (
 
 
 # -- events into facts -------------------------------------------------------------------------------
+def axis_fact(fields: Mapping[str, Any], who: str) -> AxisFact:
+    """The axis with what a new one is given (fields with no value are left out)."""
+    return AxisFact(tuple((k, v) for k, v in fields.items() if v not in (None, "")), who)
+
+
+def session_fact(session: ProcedureSession) -> SessionFact:
+    """The session as it stands now, copied (recorded later, in another thread, it is unchanged)."""
+    copy = deepcopy(session)
+    copy.path = session.path
+    return SessionFact(copy)
+
+
 def parameter_key(model: ParameterModel, mode: str, number: int) -> str:
     """The item's key (``rotary_direction``), or ``<mode>_<number>`` for one the driver lacks."""
     try:
@@ -304,6 +350,19 @@ def model_check_facts(
 
 
 # -- facts into the register ------------------------------------------------------------------------
+def _axis(register: Register, axis: str, f: AxisFact) -> None:
+    machine, name = axis.split("/", 1)
+    register.ensure_axis(machine, name, who=f.who, **dict(f.fields))
+
+
+def _actuator(register: Register, axis: str, f: ActuatorFact) -> None:
+    register.update_axis(axis, who=f.who, actuator_code=f.actuator_code)
+
+
+def _session(register: Register, axis: str, f: SessionFact) -> None:
+    record_session(register, axis, f.session)
+
+
 def _driver(register: Register, axis: str, f: DriverFact) -> None:
     register.update_axis(axis, who=f.who, driver_model=f.driver_model)
 
@@ -358,6 +417,9 @@ def _model_check(register: Register, axis: str, f: ModelCheckFact) -> None:
 #: How each kind of fact is written (``tests/register/test_facts_from_session.py`` checks every
 #: kind has its row).
 WRITERS: dict[type, Callable[[Register, str, Any], None]] = {
+    AxisFact: _axis,
+    ActuatorFact: _actuator,
+    SessionFact: _session,
     DriverFact: _driver,
     SnapshotFact: _snapshot,
     WriteFact: _write,
