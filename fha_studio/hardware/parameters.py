@@ -406,3 +406,65 @@ def load_alarm_table(driver: str = "HA-655") -> AlarmTable:
     if len({a.code for a in alarms}) != len(alarms):
         raise ParameterTableError(f"{path}: an alarm code appears twice")
     return AlarmTable(driver, alarms)
+
+
+#: The ways the encoder outputs on CN2 may count up (``[encoder_outputs] counts_up_on``).
+ENCODER_SENSES = ("FWD command", "CW")
+
+
+@dataclass(frozen=True)
+class Cn2Signal:
+    """One signal of the driver's CN2 connector (``pins`` "" where our sources give none)."""
+
+    name: str
+    pins: str
+    direction: str  # "out": the drive drives it; "in": the controller does
+    kind: str  # "analog", "logic", "line driver"
+    role: str  # the bench role(s) that read it, "" if none
+    description: str
+    source: str
+    common: str = ""  # the pin of its common, where stated
+
+
+@dataclass(frozen=True)
+class Cn2Table:
+    """The driver's CN2 as our sources give it, and which way its encoder outputs count up."""
+
+    driver: str
+    pin_table: str  # where the pins our sources lack are (the manual's table)
+    signals: tuple[Cn2Signal, ...]
+    encoder_counts_up_on: str  # one of ENCODER_SENSES
+    encoder_sense_assumed: bool
+    encoder_sense_note: str
+
+    def signal(self, role: str) -> Cn2Signal:
+        """The signal a bench role reads (KeyError when none does)."""
+        for signal in self.signals:
+            if role in (r.strip() for r in signal.role.split(",")):
+                return signal
+        raise KeyError(role)
+
+    def pins_text(self, role: str) -> str:
+        """``CN2-33``, or where to look when our sources give no pin."""
+        pins = self.signal(role).pins
+        return f"CN2-{pins}" if pins else f"CN2 pin: see {self.pin_table}"
+
+
+def load_cn2(driver: str = "HA-655") -> Cn2Table:
+    """The CN2 connector of ``driver`` from ``resources/drive/``."""
+    _, data = _read_toml(_driver_file(driver))
+    path, table = _read_toml(data.get("cn2", "ha655-cn2.toml"))
+    signals = []
+    for index, raw in enumerate(table.get("signal", [])):
+        try:
+            signals.append(Cn2Signal(str(raw["name"]), str(raw["pins"]), str(raw["direction"]),
+                                     str(raw["kind"]), str(raw["role"]), str(raw["description"]),
+                                     str(raw["source"]), str(raw.get("common", ""))))
+        except KeyError as exc:
+            raise _fail(path, f"signal #{index + 1}", f"missing field {exc}") from None
+    encoder = table.get("encoder_outputs", {})
+    sense = encoder.get("counts_up_on")
+    if sense not in ENCODER_SENSES:
+        raise _fail(path, "[encoder_outputs]", f"counts_up_on must be one of {', '.join(ENCODER_SENSES)}")
+    return Cn2Table(driver, str(table.get("pin_table", "the manual's CN2 pin table")), tuple(signals), sense,
+                    "counts_up_on" in encoder.get("assumed", ()), str(encoder.get("note", "")))

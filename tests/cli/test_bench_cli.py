@@ -139,7 +139,7 @@ def test_a_current_probe_gives_the_current_column(bench, tmp_path, capsys):
     [
         (["--signal", "torque=x.sr"], "unknown role 'torque'"),
         (["--signal", "encoder_a={folder}/cn2.sr#NOPE"], "has no channel 'NOPE' (it has ENC_A"),
-        (["--signal", "speed_monitor={folder}/cn2.sr"], "the file has 8 channels"),
+        (["--signal", "speed_monitor={folder}/cn2.sr"], "the file has 12 channels"),
         (["--signal", "speed_monitor={folder}/params.toml#X"], "params.toml: line 3: no time column"),
         (["--current-scale", "2"], "--current-scale without --signal current_probe"),
         (["--signal", "current_probe={folder}/cn2.sr#SPD_MON"], "needs --current-scale A_PER_V"),

@@ -132,3 +132,14 @@ def test_named_monitor_items_are_the_parameter_models():
         assert model.item("monitor", item).key == item.name.lower()
     extension = {i.number for i in model.in_mode("monitor") if i.number >= 100}
     assert extension == {int(i) for i in MonitorItem}
+
+
+def test_cn2_gives_the_pins_our_sources_state_and_points_to_the_manual_for_the_rest():
+    from fha_studio.hardware.parameters import load_cn2
+
+    cn2 = load_cn2("HA-655")
+    assert cn2.pins_text("speed_monitor") == "CN2-23" and cn2.pins_text("in_position") == "CN2-33"
+    assert cn2.pins_text("encoder_b") == "CN2-42 to 49"
+    assert cn2.pins_text("alm_c") == "CN2 pin: see the CN2 pin table in chapter 3 of the HA-655 manual"
+    assert cn2.encoder_counts_up_on == "FWD command" and cn2.encoder_sense_assumed
+    assert load_cn2("HA-675").signals == cn2.signals

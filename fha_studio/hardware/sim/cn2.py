@@ -12,7 +12,10 @@ between servo periods):
   gear 3/4 (the pulses the controller sends);
 - SPD-MON (CN2-23): +10 V at the motor speed of parameter 9, through the monitor's bandwidth,
   with its offset and noise (assumptions of this simulation, :class:`MonitorModel`);
-- IN-POS (|command - feedback| within the in-position range) and ALARM.
+- IN-POS (|command - feedback| within the in-position range), ALARM, and the alarm code on
+  ALM-A ... ALM-D (the 4 bits of the alarm table's code, ``resources/drive/ha655-alarms.toml``);
+- the encoder outputs count up on a FWD command, or on CW rotation of the flange, as
+  ``resources/drive/ha655-cn2.toml`` says (``[encoder_outputs]``).
 
 :class:`VirtualBenchInstrument` runs a servo axis and samples those outputs like a logic analyzer
 with one analog input: whole captures (:meth:`~VirtualBenchInstrument.record`), a stream of
@@ -34,13 +37,17 @@ import numpy as np
 from scipy import signal as _signal
 
 from fha_studio.hardware.bench import writers
-from fha_studio.hardware.bench.capture import SampleBlock, join_blocks, pack_logic
+from fha_studio.hardware.bench.capture import SampleBlock, join_blocks, logic_dtype, pack_logic
+from fha_studio.hardware.parameters import AlarmTable, load_alarm_table, load_cn2
 from fha_studio.physics import ServoAxis
 
 if TYPE_CHECKING:
     from fha_studio.hardware.sim.drive import SimDrive
 
-LOGIC_CHANNELS = ("ENC_A", "ENC_B", "ENC_Z", "CMD_A", "CMD_B", "IN_POS", "ALARM")
+LOGIC_CHANNELS = ("ENC_A", "ENC_B", "ENC_Z", "CMD_A", "CMD_B", "IN_POS", "ALARM", "ALM_A", "ALM_B", "ALM_C",
+                  "ALM_D")
+#: The alarm code lines, bit 0 (ALM-A) ... bit 3 (ALM-D) of the code written D C B A.
+ALM_CHANNELS = ("ALM_A", "ALM_B", "ALM_C", "ALM_D")
 ANALOG_CHANNELS = ("SPD_MON",)
 RAD_S_PER_RPM = 2.0 * math.pi / 60.0
 #: One sample per edge at least: the instrument refuses a rate at which its own edges would merge.
@@ -99,7 +106,13 @@ class Cn2Signals:
         in_position_range_counts: int,
         direction: float = 1.0,
         gear: tuple[int, int] = (1, 1),
+        alarm_table: AlarmTable | None = None,
+        encoder_counts_cw: bool = False,
+        logic_channels: tuple[str, ...] = LOGIC_CHANNELS,
     ):
+        """``direction``: +1 when a FWD command turns the flange CW (parameter 8); the encoder
+        outputs count up on a FWD command unless ``encoder_counts_cw`` (then on CW rotation).
+        ``logic_channels``: the ones sampled, in this order (an instrument's selection)."""
         self.rate = float(sample_rate_hz)
         self.s = settings
         self.pulse_rad = output_pulse_rad
@@ -107,6 +120,12 @@ class Cn2Signals:
         self.in_position_range = in_position_range_counts
         self.direction = direction
         self.gear_numerator, self.gear_denominator = gear
+        self.alarm_table = alarm_table or load_alarm_table("HA-655")
+        self.encoder_counts_cw = encoder_counts_cw
+        unknown = [c for c in logic_channels if c not in LOGIC_CHANNELS]
+        if unknown:
+            raise ValueError(f"no CN2 output {', '.join(unknown)} (there are {', '.join(LOGIC_CHANNELS)})")
+        self.logic_channels = tuple(logic_channels)
         self.next_sample = 0
         self._last: tuple[float, float, float, float] | None = None  # t, pos, cmd, vel
         self._sign = 0
@@ -118,9 +137,10 @@ class Cn2Signals:
         self._rng = np.random.default_rng(settings.monitor.seed)
 
     def feed(
-        self, trace: dict[str, np.ndarray], alarm: bool = False
+        self, trace: dict[str, np.ndarray], alarm: int = 0
     ) -> tuple[SampleBlock, dict[str, np.ndarray]]:
-        """The samples up to the trace's last time, and the drive's own counts at them."""
+        """The samples up to the trace's last time, and the drive's own counts at them.
+        ``alarm``: the active alarm's code (0: none)."""
         t = trace["t"]
         pos = trace["pos"] * self.direction
         cmd = trace["cmd_pos"] * self.direction
@@ -155,8 +175,10 @@ class Cn2Signals:
         pulses = np.floor_divide(edges, per)
         cmd_counts = np.floor(c / self.pulse_rad + 0.5).astype(np.int64)
         self._check_steps(counts, "encoder edges")
-        enc_a, enc_b = _quadrature_levels(counts)
-        enc_z = np.mod(counts, self.s.counts_per_motor_turn) == 0
+        # the outputs' count: in the command's sense, or the flange's CW one
+        outputs = counts if not self.encoder_counts_cw or self.direction > 0 else -counts
+        enc_a, enc_b = _quadrature_levels(outputs)
+        enc_z = np.mod(outputs, self.s.counts_per_motor_turn) == 0
         cmd_a, cmd_b = self._command_levels(edges if self.s.pulse_form == 2 else pulses)
         in_pos = np.abs(cmd_counts - counts) <= self.in_position_range
         motor_rpm = v / RAD_S_PER_RPM * self.ratio
@@ -167,21 +189,35 @@ class Cn2Signals:
         volts, self._zi = _signal.lfilter(b, a, volts, zi=self._zi)
         m = self.s.monitor
         volts = volts + m.offset_v + self._rng.normal(0.0, m.noise_v, volts.size)
-        logic = pack_logic([enc_a, enc_b, enc_z, cmd_a, cmd_b, in_pos, np.full(k.size, alarm)])
-        block = SampleBlock(self.rate, LOGIC_CHANNELS, logic, {"SPD_MON": volts.astype(np.float32)}, first)
+        levels = {"ENC_A": enc_a, "ENC_B": enc_b, "ENC_Z": enc_z, "CMD_A": cmd_a, "CMD_B": cmd_b,
+                  "IN_POS": in_pos}
+        levels.update(self._alarm_levels(int(alarm), k.size))
+        logic = pack_logic([levels[name] for name in self.logic_channels])
+        analog = {"SPD_MON": volts.astype(np.float32)}
+        block = SampleBlock(self.rate, self.logic_channels, logic, analog, first)
         truth = {
-            "encoder_counts": counts,
+            "encoder_counts": outputs,
             "command_pulses": pulses,
             "command_counts": pulses * self.gear_numerator / self.gear_denominator,
             "motor_rpm": motor_rpm,
         }
         return block, truth
 
+    def _alarm_levels(self, code: int, n: int) -> dict[str, np.ndarray]:
+        """ALARM (on while an alarm is active) and ALM-A ... D: the table's 4-bit code (a code the
+        table does not know gives 0000)."""
+        known = self.alarm_table.get(code) if code else None
+        bits = known.alm_bits if known is not None else 0
+        levels = {"ALARM": np.full(n, code != 0)}
+        for bit, name in enumerate(ALM_CHANNELS):
+            levels[name] = np.full(n, bool(bits >> bit & 1))
+        return levels
+
     def _empty(self) -> SampleBlock:
         return SampleBlock(
             self.rate,
-            LOGIC_CHANNELS,
-            np.zeros(0, np.uint8),
+            self.logic_channels,
+            np.zeros(0, logic_dtype(max(1, len(self.logic_channels)))),
             {"SPD_MON": np.zeros(0, np.float32)},
             self.next_sample,
         )
@@ -222,10 +258,13 @@ class Cn2Signals:
         return up | down, held
 
 
-def signals_of_axis(axis: ServoAxis, sample_rate_hz: float, settings: Cn2Settings) -> Cn2Signals:
+def signals_of_axis(axis: ServoAxis, sample_rate_hz: float, settings: Cn2Settings, *,
+                    alarm_table: AlarmTable | None = None,
+                    logic_channels: tuple[str, ...] = LOGIC_CHANNELS) -> Cn2Signals:
     """The CN2 outputs of a servo axis (its resolution, ratio, in-position range, direction and
-    electronic gear) at an instrument's rate."""
+    electronic gear) at an instrument's rate, with the driver's alarm table and CN2."""
     model = axis.model
+    table = alarm_table or load_alarm_table("HA-655")
     return Cn2Signals(
         sample_rate_hz,
         settings,
@@ -234,6 +273,9 @@ def signals_of_axis(axis: ServoAxis, sample_rate_hz: float, settings: Cn2Setting
         in_position_range_counts=axis.settings.in_position_range_pulses,
         direction=axis.settings.direction_sign,
         gear=(axis.settings.electronic_gear_numerator, axis.settings.electronic_gear_denominator),
+        alarm_table=table,
+        encoder_counts_cw=load_cn2(table.driver).encoder_counts_up_on == "CW",
+        logic_channels=logic_channels,
     )
 
 
@@ -269,14 +311,15 @@ class VirtualBenchInstrument:
         sample_rate_hz: float,
         settings: Cn2Settings | None = None,
         *,
-        alarm: Callable[[], bool] | None = None,
+        alarm: Callable[[], int] | None = None,
         advance: Callable[[float], None] | None = None,
+        alarm_table: AlarmTable | None = None,
     ):
         self.axis = axis
         self._advance = advance
         self.settings = settings or Cn2Settings()
-        self.signals = signals_of_axis(axis, sample_rate_hz, self.settings)
-        self.alarm = alarm or (lambda: False)
+        self.signals = signals_of_axis(axis, sample_rate_hz, self.settings, alarm_table=alarm_table)
+        self.alarm = alarm or (lambda: 0)
         self.truth = Truth()
         self._blocks: list[SampleBlock] = []
 
@@ -313,11 +356,10 @@ class VirtualBenchInstrument:
         cls, drive: SimDrive, sample_rate_hz: float, monitor: MonitorModel | None = None
     ) -> VirtualBenchInstrument:
         """The instrument on a stepped simulated drive's CN2: its parameters 1, 2 and 9, its
-        resolution, its alarm; the drive's time advances as the instrument records."""
+        resolution, its alarm (code); the drive's time advances as the instrument records."""
         settings = settings_of_drive(drive, monitor)
-        return cls(
-            drive.axis, sample_rate_hz, settings, alarm=lambda: bool(drive.alarm), advance=drive.advance
-        )
+        return cls(drive.axis, sample_rate_hz, settings, alarm=lambda: drive.alarm, advance=drive.advance,
+                   alarm_table=drive.alarm_table)
 
     def record(self, seconds: float) -> SampleBlock:
         """Run for ``seconds`` and keep what was sampled; returns everything kept so far."""

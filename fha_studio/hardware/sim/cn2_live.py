@@ -7,7 +7,8 @@ sigrok-cli finds, as ``sim-cn2`` (the first) or ``sim-cn2:drive=N``. :class:`Vir
 streams it as :class:`~fha_studio.hardware.bench.sigrok.Acquisition` streams a device: every
 ``block_s`` it takes the servo's trace of the time that passed (under the drive's lock; the
 drive's own thread advances it) and samples the CN2 outputs of :mod:`.cn2` at the instrument's
-rate (ENC_A, ENC_B, ENC_Z, CMD_A, CMD_B, IN_POS, ALARM as logic, SPD_MON in volts). A drive
+rate (ENC_A, ENC_B, ENC_Z, CMD_A, CMD_B, IN_POS, ALARM, ALM_A ... ALM_D as logic, the ones asked
+for packed in their order as sigrok-cli's ``-C`` gives them; SPD_MON in volts). A drive
 that is closed while it streams vanishes as an unplugged instrument does.
 """
 
@@ -143,7 +144,9 @@ class VirtualAcquisition:
         drive = self._drive
         assert drive is not None
         with drive.lock:
-            signals = signals_of_axis(drive.axis, self.sample_rate_hz, settings_of_drive(drive, self.monitor))
+            logic = tuple(c for c in self.requested if c in LOGIC_CHANNELS)
+            signals = signals_of_axis(drive.axis, self.sample_rate_hz, settings_of_drive(drive, self.monitor),
+                                      alarm_table=drive.alarm_table, logic_channels=logic)
             drive.axis.start_trace(1)
         while not self._stop.wait(self.block_s):
             with drive.lock:
@@ -151,7 +154,7 @@ class VirtualAcquisition:
                     raise DeviceVanished(f"{self.device}: the simulated drive was closed (after "
                                          f"{self.samples} samples)", self.samples)
                 trace = drive.axis.read_trace(clear=True)
-                alarm = bool(drive.alarm)
+                alarm = drive.alarm
             if trace["t"].size == 0:
                 continue
             try:

@@ -31,8 +31,8 @@ import numpy as np
 
 from fha_studio.hardware.bench.capture import Capture
 from fha_studio.hardware.bench.readers import read_capture
-from fha_studio.hardware.parameters import load_alarm_table
 from fha_studio.logic.bench import decode
+from fha_studio.logic.bench.alarm_code import LINES, alarms_of_code
 from fha_studio.logic.bench.edges import Lines
 from fha_studio.recording import Recording, RecordingMetadata, make_recording
 
@@ -420,19 +420,18 @@ def _alarm_code(logic: Mapping[str, Lines], idx: np.ndarray, t: np.ndarray,
     for bit, role in enumerate(ALM_ROLES):
         if role in logic:
             code |= logic[role].level_at(idx).astype(np.int64) << bit
-    mapped = [f"ALM-{'ABCD'[bit]} {src(role)}" for bit, role in enumerate(ALM_ROLES) if role in logic]
-    missing = [f"ALM-{'ABCD'[bit]}" for bit, role in enumerate(ALM_ROLES) if role not in logic]
+    mapped = [f"{LINES[bit]} {src(role)}" for bit, role in enumerate(ALM_ROLES) if role in logic]
+    missing = [LINES[bit] for bit, role in enumerate(ALM_ROLES) if role not in logic]
     source = "D C B A, ON = 1: " + ", ".join(mapped)
     if missing:
         source += f" ({', '.join(missing)} not mapped: 0)"
-    table = load_alarm_table("HA-655")
     seen: list[dict[str, Any]] = []
     changes = np.flatnonzero(np.diff(code, prepend=0) != 0)
     for at in changes:
         value = int(code[at])
         if value and all(item["alm_code"] != f"{value:04b}" for item in seen):
             seen.append({"alm_code": f"{value:04b}", "first_s": float(t[at]),
-                         "alarms": [f"{a.code} {a.name}" for a in table if a.alm_bits == value]})
+                         "alarms": [f"{a.code} {a.name}" for a in alarms_of_code(value, unmapped=missing)]})
     return code.astype(np.float64), source, seen
 
 

@@ -64,3 +64,51 @@ def test_the_roles_are_the_commands_words():
     assert parse_live_signal("alm_c=D6").role == "alm_c"
     with pytest.raises(BenchImportError, match="unknown role 'alm_e'"):
         parse_live_signal("alm_e=D6")
+
+
+def test_the_simulated_drives_cn2_gives_the_alarm_tables_code_on_alm_a_to_d(tmp_path):
+    """A stepped simulated drive raises alarm 60 (error counter overflow) while its CN2 is recorded:
+    ALARM comes on and ALM-D C B A show 0010, as the HA-655's table gives it, and the import names it."""
+    from fha_studio.hardware.sim.cn2 import VirtualBenchInstrument
+    from fha_studio.hardware.sim.drive import SimDrive
+
+    drive = SimDrive("FHA-25C-50-US250", profile="documented", stepped=True, eeprom=str(tmp_path / "e.json"))
+    try:
+        instrument = VirtualBenchInstrument.on_drive(drive, 50e3)
+        drive.set_servo(True)
+        instrument.record(0.05)
+        drive.raise_alarm(60)
+        instrument.record(0.05)
+        instrument.write(tmp_path / "cn2.sr", "sr")
+    finally:
+        drive.close()
+    roles = {"encoder_a": "ENC_A", "encoder_b": "ENC_B", "alarm": "ALARM", "alm_a": "ALM_A", "alm_b": "ALM_B",
+             "alm_c": "ALM_C", "alm_d": "ALM_D"}
+    signals = [SignalSpec(role, str(tmp_path / "cn2.sr"), channel) for role, channel in roles.items()]
+    result = import_bench(signals, AxisFacts.for_actuator("FHA-25C-50-US250"), DriveSettings(0, 4, 1, 1, 3000.0))
+    t, code = result.recording.channels["t"], result.recording.channels["alm_code"]
+    came = result.summary["alarm_codes"]
+    assert [(c["alm_code"], c["alarms"]) for c in came] == [("0010", ["60 Error counter overflow"])]
+    assert came[0]["first_s"] == pytest.approx(0.05, abs=0.002)
+    assert set(code[t < 0.045]) == {0.0} and set(code[t > 0.055]) == {2.0}
+    assert set(result.recording.channels["alarm"][t > 0.055]) == {1.0}
+
+
+def test_an_instrument_takes_the_lines_asked_for_in_their_order():
+    """As sigrok-cli's -C: the alarm lines alone, in the order given, one byte a sample."""
+    from fha_studio.catalog import get_actuator
+    from fha_studio.hardware.sim.cn2 import Cn2Settings, signals_of_axis
+    from fha_studio.physics import AxisModel, ServoAxis
+
+    axis = ServoAxis(AxisModel.from_actuator(get_actuator("FHA-25C-50-US250")))
+    signals = signals_of_axis(axis, 10e3, Cn2Settings(), logic_channels=("ALM_D", "ALM_C", "ALARM", "ALM_A"))
+    axis.start_trace(1)
+    axis.step(20)
+    block, _ = signals.feed(axis.read_trace(clear=True), alarm=50)  # encoder failure: 1101
+    assert block.logic_channels == ("ALM_D", "ALM_C", "ALARM", "ALM_A") and block.logic.dtype == np.uint8
+    assert set(block.logic) == {0b1111}  # D, C, ALARM and A on (B is 0)
+    axis.step(20)
+    block, _ = signals.feed(axis.read_trace(clear=True), alarm=0)
+    assert block.samples > 0 and set(block.logic) == {0}
+    with pytest.raises(ValueError, match="no CN2 output ALM_E"):
+        signals_of_axis(axis, 10e3, Cn2Settings(), logic_channels=("ALM_E",))

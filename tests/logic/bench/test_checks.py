@@ -5,7 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from fha_studio.logic.bench.checks import bench_checks
+import dataclasses
+
+import pytest
+
+from fha_studio.hardware.parameters import load_cn2
+from fha_studio.logic.bench.checks import bench_checks, flange_direction
 
 T = np.arange(0, 1.0, 1e-3)
 CMD = np.clip((T - 0.1) / 0.3, 0, 1) * 5000.0
@@ -25,8 +30,9 @@ def test_a_move_that_follows_its_command_passes_every_check_and_names_its_source
     assert "from the bench instrument demo" in checks["bench_encoder"].detail
     direction = checks["bench_direction"]
     assert "a FWD command (+5000 counts) turned the axis FWD" in direction.detail
-    assert "parameter 8 = 0 says a FWD command turns the output CW" in direction.detail
-    assert "do not show CW or CCW" in direction.detail and direction.values["counted"] == "FWD"
+    assert "with parameter 8 = 0 that is FWD rotation, CW viewing the output flange (1-10)" in direction.detail
+    assert "taking the encoder outputs to count up on a FWD command" in direction.detail
+    assert (direction.values["counted"], direction.values["flange"]) == ("FWD", "CW")
     assert checks["bench_in_position"].detail.startswith("IN-POS (CN2-33) came on 20.0 ms after")
 
 
@@ -42,3 +48,52 @@ def test_swapped_phases_a_wrong_gear_no_command_in_pos_and_alarm_fail_saying_why
     late = _by(bench_checks(T, CMD, ENC, in_position=np.ones(T.size), alarm=alarm, in_position_time_s=None))
     assert not late["bench_in_position"].passed and not late["bench_alarm"].passed
     assert late["bench_alarm"].detail.startswith("ALARM came on at 0.501 s")
+
+
+@pytest.mark.parametrize(("sign", "parameter_8", "words"), [
+    (+1, 0, "a FWD command (+5000 counts) turned the axis FWD as the encoder outputs count it from the bench: "
+            "with parameter 8 = 0 that is FWD rotation, CW viewing the output flange"),
+    (+1, 1, "a FWD command (+5000 counts) turned the axis FWD as the encoder outputs count it from the bench: "
+            "with parameter 8 = 1 that is REV rotation, CCW viewing the output flange"),
+    (-1, 0, "a REV command (-5000 counts) turned the axis REV as the encoder outputs count it from the bench: "
+            "with parameter 8 = 0 that is REV rotation, CCW viewing the output flange"),
+    (-1, 1, "a REV command (-5000 counts) turned the axis REV as the encoder outputs count it from the bench: "
+            "with parameter 8 = 1 that is FWD rotation, CW viewing the output flange"),
+])
+def test_the_flange_turns_as_the_encoder_outputs_and_parameter_8_say(sign, parameter_8, words):
+    direction = _by(bench_checks(T, sign * CMD, sign * ENC, parameter_8=parameter_8))["bench_direction"]
+    assert direction.passed and direction.detail.startswith(words)
+
+
+def test_without_parameter_8_the_flange_is_not_guessed():
+    direction = _by(bench_checks(T, CMD, ENC))["bench_direction"]
+    assert direction.passed and direction.values["flange"] is None
+    assert "which way that is at the output flange (CW or CCW) follows from parameter 8" in direction.detail
+    assert flange_direction(0, 0) is None and flange_direction(5, None) is None
+
+
+def test_encoder_outputs_that_counted_the_flanges_cw_are_turned_into_the_commands_sense():
+    # a drive whose encoder outputs count up on CW whatever parameter 8 says: with 1 a FWD command
+    # turns the flange CCW and the outputs count down, which is no wiring fault
+    cw = dataclasses.replace(load_cn2(), encoder_counts_up_on="CW")
+    checks = _by(bench_checks(T, CMD, -ENC, parameter_8=1, cn2=cw))
+    assert checks["bench_encoder"].passed and checks["bench_direction"].values["flange"] == "CCW"
+    unknown = _by(bench_checks(T, CMD, -ENC, alarm=np.zeros(T.size), cn2=cw))
+    assert unknown["bench_encoder"].passed is None and "needs parameter 8" in unknown["bench_encoder"].detail
+    assert "bench_direction" not in unknown and unknown["bench_alarm"].passed
+
+
+def test_an_alarm_on_the_code_lines_is_named_in_the_manuals_words():
+    code = np.where(T > 0.5, 0b0010, 0)
+    alarm = _by(bench_checks(T, CMD, ENC, alarm=(code != 0).astype(float), alarm_code=code))["bench_alarm"]
+    assert not alarm.passed and alarm.values["alm_code"] == "0010"
+    assert alarm.detail.startswith("ALARM came on at 0.501 s from the bench: ALM-D C B A 0010: "
+                                   "60 Error counter overflow")
+    # ALM-C not read: 1101 shows as 1001, which is over current or any encoder alarm
+    encoder = _by(bench_checks(T, CMD, ENC, alarm_code=np.where(T > 0.5, 0b1001, 0),
+                               alarm_lines_unmapped=("ALM-C",)))["bench_alarm"]
+    assert "an alarm code came on at 0.501 s from the bench: ALM-D C B A 1?01: 30 Over current, 50 Encoder " \
+        "failure, 51 " in encoder.detail
+    assert "(ALM-C not mapped)" in encoder.detail
+    quiet = _by(bench_checks(T, CMD, ENC, alarm=np.zeros(T.size), alarm_code=np.zeros(T.size)))["bench_alarm"]
+    assert quiet.passed and quiet.detail.startswith("ALARM and ALM-A ... D stayed off")

@@ -1,9 +1,10 @@
 """The Bench tab's channel mapping, saved per instrument and offered again for the same one.
 
 What the technician typed for an instrument (its channels, the rate, and which channels are the
-encoder, the command lines and IN-POS: the *roles*) is kept in the user's settings under the
-instrument's spec (``fx2lafw:conn=1.5``, ``demo``, ``sim-cn2``) once a stream with it started,
-so the next session with the same analyzer on the same drive starts with the same wiring.
+encoder, the command lines, IN-POS, ALARM and ALM-A ... D: the *roles*) is kept in the user's
+settings under the instrument's spec (``fx2lafw:conn=1.5``, ``demo``, ``sim-cn2``) once a stream
+with it started, so the next session with the same analyzer on the same drive starts with the
+same wiring.
 """
 
 from __future__ import annotations
@@ -15,9 +16,10 @@ from PySide6.QtCore import QSettings
 #: The settings key: one JSON object, instrument spec -> fields.
 SETTINGS_KEY = "bench/mappings"
 #: The fields of a mapping (the Bench tab's line edits).
-FIELDS = ("channels", "rate", "encoder", "command", "in_position", "alarm")
+FIELDS = ("channels", "rate", "encoder", "command", "in_position", "alarm", "alm_a", "alm_b", "alm_c",
+          "alm_d")
 #: Fields kept only when given (a mapping of an older version has none).
-OPTIONAL = ("alarm",)
+OPTIONAL = ("alarm", "alm_a", "alm_b", "alm_c", "alm_d")
 #: Instruments remembered at most (the least recently used go first).
 MAX_INSTRUMENTS = 50
 

@@ -4,7 +4,8 @@ A real HA-655 answers CN3 with ``s`` while its servo is on; its CN2 monitor outp
 encoder A/B/Z, IN-POS, ALARM) still show on a logic analyzer or an oscilloscope. This tab lists
 the instruments sigrok-cli finds, streams the channels asked for (``BenchSource``) and plots the
 newest seconds, every trace named with its source (``bench demo:D0``) so nobody takes it for a
-CN3 channel. Where sigrok-cli is missing the tab says how to install it.
+CN3 channel; ALARM and the alarm code on ALM-A ... D are shown in the manual's words as they
+come. Where sigrok-cli is missing the tab says how to install it.
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.hardware.bench import sigrok
+from fha_studio.hardware.parameters import load_cn2
+from fha_studio.logic.bench import alarm_code
 from fha_studio.logic.bench.checks import BenchCheck, bench_checks
 from fha_studio.logic.bench.display import peak_rows
 from fha_studio.logic.bench.importer import DriveSettings
@@ -105,7 +108,8 @@ class BenchPanel(QWidget):
         self.start_button.setCheckable(True)
         self.start_button.clicked.connect(self._start_clicked)
         grid.addWidget(self.start_button, 1, 3)
-        # the roles in one row: the plots get the height
+        # the roles in two rows: the plots get the height
+        cn2 = load_cn2()
         roles = QHBoxLayout()
         roles.addWidget(QLabel("Encoder"))
         self.encoder_edit = QLineEdit("")
@@ -122,16 +126,28 @@ class BenchPanel(QWidget):
         roles.addWidget(QLabel("IN-POS"))
         self.in_position_edit = QLineEdit("")
         self.in_position_edit.setPlaceholderText("e.g. D5 (CN2-33)")
-        self.in_position_edit.setToolTip("the drive's in-position output (CN2-33) among the channels: "
-                                         "the move's in-position time is taken from it")
+        self.in_position_edit.setToolTip(f"the drive's in-position output ({cn2.pins_text('in_position')}) "
+                                         "among the channels: the move's in-position time is taken from it")
         roles.addWidget(self.in_position_edit, 1)
-        roles.addWidget(QLabel("ALARM"))
+        grid.addLayout(roles, 2, 0, 1, 4)
+        alarms = QHBoxLayout()
+        alarms.addWidget(QLabel("ALARM"))
         self.alarm_edit = QLineEdit("")
         self.alarm_edit.setPlaceholderText("e.g. D6")
-        self.alarm_edit.setToolTip("the drive's ALARM output among the channels: the checks of a move say "
-                                   "whether it came on")
-        roles.addWidget(self.alarm_edit, 1)
-        grid.addLayout(roles, 2, 0, 1, 4)
+        self.alarm_edit.setToolTip(f"the drive's ALARM output ({cn2.pins_text('alarm')}) among the channels: "
+                                   "the checks of a move say whether it came on")
+        alarms.addWidget(self.alarm_edit, 1)
+        self.alm_edits: list[QLineEdit] = []
+        for role, line in zip(("alm_a", "alm_b", "alm_c", "alm_d"), alarm_code.LINES, strict=True):
+            alarms.addWidget(QLabel(line))
+            edit = QLineEdit("")
+            edit.setObjectName(f"scopeBench_{role}")
+            edit.setPlaceholderText("channel")
+            edit.setToolTip(f"the alarm code line {line} ({cn2.pins_text(role)}) among the channels: the "
+                            "code (ALM-D C B A, ON = 1) is shown as the alarms it can be")
+            alarms.addWidget(edit, 1)
+            self.alm_edits.append(edit)
+        grid.addLayout(alarms, 3, 0, 1, 4)
         grid.setColumnStretch(1, 1)
         layout.addLayout(grid)
         self.plot = pg.PlotWidget(background="w")
@@ -150,6 +166,12 @@ class BenchPanel(QWidget):
         self._x_range: tuple[float, float] | None = None
         self._counts_range: tuple[float, float] | None = None
         layout.addWidget(self.counts_plot, 2)
+        self.alarm_label = QLabel("")
+        self.alarm_label.setObjectName("scopeBenchAlarm")
+        self.alarm_label.setWordWrap(True)
+        self.alarm_label.setVisible(False)
+        layout.addWidget(self.alarm_label)
+        self._alarm_shown: tuple[bool | None, int | None] | None = None
         self.move_label = QLabel("")
         self.move_label.setObjectName("scopeBenchMove")
         self.move_label.setWordWrap(True)
@@ -187,10 +209,13 @@ class BenchPanel(QWidget):
         self.drive = drive
 
     def start(self, device: str, channels: str, rate: str = "", encoder: str = "", command: str = "",
-              in_position: str = "", alarm: str = "") -> None:
-        """Stream (what the Start button does with the fields' text)."""
+              in_position: str = "", alarm: str = "", alm: tuple[str, ...] = ()) -> None:
+        """Stream (what the Start button does with the fields' text); ``alm``: the channels of
+        ALM-A, ALM-B, ALM-C, ALM-D ("" for a line not mapped)."""
         self.device_box.setEditText(device)  # first: a mapping it offers is then replaced
         self.alarm_edit.setText(alarm)
+        for edit, name in zip(self.alm_edits, tuple(alm) + ("",) * (4 - len(alm)), strict=True):
+            edit.setText(name)
         self.encoder_edit.setText(encoder)
         self.command_edit.setText(command)
         self.in_position_edit.setText(in_position)
@@ -235,10 +260,13 @@ class BenchPanel(QWidget):
         if in_position and in_position not in names:
             self._refuse(f"IN-POS {in_position}: it must be among the channels ({', '.join(names)}).")
             return
-        alarm_name = self.alarm_edit.text().strip()
-        if alarm_name and alarm_name not in names:
-            self._refuse(f"ALARM {alarm_name}: it must be among the channels ({', '.join(names)}).")
-            return
+        for line, name in (("ALARM", self.alarm_edit.text().strip()),
+                           *zip(alarm_code.LINES, self._alm_names(), strict=True)):
+            if name and name not in names:
+                self._refuse(f"{line} {name}: it must be among the channels ({', '.join(names)}).")
+                return
+        self._alarm_shown = None
+        self.alarm_label.setVisible(False)
         self.move_figures = None
         self.checks = []
         self._move_seen_at = None
@@ -267,10 +295,16 @@ class BenchPanel(QWidget):
                                       else "sigrok-cli finds no instrument (is it plugged in?)")
         self.sigDevicesListed.emit(len(devices))
 
+    def _alm_names(self) -> tuple[str, ...]:
+        """The channels of ALM-A ... ALM-D ("" for a line not mapped)."""
+        return tuple(edit.text().strip() for edit in self.alm_edits)
+
     def _fields(self) -> dict[str, str]:
-        return {"channels": self.channels_edit.text(), "rate": self.rate_edit.text(),
-                "encoder": self.encoder_edit.text(), "command": self.command_edit.text(),
-                "in_position": self.in_position_edit.text(), "alarm": self.alarm_edit.text()}
+        fields = {"channels": self.channels_edit.text(), "rate": self.rate_edit.text(),
+                  "encoder": self.encoder_edit.text(), "command": self.command_edit.text(),
+                  "in_position": self.in_position_edit.text(), "alarm": self.alarm_edit.text()}
+        fields.update({f"alm_{'abcd'[i]}": edit.text() for i, edit in enumerate(self.alm_edits)})
+        return fields
 
     def _offer_mapping(self, text: str) -> None:
         """The channels and roles last used with this instrument, if it was used before."""
@@ -284,6 +318,8 @@ class BenchPanel(QWidget):
         self.command_edit.setText(fields.get("command", ""))
         self.in_position_edit.setText(fields.get("in_position", ""))
         self.alarm_edit.setText(fields.get("alarm", ""))
+        for i, edit in enumerate(self.alm_edits):
+            edit.setText(fields.get(f"alm_{'abcd'[i]}", ""))
         self.status_label.setText(f"Channels and roles as last used with {spec}.")
 
     def _on_started(self, started: BenchStarted) -> None:
@@ -355,7 +391,38 @@ class BenchPanel(QWidget):
                 pad = 0.1 * (hi - lo) if hi > lo else 1.0
                 self._counts_range = (lo - pad, hi + pad)
                 self.counts_plot.setYRange(*self._counts_range, padding=0)
+        self._show_alarm(started, rows[-1])
         self._measure_move(started, _rows)
+
+    def _alarm_columns(self, started: BenchStarted) -> tuple[int | None, list[int | None]]:
+        """The row columns of ALARM and of ALM-A ... D (None: not mapped)."""
+        def column(name: str) -> int | None:
+            return 1 + started.channels.index(name) if name and name in started.channels else None
+
+        return column(self.alarm_edit.text().strip()), [column(name) for name in self._alm_names()]
+
+    def _show_alarm(self, started: BenchStarted, row: np.ndarray) -> None:
+        """ALARM and the code on ALM-D C B A as the newest row has them, in the manual's words."""
+        alarm_column, alm_columns = self._alarm_columns(started)
+        if alarm_column is None and all(c is None for c in alm_columns):
+            return
+        on = None if alarm_column is None else bool(row[alarm_column] > 0.5)
+        code = None
+        if any(c is not None for c in alm_columns):
+            code = sum(1 << bit for bit, c in enumerate(alm_columns) if c is not None and row[c] > 0.5)
+        if (on, code) == self._alarm_shown:
+            return
+        self._alarm_shown = (on, code)
+        parts = [] if on is None else [f"ALARM {'ON' if on else 'off'}"]
+        if code is not None:
+            unmapped = [line for line, c in zip(alarm_code.LINES, alm_columns, strict=True) if c is None]
+            parts.append(alarm_code.code_text(code, unmapped=unmapped))
+        alarmed = bool(on) or bool(code)
+        self.alarm_label.setText(("Alarm from the bench: " if alarmed else "") + "; ".join(parts)
+                                 + ("; the front panel's 2-digit code and the Alarms page say more" if alarmed
+                                    else ""))
+        self.alarm_label.setStyleSheet("color: #b00000; font-weight: bold;" if alarmed else "")
+        self.alarm_label.setVisible(True)
 
     def _measure_move(self, started: BenchStarted, new_rows: np.ndarray) -> None:
         """The move test's figures of the last move the command made, once it has settled."""
@@ -394,14 +461,22 @@ class BenchPanel(QWidget):
             return
         self.move_figures = figures
         alarm_name = self.alarm_edit.text().strip()
-        alarm = (rows[start:, 1 + started.channels.index(alarm_name)]
-                 if alarm_name in started.channels else None)
+        alarm_column, alm_columns = self._alarm_columns(started)
+        alarm = rows[start:, alarm_column] if alarm_column is not None else None
+        code = None
+        if any(c is not None for c in alm_columns):
+            code = sum((rows[start:, c] > 0.5).astype(int) << bit for bit, c in enumerate(alm_columns)
+                       if c is not None)
+        unmapped = [line for line, c in zip(alarm_code.LINES, alm_columns, strict=True) if c is None]
         wired = [f"encoder {self.encoder_edit.text().strip()}", f"command {self.command_edit.text().strip()}"]
         wired += [f"{what} {name}" for what, name in (("IN-POS", in_position), ("ALARM", alarm_name)) if name]
+        wired += [f"{line} {name}" for line, name in zip(alarm_code.LINES, self._alm_names(), strict=True)
+                  if name]
         self.checks = bench_checks(t[start:], cmd[start:], enc[start:], in_position=in_pos, alarm=alarm,
                                    in_position_time_s=figures.in_position_time_s,
                                    parameter_8=self.parameter_8,
-                                   source=f"the bench instrument {started.device} ({', '.join(wired)})")
+                                   source=f"the bench instrument {started.device} ({', '.join(wired)})",
+                                   alarm_code=code, alarm_lines_unmapped=unmapped)
         m = figures.metrics
 
         def ms(value: float | None) -> str:
