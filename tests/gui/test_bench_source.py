@@ -97,8 +97,9 @@ def test_the_scope_page_bench_tab_finds_the_demo_and_plots_it_beside_cn3(qtbot):
             return 0 if x is None else len(x)
 
         qtbot.waitUntil(lambda: plotted() > 100, timeout=10000)
-        names = [item.text for _, item in panel.plot.plotItem.legend.items]
-        assert names == ["bench demo:D0", "bench demo:D2"]
+        lanes = [name for _, name in panel.plot.getAxis("right")._tickLevels[0]]
+        assert lanes == ["bench demo:D0", "bench demo:D2"]  # each logic lane named beside it
+        assert panel.status_label.toolTip() == "demo:D0, demo:D2, demo:D0/D2 counts"
         assert panel.counts_plot.isVisibleTo(panel)  # the demo's D0/D2 counted as an encoder
         assert panel.counts_plot.plotItem.getAxis("left").labelText == "bench demo:D0/D2 counts"
         assert panel.status_label.text().startswith("LIVE from the bench: demo at 1 MHz")

@@ -16,6 +16,7 @@ import shutil
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import Qt, Signal, Slot
+from PySide6.QtGui import QFont, QFontMetrics
 from PySide6.QtWidgets import (
     QComboBox,
     QGridLayout,
@@ -50,6 +51,8 @@ MOVE_GAP_S = 0.2
 CHECK_WORDS = {"bench_encoder": "encoder outputs follow the command", "bench_direction": "direction",
                "bench_in_position": "IN-POS", "bench_alarm": "ALARM"}
 VERDICT = {True: "pass", False: "FAIL", None: "recorded"}
+#: The width a trace's name takes in the legend [px] ("bench sim-cn2:ENC_A" and its line).
+LEGEND_NAME_PX = 190
 _COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#e07000", "#9467bd", "#8c564b", "#e377c2", "#008b8b")
 
 
@@ -81,6 +84,9 @@ class BenchPanel(QWidget):
         self.source.sigRows.connect(self._on_rows)
         self.source.sigStopped.connect(self._on_stopped)
         self._curves: list[pg.PlotDataItem] = []
+        self._lanes: list[float | None] = []  # each curve's lane offset (a logic channel), else None
+        self._named = 0  # curves named in the legend (the analog ones)
+        self._legend_columns = 1
         self._started: BenchStarted | None = None
 
         layout = QVBoxLayout(self)
@@ -153,7 +159,12 @@ class BenchPanel(QWidget):
         self.plot = pg.PlotWidget(background="w")
         self.plot.setLabel("bottom", "time", units="s")
         self.plot.addLegend(offset=(5, 5), colCount=3)  # in rows above the lanes
-        layout.addWidget(self.plot, 3)
+        layout.addWidget(self.plot, 2)
+        # the lanes' names at the right, a little smaller than the plot's numbers (many lanes)
+        lane_font = QFont(self.font())
+        lane_font.setPointSizeF(max(6.0, lane_font.pointSizeF() * 0.8))
+        self.plot.getAxis("right").setTickFont(lane_font)
+        self._lane_metrics = QFontMetrics(lane_font)
         self.counts_plot = pg.PlotWidget(background="w")
         self.counts_plot.setLabel("left", "counts")
         self.counts_plot.setXLink(self.plot)
@@ -165,7 +176,7 @@ class BenchPanel(QWidget):
         self._y_range: tuple[float, float] | None = None
         self._x_range: tuple[float, float] | None = None
         self._counts_range: tuple[float, float] | None = None
-        layout.addWidget(self.counts_plot, 2)
+        layout.addWidget(self.counts_plot, 1)
         self.alarm_label = QLabel("")
         self.alarm_label.setObjectName("scopeBenchAlarm")
         self.alarm_label.setWordWrap(True)
@@ -327,11 +338,31 @@ class BenchPanel(QWidget):
         self._started = started
         self.plot.clear()
         self._curves = []
+        # a logic analyzer's look: one lane per logic channel, named at the right beside it; the
+        # analog ones in volts on the left axis, named in the legend
+        logic = [name for name in started.channels if name in started.logic]
+        self._lanes = [1.2 * (len(logic) - 1 - logic.index(name)) if name in logic else None
+                       for name in started.channels]
         for i, label in enumerate(started.labels[: len(started.channels)]):
             pen = pg.mkPen(_COLORS[i % len(_COLORS)], width=1)
-            curve = self.plot.plot([], [], pen=pen, name=f"bench {label}")
+            lane = self._lanes[i] is not None
+            curve = self.plot.plot([], [], pen=pen, name=None if lane else f"bench {label}")
             curve.setSkipFiniteCheck(True)  # display rows are finite, and already one or two a pixel
             self._curves.append(curve)
+        lanes = [(offset + 0.4, f"bench {label}")
+                 for offset, label in zip(self._lanes, started.labels, strict=False) if offset is not None]
+        self.plot.showAxis("right", bool(lanes))
+        self.plot.getAxis("right").setTicks([lanes, []] if lanes else None)
+        # the counts' plot as wide as the lanes' (its right axis as wide and empty), so times align
+        self.counts_plot.showAxis("right", bool(lanes))
+        if lanes:
+            width = max(self._lane_metrics.horizontalAdvance(name) for _, name in lanes) + 12
+            self.plot.getAxis("right").setWidth(width)
+            self.counts_plot.getAxis("right").setStyle(showValues=False)
+            self.counts_plot.getAxis("right").setWidth(width)
+        self._named = len(self._curves) - len(lanes)  # in the legend
+        self._legend_columns = max(1, min(self._named, self.plot.width() // LEGEND_NAME_PX))
+        self.plot.plotItem.legend.setColumnCount(self._legend_columns)
         self.plot.enableAutoRange(axis="x", enable=False)
         self._y_range = self._counts_range = self._x_range = None
         self.plot.enableAutoRange(axis="y", enable=False)  # set per frame: lanes, analog, the legend
@@ -346,9 +377,12 @@ class BenchPanel(QWidget):
             legend = self.counts_plot.plotItem.legend
             legend.clear()
             legend.addItem(self._counts_curve, f"bench {label}")
+        # one line: every trace is named on the plot, and all of them in the tooltip
+        decoded = len(started.labels) - len(started.channels)
         self.status_label.setText(f"LIVE from the bench: {started.device} at "
-                                  f"{sigrok.rate_text(started.sample_rate_hz)}, "
-                                  f"{', '.join(started.labels)}")
+                                  f"{sigrok.rate_text(started.sample_rate_hz)}, {len(started.channels)} "
+                                  f"channel(s)" + (f" and {decoded} decoded" if decoded else ""))
+        self.status_label.setToolTip(", ".join(started.labels))
 
     def _on_rows(self, _rows: np.ndarray) -> None:
         started = self._started
@@ -368,16 +402,16 @@ class BenchPanel(QWidget):
             self._x_range = x_range
             self.plot.setXRange(*x_range, padding=0)
         low, high = 0.0, 1.0
-        for i, (curve, name) in enumerate(zip(self._curves, started.channels, strict=True)):
+        for i, (curve, lane) in enumerate(zip(self._curves, self._lanes, strict=True)):
             values = rows[:, 1 + i]
-            if name in started.logic:  # a logic analyzer's look: one lane per channel
-                values = values * 0.8 + 1.2 * (len(self._curves) - 1 - i)
+            if lane is not None:
+                values = values * 0.8 + lane
             curve.setData(rows[:, 0], values)
             low, high = min(low, float(values.min())), max(high, float(values.max()))
-        # room above the traces for the legend's rows (three names a row), so it covers none
-        legend_rows = 1 + (len(self._curves) - 1) // 3
+        # room above the traces for the legend's rows, so it covers none
+        legend_rows = math.ceil(self._named / self._legend_columns)
         span = high - low
-        y_range = (low - 0.05 * span, high + span * 0.28 * legend_rows)
+        y_range = (low - 0.05 * span, high + span * (0.28 * legend_rows + 0.02))
         if y_range != self._y_range:  # set only when it changes: a new range lays the axis out again
             self._y_range = y_range
             self.plot.setYRange(*y_range, padding=0)
