@@ -85,7 +85,8 @@ def test_the_simulated_drives_cn2_gives_the_alarm_tables_code_on_alm_a_to_d(tmp_
     roles = {"encoder_a": "ENC_A", "encoder_b": "ENC_B", "alarm": "ALARM", "alm_a": "ALM_A", "alm_b": "ALM_B",
              "alm_c": "ALM_C", "alm_d": "ALM_D"}
     signals = [SignalSpec(role, str(tmp_path / "cn2.sr"), channel) for role, channel in roles.items()]
-    result = import_bench(signals, AxisFacts.for_actuator("FHA-25C-50-US250"), DriveSettings(0, 4, 1, 1, 3000.0))
+    axis = AxisFacts.for_actuator("FHA-25C-50-US250")
+    result = import_bench(signals, axis, DriveSettings(0, 4, 1, 1, 3000.0))
     t, code = result.recording.channels["t"], result.recording.channels["alm_code"]
     came = result.summary["alarm_codes"]
     assert [(c["alm_code"], c["alarms"]) for c in came] == [("0010", ["60 Error counter overflow"])]

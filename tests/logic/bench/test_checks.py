@@ -3,10 +3,9 @@ command turned the axis, IN-POS after the move, ALARM through it, each naming it
 
 from __future__ import annotations
 
-import numpy as np
-
 import dataclasses
 
+import numpy as np
 import pytest
 
 from fha_studio.hardware.parameters import load_cn2
@@ -30,7 +29,8 @@ def test_a_move_that_follows_its_command_passes_every_check_and_names_its_source
     assert "from the bench instrument demo" in checks["bench_encoder"].detail
     direction = checks["bench_direction"]
     assert "a FWD command (+5000 counts) turned the axis FWD" in direction.detail
-    assert "with parameter 8 = 0 that is FWD rotation, CW viewing the output flange (1-10)" in direction.detail
+    assert "with parameter 8 = 0 that is FWD rotation, CW viewing the output flange (1-10)" \
+        in direction.detail
     assert "taking the encoder outputs to count up on a FWD command" in direction.detail
     assert (direction.values["counted"], direction.values["flange"]) == ("FWD", "CW")
     assert checks["bench_in_position"].detail.startswith("IN-POS (CN2-33) came on 20.0 ms after")
@@ -51,14 +51,14 @@ def test_swapped_phases_a_wrong_gear_no_command_in_pos_and_alarm_fail_saying_why
 
 
 @pytest.mark.parametrize(("sign", "parameter_8", "words"), [
-    (+1, 0, "a FWD command (+5000 counts) turned the axis FWD as the encoder outputs count it from the bench: "
-            "with parameter 8 = 0 that is FWD rotation, CW viewing the output flange"),
-    (+1, 1, "a FWD command (+5000 counts) turned the axis FWD as the encoder outputs count it from the bench: "
-            "with parameter 8 = 1 that is REV rotation, CCW viewing the output flange"),
-    (-1, 0, "a REV command (-5000 counts) turned the axis REV as the encoder outputs count it from the bench: "
-            "with parameter 8 = 0 that is REV rotation, CCW viewing the output flange"),
-    (-1, 1, "a REV command (-5000 counts) turned the axis REV as the encoder outputs count it from the bench: "
-            "with parameter 8 = 1 that is FWD rotation, CW viewing the output flange"),
+    (+1, 0, "a FWD command (+5000 counts) turned the axis FWD as the encoder outputs count it from the "
+            "bench: with parameter 8 = 0 that is FWD rotation, CW viewing the output flange"),
+    (+1, 1, "a FWD command (+5000 counts) turned the axis FWD as the encoder outputs count it from the "
+            "bench: with parameter 8 = 1 that is REV rotation, CCW viewing the output flange"),
+    (-1, 0, "a REV command (-5000 counts) turned the axis REV as the encoder outputs count it from the "
+            "bench: with parameter 8 = 0 that is REV rotation, CCW viewing the output flange"),
+    (-1, 1, "a REV command (-5000 counts) turned the axis REV as the encoder outputs count it from the "
+            "bench: with parameter 8 = 1 that is FWD rotation, CW viewing the output flange"),
 ])
 def test_the_flange_turns_as_the_encoder_outputs_and_parameter_8_say(sign, parameter_8, words):
     direction = _by(bench_checks(T, sign * CMD, sign * ENC, parameter_8=parameter_8))["bench_direction"]
