@@ -40,6 +40,12 @@ def _write_v1_register(path):
         " VALUES (1, ?, 'ana', 'tune', 2, 'position_loop_gain', 40, 50, 50, 1)",
         ("2025-01-02T05:00:00.000000+00:00",),
     )
+    # where the procedures stood: one row each, replaced as they moved on (wiring last written)
+    for procedure, status in (("wiring", "running"), ("installation", "paused"), ("wiring", "completed")):
+        db.execute(
+            "INSERT OR REPLACE INTO procedure_run (axis_id, procedure_id, title, status, updated_utc)"
+            " VALUES (1, ?, ?, ?, ?)",
+            (procedure, procedure.title(), status, "2025-01-02T06:00:00.000000+00:00"))
     db.execute("COMMIT")
     db.close()
 
@@ -48,7 +54,7 @@ def test_a_v1_register_is_upgraded_with_its_data(tmp_path):
     path = tmp_path / "v1.sqlite"
     _write_v1_register(path)
     with Register(path) as reg:
-        assert reg.version == 4
+        assert reg.version == 5
         feed = reg.axis("Press 7/feed")
         assert (feed.actuator_code, feed.port_url, feed.serial_number) == ("FHA-17C-50-US250", "COM3", "")
         assert [f.axis.name for f in reg.find("rotary_direction", 1)] == ["feed"]
@@ -63,8 +69,17 @@ def test_a_v1_register_is_upgraded_with_its_data(tmp_path):
         ).fetchall()
         assert "snapshot_value_by_key" in " ".join(str(tuple(r)) for r in plan)
         assert reg.integrity_check() == "ok"
+        # v5: the procedures' states kept in the order they were last written, each now a row of its own
+        assert [(r["procedure_id"], r["status"]) for r in reg.procedure_status(feed)] == [
+            ("installation", "paused"), ("wiring", "completed")]
+        reg.record_procedure_status(feed, "installation", "Installation", "completed")
+        assert [r["status"] for r in reg.procedure_status(feed)] == ["completed", "completed"]
+    # and the history is append-only from now on: the file's own triggers refuse any program
+    with sqlite3.connect(path) as raw, pytest.raises(
+            sqlite3.IntegrityError, match="append-only: parameter snapshots are never changed"):
+        raw.execute("UPDATE snapshot SET who = 'eve'")
     with Register(path) as again:  # opening an up-to-date file changes nothing
-        assert again.version == 4 and len(again.snapshots("Press 7/feed")) == 1
+        assert again.version == 5 and len(again.snapshots("Press 7/feed")) == 1
 
 
 def test_a_failing_migration_leaves_the_file_at_its_version(tmp_path, monkeypatch):
@@ -82,7 +97,7 @@ def test_a_failing_migration_leaves_the_file_at_its_version(tmp_path, monkeypatc
     db.close()
     monkeypatch.undo()
     with Register(path) as reg:
-        assert reg.version == 4
+        assert reg.version == 5
 
 
 _WRITER = textwrap.dedent(

@@ -12,7 +12,7 @@ from fha_studio import names
 from fha_studio.logic.register import guard
 from fha_studio.logic.register.connection import Connection
 from fha_studio.logic.register.guard import RegisterError
-from fha_studio.logic.register.records import Axis, Machine, utc_stamp
+from fha_studio.logic.register.records import CORRECTED_WORDS, Axis, Machine, utc_stamp
 
 _ORIGIN_PREFIX = "origin: "
 
@@ -222,14 +222,42 @@ class Axes(Connection):
             raise RegisterError(f"axis '{name}': port {port} is already axis '{row['name']}''s")
 
     def add_axis_note(
-        self, axis: Axis | str | int, text: str, who: str = "", at_utc: str | None = None
-    ) -> None:
+        self, axis: Axis | str | int, text: str, who: str = "", at_utc: str | None = None,
+        corrects: int | None = None,
+    ) -> int:
+        """A note in the axis's history (``corrects``: the number of the axis entry of the same
+        axis it corrects). Returns its number."""
         current = self.axis(axis)
         with self._transaction() as db:
-            db.execute(
-                "INSERT INTO axis_event (axis_id, at_utc, who, text) VALUES (?, ?, ?, ?)",
-                (current.id, utc_stamp(at_utc), who, f"note: {text}"),
+            cursor = db.execute(
+                "INSERT INTO axis_event (axis_id, at_utc, who, text, corrects) VALUES (?, ?, ?, ?, ?)",
+                (current.id, utc_stamp(at_utc), who, f"note: {text}",
+                 self._corrected("axis_event", corrects, current)),
             )
+        return int(cursor.lastrowid or 0)
+
+    def _corrected(
+        self, table: str, ref: int | None, axis: Axis | None, machine_id: int | None = None
+    ) -> int | None:
+        """``ref``, the number of the fact of ``table`` a new fact corrects, when that fact is of
+        the same axis (a machine's report: of the same machine); None for None."""
+        if ref is None:
+            return None
+        word = CORRECTED_WORDS[table]
+        if isinstance(ref, bool) or not isinstance(ref, int) or ref <= 0:
+            raise RegisterError(f"{names.quoted(str(ref), 40)}: a correction names the number of the "
+                                f"{word} it corrects")
+        row = self._db.execute(f"SELECT * FROM {table} WHERE id = ?", (ref,)).fetchone()
+        if row is None:
+            raise RegisterError(f"there is no {word} number {ref} in the register to correct")
+        same = row["axis_id"] == (axis.id if axis is not None else None)
+        if table == "report" and machine_id is not None:
+            same = same and row["machine_id"] == machine_id
+        if not same:
+            whose = axis.ref if axis is not None else "this machine"
+            raise RegisterError(f"{word} {ref} is not one of {names.quoted(whose, 60)}'s: a correction "
+                                f"is recorded for the axis of the fact it corrects")
+        return ref
 
     def record_origin(
         self, axis: Axis | str | int, text: str, who: str = "", at_utc: str | None = None

@@ -28,33 +28,36 @@ class Facts(Axes):
         driver_model: str = "",
         file: str | Path = "",
         note: str = "",
+        corrects: int | None = None,
     ) -> int:
         """A snapshot of parameter values: ``values`` are (mode, number, key, wire value);
         ``source`` is "link" (read from the drive), "front_panel" (read off the drive's panel by
-        a person) or "file". Returns the snapshot's number."""
+        a person) or "file"; ``corrects``: the number of the snapshot of the axis it corrects (one
+        entered wrong). Returns the snapshot's number."""
         if source not in SOURCES:
             raise RegisterError(f"snapshot source '{source}' is not one of {', '.join(SOURCES)}")
-        rows = []
+        rows: dict[tuple[str, int], tuple[str, int, str, int]] = {}
         for mode, number, key, value in values:
             if isinstance(value, bool) or not isinstance(value, int):
                 raise RegisterError(
                     f"parameter {mode} {number} ({key}): value {value!r} is not a wire integer"
                 )
-            rows.append((str(mode), int(number), str(key), int(value)))
+            # a parameter given twice: the last value given
+            rows[(str(mode), int(number))] = (str(mode), int(number), str(key), int(value))
         if not rows:
             raise RegisterError("a parameter snapshot needs at least one value")
         current = self.axis(axis)
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO snapshot (axis_id, at_utc, who, source, driver_model, file, note)"
-                " VALUES (?, ?, ?, ?, ?, ?, ?)",
-                (current.id, utc_stamp(at_utc), who, source, driver_model, str(file), note),
+                "INSERT INTO snapshot (axis_id, at_utc, who, source, driver_model, file, note, corrects)"
+                " VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
+                (current.id, utc_stamp(at_utc), who, source, driver_model, str(file), note,
+                 self._corrected("snapshot", corrects, current)),
             )
             snapshot_id = int(cursor.lastrowid or 0)
             db.executemany(
-                "INSERT OR REPLACE INTO snapshot_value (snapshot_id, mode, number, key, value)"
-                " VALUES (?, ?, ?, ?, ?)",
-                [(snapshot_id, *row) for row in rows],
+                "INSERT INTO snapshot_value (snapshot_id, mode, number, key, value) VALUES (?, ?, ?, ?, ?)",
+                [(snapshot_id, *row) for row in rows.values()],
             )
         return snapshot_id
 
@@ -71,13 +74,14 @@ class Facts(Axes):
         error: str = "",
         who: str = "",
         at_utc: str | None = None,
+        corrects: int | None = None,
     ) -> int:
         """One parameter write and whether the read-back verified it. Returns its row id."""
         current = self.axis(axis)
         with self._transaction() as db:
             cursor = db.execute(
                 "INSERT INTO parameter_write (axis_id, at_utc, who, mode, number, key, old, new, read_back,"
-                " verified, error) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                " verified, error, corrects) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 (
                     current.id,
                     utc_stamp(at_utc),
@@ -90,6 +94,7 @@ class Facts(Axes):
                     read_back,
                     int(bool(verified)),
                     error or "",
+                    self._corrected("parameter_write", corrects, current),
                 ),
             )
         return int(cursor.lastrowid or 0)
@@ -100,9 +105,9 @@ class Facts(Axes):
         records: Iterable[Any],
         session_file: str | Path = "",
     ) -> int:
-        """Procedure check records (objects with the fields of a session's CheckRecord). A record
-        already in the register (same procedure, step and time) is not added twice. Returns how
-        many were new."""
+        """Procedure check records (objects with the fields of a session's CheckRecord; one with
+        a ``corrects`` attribute corrects that check of the axis). A record already in the
+        register (same procedure, step and time) is not added twice. Returns how many were new."""
         current = self.axis(axis)
         rows = [
             (
@@ -120,6 +125,7 @@ class Facts(Axes):
                 utc_stamp(r.at_utc),
                 r.detail,
                 str(session_file),
+                self._corrected("check_result", getattr(r, "corrects", None), current),
             )
             for r in records
         ]
@@ -127,8 +133,8 @@ class Facts(Axes):
             before = db.total_changes
             db.executemany(
                 "INSERT OR IGNORE INTO check_result (axis_id, procedure_id, step_id, kind, section, text,"
-                " value_json, expected, unit, passed, who, at_utc, detail, session_file)"
-                " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                " value_json, expected, unit, passed, who, at_utc, detail, session_file, corrects)"
+                " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 rows,
             )
             return db.total_changes - before
@@ -143,12 +149,20 @@ class Facts(Axes):
         session_file: str | Path = "",
         at_utc: str | None = None,
     ) -> None:
-        """Where a procedure of the axis stands (not_started, running, paused, stopped, completed,
-        or "not applicable"); replaces what was there."""
+        """Where a procedure of the axis stands from now on (not_started, running, paused,
+        stopped, completed, or "not applicable"): a row of its own, the latest one counts; nothing
+        is added when it stands as the latest row says."""
         current = self.axis(axis)
         with self._transaction() as db:
+            latest = db.execute(
+                "SELECT title, section, status, session_file FROM procedure_run WHERE axis_id = ?"
+                " AND procedure_id = ? ORDER BY updated_utc DESC, id DESC LIMIT 1",
+                (current.id, procedure_id),
+            ).fetchone()
+            if latest is not None and tuple(latest) == (title, section, status, str(session_file)):
+                return
             db.execute(
-                "INSERT OR REPLACE INTO procedure_run (axis_id, procedure_id, title, section, status,"
+                "INSERT INTO procedure_run (axis_id, procedure_id, title, section, status,"
                 " updated_utc, session_file) VALUES (?, ?, ?, ?, ?, ?, ?)",
                 (current.id, procedure_id, title, section, status, utc_stamp(at_utc), str(session_file)),
             )
@@ -161,12 +175,15 @@ class Facts(Axes):
         who: str = "",
         at_utc: str | None = None,
         note: str = "",
+        corrects: int | None = None,
     ) -> int:
         current = self.axis(axis)
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO alarm (axis_id, at_utc, who, code, name, note) VALUES (?, ?, ?, ?, ?, ?)",
-                (current.id, utc_stamp(at_utc), who, int(code), name, note),
+                "INSERT INTO alarm (axis_id, at_utc, who, code, name, note, corrects)"
+                " VALUES (?, ?, ?, ?, ?, ?, ?)",
+                (current.id, utc_stamp(at_utc), who, int(code), name, note,
+                 self._corrected("alarm", corrects, current)),
             )
         return int(cursor.lastrowid or 0)
 
@@ -180,10 +197,12 @@ class Facts(Axes):
         open_warnings: int = 0,
         who: str = "",
         at_utc: str | None = None,
+        corrects: int | None = None,
     ) -> int:
         """A report file written for one axis (or a whole machine: ``machine`` without ``axis``);
         its SHA-256 is kept so that a report changed later can be told."""
         path = Path(file)
+        current: Axis | None = None
         if axis is not None:
             current = self.axis(axis)
             machine_id, axis_id = self.machine(current.machine).id, current.id
@@ -192,10 +211,11 @@ class Facts(Axes):
         else:
             raise RegisterError("a report belongs to an axis or a machine")
         digest = file_sha256(path)
+        corrected = self._corrected("report", corrects, current, machine_id)
         with self._transaction() as db:
             cursor = db.execute(
                 "INSERT INTO report (machine_id, axis_id, at_utc, who, file, sha256, signed_by, signed_utc,"
-                " open_warnings) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                " open_warnings, corrects) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 (
                     machine_id,
                     axis_id,
@@ -206,6 +226,7 @@ class Facts(Axes):
                     signed_by,
                     utc_stamp(signed_utc) if signed_utc else "",
                     int(open_warnings),
+                    corrected,
                 ),
             )
         return int(cursor.lastrowid or 0)
@@ -217,6 +238,7 @@ class Facts(Axes):
         summary: str = "",
         who: str = "",
         at_utc: str | None = None,
+        corrects: int | None = None,
     ) -> int:
         """A recording file (``fha-recording/1``) taken on the axis."""
         current = self.axis(axis)
@@ -224,9 +246,10 @@ class Facts(Axes):
         digest = file_sha256(path) if path.is_file() else ""
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO recording (axis_id, at_utc, who, file, sha256, summary)"
-                " VALUES (?, ?, ?, ?, ?, ?)",
-                (current.id, utc_stamp(at_utc), who, str(path.resolve()), digest, summary),
+                "INSERT INTO recording (axis_id, at_utc, who, file, sha256, summary, corrects)"
+                " VALUES (?, ?, ?, ?, ?, ?, ?)",
+                (current.id, utc_stamp(at_utc), who, str(path.resolve()), digest, summary,
+                 self._corrected("recording", corrects, current)),
             )
         return int(cursor.lastrowid or 0)
 
@@ -238,13 +261,15 @@ class Facts(Axes):
         recording_file: str | Path = "",
         who: str = "",
         at_utc: str | None = None,
+        corrects: int | None = None,
     ) -> int:
         """A model-check result: its summary, the report or model file it wrote, the recording."""
         current = self.axis(axis)
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO model_check (axis_id, at_utc, who, file, recording_file, summary)"
-                " VALUES (?, ?, ?, ?, ?, ?)",
-                (current.id, utc_stamp(at_utc), who, str(file), str(recording_file), summary),
+                "INSERT INTO model_check (axis_id, at_utc, who, file, recording_file, summary, corrects)"
+                " VALUES (?, ?, ?, ?, ?, ?, ?)",
+                (current.id, utc_stamp(at_utc), who, str(file), str(recording_file), summary,
+                 self._corrected("model_check", corrects, current)),
             )
         return int(cursor.lastrowid or 0)

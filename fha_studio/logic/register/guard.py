@@ -34,6 +34,16 @@ class RegisterError(ValueError):
     """The register cannot be used or a request does not fit it; the message says what and where."""
 
 
+#: How the register's refusal to change or remove a fact begins (:mod:`.append_only`).
+APPEND_ONLY = "append-only:"
+
+
+def append_only_refusal(where: str, said: str) -> RegisterError:
+    """The database refused to change or remove a fact: one line, from its own words."""
+    reason = said.splitlines()[0].strip() if said.strip() else APPEND_ONLY
+    return RegisterError(f"the register {where}: its history is {reason}: nothing was changed")
+
+
 def shown_path(path: str | os.PathLike[str]) -> str:
     """A path as a refusal quotes it: at most 80 characters, anything unprintable escaped."""
     return quoted(os.fspath(path), limit=80, always=False)
@@ -116,6 +126,8 @@ def problem(path: Path, exc: sqlite3.Error, db: sqlite3.Connection | None = None
     code = getattr(exc, "sqlite_errorcode", None)
     primary = code & 0xFF if isinstance(code, int) else None
     text = str(exc)
+    if text.startswith(APPEND_ONLY):  # the file's triggers refused to change or remove a fact
+        return append_only_refusal(where, text)
     if primary == sqlite3.SQLITE_READONLY or "readonly" in text:
         return RegisterError(f"the register {where} is read-only: nothing was changed (it needs write "
                              "access to the file and its folder)")

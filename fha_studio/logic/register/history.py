@@ -3,11 +3,16 @@ oldest first."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
+from collections.abc import Mapping
+from typing import Any
 
 from fha_studio.logic.register import guard, words
 from fha_studio.logic.register.queries import Queries
 from fha_studio.logic.register.records import (
+    CORRECTED_WORDS,
+    KIND_TABLES,
     SNAPSHOT_SOURCE_WORDS,
     Axis,
     Event,
@@ -40,7 +45,7 @@ class History(Queries):
         db = self._db
         events: list[Event] = []
         for r in db.execute("SELECT * FROM axis_event WHERE axis_id = ?", (a,)):
-            events.append(Event(r["at_utc"], EventKind.AXIS, r["who"], r["text"], r["id"]))
+            events.append(Event(r["at_utc"], EventKind.AXIS, r["who"], r["text"], r["id"], _corrects(r)))
         for r in self.snapshots(current):
             where = f" ({r['file']})" if r["file"] else ""
             events.append(
@@ -51,7 +56,7 @@ class History(Queries):
                     f"parameters {SNAPSHOT_SOURCE_WORDS[r['source']]}: {r['count']} values,"
                     f" snapshot {r['id']}{where}",
                     r["id"],
-                    {"source": r["source"], "file": r["file"], "count": r["count"]},
+                    {"source": r["source"], "file": r["file"], "count": r["count"], **_corrects(r)},
                 )
             )
         for r in db.execute("SELECT * FROM parameter_write WHERE axis_id = ?", (a,)):
@@ -66,8 +71,11 @@ class History(Queries):
                     f"{name}: {change}, {outcome}",
                     r["id"],
                     {
-                        k: r[k]
-                        for k in ("mode", "number", "key", "old", "new", "read_back", "verified", "error")
+                        **{
+                            k: r[k]
+                            for k in ("mode", "number", "key", "old", "new", "read_back", "verified", "error")
+                        },
+                        **_corrects(r),
                     },
                 )
             )
@@ -92,6 +100,7 @@ class History(Queries):
                         "passed": bool(r["passed"]),
                         "expected": r["expected"],
                         "detail": r["detail"],
+                        **_corrects(r),
                     },
                 )
             )
@@ -104,7 +113,7 @@ class History(Queries):
                     r["who"],
                     f"alarm {r['code']}: {r['name']}{note}",
                     r["id"],
-                    {"code": r["code"]},
+                    {"code": r["code"], **_corrects(r)},
                 )
             )
         for r in db.execute("SELECT * FROM report WHERE axis_id = ?", (a,)):
@@ -116,7 +125,7 @@ class History(Queries):
                     r["who"],
                     f"report {r['file']} ({signed}, {r['open_warnings']} open warnings)",
                     r["id"],
-                    {"file": r["file"], "sha256": r["sha256"], "signed_by": r["signed_by"]},
+                    {"file": r["file"], "sha256": r["sha256"], "signed_by": r["signed_by"], **_corrects(r)},
                 )
             )
         for r in db.execute("SELECT * FROM recording WHERE axis_id = ?", (a,)):
@@ -128,7 +137,7 @@ class History(Queries):
                     r["who"],
                     f"recording {r['file']}{summary}",
                     r["id"],
-                    {"file": r["file"]},
+                    {"file": r["file"], **_corrects(r)},
                 )
             )
         for r in db.execute("SELECT * FROM model_check WHERE axis_id = ?", (a,)):
@@ -139,11 +148,40 @@ class History(Queries):
                     r["who"],
                     f"model check: {r['summary']}",
                     r["id"],
-                    {"file": r["file"], "recording_file": r["recording_file"]},
+                    {"file": r["file"], "recording_file": r["recording_file"], **_corrects(r)},
                 )
             )
+        events = _with_corrections(events)
         if since is not None:
             cutoff = utc_stamp(since)
             events = [e for e in events if e.at_utc >= cutoff]
         order = {kind: n for n, kind in enumerate(HISTORY_ORDER)}
         return sorted(events, key=lambda e: (e.at_utc, order[e.kind], e.ref or 0))
+
+
+def _corrects(row: Mapping[str, Any]) -> dict[str, int]:
+    """A history line's data names the fact it corrects (none: nothing)."""
+    return {} if row["corrects"] is None else {"corrects": int(row["corrects"])}
+
+
+def _with_corrections(events: list[Event]) -> list[Event]:
+    """Each correction says which fact it corrects, and each corrected fact by which (its data
+    lists them in ``corrected_by``); the corrected fact stays, as it was recorded."""
+    by: dict[tuple[EventKind, int | None], list[int | None]] = {}
+    for e in events:
+        if "corrects" in e.data:
+            by.setdefault((e.kind, e.data["corrects"]), []).append(e.ref)
+    if not by:
+        return events
+    out = []
+    for e in events:
+        word = CORRECTED_WORDS[KIND_TABLES[e.kind]]
+        text, data = e.text, dict(e.data)
+        if "corrects" in data:
+            text += f" — corrects {word} {data['corrects']}"
+        later = by.get((e.kind, e.ref))
+        if later:
+            text += f" — corrected by {word} {', '.join(str(n) for n in later)}"
+            data["corrected_by"] = later
+        out.append(dataclasses.replace(e, text=text, data=data))
+    return out

@@ -162,17 +162,24 @@ class Queries(Facts):
 
     def _procedure_titles(self, axis_id: int) -> dict[str, str]:
         """{procedure id: its title} of the procedures recorded for the axis."""
-        rows = self._db.execute("SELECT procedure_id, title FROM procedure_run WHERE axis_id = ?", (axis_id,))
-        return {r["procedure_id"]: r["title"] for r in rows if r["title"]}
+        return {r["procedure_id"]: r["title"] for r in self._procedure_rows(axis_id) if r["title"]}
+
+    def _procedure_rows(self, axis_id: int) -> list[Any]:
+        """Where each procedure of the axis stands: its latest row (by time, then as recorded),
+        in the order they were last recorded."""
+        return list(self._db.execute(
+            "SELECT axis_id, procedure_id, title, section, status, updated_utc, session_file"
+            " FROM procedure_run p WHERE axis_id = ? AND NOT EXISTS (SELECT 1 FROM procedure_run q"
+            " WHERE q.axis_id = p.axis_id AND q.procedure_id = p.procedure_id"
+            " AND (q.updated_utc > p.updated_utc OR (q.updated_utc = p.updated_utc AND q.id > p.id)))"
+            " ORDER BY id",
+            (axis_id,),
+        ))
 
     def procedure_status(self, axis: Axis | str | int) -> list[dict[str, Any]]:
-        current = self.axis(axis)
-        rows = self._db.execute(
-            "SELECT axis_id, procedure_id, title, section, status, updated_utc, session_file"
-            " FROM procedure_run WHERE axis_id = ? ORDER BY rowid",
-            (current.id,),
-        )
-        return [dict(r) for r in rows]
+        """Where each procedure of the axis stands (the latest of its states), in the order they
+        were last recorded."""
+        return [dict(r) for r in self._procedure_rows(self.axis(axis).id)]
 
     def session_file(self, axis: Axis | str | int) -> str:
         """The procedure session file last recorded for the axis ("" when none was)."""

@@ -135,6 +135,30 @@ class EventKind(StrEnum):
     MODEL_CHECK = "model_check"
 
 
+#: A fact of each table a person may correct, as a correction names it ("snapshot 12").
+CORRECTED_WORDS = {
+    "axis_event": "axis entry",
+    "snapshot": "snapshot",
+    "parameter_write": "write",
+    "check_result": "check",
+    "alarm": "alarm",
+    "report": "report",
+    "recording": "recording",
+    "model_check": "model check",
+}
+#: The table of each kind of history line.
+KIND_TABLES = {
+    EventKind.AXIS: "axis_event",
+    EventKind.SNAPSHOT: "snapshot",
+    EventKind.WRITE: "parameter_write",
+    EventKind.CHECK: "check_result",
+    EventKind.ALARM: "alarm",
+    EventKind.REPORT: "report",
+    EventKind.RECORDING: "recording",
+    EventKind.MODEL_CHECK: "model_check",
+}
+
+
 @dataclass(frozen=True)
 class Event:
     """One line of an axis's history."""

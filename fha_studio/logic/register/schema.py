@@ -202,8 +202,49 @@ _V4 = [
     "CREATE INDEX snapshot_latest ON snapshot (axis_id, at_utc, id)",
 ]
 
+#: The tables a person may correct a fact of: the correction is a new row of the same table whose
+#: ``corrects`` names the row it corrects (never a change of that row).
+CORRECTABLE_TABLES = (
+    "axis_event", "snapshot", "parameter_write", "check_result", "alarm", "report", "recording",
+    "model_check",
+)
+
+# v5: history that nobody rewrites. Where a procedure stands is a row of its own each time it moves
+# on (it was one row per procedure, replaced: the table is made anew, its rows kept in the order
+# they were last written); a fact recorded wrong is corrected by a new fact that points at it.
+_V5 = [
+    """CREATE TABLE procedure_run_v5 (
+        id INTEGER PRIMARY KEY,
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        procedure_id TEXT NOT NULL,
+        title TEXT NOT NULL,
+        section TEXT NOT NULL DEFAULT '',
+        status TEXT NOT NULL,
+        updated_utc TEXT NOT NULL,
+        session_file TEXT NOT NULL DEFAULT ''
+    )""",
+    "INSERT INTO procedure_run_v5 (axis_id, procedure_id, title, section, status, updated_utc, session_file)"
+    " SELECT axis_id, procedure_id, title, section, status, updated_utc, session_file FROM procedure_run"
+    " ORDER BY rowid",
+    "DROP TABLE procedure_run",
+    "ALTER TABLE procedure_run_v5 RENAME TO procedure_run",
+    "CREATE INDEX procedure_run_latest ON procedure_run (axis_id, procedure_id, updated_utc, id)",
+    *(f"ALTER TABLE {table} ADD COLUMN corrects INTEGER REFERENCES {table}(id)"
+      for table in CORRECTABLE_TABLES),
+]
+
 #: MIGRATIONS[n] takes a file from user_version n to n + 1.
-MIGRATIONS: tuple[tuple[str, ...], ...] = (tuple(_V1), tuple(_V2), tuple(_V3), tuple(_V4))
+MIGRATIONS: tuple[tuple[str, ...], ...] = (tuple(_V1), tuple(_V2), tuple(_V3), tuple(_V4), tuple(_V5))
 
 #: The version this program writes.
 SCHEMA_VERSION = len(MIGRATIONS)
+
+#: The tables of facts: rows are added, never changed or removed (on both stores the database
+#: refuses it: :mod:`.append_only`). A new table of facts goes here.
+FACT_TABLES = (
+    "axis_event", "snapshot", "snapshot_value", "parameter_write", "procedure_run", "check_result", "alarm",
+    "report", "recording", "model_check", "signing_key", "key_revocation", "report_signature",
+)
+#: The tables of things facts are about: changed (each change a fact of the axis's history), never
+#: removed.
+ENTITY_TABLES = ("machine", "axis")

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import fileio
-from fha_studio.logic.register import guard
+from fha_studio.logic.register import append_only, guard
 from fha_studio.logic.register.connection import (
     ENV_REGISTER,
     REGISTER_FILE_NAME,
@@ -158,9 +158,32 @@ class Register(Keys):
                 current = self.version  # again inside the lock: another process may have migrated
                 if current >= target:
                     break
+                # a migration may rebuild a table: the triggers that keep the history as it was
+                # written are taken away first and made again with the last one (append_only.py)
+                for statement in self._protection(make=False):
+                    self._db.execute(statement)
                 for statement in MIGRATIONS[current]:
                     self._db.execute(statement)
                 self._db.execute(f"PRAGMA user_version = {current + 1}")
+                if current + 1 == len(MIGRATIONS):
+                    for statement in self._protection(make=True):
+                        self._db.execute(statement)
+
+    def _protection(self, make: bool) -> list[str]:
+        """The statements that make (or take away) the append-only triggers of this store."""
+        if self._url:
+            tables = {r[0] for r in self._db.execute(
+                "SELECT tablename FROM pg_tables WHERE schemaname = current_schema()")}
+            if make:
+                return append_only.server_create(tables)
+            return append_only.server_drop([(r[0], r[1]) for r in self._db.execute(
+                "SELECT c.relname, t.tgname FROM pg_trigger t JOIN pg_class c ON c.oid = t.tgrelid"
+                " WHERE NOT t.tgisinternal AND c.relnamespace = current_schema()::regnamespace")])
+        if make:
+            tables = {r[0] for r in self._db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+            return append_only.sqlite_create(tables)
+        return append_only.sqlite_drop(
+            [r[0] for r in self._db.execute("SELECT name FROM sqlite_master WHERE type = 'trigger'")])
 
     def export(self, machine: str | None = None) -> dict[str, Any]:
         """Everything about the machines (or one) as plain data (``fha-register-export/1``)."""
