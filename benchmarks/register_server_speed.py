@@ -18,6 +18,7 @@ import sys
 import time
 
 from fha_studio.logic.register import Register
+from fha_studio.logic.register.connection import FACT_IDS
 
 ITEMS = [("tune", n, f"tune_{n}", 0) for n in range(6)] + [("system", n, f"system_{n}", 0) for n in range(8)]
 YEARS = 10
@@ -39,25 +40,31 @@ def fill(url: str, axes: int, per_day: int) -> tuple[list[str], int, float]:
     with Register(url) as reg:
         reg.add_machine("park")
         refs = [reg.add_axis("park", f"axis {i}", "FHA-25C-50-US250").ref for i in range(axes)]
+        register_id = reg.register_id
     t0 = time.perf_counter()
     at = "to_char(timestamptz '2016-01-01 00:00:00+00' + {}, 'YYYY-MM-DD\"T\"HH24:MI:SS.US\"+00:00\"')"
     write_at = at.format("d * interval '1 day' + k * interval '1 second'")
     snapshot_at = at.format("m * interval '30 days' + interval '12 hours'")
     with psycopg.connect(url, autocommit=True) as db:
         db.execute("SET TIME ZONE 'UTC'")
+        # each fact its stable id, recorded in this register (as the register's own writes make them)
+        ids = f"gen_random_uuid()::text, '{register_id}', '2016-01-01T00:00:00.000000+00:00', 0"
         db.execute(
             "INSERT INTO parameter_write (axis_id, at_utc, who, mode, number, key, old, new, read_back,"
-            f" verified) SELECT a.id, {write_at}, 'bench', 'system', 8,"
-            " 'system_8', (d + a.id) %% 2, (d + a.id + 1) %% 2, (d + a.id + 1) %% 2, 1 FROM axis a,"
-            " generate_series(0, %s) d, generate_series(0, %s) k",
+            f" verified, {FACT_IDS}) SELECT a.id, {write_at}, 'bench', 'system', 8,"
+            " 'system_8', (d + a.id) %% 2, (d + a.id + 1) %% 2, (d + a.id + 1) %% 2, 1, "
+            f"{ids} FROM axis a, generate_series(0, %s) d, generate_series(0, %s) k",
             (YEARS * 365 - 1, per_day - 1),
         )
         db.execute(
-            f"INSERT INTO snapshot (axis_id, at_utc, who, source) SELECT a.id,"
-            f" {snapshot_at}, 'bench', 'link'"
+            f"INSERT INTO snapshot (axis_id, at_utc, who, source, {FACT_IDS}) SELECT a.id,"
+            f" {snapshot_at}, 'bench', 'link', {ids}"
             " FROM axis a, generate_series(0, %s) m",
             (YEARS * 12 - 1,),
         )
+        for table in ("parameter_write", "snapshot"):
+            number = "('x' || substr(uid, 1, 8))::bit(32)::bigint & 2147483647"
+            db.execute(f"UPDATE {table} SET uid_hash = {number}")
         values = ", ".join(f"('{m}', {n}, '{k}')" for m, n, k, _ in ITEMS)
         db.execute(
             "INSERT INTO snapshot_value (snapshot_id, mode, number, key, value) SELECT s.id, i.mode,"

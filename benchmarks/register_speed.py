@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 from fha_studio.logic.register import Register
+from fha_studio.logic.register.connection import FACT_ID_MARKS, FACT_IDS
 
 ITEMS = [("tune", n, f"tune_{n}", 0) for n in range(6)] + [("system", n, f"system_{n}", 0) for n in range(8)]
 
@@ -57,9 +58,10 @@ def main() -> None:
         with reg._transaction() as db:
             db.executemany(
                 "INSERT INTO parameter_write (axis_id, at_utc, who, mode, number, key, old, new, read_back,"
-                " verified) VALUES (?, ?, 'bench', 'system', 8, 'system_8', 0, ?, ?, 1)",
+                f" verified, {FACT_IDS}) VALUES (?, ?, 'bench', 'system', 8, 'system_8', 0, ?, ?, 1,"
+                f" {FACT_ID_MARKS})",
                 [
-                    (axis_id, f"2016-01-01T00:00:{i % 60:02d}.{i:06d}+00:00", i % 2, i % 2)
+                    (axis_id, f"2016-01-01T00:00:{i % 60:02d}.{i:06d}+00:00", i % 2, i % 2, *reg._fact_ids())
                     for i in range(per_axis)
                 ],
             )

@@ -54,7 +54,7 @@ def test_a_v1_register_is_upgraded_with_its_data(tmp_path):
     path = tmp_path / "v1.sqlite"
     _write_v1_register(path)
     with Register(path) as reg:
-        assert reg.version == 5
+        assert reg.version == 6
         feed = reg.axis("Press 7/feed")
         assert (feed.actuator_code, feed.port_url, feed.serial_number) == ("FHA-17C-50-US250", "COM3", "")
         assert [f.axis.name for f in reg.find("rotary_direction", 1)] == ["feed"]
@@ -72,6 +72,11 @@ def test_a_v1_register_is_upgraded_with_its_data(tmp_path):
         # v5: the procedures' states kept in the order they were last written, each now a row of its own
         assert [(r["procedure_id"], r["status"]) for r in reg.procedure_status(feed)] == [
             ("installation", "paused"), ("wiring", "completed")]
+        # v6: the facts already there have stable ids, recorded in this register at their own time
+        ids = _fact_ids(reg)
+        assert len(ids) == 5 and len({uid for uid, *_ in ids}) == 5  # snapshot, write, procedures, serial
+        assert {recorded_in for _, recorded_in, _ in ids} == {reg.register_id}
+        assert "2025-01-02T04:00:00.000000+00:00" in {recorded for *_, recorded in ids}
         reg.record_procedure_status(feed, "installation", "Installation", "completed")
         assert [r["status"] for r in reg.procedure_status(feed)] == ["completed", "completed"]
     # and the history is append-only from now on: the file's own triggers refuse any program
@@ -79,7 +84,18 @@ def test_a_v1_register_is_upgraded_with_its_data(tmp_path):
             sqlite3.IntegrityError, match="append-only: parameter snapshots are never changed"):
         raw.execute("UPDATE snapshot SET who = 'eve'")
     with Register(path) as again:  # opening an up-to-date file changes nothing
-        assert again.version == 5 and len(again.snapshots("Press 7/feed")) == 1
+        assert again.version == 6 and len(again.snapshots("Press 7/feed")) == 1
+        assert set(ids) < set(_fact_ids(again)) and again.register_id == reg.register_id
+
+
+def _fact_ids(reg):
+    from fha_studio.logic.register.identity import UID_TABLES
+
+    return sorted(
+        tuple(r)
+        for t in UID_TABLES
+        for r in reg._db.execute(f"SELECT uid, recorded_in, recorded_utc FROM {t}")
+    )
 
 
 def test_a_failing_migration_leaves_the_file_at_its_version(tmp_path, monkeypatch):
@@ -97,7 +113,7 @@ def test_a_failing_migration_leaves_the_file_at_its_version(tmp_path, monkeypatc
     db.close()
     monkeypatch.undo()
     with Register(path) as reg:
-        assert reg.version == 5
+        assert reg.version == 6
 
 
 _WRITER = textwrap.dedent(

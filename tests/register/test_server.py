@@ -11,6 +11,7 @@ import pytest
 
 from fha_studio.cli import main
 from fha_studio.logic.register import SCHEMA_VERSION, Register, RegisterError, register_location
+from fha_studio.logic.register.identity import uid_hash
 from fha_studio.logic.register.schema import MIGRATIONS
 from fha_studio.logic.register.server import ServerDatabase, problem, shown_url
 from tests.support.postgres import PASSWORD
@@ -54,10 +55,19 @@ def test_an_older_register_on_the_server_is_migrated_with_its_facts(postgres_clu
         db.execute(statement)
     db.execute("PRAGMA user_version = 1")
     db.execute("INSERT INTO machine (name, created_utc) VALUES (?, ?)", ("Press 7", "2026-01-01T00:00:00Z"))
+    db.execute("INSERT INTO axis (machine_id, name, created_utc) VALUES (1, 'feed', '2026-01-01T00:00:00Z')")
+    for n in range(3):
+        at = f"2026-01-0{n + 2}T00:00:00Z"
+        db.execute("INSERT INTO alarm (axis_id, at_utc, code) VALUES (1, ?, 20)", (at,))
     db.close()
     with Register(url, read_only=True) as reg:  # a question brings it up to date first
         assert reg.version == SCHEMA_VERSION
         assert [m.name for m in reg.machines()] == ["Press 7"]
+        # schema 5: the facts already there got stable ids; their numbers as this program makes them
+        rows = reg._db.execute(
+            "SELECT uid, recorded_in, recorded_utc, uid_hash, at_utc FROM alarm").fetchall()
+        assert len({r[0] for r in rows}) == 3 and {r[1] for r in rows} == {reg.register_id}
+        assert all(r[2] == r[4] and r[3] == uid_hash(r[0]) for r in rows)
     with Register(url) as reg:
         reg.add_axis("Press 7", "ram", "FHA-25C-50-US250", serial_number="S-1")
         assert reg.axis("Press 7/ram").serial_number == "S-1"  # the column of schema 2

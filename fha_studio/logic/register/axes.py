@@ -3,6 +3,7 @@ found by name; notes and the origin in an axis's history."""
 
 from __future__ import annotations
 
+import json
 import math
 import sqlite3
 from collections.abc import Iterable
@@ -10,7 +11,7 @@ from typing import Any, ClassVar
 
 from fha_studio import names
 from fha_studio.logic.register import guard
-from fha_studio.logic.register.connection import Connection
+from fha_studio.logic.register.connection import FACT_ID_MARKS, FACT_IDS, Connection
 from fha_studio.logic.register.guard import RegisterError
 from fha_studio.logic.register.records import CORRECTED_WORDS, Axis, Machine, utc_stamp
 
@@ -136,10 +137,16 @@ class Axes(Connection):
                 )
                 if t
             )
-            db.execute(
-                "INSERT INTO axis_event (axis_id, at_utc, who, text) VALUES (?, ?, ?, ?)",
-                (cursor.lastrowid, now, who, f"axis added: {what}" if what else "axis added"),
-            )
+            added = {
+                "actuator_code": actuator_code.strip().upper(),
+                "driver_model": driver_model.strip(),
+                "port_url": port_url.strip(),
+                "load_inertia_kgm2": load_inertia_kgm2,
+                "notes": notes,
+                "serial_number": serial_number.strip(),
+            }
+            text = f"axis added: {what}" if what else "axis added"
+            self._axis_event(int(cursor.lastrowid or 0), now, who, text, {"axis_added": added})
         return self.axis(f"{machine_row.name}/{name}")
 
     def ensure_axis(self, machine: str, name: str, **fields: Any) -> Axis:
@@ -198,14 +205,12 @@ class Axes(Connection):
             for key, value in changes.items():
                 db.execute(f"UPDATE axis SET {key} = ? WHERE id = ?", (value, current.id))
                 old = getattr(current, key)
-                db.execute(
-                    "INSERT INTO axis_event (axis_id, at_utc, who, text) VALUES (?, ?, ?, ?)",
-                    (
-                        current.id,
-                        now,
-                        who,
-                        f"{self._AXIS_FIELDS[key]}: {_field_text(key, old)} → {_field_text(key, value)}",
-                    ),
+                self._axis_event(
+                    current.id,
+                    now,
+                    who,
+                    f"{self._AXIS_FIELDS[key]}: {_field_text(key, old)} → {_field_text(key, value)}",
+                    {"field": key, "old": old, "new": value},
                 )
         return self.axis(current.id)
 
@@ -228,12 +233,23 @@ class Axes(Connection):
         """A note in the axis's history (``corrects``: the number of the axis entry of the same
         axis it corrects). Returns its number."""
         current = self.axis(axis)
-        with self._transaction() as db:
-            cursor = db.execute(
-                "INSERT INTO axis_event (axis_id, at_utc, who, text, corrects) VALUES (?, ?, ?, ?, ?)",
-                (current.id, utc_stamp(at_utc), who, f"note: {text}",
-                 self._corrected("axis_event", corrects, current)),
-            )
+        with self._transaction():
+            return self._axis_event(current.id, utc_stamp(at_utc), who, f"note: {text}",
+                                    corrects=self._corrected("axis_event", corrects, current))
+
+    def _axis_event(
+        self, axis_id: int, at_utc: str, who: str, text: str, data: dict[str, Any] | None = None,
+        corrects: int | None = None,
+    ) -> int:
+        """A line of the axis's history (inside the caller's transaction); ``data`` says what it
+        set, so that a register it is synced to sets the same (the fields of an axis added, a
+        field changed, an origin). Returns its number."""
+        cursor = self._db.execute(
+            f"INSERT INTO axis_event (axis_id, at_utc, who, text, data, corrects, {FACT_IDS})"
+            f" VALUES (?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
+            (axis_id, at_utc, who, text, json.dumps(data, ensure_ascii=False) if data else "", corrects,
+             *self._fact_ids()),
+        )
         return int(cursor.lastrowid or 0)
 
     def _corrected(
@@ -265,11 +281,8 @@ class Axes(Connection):
         """Where the axis's origin was set and how, e.g. "multi-turn data cleared (OWW) at
         +0.00°" or "origin sensor at +1.25°" (goes into its history as "origin: ...")."""
         current = self.axis(axis)
-        with self._transaction() as db:
-            db.execute(
-                "INSERT INTO axis_event (axis_id, at_utc, who, text) VALUES (?, ?, ?, ?)",
-                (current.id, utc_stamp(at_utc), who, f"{_ORIGIN_PREFIX}{text}"),
-            )
+        with self._transaction():
+            self._axis_event(current.id, utc_stamp(at_utc), who, f"{_ORIGIN_PREFIX}{text}", {"origin": text})
 
     def latest_origin(self, axis: Axis | str | int) -> dict[str, str] | None:
         """The latest origin recorded for the axis: {"text", "at_utc", "who"}; None when none was."""

@@ -15,7 +15,13 @@ from typing import Any, Self
 
 from fha_studio.logic.register import guard
 from fha_studio.logic.register.guard import RegisterError
+from fha_studio.logic.register.identity import FACT_ID_COLUMNS, fact_ids
+from fha_studio.logic.register.records import utc_stamp
 from fha_studio.paths import user_data_dir
+
+#: A new fact's identity columns and their placeholders, for an INSERT's column list and VALUES.
+FACT_IDS = ", ".join(FACT_ID_COLUMNS)
+FACT_ID_MARKS = ", ".join("?" for _ in FACT_ID_COLUMNS)
 
 #: A site chooses its register file with this environment variable (e.g. on a shared drive).
 ENV_REGISTER = "FHA_STUDIO_REGISTER"
@@ -56,9 +62,27 @@ class Connection:
     #: once: 0.27 s for a register of 46 MB, measured under load)
     _checked_sound = False
 
+    #: this register's id, read once (:attr:`register_id`)
+    _register_id = ""
+
     @property
     def version(self) -> int:
         return int(self._db.execute("PRAGMA user_version").fetchone()[0])
+
+    @property
+    def register_id(self) -> str:
+        """This register's own id (a UUID made with it; every fact recorded here carries it)."""
+        if not self._register_id:
+            row = self._db.execute("SELECT register_id FROM this_register").fetchone()
+            if row is None:
+                raise RegisterError(f"the register {guard.shown_path(self.path)} has no id of its own")
+            self._register_id = str(row[0])
+        return self._register_id
+
+    def _fact_ids(self) -> tuple[str, str, str, int]:
+        """The identity of a fact recorded now: (uid, recorded_in, recorded_utc, uid_hash), for the
+        columns of :data:`FACT_IDS`."""
+        return fact_ids(self.register_id, utc_stamp())
 
     def _set_wal(self, busy_timeout_s: float) -> str:
         """Switch the file to WAL. SQLite does not wait on its busy timeout for this switch: while

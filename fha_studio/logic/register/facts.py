@@ -10,6 +10,7 @@ from typing import Any
 
 from fha_studio.logic.register import guard
 from fha_studio.logic.register.axes import Axes
+from fha_studio.logic.register.connection import FACT_ID_MARKS, FACT_IDS
 from fha_studio.logic.register.guard import RegisterError
 from fha_studio.logic.register.records import SOURCES, Axis, file_sha256, utc_stamp
 
@@ -49,10 +50,10 @@ class Facts(Axes):
         current = self.axis(axis)
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO snapshot (axis_id, at_utc, who, source, driver_model, file, note, corrects)"
-                " VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
+                "INSERT INTO snapshot (axis_id, at_utc, who, source, driver_model, file, note, corrects,"
+                f" {FACT_IDS}) VALUES (?, ?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
                 (current.id, utc_stamp(at_utc), who, source, driver_model, str(file), note,
-                 self._corrected("snapshot", corrects, current)),
+                 self._corrected("snapshot", corrects, current), *self._fact_ids()),
             )
             snapshot_id = int(cursor.lastrowid or 0)
             db.executemany(
@@ -81,7 +82,8 @@ class Facts(Axes):
         with self._transaction() as db:
             cursor = db.execute(
                 "INSERT INTO parameter_write (axis_id, at_utc, who, mode, number, key, old, new, read_back,"
-                " verified, error, corrects) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                f" verified, error, corrects, {FACT_IDS}) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?,"
+                f" {FACT_ID_MARKS})",
                 (
                     current.id,
                     utc_stamp(at_utc),
@@ -95,6 +97,7 @@ class Facts(Axes):
                     int(bool(verified)),
                     error or "",
                     self._corrected("parameter_write", corrects, current),
+                    *self._fact_ids(),
                 ),
             )
         return int(cursor.lastrowid or 0)
@@ -126,6 +129,7 @@ class Facts(Axes):
                 r.detail,
                 str(session_file),
                 self._corrected("check_result", getattr(r, "corrects", None), current),
+                *self._fact_ids(),
             )
             for r in records
         ]
@@ -133,8 +137,8 @@ class Facts(Axes):
             before = db.total_changes
             db.executemany(
                 "INSERT OR IGNORE INTO check_result (axis_id, procedure_id, step_id, kind, section, text,"
-                " value_json, expected, unit, passed, who, at_utc, detail, session_file, corrects)"
-                " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                " value_json, expected, unit, passed, who, at_utc, detail, session_file, corrects,"
+                f" {FACT_IDS}) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
                 rows,
             )
             return db.total_changes - before
@@ -163,8 +167,9 @@ class Facts(Axes):
                 return
             db.execute(
                 "INSERT INTO procedure_run (axis_id, procedure_id, title, section, status,"
-                " updated_utc, session_file) VALUES (?, ?, ?, ?, ?, ?, ?)",
-                (current.id, procedure_id, title, section, status, utc_stamp(at_utc), str(session_file)),
+                f" updated_utc, session_file, {FACT_IDS}) VALUES (?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
+                (current.id, procedure_id, title, section, status, utc_stamp(at_utc), str(session_file),
+                 *self._fact_ids()),
             )
 
     def record_alarm(
@@ -180,10 +185,10 @@ class Facts(Axes):
         current = self.axis(axis)
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO alarm (axis_id, at_utc, who, code, name, note, corrects)"
-                " VALUES (?, ?, ?, ?, ?, ?, ?)",
+                f"INSERT INTO alarm (axis_id, at_utc, who, code, name, note, corrects, {FACT_IDS})"
+                f" VALUES (?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
                 (current.id, utc_stamp(at_utc), who, int(code), name, note,
-                 self._corrected("alarm", corrects, current)),
+                 self._corrected("alarm", corrects, current), *self._fact_ids()),
             )
         return int(cursor.lastrowid or 0)
 
@@ -215,7 +220,8 @@ class Facts(Axes):
         with self._transaction() as db:
             cursor = db.execute(
                 "INSERT INTO report (machine_id, axis_id, at_utc, who, file, sha256, signed_by, signed_utc,"
-                " open_warnings, corrects) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                f" open_warnings, corrects, {FACT_IDS})"
+                f" VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
                 (
                     machine_id,
                     axis_id,
@@ -227,6 +233,7 @@ class Facts(Axes):
                     utc_stamp(signed_utc) if signed_utc else "",
                     int(open_warnings),
                     corrected,
+                    *self._fact_ids(),
                 ),
             )
         return int(cursor.lastrowid or 0)
@@ -246,10 +253,10 @@ class Facts(Axes):
         digest = file_sha256(path) if path.is_file() else ""
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO recording (axis_id, at_utc, who, file, sha256, summary, corrects)"
-                " VALUES (?, ?, ?, ?, ?, ?, ?)",
+                f"INSERT INTO recording (axis_id, at_utc, who, file, sha256, summary, corrects, {FACT_IDS})"
+                f" VALUES (?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
                 (current.id, utc_stamp(at_utc), who, str(path.resolve()), digest, summary,
-                 self._corrected("recording", corrects, current)),
+                 self._corrected("recording", corrects, current), *self._fact_ids()),
             )
         return int(cursor.lastrowid or 0)
 
@@ -267,9 +274,9 @@ class Facts(Axes):
         current = self.axis(axis)
         with self._transaction() as db:
             cursor = db.execute(
-                "INSERT INTO model_check (axis_id, at_utc, who, file, recording_file, summary, corrects)"
-                " VALUES (?, ?, ?, ?, ?, ?, ?)",
+                "INSERT INTO model_check (axis_id, at_utc, who, file, recording_file, summary, corrects,"
+                f" {FACT_IDS}) VALUES (?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
                 (current.id, utc_stamp(at_utc), who, str(file), str(recording_file), summary,
-                 self._corrected("model_check", corrects, current)),
+                 self._corrected("model_check", corrects, current), *self._fact_ids()),
             )
         return int(cursor.lastrowid or 0)

@@ -253,6 +253,10 @@ TABLE_WORDS = {
     "signing_key": "signing keys",
     "key_revocation": "key revocations",
     "report_signature": "report signatures",
+    "known_register": "registers known",
+    "this_register": "the register's own id",
+    "conflict": "conflicts",
+    "conflict_resolution": "conflict resolutions",
 }
 
 

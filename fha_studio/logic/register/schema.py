@@ -13,6 +13,15 @@ order is time order. Parameter values are the drive's wire integers (the paramet
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
+from fha_studio.logic.register.identity import OLDER_UID_TABLES, give_ids
+
+#: A migration's step: a statement, or a function of the connection for what SQL alone does not
+#: say the same way on both stores (the new ids of the facts already there).
+Statement = str | Callable[[Any], None]
+
 # Each migration is a list of statements (run one by one: sqlite3's executescript would commit
 # the transaction the migration runs in).
 _V1 = [
@@ -233,8 +242,69 @@ _V5 = [
       for table in CORRECTABLE_TABLES),
 ]
 
+# v6: facts that travel between registers (a laptop's file and the plant's server, `register
+# sync`). Every fact gets a stable id where it is first recorded, the same in every register it is
+# synced to, and keeps where (the register's id) and when it was recorded (identity.py); the facts
+# already there get theirs now. A register knows its own id and the names of the registers its
+# facts came from. An axis event says what it set (``data``: the fields of an axis added, a field
+# changed, an origin), so that a register an event is synced to sets the same. A conflict: an axis
+# changed in two registers while they were apart, the two sides' values kept for a person to settle
+# by a resolution (a fact of its own that names the conflict); nothing is picked silently.
+_FACT_ID_COLUMNS_SQL = """uid TEXT NOT NULL UNIQUE,
+        recorded_in TEXT NOT NULL DEFAULT '',
+        recorded_utc TEXT NOT NULL DEFAULT '',
+        uid_hash INTEGER NOT NULL DEFAULT 0"""
+_V6: list[Statement] = [
+    """CREATE TABLE known_register (
+        register_id TEXT PRIMARY KEY,
+        name TEXT NOT NULL DEFAULT '',
+        created_utc TEXT NOT NULL
+    )""",
+    """CREATE TABLE this_register (
+        register_id TEXT PRIMARY KEY REFERENCES known_register(register_id)
+    )""",
+    *(
+        f"ALTER TABLE {table} ADD COLUMN {column}"
+        for table in OLDER_UID_TABLES
+        for column in (
+            "uid TEXT NOT NULL DEFAULT ''",
+            "recorded_in TEXT NOT NULL DEFAULT ''",
+            "recorded_utc TEXT NOT NULL DEFAULT ''",
+            "uid_hash INTEGER NOT NULL DEFAULT 0",
+        )
+    ),
+    "ALTER TABLE axis_event ADD COLUMN data TEXT NOT NULL DEFAULT ''",
+    give_ids,
+    *(f"CREATE UNIQUE INDEX {table}_by_uid ON {table} (uid)" for table in OLDER_UID_TABLES),
+    f"""CREATE TABLE conflict (
+        id INTEGER PRIMARY KEY,
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        subject TEXT NOT NULL,
+        sides_json TEXT NOT NULL,
+        {_FACT_ID_COLUMNS_SQL}
+    )""",
+    f"""CREATE TABLE conflict_resolution (
+        id INTEGER PRIMARY KEY,
+        conflict_uid TEXT NOT NULL REFERENCES conflict(uid),
+        axis_id INTEGER NOT NULL REFERENCES axis(id),
+        at_utc TEXT NOT NULL,
+        who TEXT NOT NULL DEFAULT '',
+        kept INTEGER NOT NULL,
+        settled_json TEXT NOT NULL,
+        note TEXT NOT NULL DEFAULT '',
+        {_FACT_ID_COLUMNS_SQL}
+    )""",
+    "CREATE INDEX conflict_by_axis ON conflict (axis_id, at_utc)",
+    "CREATE INDEX conflict_resolution_by_conflict ON conflict_resolution (conflict_uid)",
+    "CREATE INDEX conflict_resolution_by_axis ON conflict_resolution (axis_id, at_utc)",
+]
+
 #: MIGRATIONS[n] takes a file from user_version n to n + 1.
-MIGRATIONS: tuple[tuple[str, ...], ...] = (tuple(_V1), tuple(_V2), tuple(_V3), tuple(_V4), tuple(_V5))
+MIGRATIONS: tuple[tuple[Statement, ...], ...] = (
+    tuple(_V1), tuple(_V2), tuple(_V3), tuple(_V4), tuple(_V5), tuple(_V6)
+)
 
 #: The version this program writes.
 SCHEMA_VERSION = len(MIGRATIONS)
@@ -244,6 +314,7 @@ SCHEMA_VERSION = len(MIGRATIONS)
 FACT_TABLES = (
     "axis_event", "snapshot", "snapshot_value", "parameter_write", "procedure_run", "check_result", "alarm",
     "report", "recording", "model_check", "signing_key", "key_revocation", "report_signature",
+    "conflict", "conflict_resolution", "known_register", "this_register",
 )
 #: The tables of things facts are about: changed (each change a fact of the axis's history), never
 #: removed.

@@ -39,6 +39,8 @@ def _tables_with_id() -> frozenset[str]:
     tables: set[str] = set()
     for migration in MIGRATIONS:
         for statement in migration:
+            if not isinstance(statement, str):
+                continue
             if made := re.match(r"\s*CREATE TABLE (\w+) \(\s*id INTEGER PRIMARY KEY", statement):
                 tables.add(made.group(1))
             elif (renamed := re.match(r"\s*ALTER TABLE (\w+) RENAME TO (\w+)", statement)) and (

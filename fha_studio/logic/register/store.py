@@ -162,8 +162,11 @@ class Register(Keys):
                 # written are taken away first and made again with the last one (append_only.py)
                 for statement in self._protection(make=False):
                     self._db.execute(statement)
-                for statement in MIGRATIONS[current]:
-                    self._db.execute(statement)
+                for step in MIGRATIONS[current]:
+                    if callable(step):
+                        step(self._db)
+                    else:
+                        self._db.execute(step)
                 self._db.execute(f"PRAGMA user_version = {current + 1}")
                 if current + 1 == len(MIGRATIONS):
                     for statement in self._protection(make=True):
