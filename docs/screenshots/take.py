@@ -30,10 +30,10 @@ def main() -> int:
     app = QApplication(sys.argv[:1])
     QCoreApplication.setOrganizationName("FHA Studio Screenshots")
     QCoreApplication.setApplicationName("fha-studio-screenshots")
+    from fha_studio.gui.app import parse_arguments, single_axis_window
     from fha_studio.gui.link import Servo
-    from fha_studio.gui.main_window import MainWindow
 
-    window = MainWindow()
+    window = single_axis_window(parse_arguments(["--no-connect"]))  # as fha-studio makes it
     window.resize(1366, 740)
     window.show()
     window.connect_to("sim://FHA-25C-50-US250?paced=0")
@@ -75,13 +75,16 @@ def main() -> int:
     @step(600)
     def jog():
         page = window.show_page("jog")
-        page.speed_spin.setValue(8.0)
-        page._jog(+1)  # as if FWD were held
+        page.motion.speed_spin.setValue(8.0)
+        page.motion._jog(+1)  # as if FWD were held
 
     @step(700)
     def jog_shot():
         shot("jog")
-        window.jog_page.release_held()
+        window.link.jog_release()  # _jog pressed no button: releasing the buttons would not end it
+
+    @step(500)
+    def alarm():
         window.link._worker._client.transaction.transport.inner.sim_drive.raise_alarm(20)
 
     @step(800)
@@ -123,6 +126,16 @@ def main() -> int:
         dialog.grab().save(str(OUT / "connect-dialog.png"))
         print("saved", OUT / "connect-dialog.png")
         dialog.close()
+        from fha_studio.gui.window_register import WindowAxisDialog
+
+        naming = WindowAxisDialog(window.window_register, window)  # the toolbar's Register line
+        naming.machine_combo.setCurrentText("Line 3 positioner")
+        naming.axis_combo.setCurrentText("table")
+        naming.show()
+        app.processEvents()
+        naming.grab().save(str(OUT / "register-axis.png"))
+        print("saved", OUT / "register-axis.png")
+        naming.close()
         window._closing_confirmed = True
         window.close()
         app.quit()
@@ -132,12 +145,26 @@ def main() -> int:
             delay, fn = steps[index]
 
             def go():
-                fn()
+                try:
+                    fn()
+                except Exception:
+                    app.exit(1)  # a step that fails ends the script (it waited for ever)
+                    raise
                 run(index + 1)
 
             QTimer.singleShot(delay, go)
 
-    run()
+    def when_read(waited_ms: int = 0):
+        """The steps start once the drive's values are read (a loaded machine takes seconds)."""
+        if len(window.state.drive_values) >= 14:
+            run()
+        elif waited_ms > 60000:
+            print("the simulated drive did not answer within 60 s", file=sys.stderr)
+            app.exit(1)
+        else:
+            QTimer.singleShot(100, lambda: when_read(waited_ms + 100))
+
+    when_read()
     app.exec()
     window.shutdown()
     return 0
