@@ -13,6 +13,8 @@
 - ``add-machine NAME``, ``add-axis MACHINE/AXIS``, ``import FILE... --machine M``: fill it.
 - ``keys add --name PERSON [--key-file PATH]``, ``keys list``: each person's signing key;
   ``verify REPORT``: is the report the one that was signed, and by whom (exit 0, else 5).
+- ``roles setup|grant LOGIN ROLE [--person NAME]|revoke LOGIN ROLE|list``: who may add what to a
+  register on a server (technician, reviewer, administrator).
 
 Every action takes ``--json``. The register is ``--register FILE`` (or a plant's register on a
 PostgreSQL server: ``--register postgresql://USER:PASSWORD@HOST/DB``), else
@@ -33,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import fileio, plausible
-from fha_studio.cli import CliError, _register_signing
+from fha_studio.cli import CliError, _register_roles, _register_signing
 from fha_studio.cli._values import in_range
 from fha_studio.logic.register.words import (
     KIND_WORDS,
@@ -171,6 +173,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument("--operator", default="", help="who imports it (for parameter files)")
     s.set_defaults(func=_import)
     _register_signing.add_actions(sub, common, _open_register)
+    _register_roles.add_actions(sub, common)
 
 
 # -- plumbing -------------------------------------------------------------------------------------------

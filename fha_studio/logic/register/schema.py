@@ -319,3 +319,6 @@ FACT_TABLES = (
 #: The tables of things facts are about: changed (each change a fact of the axis's history), never
 #: removed.
 ENTITY_TABLES = ("machine", "axis")
+#: The register's own bookkeeping, neither facts nor what they are about (a technician's program
+#: may add to them on a server with roles, :mod:`.roles`).
+REGISTER_TABLES: tuple[str, ...] = ()

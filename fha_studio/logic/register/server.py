@@ -23,10 +23,12 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable, Iterator, Sequence
 from typing import Any
-from urllib.parse import urlsplit, urlunsplit
+from urllib.parse import unquote, urlsplit, urlunsplit
 
 from fha_studio.logic.register import append_only
 from fha_studio.logic.register.guard import APPEND_ONLY, RegisterError, append_only_refusal
+from fha_studio.logic.register.roles import SQLSTATE as ROLES_SQLSTATE
+from fha_studio.logic.register.roles import refused_words, who_writes
 from fha_studio.logic.register.schema import MIGRATIONS
 from fha_studio.names import quoted
 
@@ -186,6 +188,10 @@ class ServerDatabase:
             self.total_changes += cursor.rowcount
         return ServerCursor(cursor, returns_id)
 
+    def execute_raw(self, sql: str) -> None:
+        """A statement in PostgreSQL's own words, as it is (a trigger's function, a grant)."""
+        self._conn.execute(sql.encode("utf-8"))
+
     def executemany(self, sql: str, rows: Iterable[Sequence[Any]], /) -> None:
         for row in rows:
             self.execute(sql, row)
@@ -216,6 +222,31 @@ def is_server_error(exc: BaseException) -> bool:
     return type(exc).__module__.split(".")[0] == "psycopg"
 
 
+def _login(url: str) -> str:
+    """The user a URL logs in as ("" when it names none: the server takes the system's)."""
+    netloc = urlsplit(url.strip()).netloc
+    return unquote(netloc.rpartition("@")[0].split(":", 1)[0]) if "@" in netloc else ""
+
+
+def _not_allowed(url: str, where: str, first: str, opening: bool) -> RegisterError:
+    """The server's grants refused a write: which rule, in words."""
+    login = _login(url)
+    who = f"{login} may not do that" if login else "this login may not do that"
+    table = re.search(r"(?:permission denied for|must be owner of) (?:table|relation) (\w+)", first)
+    if "must be owner" in first or (table and table.group(1) == "register_schema"):
+        rule = ("the register was written by an older FHA Studio: its owner brings it up to date "
+                "(fha-studio register roles setup, run as the owner)")
+    elif "for schema" in first or "for database" in first:
+        rule = "its owner makes the register (fha-studio register add-machine NAME, run as the owner)"
+    elif table:
+        rule = who_writes(table.group(1))
+    else:
+        rule = quoted(first, limit=80, always=False)
+    if opening and not table:
+        who = f"{login} may not use this register" if login else "this login may not use this register"
+    return RegisterError(f"the register {where}: {who}: {rule}: nothing was changed")
+
+
 def problem(url: str, exc: BaseException, opening: bool = False) -> RegisterError:
     """A psycopg error as one line naming the register on the server and what to do."""
     where = quoted(shown_url(url), limit=120, always=False)
@@ -225,6 +256,9 @@ def problem(url: str, exc: BaseException, opening: bool = False) -> RegisterErro
     low = text.lower()
     if state == append_only.SQLSTATE or first.startswith(APPEND_ONLY):
         return append_only_refusal(where, first)
+    if state == ROLES_SQLSTATE:  # a rule of the register's roles (roles.py), in the server's words
+        return RegisterError(f"the register {where}: the server refused it: {refused_words(first)}: "
+                             "nothing was changed")
     if state == "28P01" or "password authentication failed" in low or "no password supplied" in low:
         return RegisterError(f"the register {where}: the server refused the user name or password: "
                              "nothing was changed")
@@ -234,9 +268,8 @@ def problem(url: str, exc: BaseException, opening: bool = False) -> RegisterErro
     if state in ("53100", "53200") or "no space left" in low or "disk full" in low:
         return RegisterError(f"the register {where}: the server has no space left on its disk: "
                              "nothing was changed")
-    if state == "42501" or "permission denied" in low:
-        return RegisterError(f"the register {where}: this user may not do that on the server "
-                             f"({quoted(first, limit=80, always=False)}): nothing was changed")
+    if state == "42501" or "permission denied" in low or "must be owner" in low:
+        return _not_allowed(url, where, first, opening)
     if state in ("57P01", "57P02", "57P03") or state.startswith("08") or (type(exc).__name__ in (
         "OperationalError", "InterfaceError"
     ) and ("connect" in low or "closed" in low or "terminat" in low or "server" in low)):

@@ -147,7 +147,8 @@ class Register(Keys):
                 raise server.problem(url, exc, opening=True) from None
             raise
 
-    def _migrate(self, target: int = SCHEMA_VERSION) -> None:
+    def _migrate(self, target: int | None = None) -> None:
+        target = len(MIGRATIONS) if target is None else target
         if self.version > SCHEMA_VERSION:
             raise RegisterError(
                 f"register {self.path}: written by a newer FHA Studio (schema {self.version}; "
@@ -171,6 +172,16 @@ class Register(Keys):
                 if current + 1 == len(MIGRATIONS):
                     for statement in self._protection(make=True):
                         self._db.execute(statement)
+                    if self._url:
+                        self._roles_again()
+
+    def _roles_again(self) -> None:
+        """On a server with the register's roles, the new tables get their rights and triggers."""
+        from fha_studio.logic.register import roles
+
+        if roles.is_set_up(self._db):
+            for statement in roles.protection(roles.Catalog.read(self._db)):
+                self._db.execute_raw(statement)
 
     def _protection(self, make: bool) -> list[str]:
         """The statements that make (or take away) the append-only triggers of this store."""
