@@ -130,7 +130,7 @@ def test_a_full_disk_and_the_other_refusals_in_words(postgres_cluster):
     assert str(full).endswith("the server has no space left on its disk: nothing was changed")
     assert PASSWORD not in str(full) and shown_url(url) in str(full)
     denied = problem(url, psycopg.errors.InsufficientPrivilege("permission denied for table fact"))
-    assert "may not do that on the server (permission denied for table fact)" in str(denied)
+    assert "fha may not do that: permission denied for table fact: nothing was changed" in str(denied)
     with pytest.raises(RegisterError, match="there is no register at postgresql://fha@/"):
         Register(url, create=False)
 

@@ -404,13 +404,14 @@ _WHO_WRITES = {
 
 
 def who_writes(table: str) -> str:
-    """The rule that gives the right to write ``table``, in words."""
+    """The rule that gives the right to write ``table``, in words ("" for a table the register
+    does not know)."""
     if table in _WHO_WRITES:
         return _WHO_WRITES[table]
     if table in FACT_TABLES:
         what = refusal_text(table).split(" are ")[0]
         return f"a technician adds {what}, and nobody changes or removes them"
-    return "the register's owner keeps it"
+    return ""
 
 
 def names_listed(items: Iterable[str]) -> str:

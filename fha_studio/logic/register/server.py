@@ -238,10 +238,8 @@ def _not_allowed(url: str, where: str, first: str, opening: bool) -> RegisterErr
                 "(fha-studio register roles setup, run as the owner)")
     elif "for schema" in first or "for database" in first:
         rule = "its owner makes the register (fha-studio register add-machine NAME, run as the owner)"
-    elif table:
-        rule = who_writes(table.group(1))
     else:
-        rule = quoted(first, limit=80, always=False)
+        rule = (who_writes(table.group(1)) if table else "") or quoted(first, limit=80, always=False)
     if opening and not table:
         who = f"{login} may not use this register" if login else "this login may not use this register"
     return RegisterError(f"the register {where}: {who}: {rule}: nothing was changed")
