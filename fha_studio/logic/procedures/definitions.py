@@ -16,6 +16,9 @@ the procedure stops). Kinds and their fields:
 - ``sensor_angle``: the output angle (deg) where ``sensor`` switched, taken by the sensor-dog
   wizard; passes inside the movable range of 4-7-3 and in the right order.
 
+A step may also have ``bench`` (``direction``, ``flange``, ``encoder``): a move the controller
+makes, seen on CN2 by a bench instrument, answers it (:mod:`.bench_steps`).
+
 Text in ``{...}`` is a path into the actuator's context (:func:`context.build_context`), e.g.
 ``{tightening.output_flange.torque_nm}``, ``{row.color}`` inside a ``for_each`` step (one step
 per row of a context table), or ``{answers.STEP_ID}`` (an earlier answer in the same run).

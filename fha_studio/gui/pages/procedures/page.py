@@ -10,6 +10,7 @@ with the manual's warning until someone says it was put right.
 from __future__ import annotations
 
 import logging
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -39,9 +40,11 @@ from fha_studio.gui.link import LinkInfo
 from fha_studio.gui.pages.absolute import AbsolutePage
 from fha_studio.gui.pages.base import BasePage, PageHost, PageId
 from fha_studio.gui.pages.direction import DirectionPage
+from fha_studio.gui.pages.procedures.bench_watch import BenchWatch
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
 from fha_studio.gui.pages.procedures.live_panel import LiveCheckPanel
 from fha_studio.gui.pages.procedures.signer import ReportSigner
+from fha_studio.logic.bench.checks import BenchCheck
 from fha_studio.logic.procedures import (
     Observation,
     Procedure,
@@ -89,6 +92,8 @@ class ProceduresPage(BasePage):
         # the sign step's key: in the machine window's register (else the user's), its private
         # key in the user's keys folder
         self.signer = ReportSigner(lambda: getattr(self.main_window, "signing_register", None))
+        # a move on the Scope's Bench tab answers the steps that take it (CN2, servo on)
+        self.bench_watch = BenchWatch(self)
         self._build()
         self.state.sigActuatorChanged.connect(self._axis_changed)
         self.live_panel.relay.sigSample.connect(
@@ -198,6 +203,11 @@ class ProceduresPage(BasePage):
         ):
             self._pages[name] = self.inputs.addWidget(widget)
         s.addWidget(self.inputs)
+        # a step a move seen on the bench answers (CN2 while the servo is on): what to do for it
+        self.bench_note = QLabel("")
+        self.bench_note.setObjectName("bench_note")
+        self.bench_note.setWordWrap(True)
+        s.addWidget(self.bench_note)
         m.addWidget(self.step_box, 1)
 
         self.stop_box = QGroupBox("Stopped")
@@ -339,8 +349,9 @@ class ProceduresPage(BasePage):
     def current_step(self) -> Step | None:
         return self.run.current() if self.run else None
 
-    def answer(self, value: Any) -> bool:
-        """Answer the current step (what the buttons do). False with a message when not accepted."""
+    def answer(self, value: Any, detail: str = "") -> bool:
+        """Answer the current step (what the buttons do; ``detail``: where the answer came from).
+        False with a message when not accepted."""
         if self.run is None:
             return False
         if self.axis_mismatch():
@@ -352,7 +363,7 @@ class ProceduresPage(BasePage):
         if step.kind == "live" and not isinstance(value, bool | Observation):
             return False
         try:
-            record = self.run.submit(value, who=self.who)
+            record = self.run.submit(value, who=self.who, detail=detail)
         except StepInputError as exc:
             self._message(str(exc))
             return False
@@ -375,6 +386,21 @@ class ProceduresPage(BasePage):
             self._message(self.axis_mismatch())
             return
         self.live_panel.run(step, self.context, self.session.sensor_angles_deg)
+
+    def bench_move(self, checks: Sequence[BenchCheck]) -> None:
+        """A move's checks from the Scope's Bench tab: they answer the steps that take them."""
+        self.bench_watch.answer_steps(checks)
+
+    def bench_changed(self, *_args) -> None:
+        """The step on show, or the Bench tab's stream, changed: say what the bench does for it."""
+        self.bench_watch.attach()
+        text = self.bench_watch.note()
+        self.bench_note.setText(text)
+        self.bench_note.setVisible(bool(text))
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        self.bench_changed()  # the Bench tab may have started meanwhile
 
     def retry(self, note: str = "") -> None:
         if self.run is not None and self.run.stopped:
@@ -547,6 +573,8 @@ class ProceduresPage(BasePage):
     def _message(self, text: str) -> None:
         self.message_label.setText(text)
 
+    show_message = _message
+
     def _refresh(self) -> None:
         has_session = self.session is not None
         for row, procedure in enumerate(self.procedures):
@@ -599,6 +627,7 @@ class ProceduresPage(BasePage):
             self.progress_label.setText(f"Step {done + 1} of {total}")
             self._show_input(step)
             self.step_box.setEnabled(not run.stopped)
+        self.bench_changed()
         self._fill_history()
         self.sigStepChanged.emit()
 
@@ -630,7 +659,8 @@ class ProceduresPage(BasePage):
                 (r.text, value_text(r), "pass" if r.passed else "FAIL", r.who, when_text(r.at_utc))
             ):
                 item = QTableWidgetItem(text)
-                item.setToolTip(f"{r.section}: {r.text}" if column == 0 and r.section else text)
+                item.setToolTip(f"{r.section}: {r.text}" if column == 0 and r.section
+                                else (r.detail or text) if column == 1 else text)
                 self.history.setItem(row, column, item)
 
     # -- settings (called by the main window) --------------------------------------------------

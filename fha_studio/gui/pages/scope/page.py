@@ -133,8 +133,19 @@ class ScopePage(BasePage):
             return None
         return recorder_columns(started, live_t0, self.bench.counts_per_output_turn)
 
+    def bench_watching(self) -> str:
+        """``sim-cn2 (encoder ENC_A,ENC_B, command CMD_A,CMD_B)`` while the Bench tab streams the
+        encoder outputs and the command lines, so a move's checks will come; else ""."""
+        started = self.bench.source.started
+        decoding = started is not None and {"counts", "command"} <= set(started.extra)
+        if started is None or not self.bench.source.running or not decoding:
+            return ""
+        return (f"{started.device} (encoder {self.bench.encoder_edit.text().strip()}, command "
+                f"{self.bench.command_edit.text().strip()})")
+
     def _bench_checks(self, checks: list) -> None:
-        """A move's checks from CN2 go to the DGR checks page's record (and so into the report)."""
+        """A move's checks from CN2 go to the DGR checks page's record (and so into the report;
+        the Procedures page listens to ``bench.sigChecks`` itself)."""
         from fha_studio.gui.pages.absolute import AbsolutePage
         from fha_studio.gui.pages.base import PageId
 
