@@ -31,6 +31,8 @@ def window(make_window, qtbot):
 
 def test_a_controller_move_on_cn2_is_checked_and_recorded_with_its_source(window, qtbot):
     bench = window.show_page("scope").bench
+    window.state.enter_front_panel("system", 8, 0, "T. Technician")  # rotary direction, from the panel
+    assert bench.parameter_8 == 0
     with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
         bench.scan()
     with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
@@ -50,6 +52,9 @@ def test_a_controller_move_on_cn2_is_checked_and_recorded_with_its_source(window
     assert all(source in c.detail for c in checks.values())
     assert "a FWD command (+13889 counts) turned the axis FWD" in checks["bench_direction"].detail
     assert "encoder outputs follow the command: pass" in bench.move_label.text()
+    assert "direction: pass (FWD rotation, CW viewing the output flange)" in bench.move_label.text()
+    assert "with parameter 8 = 0 that is FWD rotation, CW viewing the output flange (1-10)" \
+        in checks["bench_direction"].detail
 
     page = window.page(PageId.ABSOLUTE)
     recorded = [r for r in page.records if r.check.startswith("bench_")]

@@ -51,9 +51,19 @@ MOVE_GAP_S = 0.2
 CHECK_WORDS = {"bench_encoder": "encoder outputs follow the command", "bench_direction": "direction",
                "bench_in_position": "IN-POS", "bench_alarm": "ALARM"}
 VERDICT = {True: "pass", False: "FAIL", None: "recorded"}
+#: The width of both plots' left axes [px] (room for "-1000000").
+LEFT_AXIS_PX = 62
+#: The counts' plot shows at least this many counts above and below what it draws.
+MIN_COUNTS_PAD = 5.0
 #: The width a trace's name takes in the legend [px] ("bench sim-cn2:ENC_A" and its line).
 LEGEND_NAME_PX = 190
 _COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#e07000", "#9467bd", "#8c564b", "#e377c2", "#008b8b")
+
+
+def _flange(check: BenchCheck) -> str:
+    """`` (FWD rotation, CW viewing the output flange)`` for a direction check that knows it."""
+    flange = check.values.get("flange") if check.check == "bench_direction" else None
+    return f" ({check.values['rotation']}, {flange} viewing the output flange)" if flange else ""
 
 
 def _rate(text: str) -> float | None:
@@ -168,6 +178,8 @@ class BenchPanel(QWidget):
         self.counts_plot = pg.PlotWidget(background="w")
         self.counts_plot.setLabel("left", "counts")
         self.counts_plot.setXLink(self.plot)
+        for plot in (self.plot, self.counts_plot):  # equal left axes: the two time axes line up
+            plot.getAxis("left").setWidth(LEFT_AXIS_PX)
         self.counts_plot.setVisible(False)
         self.counts_plot.addLegend(offset=(5, 5))
         self._counts_curve = self.counts_plot.plot([], [], pen=pg.mkPen("#333333", width=1))
@@ -422,7 +434,7 @@ class BenchPanel(QWidget):
             shown = self._counts_range
             # the counts' range moves only when they leave it or fill less than half of it
             if shown is None or lo < shown[0] or hi > shown[1] or (hi - lo) < 0.5 * (shown[1] - shown[0]):
-                pad = 0.1 * (hi - lo) if hi > lo else 1.0
+                pad = max(0.1 * (hi - lo), MIN_COUNTS_PAD)  # a count's dither at standstill is no band
                 self._counts_range = (lo - pad, hi + pad)
                 self.counts_plot.setYRange(*self._counts_range, padding=0)
         self._show_alarm(started, rows[-1])
@@ -523,7 +535,7 @@ class BenchPanel(QWidget):
             f"(band ±{m.settling_band:.3g} deg); in-position (IN-POS) {inpos} after the command ended; "
             f"following error (command − encoder) at most {figures.following_error_peak_counts:.0f} "
             f"counts, {figures.following_error_end_counts:.0f} counts at the end\n"
-            + "; ".join(f"{CHECK_WORDS[c.check]}: {VERDICT[c.passed]}" for c in self.checks))
+            + "; ".join(f"{CHECK_WORDS[c.check]}: {VERDICT[c.passed]}{_flange(c)}" for c in self.checks))
         self.sigChecks.emit(list(self.checks))
 
     def _on_stopped(self, why: str) -> None:
