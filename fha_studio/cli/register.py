@@ -13,6 +13,8 @@
 - ``add-machine NAME``, ``add-axis MACHINE/AXIS``, ``import FILE... --machine M``: fill it.
 - ``keys add --name PERSON [--key-file PATH]``, ``keys list``: each person's signing key;
   ``verify REPORT``: is the report the one that was signed, and by whom (exit 0, else 5).
+- ``correct snapshot|check|note NUMBER --reason TEXT ...``: a mistake corrected by a new fact that
+  points at the wrong one (nothing is ever changed).
 - ``roles setup|grant LOGIN ROLE [--person NAME]|revoke LOGIN ROLE|list``: who may add what to a
   register on a server (technician, reviewer, administrator).
 
@@ -35,7 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import fileio, plausible
-from fha_studio.cli import CliError, _register_roles, _register_signing
+from fha_studio.cli import CliError, _register_correct, _register_roles, _register_signing
 from fha_studio.cli._values import in_range
 from fha_studio.logic.register.words import (
     KIND_WORDS,
@@ -93,6 +95,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument(
         "--since", metavar="TIME", help="from this time on (ISO 8601, e.g. 2026-11-30 or 2026-11-30T08:00Z)"
     )
+    s.add_argument("--numbers", action="store_true",
+                   help="each line's number (what register correct KIND NUMBER takes)")
     s.set_defaults(func=_history)
     s = sub.add_parser(
         "diff",
@@ -173,6 +177,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument("--operator", default="", help="who imports it (for parameter files)")
     s.set_defaults(func=_import)
     _register_signing.add_actions(sub, common, _open_register)
+    _register_correct.add_actions(sub, common, _open_register)
     _register_roles.add_actions(sub, common)
 
 
@@ -321,7 +326,8 @@ def _history(args) -> int:
     )
     for e in events:
         who = f" [{e.who}]" if e.who else ""
-        print(f"{when_text(e.at_utc)}  {KIND_WORDS[e.kind]:<11} {e.text}{who}")
+        number = f"{e.ref if e.ref is not None else '':>6}  " if args.numbers else ""
+        print(f"{when_text(e.at_utc)}  {number}{KIND_WORDS[e.kind]:<11} {e.text}{who}")
     return 0
 
 

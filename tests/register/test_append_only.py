@@ -5,6 +5,7 @@ a mistake is corrected by a new fact that points at the one it corrects."""
 from __future__ import annotations
 
 import contextlib
+import json
 import sqlite3
 
 import psycopg
@@ -126,3 +127,46 @@ def test_where_a_procedure_stands_is_a_row_each_time_it_moves_on(line3, register
         rows = db.execute(
             "SELECT status FROM procedure_run WHERE procedure_id = 'wiring' ORDER BY id").fetchall()
     assert [r[0] for r in rows] == ["running", "paused", "completed"]  # the same state twice is one row
+
+
+def _cli(capsys, target, *args):
+    from fha_studio.cli import main
+
+    code = main(["register", "--register", str(target), *args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_a_person_corrects_a_mistake_on_the_command_line(line3, register_target, capsys):
+    read = [("tune", 4, "in_position_range", 100), ("system", 8, "rotary_direction", 1)]
+    wrong = line3.record_snapshot(TABLE, read, "front_panel", who="ana")
+    check = _Check()
+    line3.record_checks(TABLE, [check])
+    note = line3.add_axis_note(TABLE, "brake wired to CN1-5", who="ana")
+    code, out, _ = _cli(capsys, register_target, "correct", "snapshot", str(wrong), "--set",
+                        "in_position_range=10", "--reason", "read 100 for 10", "--operator", "ana")
+    assert code == 0 and out.startswith(f"{TABLE}: snapshot ") and f"corrects snapshot {wrong}" in out
+    assert "(in_position_range: 100 → 10)" in out
+    values = line3.current_values(TABLE).values
+    assert (values["in_position_range"].value, values["rotary_direction"].value) == (10, 1)
+    check_ref = next(e.ref for e in line3.history(TABLE) if e.kind == "check")
+    code, out, _ = _cli(capsys, register_target, "correct", "check", str(check_ref), "--passed", "no",
+                        "--reason", "the motor was wired to U and W swapped", "--json")
+    assert code == 0 and json.loads(out)["what"] == "pass → FAIL"
+    assert [i.text for i in line3.open_items() if i.axis.ref == TABLE and "Motor wired" in i.text]
+    code, _, _ = _cli(capsys, register_target, "correct", "note", str(note), "--text", "brake wired to CN1-6")
+    assert code == 0
+    code, out, _ = _cli(capsys, register_target, "history", TABLE, "--numbers")
+    assert code == 0 and f"{note:>6}  axis" in out and f"— corrected by axis entry {note + 1}" in out
+    assert "— corrects check" in out and f"corrected by snapshot {wrong + 1}" in out
+    for args, said in (
+        (("snapshot", str(wrong), "--set", "no_such=1", "--reason", "x"), "holds no no_such"),
+        (("snapshot", str(wrong), "--set", "in_position_range=10"), "a correction says why (--reason)"),
+        (("snapshot", str(wrong), "--set", "in_position_range=ten", "--reason", "x"), "KEY=VALUE expected"),
+        (("check", str(check_ref), "--reason", "x"), "a corrected check needs its right answer"),
+        (("note", "999", "--text", "x"), "there is no note number 999 in the register"),
+        (("note", str(note), "--set", "in_position_range=1"), "--set corrects a snapshot's values"),
+    ):
+        code, _, err = _cli(capsys, register_target, "correct", *args)
+        assert code == 2 and err.count("\n") == 1 and said in err, (args, err)
+    assert len(line3.snapshots(TABLE)) == 2  # nothing half-done by the refusals
