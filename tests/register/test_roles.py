@@ -177,7 +177,11 @@ def test_a_technician_cannot_change_remove_or_back_date_a_fact(plant, capsys, se
     assert alarms[1][1] < alarms[0][1]  # the offline one claims three days ago ...
     assert receipts[1][0] - receipts[0][0] < _dt.timedelta(minutes=5)  # ... and came now
     code, out, _ = _cli(capsys, plant["ana"], "history", TABLE)
-    assert code == 0 and "alarm 10: overspeed" in out and "alarm 12: encoder" in out
+    lines = out.splitlines()
+    assert code == 0 and next(line for line in lines if "alarm 10: overspeed" in line).endswith("[Ana Lima]")
+    offline = next(line for line in lines if "alarm 12: encoder" in line)
+    came = receipts[1][0].astimezone(_dt.UTC)
+    assert f"— reached the server {came:%Y-%m-%d %H:%M:%S} UTC from ana" in offline
 
 
 def _bob_signs(plant, tmp_path):

@@ -4,6 +4,7 @@ oldest first."""
 from __future__ import annotations
 
 import dataclasses
+import datetime as _dt
 import json
 from collections.abc import Mapping
 from typing import Any
@@ -18,6 +19,7 @@ from fha_studio.logic.register.records import (
     Event,
     EventKind,
     check_name,
+    short_time,
     utc_stamp,
 )
 
@@ -151,12 +153,44 @@ class History(Queries):
                     {"file": r["file"], "recording_file": r["recording_file"], **_corrects(r)},
                 )
             )
-        events = _with_corrections(events)
+        events = self._with_receipts(_with_corrections(events), a)
         if since is not None:
             cutoff = utc_stamp(since)
             events = [e for e in events if e.at_utc >= cutoff]
         order = {kind: n for n, kind in enumerate(HISTORY_ORDER)}
         return sorted(events, key=lambda e: (e.at_utc, order[e.kind], e.ref or 0))
+
+
+    def _with_receipts(self, events: list[Event], axis_id: int) -> list[Event]:
+        """On a server with roles: when each fact reached the server and from which login (its
+        data: ``received_utc``, ``received_by``), said in its line when that was more than the
+        roles' tolerance after its own time (a laptop that worked offline, or a fact dated back)."""
+        if not self._url:
+            return events
+        from fha_studio.logic.register import roles
+
+        if not roles.has_receipts(self._db):
+            return events
+        kinds = {e.kind for e in events}
+        got = {kind: roles.receipts(self._db, KIND_TABLES[kind], axis_id) for kind in kinds}
+        late = _dt.timedelta(seconds=roles.FUTURE_TOLERANCE_S)
+        out = []
+        for e in events:
+            receipt = got[e.kind].get(e.ref) if e.ref is not None else None
+            if receipt is None:
+                out.append(e)
+                continue
+            received, login = receipt
+            text = e.text
+            if _moment(received) - _moment(e.at_utc) > late:
+                text += f" — reached the server {short_time(received)} UTC from {login}"
+            out.append(dataclasses.replace(e, text=text, data={**e.data, "received_utc": received,
+                                                               "received_by": login}))
+        return out
+
+
+def _moment(stamp: str) -> _dt.datetime:
+    return _dt.datetime.fromisoformat(stamp)
 
 
 def _corrects(row: Mapping[str, Any]) -> dict[str, int]:

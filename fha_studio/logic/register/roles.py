@@ -131,14 +131,28 @@ class Catalog:
             primary.setdefault(str(table), []).append(str(column))
         keys = {}
         for table, names in columns.items():
-            # a fact's stable id when it has one (the same in every register), else its own key
-            if "uid" in names:
-                keys[table] = "uid"
-            elif "id" in names:
+            # a fact's number (its history line's), else its own key
+            if "id" in names:
                 keys[table] = "id"
             elif len(primary.get(table, [])) == 1:
                 keys[table] = primary[table][0]
         return cls(str(database), str(schema), columns, keys)
+
+
+def has_receipts(db: Any) -> bool:
+    """Whether the register on the server keeps receipts (its roles are set up)."""
+    row = db.execute("SELECT to_regclass('register_receipt') IS NOT NULL").fetchone()
+    return bool(row and row[0])
+
+
+def receipts(db: Any, table: str, axis_id: int) -> dict[int, tuple[str, str]]:
+    """{fact number: (when the server received it, ISO UTC; the login)} of an axis's facts of
+    ``table`` (a table of :data:`~.schema.FACT_TABLES` with ``id`` and ``axis_id``)."""
+    rows = db.execute(
+        f"SELECT t.id, to_char(r.received_utc AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.US\"+00:00\"'),"
+        f" r.received_by FROM {table} t JOIN register_receipt r ON r.fact_table = '{table}'"
+        " AND r.fact_key = t.id::text WHERE t.axis_id = ?", (axis_id,)).fetchall()
+    return {int(r[0]): (str(r[1]), str(r[2])) for r in rows}
 
 
 def is_set_up(db: Any) -> bool:
