@@ -153,6 +153,14 @@ def test_a_technician_cannot_change_remove_or_back_date_a_fact(plant, capsys, se
         assert "later than the server's clock" in said and said.endswith("nothing was changed")
         # dated earlier (a laptop that worked offline): taken, and its receipt says when it came
         reg.record_alarm(TABLE, 12, "encoder", at_utc=server_clock.now_utc() - _dt.timedelta(days=3))
+        # but said to be recorded in this register earlier than now: back-dated, refused
+        server_clock.advance(-3600)  # the laptop's clock set back an hour
+        with pytest.raises(RegisterError) as back:
+            reg.record_alarm(TABLE, 13, "overload")
+        said = str(back.value)
+        assert "\n" not in said and "the server refused it: back-dated: said to be recorded in this " \
+            "register at " in said and said.endswith("is this computer's clock right?): nothing was changed")
+        server_clock.advance(3600)
     with psycopg.connect(plant["ana"], autocommit=True) as db:
         for sql in ("UPDATE alarm SET code = 13",
                     "UPDATE alarm SET at_utc = '2020-01-01T00:00:00.000000+00:00'",  # back-dated

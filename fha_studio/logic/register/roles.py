@@ -263,27 +263,51 @@ def _functions(catalog: Catalog) -> list[str]:
             END IF;
             RETURN NEW;
         END $fn$""",
+        """CREATE OR REPLACE FUNCTION register_time(said TEXT) RETURNS TIMESTAMPTZ LANGUAGE plpgsql
+        STABLE AS $fn$
+        BEGIN
+            RETURN said::timestamptz;
+        EXCEPTION WHEN others THEN
+            RETURN NULL;
+        END $fn$""",
+        """CREATE OR REPLACE FUNCTION register_utc(moment TIMESTAMPTZ) RETURNS TEXT LANGUAGE sql
+        IMMUTABLE AS $fn$
+            SELECT to_char(moment AT TIME ZONE 'UTC', 'YYYY-MM-DD HH24:MI:SS') || ' UTC'
+        $fn$""",
         f"""CREATE OR REPLACE FUNCTION register_check_time() RETURNS trigger LANGUAGE plpgsql {path} AS $fn$
         DECLARE
-            said TEXT := to_jsonb(NEW) ->> TG_ARGV[0];
-            moment TIMESTAMPTZ;
+            fact JSONB := to_jsonb(NEW);
+            moment TIMESTAMPTZ := register_time(fact ->> TG_ARGV[0]);
+            recorded TIMESTAMPTZ;
             server TIMESTAMPTZ := clock_timestamp();
         BEGIN
-            BEGIN
-                moment := said::timestamptz;
-            EXCEPTION WHEN others THEN
-                moment := NULL;
-            END;
             IF moment IS NULL THEN
-                PERFORM register_refuse(coalesce(quote_literal(said), 'no time') || ' is not a time');
+                PERFORM register_refuse(coalesce(quote_literal(fact ->> TG_ARGV[0]), 'no time')
+                    || ' is not a time');
             END IF;
             IF moment > server + {later} THEN
-                PERFORM register_refuse('dated '
-                    || to_char(moment AT TIME ZONE 'UTC', 'YYYY-MM-DD HH24:MI:SS')
-                    || ' UTC, later than the server''s clock ('
-                    || to_char(server AT TIME ZONE 'UTC', 'YYYY-MM-DD HH24:MI:SS')
-                    || ' UTC) by more than {FUTURE_TOLERANCE_S // 60} minutes: '
-                    || 'is this computer''s clock right?');
+                PERFORM register_refuse('dated ' || register_utc(moment) || ', later than the '
+                    || 'server''s clock (' || register_utc(server) || ') by more than '
+                    || '{FUTURE_TOLERANCE_S // 60} minutes: is this computer''s clock right?');
+            END IF;
+            -- when it was recorded, and where: recorded here, it was recorded now (never back-dated)
+            IF TG_NARGS > 1 AND coalesce(fact ->> 'recorded_utc', '') <> '' THEN
+                recorded := register_time(fact ->> 'recorded_utc');
+                IF recorded IS NULL THEN
+                    PERFORM register_refuse(quote_literal(fact ->> 'recorded_utc') || ' is not a time');
+                END IF;
+                IF recorded > server + {later} THEN
+                    PERFORM register_refuse('recorded ' || register_utc(recorded) || ', later than the '
+                        || 'server''s clock (' || register_utc(server) || ') by more than '
+                        || '{FUTURE_TOLERANCE_S // 60} minutes: is this computer''s clock right?');
+                END IF;
+                IF recorded < server - {later}
+                        AND fact ->> 'recorded_in' = (SELECT register_id FROM this_register LIMIT 1) THEN
+                    PERFORM register_refuse('back-dated: said to be recorded in this register at '
+                        || register_utc(recorded) || ', but the server''s clock says '
+                        || register_utc(server) || ' (a fact is recorded when it is; '
+                        || 'is this computer''s clock right?)');
+                END IF;
             END IF;
             RETURN NEW;
         END $fn$""",
@@ -349,7 +373,8 @@ def protection(catalog: Catalog) -> list[str]:
         columns = catalog.columns[table]
         time = next((c for c in TIME_COLUMNS if c in columns), None)
         if time is not None:
-            out.append(trigger("time", table, "BEFORE INSERT", "register_check_time", time))
+            recorded = ("recorded",) if {"recorded_in", "recorded_utc"} <= set(columns) else ()
+            out.append(trigger("time", table, "BEFORE INSERT", "register_check_time", time, *recorded))
         if table in catalog.keys and table != "snapshot_value":  # a snapshot's receipt is its values'
             out.append(trigger("receipt", table, "AFTER INSERT", "register_receive", catalog.keys[table]))
     checks = {
