@@ -1,11 +1,20 @@
-"""``fha-studio tune measure|propose``: the speed loop's frequency response and proposed gains.
+"""``fha-studio tune measure|propose|excitation|analyse``: the speed loop's frequency response and
+proposed gains, over CN3 or from the bench.
 
     fha-studio tune measure --url URL --actuator CODE --load-inertia KGM2 [--amplitude-rpm R] [--json OUT]
     fha-studio tune propose --url URL --actuator CODE --load-inertia KGM2 [--aim stiff|standard|soft]
                             [--json OUT]
+    fha-studio tune excitation --actuator CODE --parameters P.toml --load-inertia KGM2
+                               [--form multisine|prbs|chirp] [--amplitude-rpm R] [--rate HZ] -o EXC
+    fha-studio tune analyse --actuator CODE --parameters P.toml --load-inertia KGM2
+                            --signal ROLE=FILE[#CHANNEL] ... [--excitation EXC] [--json OUT]
 
-A drive that cannot be excited (a drive of the manual's commands, servo off, an alarm) gets one
-line saying what is needed and exit 4; nothing moves.
+``excitation`` writes the file an instrument's output plays into SPD-CMD of a real HA-655 in speed
+mode (a CSV of time and volts, a WAV, or one normalised cycle), its bounds stated first;
+``analyse`` takes the capture (SPD-MON, and SPD-CMD or the excitation file) and gives the JSON of
+``measure``. A drive that cannot be excited (a drive of the manual's commands, servo off, an
+alarm, parameter 0 not speed for SPD-CMD) gets one line saying what is needed and exit 4; nothing
+moves.
 """
 
 from __future__ import annotations
@@ -17,6 +26,7 @@ import time
 from typing import Any
 
 from fha_studio.cli import CliError
+from fha_studio.plausible import Range
 
 ORDER = 60
 EXIT_NOT_EXCITABLE = 4
@@ -47,6 +57,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                            help="where --apply saves the backup "
                            "(default: fha-tune-backup-<UTC time>.toml here)")
             q.set_defaults(func=run_propose)
+    _add_bench(sub)
 
 
 def _emit(args: argparse.Namespace, result: dict[str, Any], text: str) -> None:
@@ -166,3 +177,139 @@ def _apply(args: argparse.Namespace, client: Any, parameters: Any, tuner: Any,
     except MoveAlarm as exc:
         measured.update({"overshoot_pct": None, "settling_ms": None, "alarm": exc.code})
     return measured
+
+
+# ----- from the bench: a drive whose CN3 is silent while the servo is on ------------------------------
+
+
+def _add_bench(sub: argparse._SubParsersAction) -> None:
+    from fha_studio.cli._values import in_range, number, output_path, whole
+    from fha_studio.logic.tuning.bench_names import EXCITATION_FORMS, RESPONSE_ROLES
+    from fha_studio.plausible import LOAD_INERTIA_KGM2
+
+    def common(q: argparse.ArgumentParser) -> None:
+        q.add_argument("--actuator", required=True, help="model code, e.g. FHA-25C-50-US250")
+        q.add_argument("--parameters", required=True, metavar="PARAMS.toml",
+                       help="the drive's parameter file (fha-parameters/1, front-panel values included): "
+                       "parameters 0 and 9 and the tune items are read from it")
+        q.add_argument("--load-inertia", type=in_range(LOAD_INERTIA_KGM2), required=True, metavar="KGM2",
+                       help="the declared load inertia on the output [kg m^2]")
+
+    q = sub.add_parser("excitation", help="write an excitation file for SPD-CMD (an instrument's output)",
+                       description="The bounded excitation of the speed loop of a real HA-655 in speed mode, "
+                       "as a file an instrument's analog output plays into SPD-CMD (CN2-31/32): its bounds "
+                       "(amplitude, angle travelled, current) are printed before anything is played.")
+    common(q)
+    q.add_argument("--form", choices=EXCITATION_FORMS, default="multisine",
+                   help="the excitation (default multisine)")
+    q.add_argument("--amplitude-rpm", type=number, metavar="R",
+                   help="the speed command's peak at the output [r/min] (default: the largest the axis "
+                   "allows)")
+    q.add_argument("--rate", type=in_range(_RATE), default=10000.0, metavar="HZ",
+                   help="the instrument's output rate [samples/s] (default 10000)")
+    q.add_argument("--periods", type=whole(3, 100), default=6, metavar="N",
+                   help="periods played; the first settles the loop (default 6)")
+    q.add_argument("-o", "--output", required=True, type=output_path, metavar="EXC",
+                   help="the file to write: .csv (time and volts), .wav (16-bit, its full scale stated), "
+                   ".txt (one cycle normalised to ±1)")
+    q.add_argument("--json", metavar="OUT", help="write the excitation's figures as JSON to OUT (- = stdout)")
+    q.set_defaults(func=run_excitation)
+
+    q = sub.add_parser("analyse", help="the frequency response from a bench capture (SPD-MON, SPD-CMD)",
+                       description="The speed loop's frequency response, resonance, load inertia and "
+                       "margins from a capture of SPD-MON (CN2-23) while the excitation played into "
+                       "SPD-CMD: the JSON of 'tune measure'.")
+    common(q)
+    q.add_argument("--signal", action="append", default=[], metavar="ROLE=FILE[#CHANNEL]",
+                   help=f"a signal and where it was captured; ROLE: {', '.join(RESPONSE_ROLES)}")
+    q.add_argument("--excitation", metavar="EXC",
+                   help="the excitation file played (CSV or WAV as 'tune excitation' writes it): the input "
+                   "when SPD-CMD was not recorded, aligned by cross-correlation")
+    q.add_argument("--monitor-bandwidth-hz", type=in_range(_MONITOR_BANDWIDTH), metavar="HZ",
+                   help="SPD-MON's own bandwidth, when known: its lag is taken out of the phase")
+    q.add_argument("--json", metavar="OUT", help="write the result as JSON to OUT (- = stdout)")
+    q.set_defaults(func=run_analyse)
+
+
+_RATE = Range("rate", 1000.0, 1e6, "samples/s", "an instrument's analog output rate")
+_MONITOR_BANDWIDTH = Range("monitor bandwidth", 10.0, 1e6, "Hz", "an analog monitor's bandwidth")
+
+
+def _bench_tuner(args: argparse.Namespace) -> Any:
+    from fha_studio.cli._bench_common import parameter_values
+    from fha_studio.hardware.parameters import load_parameter_model
+    from fha_studio.logic.bench.importer import BenchImportError
+    from fha_studio.logic.tuning.bench_session import bench_tuner
+
+    try:
+        values = parameter_values(args.parameters)
+    except BenchImportError as exc:
+        raise CliError(str(exc)) from None
+    try:
+        return bench_tuner(args.actuator, args.load_inertia, load_parameter_model("HA-655"), values)
+    except ValueError as exc:
+        raise CliError(f"--actuator {args.actuator}: {exc}") from None
+
+
+def run_excitation(args: argparse.Namespace) -> int:
+    from fha_studio.hardware.bench.waveform import form_of, write_waveform
+    from fha_studio.logic.tuning.bench_excitation import NotInSpeedMode, design_excitation
+
+    tuner = _bench_tuner(args)
+    try:
+        excitation = design_excitation(tuner, args.form, args.amplitude_rpm, args.rate, args.periods)
+    except NotInSpeedMode as exc:
+        print(f"fha-studio tune excitation: {exc}", file=sys.stderr)
+        return EXIT_NOT_EXCITABLE
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    form = form_of(args.output)
+    try:
+        write_waveform(args.output, excitation.waveform, form)
+    except ValueError as exc:
+        raise CliError(f"{args.output}: {exc}") from None
+    how = {"csv": "time (s) and SPD-CMD (V)", "wav": f"16-bit WAV, full scale {excitation.peak_v:.4g} V",
+           "cycle": f"one cycle normalised to ±1: set the generator to {excitation.peak_v:.4g} V peak "
+                    f"and {1.0 / excitation.period_s:.6g} Hz, and record SPD-CMD too"}[form]
+    _emit(args, {**excitation.to_dict(), "file": str(args.output), "file_form": form},
+          f"{excitation.describe()}\nwritten to {args.output} ({how})")
+    return 0
+
+
+def run_analyse(args: argparse.Namespace) -> int:
+    from fha_studio.logic.tuning.bench_excitation import NotInSpeedMode
+    from fha_studio.logic.tuning.bench_response import BenchResponseError
+    from fha_studio.logic.tuning.bench_session import RESPONSE_ROLES, bench_response_report, parse_role
+
+    tuner = _bench_tuner(args)
+    try:
+        signals = [parse_role(text, RESPONSE_ROLES) for text in args.signal]
+        result = bench_response_report(tuner, signals, args.excitation, args.monitor_bandwidth_hz)
+    except NotInSpeedMode as exc:
+        print(f"fha-studio tune analyse: {exc}", file=sys.stderr)
+        return EXIT_NOT_EXCITABLE
+    except (BenchResponseError, ValueError) as exc:
+        raise CliError(str(exc)) from None
+    _emit(args, _finite(result), _summary(result))
+    for note in result.get("notes", []):
+        print(note)
+    return 0
+
+
+def _finite(obj: Any) -> Any:
+    from fha_studio.cli._bench_common import finite
+
+    return finite(obj)
+
+
+def _summary(result: dict[str, Any]) -> str:
+    def f(v: float | None, unit: str) -> str:
+        return "none found" if v is None else f"{v:.3g} {unit}"
+
+    spread = result.get("load_inertia_uncertainty_kgm2")
+    load = f(result["load_inertia_estimate_kgm2"], "kg m^2") + (f" ± {spread:.2g}" if spread else "")
+    return (f"resonance {f(result['resonance_hz'], 'Hz')} (predicted "
+            f"{f(result['predicted_resonance_hz'], 'Hz')}), anti-resonance "
+            f"{f(result['antiresonance_hz'], 'Hz')}; load inertia {load}; gain margin "
+            f"{f(result['gain_margin_db'], 'dB')}, phase margin {f(result['phase_margin_deg'], 'deg')}, "
+            f"crossover {f(result['crossover_hz'], 'Hz')}, bandwidth {f(result['bandwidth_hz'], 'Hz')}")

@@ -109,11 +109,14 @@ class Cn2Signals:
         alarm_table: AlarmTable | None = None,
         encoder_counts_cw: bool = False,
         logic_channels: tuple[str, ...] = LOGIC_CHANNELS,
+        speed_command: Callable[[np.ndarray], np.ndarray] | None = None,
     ):
         """``direction``: +1 when a FWD command turns the flange CW (parameter 8); the encoder
         outputs count up on a FWD command unless ``encoder_counts_cw`` (then on CW rotation).
         ``logic_channels``: the ones sampled, in this order (an instrument's selection)."""
         self.rate = float(sample_rate_hz)
+        #: SPD-CMD's volts at the drive's times, recorded as ``SPD_CMD`` (None: not probed)
+        self.speed_command = speed_command
         self.s = settings
         self.pulse_rad = output_pulse_rad
         self.ratio = ratio
@@ -194,6 +197,9 @@ class Cn2Signals:
         levels.update(self._alarm_levels(int(alarm), k.size))
         logic = pack_logic([levels[name] for name in self.logic_channels])
         analog = {"SPD_MON": volts.astype(np.float32)}
+        if self.speed_command is not None:  # the instrument's second input on CN2-31/32
+            command = self.speed_command(ts) + self._rng.normal(0.0, m.noise_v, ts.size)
+            analog["SPD_CMD"] = np.asarray(command, np.float32)
         block = SampleBlock(self.rate, self.logic_channels, logic, analog, first)
         truth = {
             "encoder_counts": outputs,
@@ -218,7 +224,8 @@ class Cn2Signals:
             self.rate,
             self.logic_channels,
             np.zeros(0, logic_dtype(max(1, len(self.logic_channels)))),
-            {"SPD_MON": np.zeros(0, np.float32)},
+            {name: np.zeros(0, np.float32)
+             for name in ("SPD_MON", *(("SPD_CMD",) if self.speed_command is not None else ()))},
             self.next_sample,
         )
 
@@ -260,9 +267,11 @@ class Cn2Signals:
 
 def signals_of_axis(axis: ServoAxis, sample_rate_hz: float, settings: Cn2Settings, *,
                     alarm_table: AlarmTable | None = None,
-                    logic_channels: tuple[str, ...] = LOGIC_CHANNELS) -> Cn2Signals:
+                    logic_channels: tuple[str, ...] = LOGIC_CHANNELS,
+                    speed_command: Callable[[np.ndarray], np.ndarray] | None = None) -> Cn2Signals:
     """The CN2 outputs of a servo axis (its resolution, ratio, in-position range, direction and
-    electronic gear) at an instrument's rate, with the driver's alarm table and CN2."""
+    electronic gear) at an instrument's rate, with the driver's alarm table and CN2; with
+    ``speed_command`` SPD-CMD's volts beside them."""
     model = axis.model
     table = alarm_table or load_alarm_table("HA-655")
     return Cn2Signals(
@@ -276,6 +285,7 @@ def signals_of_axis(axis: ServoAxis, sample_rate_hz: float, settings: Cn2Setting
         alarm_table=table,
         encoder_counts_cw=load_cn2(table.driver).encoder_counts_up_on == "CW",
         logic_channels=logic_channels,
+        speed_command=speed_command,
     )
 
 
@@ -314,11 +324,13 @@ class VirtualBenchInstrument:
         alarm: Callable[[], int] | None = None,
         advance: Callable[[float], None] | None = None,
         alarm_table: AlarmTable | None = None,
+        speed_command: Callable[[np.ndarray], np.ndarray] | None = None,
     ):
         self.axis = axis
         self._advance = advance
         self.settings = settings or Cn2Settings()
-        self.signals = signals_of_axis(axis, sample_rate_hz, self.settings, alarm_table=alarm_table)
+        self.signals = signals_of_axis(axis, sample_rate_hz, self.settings, alarm_table=alarm_table,
+                                       speed_command=speed_command)
         self.alarm = alarm or (lambda: 0)
         self.truth = Truth()
         self._blocks: list[SampleBlock] = []
@@ -353,13 +365,16 @@ class VirtualBenchInstrument:
 
     @classmethod
     def on_drive(
-        cls, drive: SimDrive, sample_rate_hz: float, monitor: MonitorModel | None = None
+        cls, drive: SimDrive, sample_rate_hz: float, monitor: MonitorModel | None = None,
+        *, speed_command: bool = False,
     ) -> VirtualBenchInstrument:
         """The instrument on a stepped simulated drive's CN2: its parameters 1, 2 and 9, its
-        resolution, its alarm (code); the drive's time advances as the instrument records."""
+        resolution, its alarm (code); the drive's time advances as the instrument records. With
+        ``speed_command`` an analog input on SPD-CMD (CN2-31/32) too: channel ``SPD_CMD``."""
         settings = settings_of_drive(drive, monitor)
         return cls(drive.axis, sample_rate_hz, settings, alarm=lambda: drive.alarm, advance=drive.advance,
-                   alarm_table=drive.alarm_table)
+                   alarm_table=drive.alarm_table,
+                   speed_command=drive.speed_command_input.volts if speed_command else None)
 
     def record(self, seconds: float) -> SampleBlock:
         """Run for ``seconds`` and keep what was sampled; returns everything kept so far."""

@@ -54,6 +54,7 @@ from fha_studio.hardware.sim.options import Battery, SimConfig, SimConfigError, 
 from fha_studio.hardware.sim.realtime import RealTime
 from fha_studio.hardware.sim.recorder import SimRecorder
 from fha_studio.hardware.sim.reply import SimRefused, SimReply, rejected, servo_is_on
+from fha_studio.hardware.sim.spd_cmd import SpeedCommandInput, spd_cmd_speeds
 from fha_studio.hardware.sim.supervision import (
     MOTION_WIRING_FAULTS,
     SUPERVISION_PERIOD_S,
@@ -167,6 +168,7 @@ class SimDrive:
         )
 
         self.trace = SimTrace()
+        self.speed_command_input = SpeedCommandInput()  # CN2-31/32 SPD-CMD (.spd_cmd), 0 V unwired
         #: clears of the multi-turn data finished (OWW's ``q`` comes when one finishes)
         self.multi_turn_clears_done = 0
         self.clock_s = 0.0  # simulated time since the drive was built (not reset by PWC)
@@ -578,7 +580,8 @@ class SimDrive:
             tracing = self.trace.active
             if tracing:
                 chunk = min(chunk, self.trace.steps_until_sample())
-            axis.step(chunk, self.excitation.values(chunk) if self.excitation.active else None)
+            added = self.excitation.values(chunk) if self.excitation.active else None
+            axis.step(chunk, spd_cmd_speeds(self, chunk, added))
             steps -= chunk
             self._steps_to_supervision -= chunk
             self.time_s += chunk * dt

@@ -1,9 +1,10 @@
 """Frequency response from measured signals, the gear's resonance in it, the inertia, the margins.
 
-- ``estimate_response``: H1 = Pxy / Pxx and the coherence |Pxy|^2 / (Pxx Pyy) from Welch's
-  cross-spectra (scipy.signal.csd / welch), averaged over records. A record of exactly one period
-  of a periodic excitation is leakage-free with a rectangular window, which is how the excitation
-  and the trace are sized (protocol.excitation_period_periods).
+- ``estimate_response``: H1 = Pxy / Pxx and the coherence |Pxy|^2 / (Pxx Pyy) from the
+  records' cross-spectra (Welch's with one rectangular segment per record), averaged over
+  records. A record of exactly one period of a periodic excitation is leakage-free with a
+  rectangular window, which is how the excitation and the trace are sized
+  (protocol.excitation_period_periods).
 - ``find_resonance``: on the plant (current -> speed) normalised by the rigid body's 1/s slope,
   the anti-resonance is the dip and the resonance the peak above it (parabolic interpolation
   between the bins).
@@ -24,7 +25,7 @@ from typing import Any
 
 import control
 import numpy as np
-from scipy import optimize, signal
+from scipy import optimize
 
 TWO_PI = 2.0 * math.pi
 #: bins of at least this coherence are trusted
@@ -64,17 +65,17 @@ def estimate_response(records: Sequence[tuple[np.ndarray, np.ndarray]], sample_r
     n = min(len(x) for x, _ in records)
     if n < 16:
         raise ValueError(f"frequency response: records of {n} samples are too short")
-    pxx = pyy = pxy = 0.0
-    freq = np.empty(0)
-    for x, y in records:
-        xs, ys = np.asarray(x[:n], float), np.asarray(y[:n], float)
-        kw: dict[str, Any] = dict(fs=sample_rate_hz, window="boxcar", nperseg=n, noverlap=0,
-                                  detrend="constant")
-        freq, sxx = signal.welch(xs, **kw)
-        _, syy = signal.welch(ys, **kw)
-        _, sxy = signal.csd(xs, ys, **kw)
-        pxx, pyy, pxy = pxx + sxx, pyy + syy, pxy + sxy
-    pxx_a, pyy_a, pxy_a = np.asarray(pxx), np.asarray(pyy), np.asarray(pxy)
+    # Welch's estimates with one segment per record, a rectangular window and the mean taken out
+    # (scipy.signal.welch / csd with nperseg = n) are these sums of periodograms up to one scale,
+    # which H1 and the coherence cancel; the FFTs directly are several times faster
+    xs = np.asarray([np.asarray(x[:n], float) for x, _y in records])
+    ys = np.asarray([np.asarray(y[:n], float) for _x, y in records])
+    fx = np.fft.rfft(xs - xs.mean(axis=1, keepdims=True), axis=1)
+    fy = np.fft.rfft(ys - ys.mean(axis=1, keepdims=True), axis=1)
+    freq = np.fft.rfftfreq(n, 1.0 / sample_rate_hz)
+    pxx_a = np.sum(np.abs(fx) ** 2, axis=0)
+    pyy_a = np.sum(np.abs(fy) ** 2, axis=0)
+    pxy_a = np.sum(np.conj(fx) * fy, axis=0)
     top = sample_rate_hz / 2.0 if f_max_hz is None else f_max_hz
     keep = (freq > max(f_min_hz, 0.0)) & (freq <= top) & (pxx_a > 0) & (pyy_a > 0)
     h = pxy_a[keep] / pxx_a[keep]

@@ -1,0 +1,145 @@
+"""Tuning a drive whose CN3 is silent while the servo is on, from the bench: what the command line
+and the Tuning page share (no Qt).
+
+- the drive's items from a parameter file (``fha-parameters/1``, front-panel values included),
+  the rest at their defaults;
+- the capture's signals by role (``ROLE=FILE[#CHANNEL]``, as ``bench import`` takes them):
+  ``speed_monitor`` (SPD-MON, CN2-23) and ``speed_command`` (SPD-CMD, CN2-31/32);
+- the frequency response from them (:mod:`.bench_response`), ``tune measure``'s JSON.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fha_studio.hardware.bench.capture import Capture
+from fha_studio.hardware.bench.readers import read_capture
+from fha_studio.hardware.bench.waveform import Waveform, read_waveform
+from fha_studio.hardware.parameters import Mode, ParameterModel
+from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
+from fha_studio.logic.tuning import bench_names
+from fha_studio.logic.tuning.bench_response import BenchCapture, BenchResponseError, analyse_bench_response
+from fha_studio.logic.tuning.propose import Tuner, present_items
+from fha_studio.logic.tuning.session import declared_model
+
+RESPONSE_ROLES = bench_names.RESPONSE_ROLES
+
+
+@dataclass(frozen=True)
+class RoleSignal:
+    """``ROLE=FILE[#CHANNEL]``."""
+
+    role: str
+    path: str
+    channel: str | None = None
+
+    @property
+    def text(self) -> str:
+        return f"{self.path}#{self.channel}" if self.channel else self.path
+
+
+def parse_role(text: str, roles: Sequence[str]) -> RoleSignal:
+    """``ROLE=FILE[#CHANNEL]`` with ROLE one of ``roles``; BenchResponseError naming what is wrong."""
+    role, sep, rest = text.partition("=")
+    role = role.strip()
+    if not sep or not rest:
+        raise BenchResponseError(f"--signal '{text}': expected ROLE=FILE or ROLE=FILE#CHANNEL")
+    if role not in roles:
+        raise BenchResponseError(f"--signal '{text}': unknown role '{role}' (roles: {', '.join(roles)})")
+    path, hash_, channel = rest.rpartition("#") if "#" in rest else (rest, "", "")
+    if hash_ and not channel:
+        raise BenchResponseError(f"--signal '{text}': no channel after '#'")
+    if not path:
+        raise BenchResponseError(f"--signal '{text}': no file before '#'")
+    return RoleSignal(role, path, channel or None)
+
+
+def bench_items(parameters: ParameterModel,
+                values: Mapping[tuple[str, int], int] | None = None) -> dict[str, int]:
+    """Every tune and parameter-mode item by key: the defaults, then ``values`` ((mode, number) ->
+    wire value, a parameter file's or the front-panel worksheet's)."""
+    items = {it.key: int(it.default) for it in parameters if it.mode in (Mode.TUNE, Mode.SYSTEM)
+             and it.default is not None}
+    items.update(present_items(parameters, {(Mode(m), n): v for (m, n), v in (values or {}).items()}))
+    return items
+
+
+def bench_tuner(actuator: str, load_inertia_kgm2: float, parameters: ParameterModel,
+                values: Mapping[tuple[str, int], int] | None = None,
+                quantised_feedback: bool = True) -> Tuner:
+    """The declared axis with the drive's items, at the servo rate the models assume (the speed fed
+    back from whole encoder pulses, as a real drive's, unless ``quantised_feedback`` is off)."""
+    return Tuner(declared_model(actuator, load_inertia_kgm2), bench_items(parameters, values), parameters,
+                 DEFAULT_SERVO_RATE_HZ, quantised_feedback)
+
+
+def _read(path: str) -> Capture:
+    try:
+        return read_capture(path)
+    except ValueError as exc:  # FileProblem, CaptureError: one line naming the file already
+        raise BenchResponseError(str(exc)) from None
+
+
+def _analog(capture: Capture, signal: RoleSignal) -> np.ndarray:
+    names = list(capture.block.analog)
+    channel = signal.channel
+    if channel is None:
+        if len(names) != 1:
+            raise BenchResponseError(f"--signal {signal.role}={signal.path}: the file has "
+                                     f"{len(names)} analog channels ({', '.join(names) or 'none'}): name "
+                                     "one after '#'")
+        channel = names[0]
+    try:
+        return np.asarray(capture.analog(channel), float)
+    except ValueError as exc:
+        raise BenchResponseError(str(exc)) from None
+
+
+def response_capture(signals: Sequence[RoleSignal]) -> BenchCapture:
+    """SPD-MON (and SPD-CMD) from the capture files, at one rate, cut to the shorter."""
+    by_role: dict[str, RoleSignal] = {}
+    for s in signals:
+        if s.role in by_role:
+            raise BenchResponseError(f"--signal {s.role}: given twice ({by_role[s.role].text} and {s.text})")
+        by_role[s.role] = s
+    if "speed_monitor" not in by_role:
+        raise BenchResponseError("--signal speed_monitor=FILE[#CHANNEL] is needed: SPD-MON (CN2-23) recorded "
+                                 "while the excitation played")
+    captures = {s.path: _read(s.path) for s in by_role.values()}
+    monitor = by_role["speed_monitor"]
+    rate = captures[monitor.path].sample_rate_hz
+    for s in by_role.values():
+        other = captures[s.path].sample_rate_hz
+        if abs(other / rate - 1.0) > 1e-9:
+            raise BenchResponseError(f"{s.path}: sampled at {other:g} Hz but {monitor.path} at {rate:g} Hz: "
+                                     "SPD-MON and SPD-CMD must be recorded together, at one rate")
+    y = _analog(captures[monitor.path], monitor)
+    u = None
+    if "speed_command" in by_role:
+        command = by_role["speed_command"]
+        u = _analog(captures[command.path], command)
+        n = min(len(u), len(y))
+        u, y = u[:n], y[:n]
+    return BenchCapture(rate, y, u, {s.role: s.text for s in by_role.values()})
+
+
+def read_excitation(path: str) -> Waveform:
+    try:
+        return read_waveform(path)
+    except ValueError as exc:
+        raise BenchResponseError(str(exc)) from None
+
+
+def bench_response_report(tuner: Tuner, signals: Sequence[RoleSignal], excitation: str | None = None,
+                          monitor_bandwidth_hz: float | None = None) -> dict[str, Any]:
+    """``tune analyse``'s JSON for a frequency response from the bench."""
+    capture = response_capture(signals)
+    wave = read_excitation(excitation) if excitation else None
+    result = analyse_bench_response(tuner, capture, wave, monitor_bandwidth_hz)
+    if excitation:
+        result["bench"]["excitation_file"] = excitation
+    return result
