@@ -6,12 +6,19 @@ more than a float64 ring holds. Each window of ``factor`` samples becomes one ro
 channel is high if it was high anywhere in the window (a pulse shorter than a window still
 shows), an analog channel is the window's mean (noise averaged, not aliased). Windows run on
 across blocks, so the rows of a stream are the same however sigrok-cli cut it.
+
+The encoder's counts and the commanded counts of a row are those at its window's last sample.
+A live stream needs no more of them, so :meth:`LiveQuadrature.feed_windows` and
+:meth:`LiveCommandPulses.feed_windows` take them from every sample's step with a few bit
+operations and one sum per window, instead of finding each change of the lines first: the
+same counts for a third of the CPU where the lines change often (sigrok's demo changes its
+D0/D1 in 42 % of the samples; a real encoder at speed in a few %).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
@@ -50,9 +57,12 @@ class Decimator:
     def row_rate_hz(self) -> float:
         return self.sample_rate_hz / self.factor
 
-    def feed(self, block: SampleBlock, extra: Mapping[str, np.ndarray | Steps] | None = None) -> np.ndarray:
+    def feed(self, block: SampleBlock,
+             extra: Mapping[str, np.ndarray | Steps | Callable[[np.ndarray], np.ndarray]] | None = None
+             ) -> np.ndarray:
         """The rows the block completes: shape ``(rows, 1 + channels + extra)``, ``t_s`` first.
-        ``extra``: per sample of the block, an array or :class:`Steps`."""
+        ``extra``: per sample of the block, an array or :class:`Steps`; or a function that is
+        given the block's samples that end a window (maybe none) and returns the values there."""
         extra = extra or {}
         k, m = self.factor, self._carried
         n = m + block.samples
@@ -80,8 +90,12 @@ class Decimator:
         ends = (k - m - 1) + np.arange(count) * k  # each window's last sample, in the block
         for i, name in enumerate(self.extra):
             column = extra[name]
-            rows[:, 1 + len(self.channels) + i] = column.sample(ends) if isinstance(column, Steps) \
-                else column[ends]
+            if isinstance(column, Steps):
+                rows[:, 1 + len(self.channels) + i] = column.sample(ends)
+            elif callable(column):
+                rows[:, 1 + len(self.channels) + i] = column(ends)
+            else:
+                rows[:, 1 + len(self.channels) + i] = column[ends]
         self._carry_logic = logic[whole:] if block.logic_channels else None
         self._carried = n - whole
         self._next_sample += whole
@@ -117,6 +131,22 @@ class LiveQuadrature:
         self.illegal_transitions += result.illegal_transitions
         return counts
 
+    def feed_windows(self, logic: np.ndarray, bit_a: int, bit_b: int, ends: np.ndarray) -> np.ndarray:
+        """The counts (int64) at the block's samples ``ends`` (sorted), as
+        ``feed_packed(...).sample(ends)`` gives them, from every sample's step (see the module's
+        text); the whole block is counted whatever ``ends`` holds."""
+        levels = _levels(self, logic, bit_a, bit_b)
+        if levels is None:
+            return np.full(len(ends), self.counts, np.int64)
+        a, b = levels
+        assert b is not None
+        ap, ac, bp, bc = a[:-1], a[1:], b[:-1], b[1:]
+        # Gray code steps: +1 where A leads B, -1 where B leads A, 0 where nothing or both changed
+        step = (bp ^ ac).view(np.int8) - (ap ^ bc).view(np.int8)
+        self.illegal_transitions += int(np.count_nonzero((ap ^ ac) & (bp ^ bc)))
+        values, self.counts = _running(step, ends, self.counts)
+        return values
+
 
 def _with_last(owner: LiveQuadrature | LiveCommandPulses, logic: np.ndarray, *bits: int) -> Lines | None:
     """The block's lines with the previous block's last sample before its first (the reference
@@ -128,6 +158,39 @@ def _with_last(owner: LiveQuadrature | LiveCommandPulses, logic: np.ndarray, *bi
     lines = Lines.from_packed(np.concatenate([owner._last, logic]), *bits)
     owner._last = logic[-1:].copy()
     return lines
+
+
+def _levels(owner: LiveQuadrature | LiveCommandPulses, logic: np.ndarray, bit_a: int,
+            bit_b: int | None) -> tuple[np.ndarray, np.ndarray | None] | None:
+    """Bits A and B's levels (uint8 0/1) at the previous block's last sample and every sample of
+    this one (B None: None), or None for an empty block."""
+    if logic.size == 0:
+        return None
+    if owner._last is None or owner._last.dtype != logic.dtype:
+        owner._last = logic[:1]
+    words = np.empty(logic.size + 1, logic.dtype)
+    words[0] = owner._last[0]
+    words[1:] = logic
+    owner._last = logic[-1:].copy()
+    one = logic.dtype.type(1)
+
+    def level(bit: int) -> np.ndarray:
+        out: np.ndarray = ((words >> logic.dtype.type(bit)) & one).astype(np.uint8, copy=False)
+        return out
+
+    return level(bit_a), None if bit_b is None else level(bit_b)
+
+
+def _running(step: np.ndarray, ends: np.ndarray, start: int) -> tuple[np.ndarray, int]:
+    """The running sum of ``step`` from ``start`` at samples ``ends`` (sorted), and at the end:
+    one sum per stretch up to each end, then their running sum."""
+    starts = np.empty(len(ends) + 1, np.intp)
+    starts[0] = 0
+    starts[1:] = np.asarray(ends) + 1
+    if starts[-1] >= step.size:  # the last window ends with the block
+        starts = starts[:-1]
+    run = start + np.cumsum(np.add.reduceat(step, starts, dtype=np.int64))
+    return run[: len(ends)], int(run[-1])
 
 
 def _shifted(steps: Steps, offset: float) -> Steps:
@@ -182,6 +245,32 @@ class LiveCommandPulses:
             pulses = _shifted(result.pulse_steps, self.pulses)
         self.pulses = int(pulses.final)
         return pulses.scaled(numerator / denominator)
+
+    def feed_windows(self, logic: np.ndarray, bit_a: int, bit_b: int | None, ends: np.ndarray) -> np.ndarray:
+        """The commanded counts at the block's samples ``ends`` (sorted), as
+        ``feed_packed(...).sample(ends)`` gives them, from every sample (see the module's text)."""
+        numerator, denominator = self.gear
+        if self._edges is not None:
+            if bit_b is None:
+                raise decode.DecodeError("two-phase command pulses (parameter 1 = 2) need both lines")
+            divisor = 4 // self.multiplication
+            edges = self._edges.feed_windows(logic, bit_a, bit_b, ends)
+            self.illegal_transitions = self._edges.illegal_transitions
+            self.pulses = self._edges.counts // divisor
+            out: np.ndarray = np.floor_divide(edges, divisor) * (numerator / denominator)
+            return out
+        levels = _levels(self, logic, bit_a, bit_b)
+        if levels is None:
+            return np.full(len(ends), self.pulses * numerator / denominator)
+        a, b = levels
+        rises = a[1:] & (a[:-1] ^ 1)  # A low before, high now
+        inc = rises.view(np.int8)
+        if b is not None and self.pulse_form == 0:  # two-pulse: REV pulses on B
+            inc = inc - (b[1:] & (b[:-1] ^ 1)).view(np.int8)
+        elif b is not None:  # pulse + sign: B high (ON) at the pulse = REV
+            inc = inc - 2 * (rises & b[1:]).view(np.int8)
+        values, self.pulses = _running(inc, ends, self.pulses)
+        return values * (numerator / denominator)
 
 
 def peak_rows(rows: np.ndarray, buckets: int) -> np.ndarray:

@@ -97,3 +97,36 @@ def test_an_alarm_on_the_code_lines_is_named_in_the_manuals_words():
     assert "(ALM-C not mapped)" in encoder.detail
     quiet = _by(bench_checks(T, CMD, ENC, alarm=np.zeros(T.size), alarm_code=np.zeros(T.size)))["bench_alarm"]
     assert quiet.passed and quiet.detail.startswith("ALARM and ALM-A ... D stayed off")
+
+
+@pytest.mark.parametrize("counts_cw", [False, True])
+def test_the_simulated_drives_encoder_outputs_and_parameter_8_give_the_flanges_direction(counts_cw):
+    """Parameter 8 = 1 on the simulated drive: a FWD command turns the flange CCW; its CN2 encoder
+    outputs count in the command's sense (the data's assumption) or the flange's CW one, and the
+    check, told which, says CCW either way."""
+    from fha_studio.catalog import get_actuator
+    from fha_studio.hardware.sim.cn2 import Cn2Settings, Cn2Signals, VirtualBenchInstrument
+    from fha_studio.logic.bench.decode import command_pulses, quadrature
+    from fha_studio.physics import AxisModel, ServoAxis
+
+    axis = ServoAxis(AxisModel.from_actuator(get_actuator("FHA-25C-50-US250")))
+    axis.set_settings(axis.settings.replace(rotary_direction=1))
+    axis.servo_on()
+    instrument = VirtualBenchInstrument(axis, 100e3, Cn2Settings(pulse_form=0))
+    if counts_cw:
+        s = instrument.signals
+        instrument.signals = Cn2Signals(s.rate, s.s, output_pulse_rad=s.pulse_rad, ratio=s.ratio,
+                                        in_position_range_counts=s.in_position_range, direction=s.direction,
+                                        encoder_counts_cw=True)
+    instrument.record(0.02)
+    axis.move_by_pulses(2000, speed_rad_s=0.5)
+    block = instrument.record(0.3)
+    encoder = quadrature(block.bit("ENC_A"), block.bit("ENC_B")).counts
+    command = command_pulses(block.bit("CMD_A"), block.bit("CMD_B"), 0, 4, 1, 1).counts
+    assert command[-1] == 2000 and abs(encoder[-1] - (-2000 if counts_cw else 2000)) <= 10  # still settling
+    cn2 = dataclasses.replace(load_cn2(), encoder_counts_up_on="CW" if counts_cw else "FWD command")
+    t = np.arange(block.samples) / block.sample_rate_hz
+    checks = _by(bench_checks(t, command, encoder, parameter_8=1, cn2=cn2))
+    assert checks["bench_encoder"].passed and checks["bench_direction"].passed
+    assert (checks["bench_direction"].values["rotation"], checks["bench_direction"].values["flange"]) == (
+        "REV rotation", "CCW")

@@ -107,3 +107,50 @@ def test_bench_move_figures_take_in_position_from_in_pos_and_following_error_in_
     assert figures.following_error_peak_counts == pytest.approx(100.0, abs=1.0)
     assert figures.following_error_end_counts == 0.0
     assert bench_move_figures(t, cmd, enc, np.zeros(t.size), 100.0).in_position_time_s is None
+
+
+def _windows(rng, sizes, k):
+    """Each block's samples that end a window of ``k``, as the Decimator gives them."""
+    m, out = 0, []
+    for size in sizes:
+        n = m + size
+        out.append((k - m - 1) + np.arange(n // k) * k)
+        m = n - (n // k) * k
+    return out
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
+@pytest.mark.parametrize("decoder", ["quadrature", "two-pulse", "two-pulse, A only", "pulse + sign",
+                                     "two-phase x4", "two-phase x2", "two-phase x1"])
+def test_counts_at_window_ends_from_every_sample_equal_the_changes_decoding(decoder, dtype):
+    """feed_windows (every sample's step, summed per window) gives what feed_packed (the changes)
+    gives at the windows' last samples, on lines that change at random (every transition, the
+    illegal ones too), cut into blocks at random, and counts the same illegal transitions."""
+    from fha_studio.logic.bench.display import LiveCommandPulses, LiveQuadrature
+
+    rng = np.random.default_rng(len(decoder) + dtype().itemsize)
+    n, k = 20_000, 7
+    words = rng.integers(0, 1 << (8 * np.dtype(dtype).itemsize), n, dtype=dtype)
+    words[5000:9000] = words[5000]  # a stretch where nothing changes
+    bits = (3, 6) if dtype == np.uint8 else (12, 1)
+    sizes = np.diff(np.concatenate(([0], np.sort(rng.choice(np.arange(1, n), 30, replace=False)), [n])))
+    if decoder == "quadrature":
+        by_changes, by_samples = LiveQuadrature(), LiveQuadrature()
+        feed = (lambda d, block: d.feed_packed(block, *bits)), \
+            (lambda d, block, e: d.feed_windows(block, *bits, e))
+    else:
+        form = {"two-pulse": 0, "two-pulse, A only": 0, "pulse + sign": 1}.get(decoder, 2)
+        multiplication = int(decoder[-1]) if form == 2 else 4
+        b = None if decoder.endswith("A only") else bits[1]
+        by_changes, by_samples = (LiveCommandPulses(form, multiplication, 3, 2) for _ in range(2))
+        feed = (lambda d, block: d.feed_packed(block, bits[0], b)), \
+            (lambda d, block, e: d.feed_windows(block, bits[0], b, e))
+    start = 0
+    for size, ends in zip(sizes, _windows(rng, sizes, k), strict=True):
+        block = words[start:start + size]
+        start += size
+        expected = feed[0](by_changes, block).sample(ends)
+        assert np.array_equal(feed[1](by_samples, block, ends), expected)
+    final = (by_changes.counts, by_samples.counts) if decoder == "quadrature" else \
+        (by_changes.pulses, by_samples.pulses)
+    assert final[0] == final[1] and by_changes.illegal_transitions == by_samples.illegal_transitions

@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
@@ -28,7 +30,6 @@ from fha_studio.logic.bench.display import (
     LiveQuadrature,
     display_factor,
 )
-from fha_studio.logic.bench.edges import Steps
 from fha_studio.logic.bench.importer import DriveSettings
 from fha_studio.logic.scope.ring import RingBuffer
 
@@ -161,14 +162,16 @@ class BenchWorker(QObject):
         last_status = 0.0
         try:
             for block in acquisition.blocks():
-                counts: dict[str, Steps] = {}  # decoded on the packed words, held where they change
+                # decoded on the packed words at each display row's last sample (all a row shows)
+                counts: dict[str, Callable[[np.ndarray], np.ndarray]] = {}
                 bit = block.logic_channels.index
                 if quadrature is not None and encoder is not None:
-                    counts["counts"] = quadrature.feed_packed(block.logic, bit(encoder[0]), bit(encoder[1]))
+                    counts["counts"] = partial(quadrature.feed_windows, block.logic, bit(encoder[0]),
+                                               bit(encoder[1]))
                 if commands is not None and settings.command is not None:
                     line_a, line_b = settings.command
-                    counts["command"] = commands.feed_packed(block.logic, bit(line_a),
-                                                             bit(line_b) if line_b else None)
+                    counts["command"] = partial(commands.feed_windows, block.logic, bit(line_a),
+                                                bit(line_b) if line_b else None)
                 rows = decimator.feed(block, counts)
                 if len(rows):
                     ring.write(rows)
