@@ -136,6 +136,8 @@ def test_each_role_adds_what_it_may_and_nothing_else(plant, capsys):
     with Register(plant["bob"]) as reg, pytest.raises(RegisterError, match=(
             "bob may not do that: a technician adds parameter snapshots, and nobody changes or removes")):
         reg.record_snapshot(TABLE, [("system", 8, "rotary_direction", 0)], "link")
+    with psycopg.connect(plant["ana"]) as db:  # a temporary table of her own (a sync brings facts so)
+        db.execute("CREATE TEMPORARY TABLE incoming (uid TEXT)")
     with psycopg.connect(plant[ROLE]) as db:  # each fact's receipt: the server's clock, the login
         receipts = db.execute("SELECT fact_table, received_by FROM register_receipt ORDER BY received_utc")
         assert [tuple(r) for r in receipts] == [
@@ -167,7 +169,8 @@ def test_a_technician_cannot_change_remove_or_back_date_a_fact(plant, capsys, se
                     "DELETE FROM alarm", "TRUNCATE alarm",
                     "UPDATE register_receipt SET received_utc = received_utc - interval '3 days'",
                     "INSERT INTO register_receipt VALUES ('alarm', '99', now(), 'ana', pg_current_xact_id())",
-                    "DELETE FROM register_receipt"):
+                    "DELETE FROM register_receipt",
+                    "INSERT INTO this_register VALUES ((SELECT register_id FROM known_register LIMIT 1))"):
             with pytest.raises(psycopg.errors.InsufficientPrivilege):
                 db.execute(sql)
         with pytest.raises(psycopg.Error, match="values are added with their snapshot, never to it later"):

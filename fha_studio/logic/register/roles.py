@@ -69,6 +69,8 @@ TECHNICIAN_AXIS_FIELDS = (
 REVIEWER_TABLES = ("report", "report_signature", "signing_key", "key_revocation", "axis_event")
 #: The facts only a reviewer adds.
 REVIEWER_ONLY = ("report_signature",)
+#: What only the owner writes: the register's own id, made with it.
+OWNER_ONLY = ("this_register",)
 #: What an administrator adds (and changes: machines and axes).
 ADMINISTRATOR_TABLES = ("machine", "axis", "axis_event", "signing_key", "key_revocation", "register_person")
 #: The column that says when a fact happened, by table (the first of these it has).
@@ -322,9 +324,7 @@ def _functions(catalog: Catalog) -> list[str]:
         f"""CREATE OR REPLACE FUNCTION register_check_values() RETURNS trigger LANGUAGE plpgsql {path} AS $fn$
         BEGIN
             IF NOT EXISTS (SELECT 1 FROM register_receipt WHERE fact_table = 'snapshot'
-                    AND fact_key = (SELECT (to_jsonb(s) ->> TG_ARGV[0]) FROM snapshot s
-                                    WHERE s.id = NEW.snapshot_id)
-                    AND in_transaction = pg_current_xact_id()) THEN
+                    AND fact_key = NEW.snapshot_id::text AND in_transaction = pg_current_xact_id()) THEN
                 PERFORM register_refuse('snapshot ' || NEW.snapshot_id || ' was recorded before: '
                     || 'values are added with their snapshot, never to it later');
             END IF;
@@ -348,11 +348,13 @@ def protection(catalog: Catalog) -> list[str]:
     out = [*_functions(catalog)]
     out += [
         f"REVOKE ALL ON DATABASE {ident(catalog.database)} FROM PUBLIC",
-        f"GRANT CONNECT ON DATABASE {ident(catalog.database)} TO {everyone}",
+        # (temporary tables: a sync brings many facts in through one, COPY then INSERT)
+        f"GRANT CONNECT, TEMPORARY ON DATABASE {ident(catalog.database)} TO {everyone}",
         f"GRANT USAGE ON SCHEMA {ident(catalog.schema)} TO {everyone}",
         f"GRANT SELECT ON ALL TABLES IN SCHEMA {ident(catalog.schema)} TO {everyone}",
     ]
-    technician = [t for t in (*FACT_TABLES, *REGISTER_TABLES) if t in tables and t not in REVIEWER_ONLY]
+    technician = [t for t in (*FACT_TABLES, *REGISTER_TABLES)
+                  if t in tables and t not in REVIEWER_ONLY and t not in OWNER_ONLY]
     out.append(f"GRANT INSERT ON {', '.join(technician)} TO {groups['technician']}")
     fields = [c for c in TECHNICIAN_AXIS_FIELDS if c in catalog.columns.get("axis", [])]
     out.append(f"GRANT UPDATE ({', '.join(fields)}) ON axis TO {groups['technician']}")
@@ -386,9 +388,8 @@ def protection(catalog: Catalog) -> list[str]:
     for table, function in checks.items():
         if table in tables:
             out.append(trigger("who", table, "BEFORE INSERT", function))
-    if "snapshot_value" in tables and "snapshot" in catalog.keys:
-        out.append(trigger("values", "snapshot_value", "BEFORE INSERT", "register_check_values",
-                           catalog.keys["snapshot"]))
+    if "snapshot_value" in tables:
+        out.append(trigger("values", "snapshot_value", "BEFORE INSERT", "register_check_values"))
     out.append(trigger("stamp", "register_person", "BEFORE INSERT", "register_stamp_person"))
     for table, words in (("register_person", "who each login is"), ("register_receipt", "receipts")):
         said = literal(f"append-only: {words} are never changed or removed")
@@ -439,6 +440,7 @@ _WHO_WRITES = {
     "register_person": "an administrator says who each login is",
     "register_schema": "the register's owner brings it up to date (fha-studio register roles setup)",
     "register_receipt": "the server writes the receipts itself",
+    "this_register": "the register's own id is made with it, by its owner",
 }
 
 
