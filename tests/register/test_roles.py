@@ -233,6 +233,12 @@ def test_signing_as_someone_else_is_refused_by_the_server(plant, tmp_path, capsy
     with psycopg.connect(plant[ROLE]) as db:
         assert db.execute("SELECT signer FROM report_signature").fetchall() == [("Bob Reviewer",)]
     assert Path(bob_file).exists()
+    # a key is revoked by its own person, or by an administrator (a lost laptop), by nobody else
+    bob_id = key_id_of(public_raw(bob_key))
+    code, _, err = _cli(capsys, plant["dave"], "keys", "revoke", bob_id)
+    assert code == 2 and f"key {bob_id} is Bob Reviewer's: the login dave (Dave Other) revokes only its " \
+        "own keys (an administrator revokes anyone's)" in _one_line(err)
+    assert _cli(capsys, plant["cleo"], "keys", "revoke", bob_id, "--reason", "laptop lost")[0] == 0
 
 
 def test_twenty_writers_at_once_leave_every_fact_once(plant, postgres_cluster):
