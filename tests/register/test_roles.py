@@ -32,6 +32,8 @@ PEOPLE = (
     ("cleo", "administrator", "Cleo Admin"),
     ("dave", "reviewer", "Dave Other"),
 )
+#: A login of the server with no role of the register.
+STRANGER = "eve"
 LOGIN_PASSWORD = "login-test-password"
 
 
@@ -41,7 +43,7 @@ def logins(postgres_cluster):
     make roles (its owner sets the roles up)."""
     with psycopg.connect(postgres_cluster.url("postgres", "postgres", SUPER_PASSWORD), autocommit=True) as db:
         db.execute(f"ALTER ROLE {ROLE} CREATEROLE")
-        for login, _, _ in PEOPLE:
+        for login in (*(p[0] for p in PEOPLE), STRANGER):
             if db.execute("SELECT 1 FROM pg_roles WHERE rolname = %s", (login,)).fetchone() is None:
                 db.execute(f"CREATE ROLE {login} LOGIN PASSWORD '{LOGIN_PASSWORD}'")
     return [login for login, _, _ in PEOPLE]
@@ -108,6 +110,10 @@ def test_the_owner_sets_the_roles_up_and_gives_them(postgres_cluster, logins, se
     assert _cli(capsys, url, "roles", "revoke", "ana", "reviewer")[1] == "ana (Ana Lima): technician\n"
     code, out, _ = _cli(capsys, _as(url, "ana"), "roles", "list")  # anyone with a role may ask
     assert code == 0 and out == "ana (Ana Lima): technician\n"
+    code, _, err = _cli(capsys, _as(url, STRANGER), "machines")  # a login without a role of it
+    assert code == 2 and _one_line(err).endswith(
+        "eve may not use this register: a login works with it when its owner gives the login a role "
+        "(fha-studio register roles grant LOGIN ROLE --person NAME): nothing was changed")
     code, _, err = _cli(capsys, _as(url, "ana"), "roles", "setup")  # not the owner
     said = _one_line(err)
     assert code == 2 and f"the roles are set up by the register's owner, {ROLE}; this is ana" in said

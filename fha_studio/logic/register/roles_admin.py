@@ -6,7 +6,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from fha_studio.logic.register.guard import RegisterError
 from fha_studio.logic.register.roles import (
     ROLES,
     Catalog,
@@ -26,10 +25,6 @@ def _connect(url: str) -> Any:
     import psycopg
 
     return psycopg.connect(url, autocommit=True, connect_timeout=10)
-
-
-def _in_words(url: str, exc: BaseException) -> RegisterError:
-    return problem(url, exc)
 
 
 def setup(url: str) -> list[str]:
@@ -69,7 +64,7 @@ def setup(url: str) -> list[str]:
                     db.execute(statement.encode())
             return made
     except psycopg.Error as exc:
-        raise _in_words(url, exc) from None
+        raise problem(url, exc) from None
 
 
 def _person_of(db: Any, login: str) -> str:
@@ -112,7 +107,7 @@ def grant(url: str, login: str, role: str, person: str = "") -> Member:
                 db.execute(f"GRANT {ident(group)} TO {ident(login)}".encode())
             return next(m for m in members(db, database) if m.login == login)
     except psycopg.Error as exc:
-        raise _in_words(url, exc) from None
+        raise problem(url, exc) from None
 
 
 def revoke(url: str, login: str, role: str) -> Member:
@@ -128,7 +123,7 @@ def revoke(url: str, login: str, role: str) -> Member:
             found = [m for m in members(db, database) if m.login == login]
             return found[0] if found else Member(login, "", ())
     except psycopg.Error as exc:
-        raise _in_words(url, exc) from None
+        raise problem(url, exc) from None
 
 
 def listing(url: str) -> list[Member]:
@@ -142,4 +137,4 @@ def listing(url: str) -> list[Member]:
                                  "fha-studio register roles setup)")
             return members(db, db.execute("SELECT current_database()").fetchone()[0])
     except psycopg.Error as exc:
-        raise _in_words(url, exc) from None
+        raise problem(url, exc) from None

@@ -245,11 +245,15 @@ def _not_allowed(url: str, where: str, first: str, opening: bool) -> RegisterErr
     if "must be owner" in first or (table and table.group(1) == "register_schema"):
         rule = ("the register was written by an older FHA Studio: its owner brings it up to date "
                 "(fha-studio register roles setup, run as the owner)")
-    elif "for schema" in first or "for database" in first:
+    elif "for database" in first:  # no CONNECT: a login without a role of the register
+        who = f"{login} may not use this register" if login else "this login may not use this register"
+        rule = ("a login works with it when its owner gives the login a role "
+                "(fha-studio register roles grant LOGIN ROLE --person NAME)")
+    elif "for schema" in first:
         rule = "its owner makes the register (fha-studio register add-machine NAME, run as the owner)"
     else:
         rule = (who_writes(table.group(1)) if table else "") or quoted(first, limit=80, always=False)
-    if opening and not table:
+    if opening and not table and "for database" not in first:
         who = f"{login} may not use this register" if login else "this login may not use this register"
     return RegisterError(f"the register {where}: {who}: {rule}: nothing was changed")
 
