@@ -117,6 +117,10 @@ def test_the_owner_sets_the_roles_up_and_gives_them(postgres_cluster, logins, se
     code, _, err = _cli(capsys, _as(url, "ana"), "roles", "setup")  # not the owner
     said = _one_line(err)
     assert code == 2 and f"the roles are set up by the register's owner, {ROLE}; this is ana" in said
+    code, _, err = _cli(capsys, url, "add-machine", "Press 7")  # nobody works as the owner
+    assert code == 2 and _one_line(err).endswith(
+        f"the server refused it: the register's owner, {ROLE}, records nothing: people work with their "
+        "own logins (fha-studio register roles grant LOGIN ROLE --person NAME): nothing was changed")
     with psycopg.connect(url) as db:  # who each login is: a row per change, stamped by the server
         rows = db.execute("SELECT login, person, by_login FROM register_person").fetchall()
     assert rows == [("ana", "Ana Lima", ROLE)]

@@ -75,10 +75,12 @@ END
 $body$"""
 
 
-def server_drop(existing: list[tuple[str, str]]) -> list[str]:
-    """Statements removing the protecting triggers in ``existing`` ((table, trigger) pairs)."""
+def server_drop(existing: list[tuple[str, str]], prefixes: tuple[str, ...] = (PREFIX,)) -> list[str]:
+    """Statements removing the protecting triggers in ``existing`` ((table, trigger) pairs), those
+    whose names begin with one of ``prefixes`` (the roles' too: :mod:`.roles`, made again after
+    the migrations)."""
     return [f'DROP TRIGGER IF EXISTS "{name}" ON "{table}"'
-            for table, name in existing if name.startswith(PREFIX)]
+            for table, name in existing if name.startswith(prefixes)]
 
 
 def server_create(tables: set[str]) -> list[str]:

@@ -14,7 +14,8 @@ PostgreSQL's ``createuser``) that is a member of one or more of them:
 Every role reads the whole register. Each person adds their own signing key and may revoke it
 (an administrator may revoke anyone's: a lost laptop). The register's **owner** (the role that
 made its tables, and runs ``register roles setup``) keeps the rest: migrations, roles, grants.
-The owner is no role of FHA Studio's people: nobody works as the owner.
+The owner is no role of FHA Studio's people: once the roles are set up the server refuses any
+fact, machine or axis the owner would add (nobody works as the owner).
 
 What the server enforces (the triggers and grants :func:`protection` makes, on top of the
 append-only triggers every register has, :mod:`.append_only`):
@@ -43,7 +44,7 @@ from typing import Any
 from fha_studio.logic.register.append_only import PREFIX as APPEND_ONLY_PREFIX
 from fha_studio.logic.register.append_only import refusal_text
 from fha_studio.logic.register.guard import RegisterError
-from fha_studio.logic.register.schema import FACT_TABLES, REGISTER_TABLES
+from fha_studio.logic.register.schema import ENTITY_TABLES, FACT_TABLES, REGISTER_TABLES
 
 #: The register's roles, in words for people and in the group role's name.
 ROLES = ("technician", "reviewer", "administrator")
@@ -111,13 +112,16 @@ class Catalog:
 
     database: str
     schema: str
+    owner: str  # the role that owns the register's tables
     columns: dict[str, list[str]]
     keys: dict[str, str]
 
     @classmethod
     def read(cls, db: Any) -> Catalog:
         """From an open connection (psycopg's or the register's :class:`~.server.ServerDatabase`)."""
-        database, schema = db.execute("SELECT current_database(), current_schema()").fetchone()
+        database, schema, owner = db.execute(
+            "SELECT current_database(), current_schema(), (SELECT tableowner FROM pg_tables"
+            " WHERE tablename = 'register_schema' AND schemaname = current_schema())").fetchone()
         columns: dict[str, list[str]] = {}
         for table, column in db.execute(
             "SELECT table_name, column_name FROM information_schema.columns"
@@ -138,7 +142,7 @@ class Catalog:
                 keys[table] = "id"
             elif len(primary.get(table, [])) == 1:
                 keys[table] = primary[table][0]
-        return cls(str(database), str(schema), columns, keys)
+        return cls(str(database), str(schema), str(owner or ""), columns, keys)
 
 
 def has_receipts(db: Any) -> bool:
@@ -313,6 +317,15 @@ def _functions(catalog: Catalog) -> list[str]:
             END IF;
             RETURN NEW;
         END $fn$""",
+        f"""CREATE OR REPLACE FUNCTION register_not_owner() RETURNS trigger LANGUAGE plpgsql AS $fn$
+        BEGIN
+            IF session_user = {literal(catalog.owner)} THEN
+                PERFORM register_refuse('the register''s owner, ' || session_user || ', records nothing: '
+                    || 'people work with their own logins (fha-studio register roles grant LOGIN ROLE '
+                    || '--person NAME)');
+            END IF;
+            RETURN NEW;
+        END $fn$""",
         f"""CREATE OR REPLACE FUNCTION register_receive() RETURNS trigger LANGUAGE plpgsql
         SECURITY DEFINER {path} AS $fn$
         BEGIN
@@ -369,6 +382,9 @@ def protection(catalog: Catalog) -> list[str]:
         return (f"CREATE OR REPLACE TRIGGER {TRIGGER_PREFIX}{name}_{table} {when} ON {table}"
                 f" FOR EACH ROW EXECUTE FUNCTION {function}({given})")
 
+    for table in (*ENTITY_TABLES, *FACT_TABLES, *REGISTER_TABLES):
+        if table in tables and table not in OWNER_ONLY:
+            out.append(trigger("owner", table, "BEFORE INSERT", "register_not_owner"))
     for table in (*FACT_TABLES, *REGISTER_TABLES):
         if table not in tables:
             continue

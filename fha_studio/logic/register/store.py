@@ -190,9 +190,12 @@ class Register(Keys):
                 "SELECT tablename FROM pg_tables WHERE schemaname = current_schema()")}
             if make:
                 return append_only.server_create(tables)
+            from fha_studio.logic.register.roles import TRIGGER_PREFIX  # the roles' too: made again after
+
             return append_only.server_drop([(r[0], r[1]) for r in self._db.execute(
                 "SELECT c.relname, t.tgname FROM pg_trigger t JOIN pg_class c ON c.oid = t.tgrelid"
-                " WHERE NOT t.tgisinternal AND c.relnamespace = current_schema()::regnamespace")])
+                " WHERE NOT t.tgisinternal AND c.relnamespace = current_schema()::regnamespace")],
+                (append_only.PREFIX, TRIGGER_PREFIX))
         if make:
             tables = {r[0] for r in self._db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
             return append_only.sqlite_create(tables)
