@@ -184,7 +184,7 @@ def _apply(args: argparse.Namespace, client: Any, parameters: Any, tuner: Any,
 
 def _add_bench(sub: argparse._SubParsersAction) -> None:
     from fha_studio.cli._values import in_range, number, output_path, whole
-    from fha_studio.logic.tuning.bench_names import EXCITATION_FORMS, RESPONSE_ROLES
+    from fha_studio.logic.tuning.bench_names import ANALYSE_ROLES, EXCITATION_FORMS
     from fha_studio.plausible import LOAD_INERTIA_KGM2
 
     def common(q: argparse.ArgumentParser) -> None:
@@ -215,13 +215,17 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--json", metavar="OUT", help="write the excitation's figures as JSON to OUT (- = stdout)")
     q.set_defaults(func=run_excitation)
 
-    q = sub.add_parser("analyse", help="the frequency response from a bench capture (SPD-MON, SPD-CMD)",
+    q = sub.add_parser("analyse", help="the loop from a bench capture: a frequency response or a move",
                        description="The speed loop's frequency response, resonance, load inertia and "
                        "margins from a capture of SPD-MON (CN2-23) while the excitation played into "
-                       "SPD-CMD: the JSON of 'tune measure'.")
+                       "SPD-CMD (speed mode); or, where no output can drive SPD-CMD, the loop fitted to a "
+                       "move captured in position mode (the command pulses, the encoder outputs, SPD-MON): "
+                       "the JSON of 'tune measure'.")
     common(q)
     q.add_argument("--signal", action="append", default=[], metavar="ROLE=FILE[#CHANNEL]",
-                   help=f"a signal and where it was captured; ROLE: {', '.join(RESPONSE_ROLES)}")
+                   help=f"a signal and where it was captured; ROLE: {', '.join(ANALYSE_ROLES)} (a response: "
+                   "speed_monitor with speed_command or --excitation; a move: encoder_a, encoder_b, "
+                   "command_a [command_b] [speed_monitor] [in_position])")
     q.add_argument("--excitation", metavar="EXC",
                    help="the excitation file played (CSV or WAV as 'tune excitation' writes it): the input "
                    "when SPD-CMD was not recorded, aligned by cross-correlation")
@@ -235,7 +239,8 @@ _RATE = Range("rate", 1000.0, 1e6, "samples/s", "an instrument's analog output r
 _MONITOR_BANDWIDTH = Range("monitor bandwidth", 10.0, 1e6, "Hz", "an analog monitor's bandwidth")
 
 
-def _bench_tuner(args: argparse.Namespace) -> Any:
+def _bench_tuner(args: argparse.Namespace) -> tuple[Any, dict[tuple[str, int], int]]:
+    """The declared axis with the parameter file's items, and the file's values."""
     from fha_studio.cli._bench_common import parameter_values
     from fha_studio.hardware.parameters import load_parameter_model
     from fha_studio.logic.bench.importer import BenchImportError
@@ -246,7 +251,7 @@ def _bench_tuner(args: argparse.Namespace) -> Any:
     except BenchImportError as exc:
         raise CliError(str(exc)) from None
     try:
-        return bench_tuner(args.actuator, args.load_inertia, load_parameter_model("HA-655"), values)
+        return bench_tuner(args.actuator, args.load_inertia, load_parameter_model("HA-655"), values), values
     except ValueError as exc:
         raise CliError(f"--actuator {args.actuator}: {exc}") from None
 
@@ -255,7 +260,7 @@ def run_excitation(args: argparse.Namespace) -> int:
     from fha_studio.hardware.bench.waveform import form_of, write_waveform
     from fha_studio.logic.tuning.bench_excitation import NotInSpeedMode, design_excitation
 
-    tuner = _bench_tuner(args)
+    tuner, _values = _bench_tuner(args)
     try:
         excitation = design_excitation(tuner, args.form, args.amplitude_rpm, args.rate, args.periods)
     except NotInSpeedMode as exc:
@@ -278,13 +283,22 @@ def run_excitation(args: argparse.Namespace) -> int:
 
 def run_analyse(args: argparse.Namespace) -> int:
     from fha_studio.logic.tuning.bench_excitation import NotInSpeedMode
+    from fha_studio.logic.tuning.bench_names import ANALYSE_ROLES
     from fha_studio.logic.tuning.bench_response import BenchResponseError
-    from fha_studio.logic.tuning.bench_session import RESPONSE_ROLES, bench_response_report, parse_role
+    from fha_studio.logic.tuning.bench_session import (
+        bench_move_report,
+        bench_response_report,
+        is_move,
+        parse_role,
+    )
 
-    tuner = _bench_tuner(args)
+    tuner, values = _bench_tuner(args)
     try:
-        signals = [parse_role(text, RESPONSE_ROLES) for text in args.signal]
-        result = bench_response_report(tuner, signals, args.excitation, args.monitor_bandwidth_hz)
+        signals = [parse_role(text, ANALYSE_ROLES) for text in args.signal]
+        if is_move(signals) and not args.excitation:
+            result = bench_move_report(tuner, signals, values)
+        else:
+            result = bench_response_report(tuner, signals, args.excitation, args.monitor_bandwidth_hz)
     except NotInSpeedMode as exc:
         print(f"fha-studio tune analyse: {exc}", file=sys.stderr)
         return EXIT_NOT_EXCITABLE

@@ -5,7 +5,9 @@ and the Tuning page share (no Qt).
   the rest at their defaults;
 - the capture's signals by role (``ROLE=FILE[#CHANNEL]``, as ``bench import`` takes them):
   ``speed_monitor`` (SPD-MON, CN2-23) and ``speed_command`` (SPD-CMD, CN2-31/32);
-- the frequency response from them (:mod:`.bench_response`), ``tune measure``'s JSON.
+- the frequency response from them (:mod:`.bench_response`), ``tune measure``'s JSON;
+- or, where no output can drive SPD-CMD, a position-mode move (the command pulses, the encoder
+  outputs, SPD-MON: ``bench import``) and the loop fitted to it (:mod:`.bench_move`).
 """
 
 from __future__ import annotations
@@ -22,11 +24,13 @@ from fha_studio.hardware.bench.waveform import Waveform, read_waveform
 from fha_studio.hardware.parameters import Mode, ParameterModel
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
 from fha_studio.logic.tuning import bench_names
+from fha_studio.logic.tuning.bench_move import MoveFitError, MoveSamples, move_fit_report
 from fha_studio.logic.tuning.bench_response import BenchCapture, BenchResponseError, analyse_bench_response
 from fha_studio.logic.tuning.propose import Tuner, present_items
 from fha_studio.logic.tuning.session import declared_model
 
 RESPONSE_ROLES = bench_names.RESPONSE_ROLES
+MOVE_ROLES = bench_names.MOVE_ROLES
 
 
 @dataclass(frozen=True)
@@ -142,4 +146,50 @@ def bench_response_report(tuner: Tuner, signals: Sequence[RoleSignal], excitatio
     result = analyse_bench_response(tuner, capture, wave, monitor_bandwidth_hz)
     if excitation:
         result["bench"]["excitation_file"] = excitation
+    return result
+
+
+def is_move(signals: Sequence[RoleSignal]) -> bool:
+    """True when the signals are a move's (no SPD-CMD: the encoder and the command pulses)."""
+    roles = {s.role for s in signals}
+    return "speed_command" not in roles and bool(roles & {"encoder_a", "command_a"})
+
+
+def move_samples(tuner: Tuner, signals: Sequence[RoleSignal],
+                 values: Mapping[tuple[str, int], int]) -> MoveSamples:
+    """The move in the capture files, imported as ``bench import`` does (parameters 1, 2, 3, 4 and
+    9 from ``values``) and resampled to the servo rate."""
+    from fha_studio.logic.bench.importer import (
+        AxisFacts,
+        BenchImportError,
+        DriveSettings,
+        SignalSpec,
+        import_bench,
+    )
+
+    if int(tuner.items.get("control_mode", 0)) != 0:
+        raise BenchResponseError("parameter 0 (control mode) is speed: a move by command pulses needs "
+                                 "position mode (in speed mode give the SPD-CMD excitation's capture)")
+    missing = [r for r in ("encoder_a", "encoder_b", "command_a") if r not in {s.role for s in signals}]
+    if missing:
+        raise BenchResponseError(f"a move needs {', '.join(missing)} too: the encoder outputs and the "
+                                 "command pulses, captured together")
+    specs = [SignalSpec(s.role, s.path, s.channel) for s in signals]
+    try:
+        settings = DriveSettings.from_values({(str(m), n): v for (m, n), v in values.items()})
+        result = import_bench(specs, AxisFacts.for_actuator(tuner.model.actuator_code), settings,
+                              output_rate_hz=tuner.servo_rate_hz)
+    except BenchImportError as exc:
+        raise BenchResponseError(str(exc)) from None
+    try:
+        return MoveSamples.from_recording(result.recording, tuner.servo_rate_hz, tuner.model.output_pulse_rad)
+    except MoveFitError as exc:
+        raise BenchResponseError(str(exc)) from None
+
+
+def bench_move_report(tuner: Tuner, signals: Sequence[RoleSignal],
+                      values: Mapping[tuple[str, int], int]) -> dict[str, Any]:
+    """``tune analyse``'s JSON for a move captured on the bench: the loop fitted to it."""
+    result = move_fit_report(tuner, move_samples(tuner, signals, values))
+    result["bench"] = {"sources": {s.role: s.text for s in signals}}
     return result
