@@ -89,3 +89,21 @@ del window
                             env=env, timeout=120)
     assert result.returncode == 0, result.stderr
     assert "heavy: []" in result.stdout, result.stdout
+
+
+def test_a_command_on_the_simulated_drive_starts_without_scipy(tmp_path):
+    """The simulated drive samples its CN2 outputs (scipy.signal, a second of CPU to import) only
+    for a bench instrument: ``drive params read`` on it does without."""
+    url = f"sim://FHA-25C-50-US250?eeprom={tmp_path / 'e.json'}&paced=0"
+    script = f"""
+import sys
+from fha_studio.cli import main
+code = main(["drive", "params", "read", "--url", {url!r}])
+assert code == 0, code
+print('heavy:', sorted({{m.split('.')[0] for m in sys.modules if m.split('.')[0] in ('scipy', 'control')}}))
+"""
+    env = {**os.environ, "XDG_DATA_HOME": str(tmp_path / "data"), "PYTHONPATH": str(ROOT)}
+    result = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True,
+                            env=env, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "heavy: []" in result.stdout, result.stdout[-500:]

@@ -34,7 +34,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy import signal as _signal
 
 from fha_studio.hardware.bench import writers
 from fha_studio.hardware.bench.capture import SampleBlock, join_blocks, logic_dtype, pack_logic
@@ -187,6 +186,9 @@ class Cn2Signals:
         motor_rpm = v / RAD_S_PER_RPM * self.ratio
         volts = motor_rpm / self.s.speed_conversion_rpm * 10.0
         b, a = self._filter
+        # scipy.signal takes a second of CPU to import: only a drive whose CN2 is sampled pays it
+        from scipy import signal as _signal
+
         if self._zi is None:
             self._zi = _signal.lfilter_zi(b, a) * volts[0]
         volts, self._zi = _signal.lfilter(b, a, volts, zi=self._zi)
