@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as _dt
+import gc
 import json
 import os
 import threading
@@ -36,6 +37,15 @@ def pytest_configure(config):
         start = _dt.datetime.now(_dt.UTC) + _dt.timedelta(days=float(days))
         _travel = time_machine.travel(start, tick=True)
         _travel.start()
+
+
+def pytest_collection_finish(session):
+    """Every test module and what it imports stays for the whole session: the garbage collector
+    need not walk those objects again (gc.freeze). A window's teardown collects garbage, and so
+    does Python itself as tests allocate; each full collection walked some 250 000 objects of
+    modules (0.2-0.35 s under load, about 100 times a session), now only what tests made."""
+    gc.collect()
+    gc.freeze()
 
 
 def pytest_unconfigure(config):
