@@ -87,7 +87,7 @@ def writer_in_the_middle(tmp_path):
     from fha_studio.logic.register import Register
 
     register = tmp_path / "r.sqlite"
-    with Register(register) as reg:
+    with Register(register) as reg, reg.batch():  # one transaction: 2000 commits took 5-10 s
         for n in range(2000):
             reg.add_machine(f"cell {n}")
     out = tmp_path / "export.json"
