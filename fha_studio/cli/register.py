@@ -37,7 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import fileio, plausible
-from fha_studio.cli import CliError, _register_correct, _register_roles, _register_signing
+from fha_studio.cli import CliError, _register_correct, _register_roles, _register_signing, _register_sync
 from fha_studio.cli._values import in_range
 from fha_studio.logic.register.words import (
     KIND_WORDS,
@@ -179,6 +179,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     _register_signing.add_actions(sub, common, _open_register)
     _register_correct.add_actions(sub, common, _open_register)
     _register_roles.add_actions(sub, common)
+    _register_sync.add_actions(sub, common, _open_register)
 
 
 # -- plumbing -------------------------------------------------------------------------------------------
@@ -192,7 +193,7 @@ def _open_register(args):
     # answer; adding or importing creates it
     create = args.action in ("add-machine", "add-axis", "import") or getattr(args, "writes", False)
     # a question changes nothing in the file (the report records itself: it writes)
-    question = not create and args.action != "report"
+    question = not create and args.action not in ("report", "resolve")
     try:
         reg = Register(register_location(args.register), create=create, read_only=question)
     except RegisterError as exc:
@@ -315,8 +316,10 @@ def _history(args) -> int:
     with _open_register(args) as reg:
         axis = reg.axis(args.axis)
         events = reg.history(axis, since=args.since)
+        conflicts = reg.conflicts(axis)
     if args.json:
-        _print_json({"axis": asdict(axis), "events": [e.as_dict() for e in events]})
+        _print_json({"axis": asdict(axis), "events": [e.as_dict() for e in events],
+                     "open_conflicts": [c.as_dict() for c in conflicts]})
         return 0
     entries = "entry" if len(events) == 1 else "entries"
     driver = f" on {axis.driver_model}" if axis.driver_model else ""
@@ -328,6 +331,12 @@ def _history(args) -> int:
         who = f" [{e.who}]" if e.who else ""
         number = f"{e.ref if e.ref is not None else '':>6}  " if args.numbers else ""
         print(f"{when_text(e.at_utc)}  {number}{KIND_WORDS[e.kind]:<11} {e.text}{who}")
+    if conflicts:
+        print(f"OPEN CONFLICTS: {len(conflicts)} (registers synced after they were apart disagree; "
+              "settle each: fha-studio register resolve ID --keep N)")
+        for c in conflicts:
+            print(f"conflict {c.short}: {c.summary()}")
+            print("\n".join(c.lines()))
     return 0
 
 
@@ -434,7 +443,7 @@ def _open(args) -> int:
         print("Nothing open: every check passed and every report is signed.")
         return 0
     for i in items:
-        print(f"{i.axis.ref}: {'report' if i.kind == 'report' else 'check'}: {i.text}")
+        print(f"{i.axis.ref}: {i.kind if i.kind in ('report', 'conflict') else 'check'}: {i.text}")
     return 0
 
 
@@ -494,7 +503,8 @@ def _report(args) -> int:
         return 0
     print(f"{output}: {len(report.summaries)} axes")
     for s in report.summaries:
-        print(f"  {s.axis}: {s.checks_passed} passed, {s.checks_failed} failed, {s.signed}")
+        conflicts = f", {len(s.open_conflicts)} OPEN CONFLICT(S)" if s.open_conflicts else ""
+        print(f"  {s.axis}: {s.checks_passed} passed, {s.checks_failed} failed, {s.signed}{conflicts}")
     for problem in report.problems:
         print(f"  - {problem}", file=sys.stderr)
     return 0

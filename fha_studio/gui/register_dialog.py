@@ -309,5 +309,5 @@ class RegisterDialog(QDialog):
             if not items
             else f"{len(items)} open item(s): checks not done or failed, reports missing or not signed."
         )
-        rows = [[i.axis.name, "report" if i.kind == "report" else "check", i.text] for i in items]
+        rows = [[i.axis.name, i.kind if i.kind in ("report", "conflict") else "check", i.text] for i in items]
         _fill(self.open_table, rows)

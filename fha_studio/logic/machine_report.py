@@ -39,6 +39,8 @@ class AxisSummary:
     signed: str  # "signed by NAME (time UTC)" or "not signed"
     is_signed: bool
     open_warnings: int
+    #: conflicts between registers not settled yet, one line each (what differs, each side's value)
+    open_conflicts: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -143,6 +145,11 @@ def build_machine_report(
         else:
             signed = "not signed"
         driver = axis.driver_model or (session.driver.get("model", "") if session is not None else "")
+        conflicts: list[str] = []
+        if register is not None:
+            with contextlib.suppress(ValueError):  # an axis the register does not have
+                conflicts = [f"conflict {c.short}: {c.summary()}: "
+                             + "; ".join(line.strip() for line in c.lines()) for c in register.conflicts(ref)]
         summaries.append(
             AxisSummary(
                 axis=axis.name,
@@ -155,6 +162,7 @@ def build_machine_report(
                 signed=signed,
                 is_signed=bool(signature),
                 open_warnings=len(report.warnings) if report is not None else 0,
+                open_conflicts=tuple(conflicts),
             )
         )
         reports.append(report)
@@ -227,6 +235,12 @@ def render_machine_html(report: MachineReport) -> str:
     out.append(f"<table width='100%'><tr>{header}</tr>{body}</table>")
     if report.problems:
         out.append("<ul>" + "".join(f"<li class='warn'>{_e(p)}</li>" for p in report.problems) + "</ul>")
+    conflicts = [(s.axis, c) for s in report.summaries for c in s.open_conflicts]
+    if conflicts:
+        out.append("<h2>Open conflicts</h2><p>Registers synced after they were apart disagree on these; "
+                   "a person settles each (fha-studio register conflicts, register resolve).</p>")
+        out.append("<ul>" + "".join(f"<li class='warn'>Axis {_e(a)}: {_e(c)}</li>" for a, c in conflicts)
+                   + "</ul>")
     for summary, axis_report, text in zip(report.summaries, report.axis_reports, axis_html, strict=True):
         out.append(f"<h1 style='page-break-before: always'>Axis {_e(summary.axis)}</h1>")
         if axis_report is None:

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from fha_studio.logic.register import guard, words
-from fha_studio.logic.register.queries import Queries
+from fha_studio.logic.register.conflicts import Conflict, Conflicts, item_name, side_name, value_words
 from fha_studio.logic.register.records import (
     CORRECTED_WORDS,
     KIND_TABLES,
@@ -33,11 +33,13 @@ HISTORY_ORDER = (
     EventKind.RECORDING,
     EventKind.MODEL_CHECK,
     EventKind.REPORT,
+    EventKind.CONFLICT,
+    EventKind.SETTLED,
 )
 
 
 @guard.in_words
-class History(Queries):
+class History(Conflicts):
     """The history of an axis."""
 
     def history(self, axis: Axis | str | int, since: str | None = None) -> list[Event]:
@@ -47,7 +49,8 @@ class History(Queries):
         db = self._db
         events: list[Event] = []
         for r in db.execute("SELECT * FROM axis_event WHERE axis_id = ?", (a,)):
-            events.append(Event(r["at_utc"], EventKind.AXIS, r["who"], r["text"], r["id"], _corrects(r)))
+            events.append(Event(r["at_utc"], EventKind.AXIS, r["who"], r["text"], r["id"], _corrects(r),
+                                r["uid"]))
         for r in self.snapshots(current):
             where = f" ({r['file']})" if r["file"] else ""
             events.append(
@@ -59,6 +62,7 @@ class History(Queries):
                     f" snapshot {r['id']}{where}",
                     r["id"],
                     {"source": r["source"], "file": r["file"], "count": r["count"], **_corrects(r)},
+                    uid=r["uid"],
                 )
             )
         for r in db.execute("SELECT * FROM parameter_write WHERE axis_id = ?", (a,)):
@@ -79,6 +83,7 @@ class History(Queries):
                         },
                         **_corrects(r),
                     },
+                    uid=r["uid"],
                 )
             )
         titles = self._procedure_titles(a)
@@ -104,6 +109,7 @@ class History(Queries):
                         "detail": r["detail"],
                         **_corrects(r),
                     },
+                    uid=r["uid"],
                 )
             )
         for r in db.execute("SELECT * FROM alarm WHERE axis_id = ?", (a,)):
@@ -116,6 +122,7 @@ class History(Queries):
                     f"alarm {r['code']}: {r['name']}{note}",
                     r["id"],
                     {"code": r["code"], **_corrects(r)},
+                    uid=r["uid"],
                 )
             )
         for r in db.execute("SELECT * FROM report WHERE axis_id = ?", (a,)):
@@ -128,6 +135,7 @@ class History(Queries):
                     f"report {r['file']} ({signed}, {r['open_warnings']} open warnings)",
                     r["id"],
                     {"file": r["file"], "sha256": r["sha256"], "signed_by": r["signed_by"], **_corrects(r)},
+                    uid=r["uid"],
                 )
             )
         for r in db.execute("SELECT * FROM recording WHERE axis_id = ?", (a,)):
@@ -140,6 +148,7 @@ class History(Queries):
                     f"recording {r['file']}{summary}",
                     r["id"],
                     {"file": r["file"], **_corrects(r)},
+                    uid=r["uid"],
                 )
             )
         for r in db.execute("SELECT * FROM model_check WHERE axis_id = ?", (a,)):
@@ -151,8 +160,10 @@ class History(Queries):
                     f"model check: {r['summary']}",
                     r["id"],
                     {"file": r["file"], "recording_file": r["recording_file"], **_corrects(r)},
+                    uid=r["uid"],
                 )
             )
+        events += _conflict_events(self.conflicts(current, open_only=False))
         events = self._with_receipts(_with_corrections(events), a)
         if since is not None:
             cutoff = utc_stamp(since)
@@ -191,6 +202,26 @@ class History(Queries):
 
 def _moment(stamp: str) -> _dt.datetime:
     return _dt.datetime.fromisoformat(stamp)
+
+
+def _conflict_events(conflicts: list[Conflict]) -> list[Event]:
+    """A conflict a sync found (open: how to settle it), and each settlement of it."""
+    out = []
+    for c in conflicts:
+        hint = f" — settle it: fha-studio register resolve {c.short} --keep 1 or 2" if c.open else ""
+        out.append(Event(c.at_utc, EventKind.CONFLICT, c.who, f"conflict {c.short}: {c.summary()}{hint}",
+                         c.id, {"conflict": c.short, "subject": c.subject, "open": c.open}, c.uid))
+        for r in c.resolutions:
+            side = c.sides[r.kept - 1] if 0 < r.kept <= len(c.sides) else None
+            kept = "; ".join(
+                f"{item_name(c.subject, k, c.sides, c.axis.driver_model)} "
+                f"{value_words(c.subject, k, v, c.axis.driver_model)}"
+                for k, v in (side.values.items() if side else ()))
+            note = f" ({r.note})" if r.note else ""
+            out.append(Event(r.at_utc, EventKind.SETTLED, r.who,
+                             f"conflict {c.short} settled: kept {r.kept}, {side_name(side) if side else ''}: "
+                             f"{kept}{note}", r.id, {"conflict": c.short, "kept": r.kept}, r.uid))
+    return out
 
 
 def _corrects(row: Mapping[str, Any]) -> dict[str, int]:

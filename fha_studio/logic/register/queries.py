@@ -3,6 +3,7 @@ axes hold a value, where the procedures stand, the latest report, what is still 
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
@@ -84,8 +85,8 @@ class Queries(Facts):
             " FROM parameter_write WHERE axis_id = ? AND verified = 1",
             (current.id,),
         )
-        for row in [*snapshot_rows, *write_rows]:
-            value = ParameterValue(*tuple(row))
+        settled = [value for _, value in self._settled_values(current.id)]
+        for value in [*(ParameterValue(*tuple(row)) for row in [*snapshot_rows, *write_rows]), *settled]:
             known = latest.get(value.key)
             if known is None or (value.at_utc, value.ref) > (known.at_utc, known.ref):
                 latest[value.key] = value
@@ -140,18 +141,44 @@ class Queries(Facts):
             " w.id"
             " FROM latest JOIN parameter_write w ON w.id = latest.id",
         )
-        for query in queries:
-            for row in self._db.execute(query, (key,) * query.count("?")):
-                axis_id, *fields = tuple(row)
-                known = ParameterValue(*fields)
-                best = latest.get(axis_id)
-                if best is None or (known.at_utc, known.ref) > (best.at_utc, best.ref):
-                    latest[axis_id] = known
+        found = [
+            (int(axis_id), ParameterValue(*fields))
+            for query in queries
+            for axis_id, *fields in (tuple(row) for row in self._db.execute(query, (key,) * query.count("?")))
+        ]
+        for axis_id, known in [*found, *self._settled_values(None, key)]:
+            best = latest.get(axis_id)
+            if best is None or (known.at_utc, known.ref) > (best.at_utc, best.ref):
+                latest[axis_id] = known
         return [
             Found(axis, latest[axis_id])
             for axis_id, axis in axes.items()
             if axis_id in latest and (value is None or latest[axis_id].value == value)
         ]
+
+    def _settled_values(
+        self, axis_id: int | None, key: str | None = None
+    ) -> list[tuple[int, ParameterValue]]:
+        """(axis id, value) of the parameter values people settled in conflicts (of one axis, of
+        one key): a settlement is a newer known value than those it settles (conflicts.py)."""
+        sql = ("SELECT r.axis_id, r.id, r.at_utc, r.settled_json FROM conflict_resolution r"
+               " JOIN conflict c ON c.uid = r.conflict_uid WHERE c.subject = 'parameters'")
+        rows = self._db.execute(sql + " AND r.axis_id = ?", (axis_id,)) if axis_id is not None else (
+            self._db.execute(sql))
+        out = []
+        for r in rows:
+            try:
+                settled = json.loads(r["settled_json"])
+            except ValueError:
+                continue
+            for name, held in settled.items() if isinstance(settled, dict) else ():
+                wire = held.get("value") if isinstance(held, dict) else None
+                if key not in (None, name) or not isinstance(wire, int):
+                    continue
+                value = ParameterValue(str(held.get("mode", "")), int(held.get("number", 0)), name, wire,
+                                       r["at_utc"], "settled", int(r["id"]))
+                out.append((int(r["axis_id"]), value))
+        return out
 
     def known_keys(self) -> set[str]:
         """Every parameter key the register has a value for."""

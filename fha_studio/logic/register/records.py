@@ -133,6 +133,8 @@ class EventKind(StrEnum):
     REPORT = "report"
     RECORDING = "recording"
     MODEL_CHECK = "model_check"
+    CONFLICT = "conflict"
+    SETTLED = "settled"
 
 
 #: A fact of each table a person may correct, as a correction names it ("snapshot 12").
@@ -145,6 +147,8 @@ CORRECTED_WORDS = {
     "report": "report",
     "recording": "recording",
     "model_check": "model check",
+    "conflict": "conflict",
+    "conflict_resolution": "settlement",
 }
 #: The table of each kind of history line.
 KIND_TABLES = {
@@ -156,6 +160,8 @@ KIND_TABLES = {
     EventKind.REPORT: "report",
     EventKind.RECORDING: "recording",
     EventKind.MODEL_CHECK: "model_check",
+    EventKind.CONFLICT: "conflict",
+    EventKind.SETTLED: "conflict_resolution",
 }
 
 
@@ -169,6 +175,7 @@ class Event:
     text: str  # for people
     ref: int | None = None  # the row (a snapshot's number is what `diff` takes)
     data: Mapping[str, Any] = field(default_factory=dict)
+    uid: str = ""  # the fact's stable id, the same in every register it is synced to
 
     def as_dict(self) -> dict[str, Any]:
         return {**asdict(self), "kind": str(self.kind), "data": dict(self.data)}
@@ -179,7 +186,7 @@ class OpenItem:
     """Something that keeps an axis from being done: an open check or an unsigned report."""
 
     axis: Axis
-    kind: str  # "check" or "report"
+    kind: str  # "check", "report" or "conflict" (registers that disagree)
     text: str
 
 

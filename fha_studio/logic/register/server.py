@@ -20,8 +20,10 @@ disk, a role without the right.
 
 from __future__ import annotations
 
+import contextlib
 import re
-from collections.abc import Iterable, Iterator, Sequence
+import zlib
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from typing import Any
 from urllib.parse import unquote, urlsplit, urlunsplit
 
@@ -161,6 +163,8 @@ class ServerDatabase:
         # the register's questions are small: compiling them costs more than it saves (20 ms)
         self._conn.execute("SET jit = off")
         self.total_changes = 0
+        #: the temporary tables made outside a transaction (:meth:`prepare_inserts`)
+        self._made: set[str] = set()
 
     @property
     def in_transaction(self) -> bool:
@@ -204,6 +208,54 @@ class ServerDatabase:
             cursor.executemany(statement, given)
             if cursor.rowcount > 0:
                 self.total_changes += cursor.rowcount
+
+    def insert_rows(self, table: str, columns: Sequence[str], rows: Sequence[Sequence[Any]]) -> int:
+        """``INSERT OR IGNORE`` of many rows: copied (``COPY``) into a temporary table of this
+        session, then inserted from it, those already there (by any key) left out; how many were
+        new. A statement per row, or one with a parameter per value, would make a sync of ten
+        thousand facts take tens of seconds."""
+        if not rows:
+            return 0
+        names = ", ".join(columns)
+        temporary = self._incoming_table(table, names)
+        with contextlib.ExitStack() as stack:
+            if not self.in_transaction:
+                stack.enter_context(self._conn.transaction())
+            cursor = stack.enter_context(self._conn.cursor())
+            if temporary not in self._made:  # (made again after a transaction that made it was undone)
+                cursor.execute(f"CREATE TEMPORARY TABLE IF NOT EXISTS {temporary} ON COMMIT DELETE ROWS"
+                               f" AS SELECT {names} FROM {table} WITH NO DATA")
+            with cursor.copy(f"COPY {temporary} ({names}) FROM STDIN") as copy:
+                for row in rows:
+                    copy.write_row(row)
+            # one round trip: the rows in, and the temporary table empty for the transaction's next
+            cursor.execute(f"INSERT INTO {table} ({names}) SELECT {names} FROM {temporary}"
+                           f" ON CONFLICT DO NOTHING; DELETE FROM {temporary}")
+            added = max(cursor.rowcount, 0)  # the first statement's
+        self.total_changes += added
+        return added
+
+    def prepare_inserts(self, tables: Mapping[str, Sequence[str]]) -> None:
+        """Makes the temporary tables :meth:`insert_rows` copies rows of these tables (and
+        columns) into, for the rest of this connection (outside a transaction: none undoes them)."""
+        if self.in_transaction:
+            return
+        for table, columns in tables.items():
+            names = ", ".join(columns)
+            temporary = self._incoming_table(table, names)
+            if temporary not in self._made:
+                self._conn.execute(f"CREATE TEMPORARY TABLE IF NOT EXISTS {temporary} ON COMMIT DELETE ROWS"
+                                   f" AS SELECT {names} FROM {table} WITH NO DATA")
+                self._made.add(temporary)
+
+    def columns(self, table: str) -> list[str]:
+        """The table's columns, in their order."""
+        cursor = self._conn.execute(f"SELECT * FROM {table} WHERE false")
+        return [d.name for d in cursor.description or ()]
+
+    @staticmethod
+    def _incoming_table(table: str, names: str) -> str:
+        return f"incoming_{table}_{zlib.crc32(names.encode()):08x}"
 
     def prepare_register(self, create: bool) -> bool:
         """Makes the table of the schema version when missing (``create``); False when the

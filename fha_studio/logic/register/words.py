@@ -15,6 +15,7 @@ SOURCE_WORDS = {
     "front_panel": "front panel",
     "file": "from a file",
     "write": "verified write",
+    "settled": "settled by a person (a conflict)",
 }
 
 #: What a history entry is.
@@ -27,6 +28,8 @@ KIND_WORDS: dict[EventKind, str] = {
     EventKind.REPORT: "report",
     EventKind.RECORDING: "recording",
     EventKind.MODEL_CHECK: "model check",
+    EventKind.CONFLICT: "conflict",
+    EventKind.SETTLED: "settled",
 }
 
 
