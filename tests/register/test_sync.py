@@ -23,6 +23,7 @@ from fha_studio.logic.register import facts_from_session as f
 from fha_studio.logic.register import sync as sync_module
 from fha_studio.logic.register.identity import UID_TABLES
 from fha_studio.logic.register.sync import sync_registers
+from tests.register.test_roles import logins, plant, server_clock  # noqa: F401 (fixtures)
 from tests.support.processes import Child
 
 M = "Line 3 positioner"
@@ -143,10 +144,10 @@ def laptops(tmp_path, fixed_clock):
 
 def test_two_laptops_and_the_plant_register_end_with_every_fact_once(laptops, register_target):
     ana, ben = laptops
-    plant = register_target
-    first = sync_registers(ana, plant, who="ana")
+    plant_register = register_target
+    first = sync_registers(ana, plant_register, who="ana")
     assert (first.received, first.already_there, first.conflicts) == (0, 0, ())  # the plant had nothing
-    second = sync_registers(ben, plant, who="ben")
+    second = sync_registers(ben, plant_register, who="ben")
     assert second.sent > 0 and second.received == first.sent
     # the shared axis changed on both laptops while apart: its rotary direction and its origin
     # differ, one conflict each, in both registers
@@ -162,20 +163,20 @@ def test_two_laptops_and_the_plant_register_end_with_every_fact_once(laptops, re
     assert where == ["ana.sqlite", "ben.sqlite"]  # where each side's fact was recorded
     values = {s.values["rotary_direction"].value for s in conflict.sides}
     assert values == {0, 1} and {s.values["rotary_direction"].who for s in conflict.sides} == {"ana", "ben"}
-    third = sync_registers(ana, plant)  # Ana's laptop receives Ben's facts and the conflicts
+    third = sync_registers(ana, plant_register)  # Ana's laptop receives Ben's facts and the conflicts
     assert third.sent == 0 and third.received == second.sent + 2
     # twice = once: nothing moves any more, in either direction
     for laptop in (ana, ben):
-        again = sync_registers(laptop, plant)
+        again = sync_registers(laptop, plant_register)
         assert (again.sent, again.received, again.found_now) == (0, 0, frozenset())
         assert {c.uid for c in again.conflicts} == {conflict.uid, origin.uid}
-    everywhere = [contents(where) for where in (ana, ben, plant)]
+    everywhere = [contents(where) for where in (ana, ben, plant_register)]
     assert everywhere[0] == everywhere[1] == everywhere[2]
     facts = everywhere[0]
     assert again.already_there == sum(len(t) for t in facts.values())
-    for where in (ana, ben, plant):
+    for where in (ana, ben, plant_register):
         sound(where)
-    with Register(plant) as reg:  # one machine, one shared axis: matched by machine and axis name
+    with Register(plant_register) as reg:  # one machine, one shared axis: matched by machine and axis name
         assert sorted(a.ref for a in reg.axes()) == [f"{M}/gripper", SHARED, f"{M}/tilt"]
         kinds = [e.kind.value for e in reg.history(SHARED)]
         assert kinds.count("snapshot") == 2 and kinds.count("conflict") == 2
@@ -185,17 +186,17 @@ def test_two_laptops_and_the_plant_register_end_with_every_fact_once(laptops, re
 
 def test_a_person_settles_a_conflict_by_a_fact_that_travels(laptops, register_target, capsys):
     ana, ben = laptops
-    plant = register_target
-    sync_registers(ana, plant)
-    sync_registers(ben, plant)
-    with Register(plant) as reg:
+    plant_register = register_target
+    sync_registers(ana, plant_register)
+    sync_registers(ben, plant_register)
+    with Register(plant_register) as reg:
         (conflict,) = [c for c in reg.conflicts() if c.subject == "parameters"]
         assert reg.current_values(SHARED).values["rotary_direction"].source == "link"
     # Ben's laptop does not know it yet; the plant's register says it in the history and `open`
-    assert main(["register", "--register", str(plant), "history", SHARED]) == 0
+    assert main(["register", "--register", str(plant_register), "history", SHARED]) == 0
     out = capsys.readouterr().out
     assert f"conflict {conflict.short}" in out and "OPEN CONFLICTS: 2" in out and "Rotary direction" in out
-    assert main(["register", "--register", str(plant), "conflicts", SHARED, "--json"]) == 0
+    assert main(["register", "--register", str(plant_register), "conflicts", SHARED, "--json"]) == 0
     listed = json.loads(capsys.readouterr().out)
     assert [c["subject"] for c in listed] == ["parameters", "origin"] or len(listed) == 2
     assert all(c["axis"] == SHARED and c["open"] and len(c["sides"]) == 2 for c in listed)
@@ -205,7 +206,7 @@ def test_a_person_settles_a_conflict_by_a_fact_that_travels(laptops, register_ta
             [
                 "register",
                 "--register",
-                str(plant),
+                str(plant_register),
                 "resolve",
                 conflict.short[:6],
                 "--keep",
@@ -219,9 +220,10 @@ def test_a_person_settles_a_conflict_by_a_fact_that_travels(laptops, register_ta
         == 0
     )
     assert "settled" in capsys.readouterr().out
-    assert main(["register", "--register", str(plant), "resolve", conflict.short, "--keep", "1"]) == 2
+    again = ["register", "--register", str(plant_register), "resolve", conflict.short, "--keep", "1"]
+    assert main(again) == 2
     assert "was settled by carla" in capsys.readouterr().err
-    sync_registers(ben, plant)
+    sync_registers(ben, plant_register)
     with Register(ben) as reg:
         assert [c.subject for c in reg.conflicts()] == ["origin"]  # the other is still open
         (settled,) = [c for c in reg.conflicts(open_only=False) if not c.open]
@@ -394,9 +396,9 @@ def test_a_sync_killed_for_real_and_run_again_moves_each_fact_once(
     tmp_path, fixed_clock, postgres_cluster, children
 ):
     laptop = tmp_path / "laptop.sqlite"
-    plant = postgres_cluster.new_database()
+    plant_register = postgres_cluster.new_database()
     fill_offline(laptop, "ana", fixed_clock, 1, "tilt", facts_per_axis=4)
-    fill_offline(plant, "ben", fixed_clock, 0, "gripper", facts_per_axis=4)
+    fill_offline(plant_register, "ben", fixed_clock, 0, "gripper", facts_per_axis=4)
     rng = random.Random(2026)
     for _ in range(3):
         child = children(
@@ -406,7 +408,7 @@ def test_a_sync_killed_for_real_and_run_again_moves_each_fact_once(
             "--from",
             laptop,
             "--to",
-            plant,
+            plant_register,
             "--progress",
             "--batch",
             "2",
@@ -417,9 +419,9 @@ def test_a_sync_killed_for_real_and_run_again_moves_each_fact_once(
                 break
         # SIGKILL: wherever it is, inside a transaction on either side or between them
         assert child.kill() == -signal.SIGKILL
-    assert main(["register", "sync", "--from", str(laptop), "--to", plant]) == 0
-    assert contents(laptop) == contents(plant)
-    for where in (laptop, plant):
+    assert main(["register", "sync", "--from", str(laptop), "--to", plant_register]) == 0
+    assert contents(laptop) == contents(plant_register)
+    for where in (laptop, plant_register):
         sound(where)
     with sqlite3.connect(laptop) as db:
         assert db.execute("PRAGMA integrity_check").fetchone() == ("ok",)
@@ -429,7 +431,7 @@ def test_a_server_that_goes_away_mid_sync_is_one_line_and_a_second_run_finishes(
     tmp_path, fixed_clock, postgres_cluster, monkeypatch, capsys
 ):
     laptop = tmp_path / "laptop.sqlite"
-    plant = postgres_cluster.new_database()
+    plant_register = postgres_cluster.new_database()
     fill_offline(laptop, "ana", fixed_clock, 1, "tilt", facts_per_axis=3)
     real_tell = sync_module._Sync._tell
     stopped = []
@@ -442,7 +444,7 @@ def test_a_server_that_goes_away_mid_sync_is_one_line_and_a_second_run_finishes(
 
     monkeypatch.setattr(sync_module._Sync, "_tell", tell)
     try:
-        assert main(["register", "sync", "--from", str(laptop), "--to", plant, "--batch", "4"]) == 3
+        assert main(["register", "sync", "--from", str(laptop), "--to", plant_register, "--batch", "4"]) == 3
     finally:
         postgres_cluster.start()
     err = capsys.readouterr().err
@@ -450,11 +452,11 @@ def test_a_server_that_goes_away_mid_sync_is_one_line_and_a_second_run_finishes(
     assert "fha-test-password" not in err
     assert stopped == [8]
     monkeypatch.setattr(sync_module._Sync, "_tell", real_tell)
-    with Register(plant) as reg:  # the two batches before are there, whole
+    with Register(plant_register) as reg:  # the two batches before are there, whole
         assert reg._db.execute("SELECT COUNT(*) FROM axis_event").fetchone()[0] >= 1
-    assert main(["register", "sync", "--from", str(laptop), "--to", plant]) == 0
-    assert contents(laptop) == contents(plant)
-    sound(plant)
+    assert main(["register", "sync", "--from", str(laptop), "--to", plant_register]) == 0
+    assert contents(laptop) == contents(plant_register)
+    sound(plant_register)
 
 
 def test_a_register_that_cannot_be_opened_is_one_line(tmp_path, capsys):
@@ -469,3 +471,35 @@ def test_a_register_that_cannot_be_opened_is_one_line(tmp_path, capsys):
     assert not (tmp_path / "b.sqlite").exists()
     with pytest.raises(RegisterError, match="there is no register"):
         sync_registers(tmp_path / "none.sqlite", tmp_path / "b.sqlite")
+
+
+def test_a_technician_syncs_a_laptop_into_a_plant_register_with_roles(
+    plant, server_clock, tmp_path, capsys  # noqa: F811 (the roles' fixtures)
+):
+    """On a server with roles: Ana's login (a technician) syncs the facts her laptop recorded
+    offline two days ago; the server says when they came. An axis only her laptop has is an
+    administrator's to add: her sync says so in one line and moves nothing, until Cleo adds it."""
+    laptop = tmp_path / "ana.sqlite"
+    server_clock.advance(-2 * 86400)
+    with Register(laptop) as reg:
+        for axis in ("Line 3/table", "Line 3/tilt"):
+            for fact in (
+                f.axis_fact({"actuator_code": "FHA-25C-50-US250"}, "Ana Lima"),
+                *f.read_facts(MODEL, {("system", 8): 1}, "Ana Lima", "HA-655-2-200"),
+                *f.alarm_facts(20, "HA-655", "Ana Lima"),
+            ):
+                f.record_fact(reg, axis, fact)
+    server_clock.advance(2 * 86400)
+    assert main(["register", "sync", "--from", str(laptop), "--to", plant["ana"]]) == 3
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "adds and renames machines and axes" in err
+    assert main(["register", "--register", plant["cleo"], "add-axis", "Line 3/tilt",
+                 "--actuator", "FHA-25C-50-US250"]) == 0
+    capsys.readouterr()
+    assert main(["register", "sync", "--from", str(laptop), "--to", plant["ana"], "--json"]) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert said["sent"] > 0 and said["received"] == 2  # the axes' entries the server made
+    assert contents(laptop) == contents(plant["fha"])
+    with Register(plant["ana"]) as reg:
+        alarm = next(e for e in reg.history("Line 3/tilt") if e.kind.value == "alarm")
+        assert "reached the server" in alarm.text and alarm.data["received_by"] == "ana"
