@@ -1,5 +1,6 @@
 """A throw-away PostgreSQL server for the tests: one cluster per test session, on a unix socket
-only (no TCP), in a temporary folder owned by the server's user; a database of its own for each
+only (no TCP), in a temporary folder owned by the server's user (in memory where there is room:
+``/dev/shm``); a database of its own for each
 test that asks (``postgres_cluster.new_database()``, a ``postgresql://`` URL with a password).
 
 The server refuses to run as root: ``initdb`` and ``pg_ctl`` run as ``postgres`` (``runuser``)
@@ -27,6 +28,24 @@ SERVER_USER = "postgres"
 #: The role the register is used as, and its password.
 ROLE, PASSWORD = "fha", "fha-test-password"
 SUPER_PASSWORD = "fha-test-superuser"
+
+
+#: Where a cluster's folder goes when it can: memory (a tmpfs), so that the databases the tests
+#: make (7.5 MB each, about 60 a session), the server's checkpoints and the folder's removal at the
+#: end cost no disk writes (on this machine's disk, shared with other work, they took 0.4-1 s per
+#: database and 16-30 s for the stop and removal under load; in memory 0.2 s and under 1 s).
+MEMORY_DIR = Path("/dev/shm")
+#: The room the memory folder must have left for a cluster to go there.
+MEMORY_NEEDED_BYTES = 2 * 1024**3
+
+
+def _cluster_parent() -> str | None:
+    """The folder for a cluster's folder: memory where it has room, else the temporary folder."""
+    try:
+        roomy = shutil.disk_usage(MEMORY_DIR).free >= MEMORY_NEEDED_BYTES
+    except OSError:
+        return None
+    return str(MEMORY_DIR) if roomy and os.access(MEMORY_DIR, os.W_OK | os.X_OK) else None
 
 
 def _binaries() -> Path | None:
@@ -103,7 +122,7 @@ def throwaway_cluster() -> Iterator[Cluster]:
             pytest.skip(f"no user {SERVER_USER!r} to run PostgreSQL as "
                         "(Debian's postgresql package makes it)")
         as_user = ["runuser", "-u", SERVER_USER, "--"]
-    root = Path(tempfile.mkdtemp(prefix="fha-postgres-"))
+    root = Path(tempfile.mkdtemp(prefix="fha-postgres-", dir=_cluster_parent()))
     root.chmod(0o755)  # the server's user reaches its folders, this process its socket
     cluster = Cluster(bin_dir, root, as_user)
     for folder in (cluster.data, cluster.socket):
