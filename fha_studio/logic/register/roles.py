@@ -28,9 +28,11 @@ append-only triggers every register has, :mod:`.append_only`):
 - **when a fact reached the server is the server's to say**: each fact added gets a receipt
   (``register_receipt``: the table, the fact's id, the server's clock, the login; written by the
   server, readable by all, never changed), so a fact cannot be made to look as if it had been
-  recorded earlier than it was; a fact dated later than the server's clock by more than
-  :data:`FUTURE_TOLERANCE_S` is refused (a laptop's clock that is ahead). A fact dated earlier is
-  taken (a laptop that worked offline syncs days later) and its receipt says when it came;
+  recorded earlier than it was; a fact dated or recorded later than the server's clock by more
+  than :data:`FUTURE_TOLERANCE_S` is refused (a laptop's clock that is ahead), and so is one said
+  to be recorded in the server's own register (``recorded_in``) earlier than that (back-dated).
+  A fact dated earlier is taken (an alarm seen yesterday; a laptop that worked offline syncs days
+  later, its facts recorded in its own register) and its receipt says when it came;
 - a snapshot's values are added with the snapshot, in its transaction, never to it later;
 - who each login is (``register_person``) is a row per change, stamped by the server.
 """
