@@ -307,7 +307,8 @@ class RegisterDialog(QDialog):
         self.open_label.setText(
             "Nothing open: every check passed and every report is signed."
             if not items
-            else f"{len(items)} open item(s): checks not done or failed, reports missing or not signed."
+            else f"{len(items)} open item(s): checks not done or failed, reports missing or not signed, "
+            "conflicts between registers to settle."
         )
         rows = [[i.axis.name, i.kind if i.kind in ("report", "conflict") else "check", i.text] for i in items]
         _fill(self.open_table, rows)

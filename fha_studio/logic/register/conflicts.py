@@ -33,8 +33,8 @@ from fha_studio.logic.register.guard import RegisterError
 from fha_studio.logic.register.queries import Queries
 from fha_studio.logic.register.records import Axis, OpenItem, utc_stamp
 
-#: What a conflict is about, in words.
-SUBJECTS = {"parameters": "parameters", "origin": "origin", "axis": "axis fields"}
+#: What a conflict is about, in words: what differs.
+SUBJECTS = {"parameters": "parameters differ", "origin": "the origin differs", "axis": "axis fields differ"}
 #: The fields of an axis two registers may disagree on (the port is each computer's own: a laptop's
 #: COM3 is another's /dev/ttyUSB0; the name is how the axis is found).
 COMPARED_FIELDS = ("actuator_code", "driver_model", "serial_number", "load_inertia_kgm2", "notes")
@@ -152,7 +152,7 @@ class Conflict:
         state = "open" if self.open else f"settled: kept {self.resolutions[-1].kept}"
         if self.open and len(self.resolutions) > 1:
             state = "open: settled twice differently"
-        return f"{SUBJECTS.get(self.subject, self.subject)} differ between {where} ({what}): {state}"
+        return f"{SUBJECTS.get(self.subject, self.subject)} between {where} ({what}): {state}"
 
     def as_dict(self) -> dict[str, Any]:
         return {
