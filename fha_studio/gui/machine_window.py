@@ -41,10 +41,12 @@ from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.register_dialog import RegisterDialog
+from fha_studio.gui.register_worker import ServerWriter
 from fha_studio.gui.widgets import StopButton
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures import ProcedureSession
 from fha_studio.logic.register import Register, RegisterError
+from fha_studio.logic.register.server import is_server_url
 
 log = logging.getLogger(__name__)
 
@@ -68,6 +70,13 @@ class MachineWindow(QMainWindow):
         self.register = register
         self.axis_windows: list[MainWindow] = []
         self.recorders: list[AxisRecorder] = []
+        #: a register on a server is written from threads of their own, never this one's
+        self.server_writer: ServerWriter | None = None
+        if register is not None and is_server_url(register.location):
+            self.server_writer = ServerWriter(str(register.location), self)
+            self.server_writer.sigSay.connect(
+                lambda text, level: self.current_window.show_message(text, level)
+            )
         self._shut_down = False
         self._closing_confirmed = False
         self._register_dialog: RegisterDialog | None = None
@@ -195,7 +204,7 @@ class MachineWindow(QMainWindow):
             window.signing_register = self.register.location  # the sign step finds the keys there
             self.recorders.append(
                 AxisRecorder(
-                    self.register,
+                    self.server_writer or self.register,
                     f"{self.project.name}/{axis.name}",
                     window,
                     lambda: self.operator,
@@ -317,16 +326,8 @@ class MachineWindow(QMainWindow):
         self.setWindowTitle(f"FHA Studio — {self.project.name} — axis {axis.name}")
 
     def _on_actuator(self, index: int, code: str) -> None:
-        axis = self.project.axes[index]
-        if self.register is not None:
-            try:
-                self.register.update_axis(
-                    f"{self.project.name}/{axis.name}", who=self.operator, actuator_code=code
-                )
-            except (RegisterError, OSError) as exc:
-                self.current_window.show_message(
-                    f"Register: the actuator was not recorded ({exc}).", Level.WARNING
-                )
+        if self.recorders:
+            self.recorders[index].record_actuator(code)
         self._refresh_axis(index)
 
     # -- actions --------------------------------------------------------------------------------------
@@ -480,3 +481,5 @@ class MachineWindow(QMainWindow):
         for window in self.axis_windows:
             window._closing_confirmed = True
             window.shutdown()
+        if self.server_writer is not None:
+            self.server_writer.shutdown()  # the facts handed over are in this computer's queue

@@ -79,3 +79,8 @@ def write_fact(register: Register, axis: str, fact: Fact) -> str:
     except Exception as exc:  # sqlite3 errors (a locked or damaged file): said, not raised
         log.exception("register: %s of %s not recorded", fact.what, axis)
         return str(exc) or type(exc).__name__
+
+
+def facts_text(count: int) -> str:
+    """``1 fact``, ``3 facts``."""
+    return f"{count} fact{'' if count == 1 else 's'}"

@@ -34,7 +34,9 @@ from fha_studio import names
 from fha_studio.gui.axis_recorder import OPERATOR_KEY, AxisRecorder, login_name
 from fha_studio.gui.link import LinkInfo
 from fha_studio.gui.messages import Level
+from fha_studio.gui.register_writer import DirectWriter, RegisterWriter, facts_text
 from fha_studio.logic.register import Register, RegisterError, register_location
+from fha_studio.logic.register.server import is_server_url
 from fha_studio.logic.register.window_axis import (
     DefaultAxis,
     WindowAxis,
@@ -44,6 +46,7 @@ from fha_studio.logic.register.window_axis import (
 
 if TYPE_CHECKING:
     from fha_studio.gui.main_window import MainWindow
+    from fha_studio.gui.register_worker import ServerWriter
 
 log = logging.getLogger(__name__)
 
@@ -88,19 +91,25 @@ class WindowRegister(QObject):
         self._default_axis = DefaultAxis()
         self._url, self._simulated = "", False
         self.problem = ""
+        #: the register file, open on the GUI thread (None for a server's, or one that failed)
         self.register: Register | None = None
-        try:
-            self.register = Register(self.location)
-        except (RegisterError, OSError) as exc:  # read-only, damaged, locked: said, not raised
-            log.warning("register %s not opened: %s", shown_location(self.location), exc)
-            self.problem = str(exc)
+        self.writer: RegisterWriter | None = None
+        if is_server_url(self.location):
+            self.writer = self._server_writer(str(self.location))
+        else:
+            try:
+                self.register = Register(self.location)
+                self.writer = DirectWriter(self.register, self)
+            except (RegisterError, OSError) as exc:  # read-only, damaged, locked: said, not raised
+                log.warning("register %s not opened: %s", shown_location(self.location), exc)
+                self.problem = str(exc)
         # before the recorder's: the connection's URL is known when the recorder asks for the axis
         window.link.sigConnected.connect(self._on_connected)
         window.state.sigActuatorChanged.connect(self._on_actuator)
         self.recorder: AxisRecorder | None = None
-        if self.register is not None:
+        if self.writer is not None:
             self.recorder = AxisRecorder(
-                self.register, self._axis_for_fact, window, self.operator, axis_fields=self._axis_fields
+                self.writer, self._axis_for_fact, window, self.operator, axis_fields=self._axis_fields
             )
         self.button = QToolButton()
         self.button.setObjectName("registerLine")
@@ -114,6 +123,27 @@ class WindowRegister(QObject):
         self._refresh()
         if self.problem:
             window.show_message(f"Register: nothing is recorded: {self.problem}.", Level.WARNING)
+
+    # -- a register on a server ------------------------------------------------------------------------
+    def _server_writer(self, url: str) -> RegisterWriter:
+        from fha_studio.gui.register_worker import ServerWriter
+
+        writer = ServerWriter(url, self)
+        writer.sigSay.connect(self.window.show_message)
+        writer.sigChanged.connect(self._show)
+        return writer
+
+    @property
+    def server(self) -> ServerWriter | None:
+        """The writer of a register on a server (its state: ``answers``, ``waiting``), else None."""
+        from fha_studio.gui.register_worker import ServerWriter
+
+        return self.writer if isinstance(self.writer, ServerWriter) else None
+
+    def deliver_now(self) -> None:
+        """Tries the server now with what waits on this computer (a register on a server only)."""
+        if self.server is not None:
+            self.server.deliver_now()
 
     # -- where the facts go ---------------------------------------------------------------------------
     @property
@@ -163,14 +193,22 @@ class WindowRegister(QObject):
         known: dict[str, list[str]] = {}
         for machine, axis in _recent():
             known.setdefault(machine, []).append(axis)
-        if self.register is not None:
-            try:
-                for axis_row in self.register.axes():
-                    names_there = known.setdefault(axis_row.machine, [])
-                    if axis_row.name not in names_there:
-                        names_there.append(axis_row.name)
-            except (RegisterError, OSError) as exc:
-                log.warning("register's axes not listed: %s", exc)
+        try:
+            if self.register is not None:
+                rows = self.register.axes()
+            elif self.server is not None and self.server.queue.exists():
+                # a server's: this computer's copy of it (the server is never asked on this thread)
+                with Register(self.server.queue, read_only=True) as copy:
+                    rows = copy.axes()
+            else:
+                rows = []
+        except (RegisterError, OSError) as exc:
+            log.warning("register's axes not listed: %s", exc)
+            rows = []
+        for axis_row in rows:
+            names_there = known.setdefault(axis_row.machine, [])
+            if axis_row.name not in names_there:
+                names_there.append(axis_row.name)
         return known
 
     # -- what the window hears ------------------------------------------------------------------------
@@ -198,21 +236,30 @@ class WindowRegister(QObject):
 
     def _show(self) -> None:
         where = shown_location(self.location)
-        if self.register is None:
+        if self.writer is None:
             self.button.setText("Register: not recording")
             self.button.setStyleSheet("color: #b00020; font-weight: bold;")
             self.button.setToolTip(f"Nothing is recorded: {self.problem}")
         else:
             axis = self.axis
             width = max(160, min(LINE_WIDTH_MAX_PX, int(self.window.width() * LINE_WIDTH_SHARE)))
-            self.button.setText(_line(self.button.fontMetrics(), axis, width - 16))
-            self.button.setStyleSheet("")
+            server = self.server
+            away = server is not None and server.answers is False
+            tail = f" · server away, {facts_text(server.waiting)} waiting" if server and away else ""
+            self.button.setText(_line(self.button.fontMetrics(), axis, width - 16, tail))
+            self.button.setStyleSheet("color: #8a5a00; font-weight: bold;" if away else "")
             how = "" if axis.named else (
                 "\n(a default name: this computer's bench, the axis after its actuator or connection)"
             )
+            queue = ""
+            if server is not None:
+                state = {None: "not reached yet", True: "answers", False: "does not answer"}
+                queue = (f"\nThe server {state[server.answers]}; what is recorded goes first into "
+                         f"this computer's {server.queue}, then to the server.")
             self.button.setToolTip(
                 f"What this window learns is recorded in the register {where}\n"
-                f"as machine {axis.machine}, axis {axis.axis}{how}.\nClick to name the machine and axis."
+                f"as machine {axis.machine}, axis {axis.axis}{how}.{queue}\n"
+                "Click to name the machine and axis."
             )
 
     @Slot()
@@ -227,24 +274,27 @@ class WindowRegister(QObject):
         if self.recorder is not None:
             self.recorder.stop()  # a reply the link sent before it ended is not recorded any more
             self.recorder = None
+        if self.writer is not None:
+            self.writer.shutdown()  # a server's: the facts handed over are in this computer's queue
+            self.writer = None
         if self.register is not None:
             self.register.close()
             self.register = None
 
 
-def _line(metrics: QFontMetrics, axis: WindowAxis, width: int) -> str:
-    """``Register: MACHINE › AXIS`` within ``width`` pixels: the machine shortened first (the axis
-    is what a person checks), then the axis in its middle."""
+def _line(metrics: QFontMetrics, axis: WindowAxis, width: int, state: str = "") -> str:
+    """``Register: MACHINE › AXIS`` (and the server's ``state``) within ``width`` pixels: the
+    machine shortened first (the axis is what a person checks), then the axis in its middle."""
     head = "Register: "
-    text = f"{head}{axis.machine} › {axis.axis}"
+    text = f"{head}{axis.machine} › {axis.axis}{state}"
     if metrics.horizontalAdvance(text) <= width:
         return text
-    tail = f" › {axis.axis}"
+    tail = f" › {axis.axis}{state}"
     room = width - metrics.horizontalAdvance(head + tail)
     if room >= metrics.horizontalAdvance("M…"):
         return head + metrics.elidedText(axis.machine, Qt.TextElideMode.ElideRight, room) + tail
-    room = width - metrics.horizontalAdvance(head + "… › ")
-    return f"{head}… › {metrics.elidedText(axis.axis, Qt.TextElideMode.ElideMiddle, max(room, 40))}"
+    room = width - metrics.horizontalAdvance(f"{head}… › {state}")
+    return f"{head}… › {metrics.elidedText(axis.axis, Qt.TextElideMode.ElideMiddle, max(room, 40))}{state}"
 
 
 def _recent() -> list[tuple[str, str]]:
@@ -279,6 +329,11 @@ class WindowAxisDialog(QDialog):
             f"<b>{_html(shown_location(recording.location))}</b> under this machine and axis. "
             "Facts recorded before stay where they are."
         )
+        if recording.server is not None:
+            intro.setText(
+                intro.text() + " They go to the server through this computer's copy of it, "
+                f"{_html(str(recording.server.queue))}, which keeps them while the server does not answer."
+            )
         intro.setWordWrap(True)
         layout.addWidget(intro)
         form = QFormLayout()
@@ -313,6 +368,14 @@ class WindowAxisDialog(QDialog):
         )
         buttons.addButton(self.default_button, QDialogButtonBox.ButtonRole.ResetRole)
         self.default_button.clicked.connect(self._defaults)
+        self.deliver_button: QPushButton | None = None
+        if recording.server is not None:
+            self.deliver_button = QPushButton("&Try the server now")
+            self.deliver_button.setToolTip(
+                "Send what waits on this computer to the server now (it is tried again by itself too)"
+            )
+            buttons.addButton(self.deliver_button, QDialogButtonBox.ButtonRole.ActionRole)
+            self.deliver_button.clicked.connect(recording.deliver_now)
         buttons.accepted.connect(self.accept)
         buttons.rejected.connect(self.reject)
         layout.addWidget(buttons)
