@@ -8,7 +8,8 @@ temporary directory. FACTS front-panel values (200) are entered one after anothe
 technician's fast typing would: the GUI thread's time for each (what the window spends before it
 can draw again), the longest the GUI thread went without its event loop, and how long until the
 last of them is on the server. The same again with the server stopped (the facts wait in this
-computer's queue), then how long until the server has them once it is back.
+computer's queue), then how long until the server has them once it is back; beside it, the GUI
+thread's time per fact for a register file (written on that thread).
 """
 
 from __future__ import annotations
@@ -25,7 +26,6 @@ os.environ["XDG_DATA_HOME"] = f"{TMP}/data"
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 from PySide6.QtCore import QCoreApplication, QTimer  # noqa: E402
-from PySide6.QtWidgets import QApplication  # noqa: E402
 
 from fha_studio.logic.register import Register, RegisterError  # noqa: E402
 
@@ -42,11 +42,11 @@ def snapshots(url: str) -> int:
 
 def main() -> int:
     facts = int(sys.argv[1]) if len(sys.argv) > 1 else 200
+    from fha_studio.gui.app import make_application, parse_arguments, single_axis_window
     from tests.support.postgres import throwaway_cluster
 
-    app = QApplication(sys.argv[:1])
     QCoreApplication.setOrganizationName("FHA Studio Benchmarks")
-    from fha_studio.gui.app import parse_arguments, single_axis_window
+    app = make_application()  # as fha-studio: its GIL switch interval too
 
     def wait_until(condition, timeout_s: float = 300.0) -> float:
         started = time.perf_counter()
@@ -113,6 +113,16 @@ def main() -> int:
         window.shutdown()
         window.deleteLater()
 
+    # beside it: a register file, written on the GUI thread
+    window = single_axis_window(parse_arguments(["--no-connect", "--register", f"{TMP}/file.sqlite",
+                                                 "--machine", "Bench", "--axis", "table"]))
+    window.show()
+    enter(1, 1)
+    in_file = enter(facts, 2)
+    window._closing_confirmed = True
+    window.shutdown()
+    window.deleteLater()
+
     def ms(values: list[float]) -> str:
         return (f"median {statistics.median(values) * 1000:.2f} ms, "
                 f"max {max(values) * 1000:.2f} ms")
@@ -121,6 +131,7 @@ def main() -> int:
           f"its event loop {online_longest * 1000:.0f} ms; all on the server after {delivered_s:.2f} s")
     print(f"{facts} facts, server stopped:   GUI thread per fact {ms(offline)}; longest without "
           f"its event loop {offline_longest * 1000:.0f} ms")
+    print(f"{facts} facts, a register file:  GUI thread per fact {ms(in_file)} (written on it)")
     print(f"server back: the {facts} waiting facts on it after {back_s:.2f} s; "
           f"the server holds {total} snapshots (expected {2 * facts + 1})")
     return 0 if total == 2 * facts + 1 else 1
