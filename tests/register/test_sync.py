@@ -522,3 +522,29 @@ def test_the_machine_report_and_open_items_show_an_open_conflict(laptops, tmp_pa
     assert len(items) == 2 and {i.axis.ref for i in items} == {SHARED}
     assert main(["register", "--register", str(ben), "open", M]) == 0
     assert capsys.readouterr().out.count(f"{SHARED}: conflict: conflict ") == 2
+
+
+def test_axes_two_registers_held_differently_before_ids_are_a_conflict_once(tmp_path):
+    """Axes of registers older than stable ids (no entry says what set their fields): a field they
+    hold differently is a conflict; settled, it stays settled."""
+    a, b = tmp_path / "a.sqlite", tmp_path / "b.sqlite"
+    for where, actuator in ((a, "FHA-25C-50-US250"), (b, "FHA-32C-100-US250")):
+        with Register(where) as reg:
+            reg.add_machine(M)
+            reg._db.execute(  # as schema 5 and before left it: the field without an entry saying so
+                "INSERT INTO axis (machine_id, name, actuator_code, created_utc) VALUES (1, 'table', ?, ?)",
+                (actuator, "2025-01-02T03:04:05.000000+00:00"),
+            )
+    (conflict,) = sync_registers(a, b).conflicts
+    assert conflict.subject == "axis" and {s.values["actuator_code"].value for s in conflict.sides} == {
+        "FHA-25C-50-US250", "FHA-32C-100-US250"}
+    # settled in the register that held the kept value all along: its row does not change
+    keep = next(n for n, s in enumerate(conflict.sides, 1) if s.values["actuator_code"].value[4:7] == "25C")
+    with Register(a) as reg:
+        reg.resolve_conflict(conflict.short, keep, who="carla")
+    again = sync_registers(a, b)
+    assert again.conflicts == () and again.found_now == frozenset()
+    for where in (a, b):
+        with Register(where) as reg:
+            assert reg.axis(SHARED).actuator_code == "FHA-25C-50-US250"
+    assert sync_registers(b, a).conflicts == ()

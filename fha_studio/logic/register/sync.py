@@ -618,14 +618,20 @@ class _Sync:
             return None
         sql = "SELECT uid, at_utc, who, recorded_in, data FROM axis_event WHERE axis_id = ? AND data != ''"
         every_s, every_t = self.s.rows(sql, (i,)), self.t.rows(sql, (j,))
-        new_s = field_settings(r for r in every_s if r["uid"] in set(sent))
-        new_t = field_settings(r for r in every_t if r["uid"] in set(got))
+        fresh_s = [r for r in every_s if r["uid"] in set(sent)]
+        fresh_t = [r for r in every_t if r["uid"] in set(got)]
+        new_s, new_t = field_settings(fresh_s), field_settings(fresh_t)
         held_s, held_t = field_settings(every_s), field_settings(every_t)
+        settled_s, settled_t = _settled_fields(fresh_s), _settled_fields(fresh_t)
         items = []
         for f in differ:
-            if f in new_s and f not in new_t and f in held_t and held_t[f].value == theirs[f]:
-                continue  # changed in the source; the target held what it had before
-            if f in new_t and f not in new_s and f in held_s and held_s[f].value == mine[f]:
+            if f in new_s and f not in new_t and (
+                f in settled_s or (f in held_t and held_t[f].value == theirs[f])
+            ):
+                continue  # changed (or settled by a person) in the source; the target kept what it had
+            if f in new_t and f not in new_s and (
+                f in settled_t or (f in held_s and held_s[f].value == mine[f])
+            ):
                 continue
             items.append(f)
         if not items:
@@ -756,6 +762,11 @@ class _Sync:
             ):
                 continue
             side.execute(f"UPDATE axis SET {key} = ? WHERE id = ?", (value.value, axis_id))
+
+
+def _settled_fields(entries: list[dict[str, Any]]) -> set[str]:
+    """The fields that axis entries among ``entries`` set in settling a conflict."""
+    return {str(d["field"]) for d in (_json(r["data"]) for r in entries) if d.get("settles") and "field" in d}
 
 
 def _json(text: Any) -> dict[str, Any]:
