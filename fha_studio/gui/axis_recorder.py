@@ -148,9 +148,10 @@ class AxisRecorder(QObject):
         self._axes_sent.add(axis)
         self.writer.record(axis, facts)
 
-    @Slot(str, str)
-    def _on_not_recorded(self, what: str, why: str) -> None:
-        self.window.show_message(f"Register: the {what} was not recorded ({why}).", Level.WARNING)
+    @Slot(str, str, str)
+    def _on_not_recorded(self, axis: str, what: str, why: str) -> None:
+        if axis in self._axes_sent:  # one writer may serve several axes (a machine's, on a server)
+            self.window.show_message(f"Register: the {what} was not recorded ({why}).", Level.WARNING)
 
     @property
     def who(self) -> str:
@@ -219,7 +220,9 @@ class AxisRecorder(QObject):
                 try:
                     session.save()
                 except (OSError, ValueError) as exc:
-                    self._on_not_recorded("session file", str(exc))
+                    self.window.show_message(
+                        f"Register: the session file was not recorded ({exc}).", Level.WARNING
+                    )
         self.record([session_fact(session)])
 
     def _on_report(self, page: ProceduresPage, html: Path, pdf: Path | None) -> None:

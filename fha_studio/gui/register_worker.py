@@ -90,7 +90,7 @@ class ServerState:
 class QueueWorker(QObject):
     """Writes facts into this computer's register file for the server (in its own thread)."""
 
-    sigNotRecorded = Signal(str, str)  # what, why
+    sigNotRecorded = Signal(str, str, str)  # axis, what, why
     sigQueued = Signal(int)  # how many facts were written into the file
 
     def __init__(self, path: Path):
@@ -112,7 +112,7 @@ class QueueWorker(QObject):
         queue = self._queue
         if queue is None:
             for fact in request.facts:
-                self.sigNotRecorded.emit(fact.what, self._problem)
+                self.sigNotRecorded.emit(request.axis, fact.what, self._problem)
             return
         facts = list(request.facts)
         if not facts or not isinstance(facts[0], AxisFact):
@@ -121,7 +121,7 @@ class QueueWorker(QObject):
         for fact in facts:
             problem = write_fact(queue, request.axis, fact)
             if problem:
-                self.sigNotRecorded.emit(fact.what, problem)
+                self.sigNotRecorded.emit(request.axis, fact.what, problem)
                 if isinstance(fact, AxisFact):
                     break
             elif not isinstance(fact, AxisFact):

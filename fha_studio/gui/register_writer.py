@@ -23,8 +23,9 @@ log = logging.getLogger(__name__)
 class RegisterWriter(QObject):
     """Takes an axis's facts for the register; says each one that was not recorded."""
 
-    #: (what, why): a fact the register did not take, in words ("parameter write", one line)
-    sigNotRecorded = Signal(str, str)
+    #: (axis, what, why): a fact of the axis (``MACHINE/AXIS``) the register did not take, in
+    #: words ("parameter write", one line)
+    sigNotRecorded = Signal(str, str, str)
 
     @property
     def location(self) -> Path | str:
@@ -59,7 +60,7 @@ class DirectWriter(RegisterWriter):
                 return
             problem = write_fact(self.register, axis, fact)
             if problem:
-                self.sigNotRecorded.emit(fact.what, problem)
+                self.sigNotRecorded.emit(axis, fact.what, problem)
                 if isinstance(fact, AxisFact):
                     return
 

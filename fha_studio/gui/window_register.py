@@ -15,7 +15,7 @@ import logging
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from PySide6.QtCore import QEvent, QObject, QSettings, Qt, Signal, Slot
+from PySide6.QtCore import QEvent, QObject, QSettings, Qt, Slot
 from PySide6.QtGui import QFontMetrics
 from PySide6.QtWidgets import (
     QComboBox,
@@ -70,8 +70,6 @@ def shown_location(location: Path | str) -> str:
 class WindowRegister(QObject):
     """The register one single-axis window records into, and the machine and axis it records under."""
 
-    sigAxisChanged = Signal(object)  # WindowAxis: where the next fact goes
-
     def __init__(
         self,
         window: MainWindow,
@@ -120,7 +118,7 @@ class WindowRegister(QObject):
         window.installEventFilter(self)  # the line is elided again to a new width
         window.window_register = self
         window.signing_register = self.location  # the sign step finds the signer's key there
-        self._refresh()
+        self._show()
         if self.problem:
             window.show_message(f"Register: nothing is recorded: {self.problem}.", Level.WARNING)
 
@@ -162,7 +160,6 @@ class WindowRegister(QObject):
         if not self._axis:
             state = self.window.state
             self._default_axis.take(state.actuator_code, self._url, self._simulated)
-            self._refresh()
         return self.axis.ref
 
     def _axis_fields(self, _axis_ref: str) -> dict[str, Any]:
@@ -185,7 +182,7 @@ class WindowRegister(QObject):
             self._default_axis.forget()  # back to the default: it is chosen again at the next fact
         if self._machine and self._axis:
             _remember(self._machine, self._axis)
-        self._refresh()
+        self._show()
         return self.axis
 
     def known_axes(self) -> dict[str, list[str]]:
@@ -215,20 +212,16 @@ class WindowRegister(QObject):
     @Slot(object)
     def _on_connected(self, info: LinkInfo) -> None:
         self._url, self._simulated = info.url, info.is_simulated
-        self._refresh()
+        self._show()
 
     @Slot(str)
     def _on_actuator(self, code: str) -> None:
         """The actuator declared: the axis's record says it (once its axis is in the register)."""
-        self._refresh()
+        self._show()
         if self.recorder is not None and code and self.axis.ref in self.recorder.recorded_axes():
             self.recorder.record_actuator(code)
 
     # -- showing it -----------------------------------------------------------------------------------
-    def _refresh(self) -> None:
-        self._show()
-        self.sigAxisChanged.emit(self.axis)
-
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
         if watched is self.window and event.type() == QEvent.Type.Resize:
             self._show()

@@ -176,3 +176,20 @@ def test_the_register_line_fits_beside_the_toolbar(make_window, qtbot, tmp_path,
     assert not hidden_actions(window) and not cut_texts(window)
     text = window.window_register.button.text()
     assert text.startswith("Register: ") and "…" in text
+
+
+def test_a_fact_the_register_refuses_is_said_in_the_axis_message_line(make_window, tmp_path):
+    from fha_studio.gui.axis_recorder import AxisRecorder
+
+    path = tmp_path / "line3.sqlite"
+    with Register(path) as register:
+        register.add_machine("Line 3")
+        register.add_axis("Line 3", "tilt")
+    window = make_window("--register", str(tmp_path / "r.sqlite"))
+    with Register(path, read_only=True) as refusing:
+        AxisRecorder(refusing, "Line 3/tilt", window, lambda: "ana")
+        window.state.enter_front_panel("system", 8, 1, "ana")
+        said = [m.text for m in window.message_area.messages]
+        assert said == [f"Register: the front-panel value was not recorded (the register {path} is "
+                        "read-only: nothing was changed (it needs write access to the file and its "
+                        "folder))."], said
