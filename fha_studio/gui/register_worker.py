@@ -408,9 +408,12 @@ class ServerWriter(RegisterWriter):
 
     @Slot()
     def _on_answered(self) -> None:
-        """A long delivery goes on: the server answers, it is not slow."""
+        """A long delivery goes on (the first sync of a large register): the server answers, so it
+        neither is slow nor hangs."""
+        if self._give_up_timer.isActive():
+            self._give_up_timer.start()
         if self._slow_timer.isActive():
-            self._on_busy(True)
+            self._slow_timer.start()
 
     @Slot(bool)
     def _on_busy(self, busy: bool) -> None:

@@ -238,3 +238,19 @@ def test_a_machine_window_on_a_server_records_through_this_computers_queue(qtbot
         qtbot.waitUntil(lambda: _snapshot_count(url) == 1, timeout=30000)
         assert register_worker.queue_path(url).exists()
     register.close()
+
+
+def test_a_delivery_that_hangs_is_cut_off_and_made_again_on_a_new_connection(
+    make_window, qtbot, postgres_cluster, monkeypatch
+):
+    """A connection the network left waiting (here: its server process stopped) is given up after
+    GIVE_UP_S and the delivery made again on a new one, while the old one still hangs."""
+    monkeypatch.setattr(register_worker, "GIVE_UP_S", 1.0)
+    url = postgres_cluster.new_database()
+    window = make_window("--register", url, "--machine", "Line 3", "--axis", "table")
+    window.state.enter_front_panel("system", 8, 1, "ana")
+    qtbot.waitUntil(lambda: window.window_register.server.answers is True, timeout=30000)
+    with _hung(postgres_cluster, urlsplit(url).path.lstrip("/")):
+        window.state.enter_front_panel("tune", 4, 20, "ben")
+        qtbot.waitUntil(lambda: "the server answered" in _said(window), timeout=30000)
+        assert _snapshot_count(url) == 2
