@@ -183,7 +183,9 @@ def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelPa
 
 
 SMALL_STEP_COUNT = 16
-TRACE_CHANNELS = ("t", "cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd")
+TRACE_CHANNELS = ("t", "cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd", "controller_pos")
+#: the channels the kernel records; ``controller_pos`` is the axis's own (see ``controller_pos_rad``)
+_KERNEL_CHANNELS = len(TRACE_CHANNELS) - 1
 
 
 class ServoAxis:
@@ -205,6 +207,10 @@ class ServoAxis:
         self._state.cprev = d * self._state.xm
         self._generator = MotionGenerator(d * self._state.xm)
         self._pulse_offset_rad = 0.0
+        # the controller's command (command frame): the generator's while the servo is on, plus
+        # what the error counter's re-basings took away from the generator (see controller_pos_rad)
+        self._controller_rad = d * self._state.xm
+        self._controller_offset_rad = 0.0
         self._trace: tuple[list, ...] | None = None
         self._trace_every = 1
         self._trace_max = 0
@@ -254,8 +260,8 @@ class ServoAxis:
         if speed_injection is not None and len(speed_injection) != n:
             raise ValueError(f"speed_injection: {len(speed_injection)} values for {n} periods")
         p = self._params
+        k0 = self._state.step_index + 1
         if self._servo_on:
-            k0 = self._state.step_index + 1
             off = self._pulse_offset_rad
             if n <= SMALL_STEP_COUNT:  # numpy's call overhead dominates for a few periods
                 state_at = self._generator.state_at
@@ -265,9 +271,14 @@ class ServoAxis:
         else:
             cmd = None
         rec = self._trace
-        _kernel.run(p, self._state, cmd, n, self._servo_on, rec, self._trace_every,
+        recorded = len(rec[0]) if rec is not None else 0
+        kernel_rec = rec[:_KERNEL_CHANNELS] if rec is not None else None
+        _kernel.run(p, self._state, cmd, n, self._servo_on, kernel_rec, self._trace_every,
                     speed_injection if self._servo_on else None)
+        if cmd is not None:
+            self._controller_rad = cmd[-1] + self._controller_offset_rad
         if rec is not None:
+            self._record_controller(rec, recorded, cmd, k0)
             overflow = len(rec[0]) - self._trace_max
             if overflow > 0:
                 for ch in rec:
@@ -275,6 +286,20 @@ class ServoAxis:
         if not self._servo_on:
             self._generator.hold(self.time_s, self._state.cprev)
             self._pulse_offset_rad = 0.0
+
+    def _record_controller(self, rec: tuple[list, ...], recorded: int, cmd: list[float] | None,
+                           k0: int) -> None:
+        """The controller's command at the periods the kernel just recorded (its times say which)."""
+        new = rec[0][recorded:]
+        if cmd is None:  # the servo is off: the controller sends nothing
+            rec[-1].extend([self._controller_rad] * len(new))
+            return
+        off = self._controller_offset_rad
+        if len(new) == len(cmd):  # every period recorded
+            rec[-1].extend([c + off for c in cmd])
+        else:
+            dt = self._params.dt
+            rec[-1].extend([cmd[round(t / dt) - k0] + off for t in new])
 
     def advance(self, seconds: float) -> None:
         """Advance by a duration (rounded to whole servo periods)."""
@@ -381,6 +406,7 @@ class ServoAxis:
             x = self._to_pulses(x) * self._model.output_pulse_rad
         self._generator.hold(self.time_s, d * x)
         self._pulse_offset_rad = 0.0
+        self._controller_offset_rad = self._controller_rad - d * x  # the controller's count goes on
         self._state.cprev = d * x
 
     def _load_rest_position(self, xm: float) -> float:
@@ -438,6 +464,14 @@ class ServoAxis:
     def command_pos_rad(self) -> float:
         """The position command in the physical frame (rad)."""
         return self._settings.direction_sign * self._state.cprev
+
+    @property
+    def controller_pos_rad(self) -> float:
+        """What the controller has commanded so far (command frame, rad, after the electronic gear):
+        the command while the servo is on; it holds while the servo is off (the error counter then
+        follows the feedback, the controller sends nothing) and does not jump when the error counter
+        is cleared or the command re-based (the drive's command does)."""
+        return self._controller_rad
 
     @property
     def speed_command_rad_s(self) -> float:
@@ -538,14 +572,15 @@ class ServoAxis:
         """Record TRACE_CHANNELS every n servo periods (oldest samples dropped past max_samples)."""
         if every_n_periods < 1 or max_samples < 1:
             raise ValueError("trace: every_n_periods and max_samples must be at least 1")
-        self._trace = ([], [], [], [], [], [], [])
+        self._trace = tuple([] for _ in TRACE_CHANNELS)
         self._state.rec_count = 0
         self._trace_every = int(every_n_periods)
         self._trace_max = int(max_samples)
 
     def read_trace(self, clear: bool = True) -> dict[str, np.ndarray]:
         """The recorded samples (t s, cmd_pos rad, pos rad, load_pos rad, vel rad/s, current A,
-        speed_cmd rad/s command frame); clear=True empties the buffer, recording continues."""
+        speed_cmd rad/s command frame, controller_pos rad command frame); clear=True empties the
+        buffer, recording continues."""
         if self._trace is None:
             return {name: np.empty(0) for name in TRACE_CHANNELS}
         out = {name: np.array(ch) for name, ch in zip(TRACE_CHANNELS, self._trace, strict=True)}

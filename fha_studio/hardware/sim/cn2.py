@@ -6,10 +6,12 @@ between servo periods):
 
 - encoder A/B line-driver outputs at the actuator's resolution (the drive's feedback pulses,
   x4: A leads B going forward) and Z once per motor turn (high for one count);
-- the command pulses of the drive's own moves in the form of parameter 1 (two-pulse: FWD pulses
-  on CMD_A, REV on CMD_B; pulse + sign: pulses on CMD_A, CMD_B high = REV; two-phase: CMD_A
-  leading CMD_B = FWD, an edge per pulse at x4, a cycle per pulse at x1), before the electronic
-  gear 3/4 (the pulses the controller sends);
+- the command pulses the controller sends (the moves commanded while the servo is on) in the form
+  of parameter 1 (two-pulse: FWD pulses on CMD_A, REV on CMD_B; pulse + sign: pulses on CMD_A,
+  CMD_B high = REV; two-phase: CMD_A leading CMD_B = FWD, an edge per pulse at x4, a cycle per
+  pulse at x1), before the electronic gear 3/4. They are inputs on a real drive: when the servo
+  goes off (an alarm) and the axis coasts, the drive's error counter follows the encoder but the
+  lines stay still, and clearing the error counter sends nothing (the trace's ``controller_pos``);
 - SPD-MON (CN2-23): +10 V at the motor speed of parameter 9, through the monitor's bandwidth,
   with its offset and noise (assumptions of this simulation, :class:`MonitorModel`);
 - IN-POS (|command - feedback| within the in-position range), ALARM, and the alarm code on
@@ -129,7 +131,7 @@ class Cn2Signals:
             raise ValueError(f"no CN2 output {', '.join(unknown)} (there are {', '.join(LOGIC_CHANNELS)})")
         self.logic_channels = tuple(logic_channels)
         self.next_sample = 0
-        self._last: tuple[float, float, float, float] | None = None  # t, pos, cmd, vel
+        self._last: tuple[float, float, float, float, float] | None = None  # t, pos, cmd, vel, controller
         self._sign = 0
         self._last_pulses: int | None = None
         wc = 2.0 * math.pi * settings.monitor.bandwidth_hz
@@ -147,11 +149,13 @@ class Cn2Signals:
         pos = trace["pos"] * self.direction
         cmd = trace["cmd_pos"] * self.direction
         vel = trace["vel"] * self.direction
+        sent = trace["controller_pos"]  # the controller's command, already in the command frame
         if self._last is not None:
             t = np.concatenate(([self._last[0]], t))
             pos = np.concatenate(([self._last[1]], pos))
             cmd = np.concatenate(([self._last[2]], cmd))
             vel = np.concatenate(([self._last[3]], vel))
+            sent = np.concatenate(([self._last[4]], sent))
         if t.size == 0:
             return self._empty(), {}
         if self._last is None and self.next_sample == 0:
@@ -161,19 +165,20 @@ class Cn2Signals:
         ts = k / self.rate
         first = self.next_sample
         self.next_sample = last_index + 1
-        self._last = (float(t[-1]), float(pos[-1]), float(cmd[-1]), float(vel[-1]))
+        self._last = (float(t[-1]), float(pos[-1]), float(cmd[-1]), float(vel[-1]), float(sent[-1]))
         if k.size == 0:
             return self._empty(), {}
         p = np.interp(ts, t, pos)
         c = np.interp(ts, t, cmd)
         v = np.interp(ts, t, vel)
+        sent_rad = np.interp(ts, t, sent)
         counts = np.floor(p / self.pulse_rad + 0.5).astype(np.int64)
         # command input pulses (before the electronic gear); two-phase at x2 / x1 takes 2 / 4 edges
         # per pulse, so its lines follow the command edge by edge
         per = 4 // self.s.multiplication if self.s.pulse_form == 2 else 1
-        edges = np.floor(c / self.pulse_rad * self.gear_denominator / self.gear_numerator * per + 0.5).astype(
-            np.int64
-        )
+        edges = np.floor(
+            sent_rad / self.pulse_rad * self.gear_denominator / self.gear_numerator * per + 0.5
+        ).astype(np.int64)
         pulses = np.floor_divide(edges, per)
         cmd_counts = np.floor(c / self.pulse_rad + 0.5).astype(np.int64)
         self._check_steps(counts, "encoder edges")
