@@ -11,6 +11,7 @@ omega x h < 2; the substep count keeps omega_max x h <= MAX_OMEGA_H.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 # Stability/accuracy margin of the spring integration (symplectic Euler is stable below 2;
@@ -23,7 +24,7 @@ class KernelParams:
     """Everything the loop reads, flattened to floats (built by ServoAxis from model + settings)."""
 
     dt: float
-    nsub: int
+    nsub: int  # substeps per servo period (1 for a rigid axis: no spring to resolve)
     direction: float
     kp: float
     kv: float
@@ -91,16 +92,23 @@ class KernelState:
 
 def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_on: bool,
         rec: tuple[list, ...] | None = None, rec_every: int = 1,
-        speed_injection: list[float] | None = None) -> None:
+        speed_injection: list[float] | None = None, *, record_at: Iterable[int] | None = None,
+        accounting: bool = True) -> None:
     """Advance n servo periods. cmd: n command positions (rad, command frame), or None to hold.
     speed_injection: n speeds (rad/s, command frame) added to the speed command (an excitation
     at the speed loop's summing point), or None.
 
-    rec: lists (t, cmd_phys, xm, xl, vm, current, vref) appended every rec_every periods.
+    rec: lists (t, cmd_phys, xm, xl, vm, current, vref) appended every rec_every periods, or only
+    at the periods record_at names (increasing, 0 = the first of these n; rec_every is then unused):
+    simulate() keeps only the periods its samples fall between.
+    accounting: False skips the cumulative figures (I^2 t, work, regeneration, peaks) that only the
+    simulated drive reads; the motion is the same.
     """
     dt = p.dt
     rate = 1.0 / dt
     nsub = p.nsub
+    if not p.compliant and nsub != 1:
+        raise ValueError(f"a rigid axis takes one step per servo period, not {nsub}")
     h = dt / nsub
     d = p.direction
     kp, kv, tv_inv, ff, ilim, kt = p.kp, p.kv, p.tv_inv, p.ff, p.ilim, p.kt
@@ -147,6 +155,9 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     if rec is not None:
         r_t, r_c, r_xm, r_xl, r_vm, r_i, r_vr = rec
     rec_count = s.rec_count
+    # the next period to record when record_at is given (-1: none left)
+    at = iter(record_at) if record_at is not None else None
+    next_at = next(at, -1) if at is not None else -1
     k0 = s.step_index + 1
 
     for k in range(n):
@@ -246,28 +257,28 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
                 xm += h * vm
                 xl += h * vl
         else:
-            for _ in range(nsub):
-                tm = motor_torque - off
-                if sin_ga:
-                    tm -= ga * sin(xm + gph)
-                if sin_ra:
-                    tm -= ra * sin(rw * xm + rph)
-                v = vm + h_jm * tm
-                if has_visc:
-                    v *= visc_den
-                up, dn = fcp_dv, fcn_dv
-                if has_st:
-                    q = vm * st_iv
-                    e = st_dv * exp(-q * q)
-                    up += e
-                    dn += e
-                if v > up:
-                    vm = v - up
-                elif v < -dn:
-                    vm = v + dn
-                else:
-                    vm = 0.0
-                xm += h * vm
+            # one rigid mass: no spring to resolve, one step per period (nsub is 1)
+            tm = motor_torque - off
+            if sin_ga:
+                tm -= ga * sin(xm + gph)
+            if sin_ra:
+                tm -= ra * sin(rw * xm + rph)
+            v = vm + h_jm * tm
+            if has_visc:
+                v *= visc_den
+            up, dn = fcp_dv, fcn_dv
+            if has_st:
+                q = vm * st_iv
+                e = st_dv * exp(-q * q)
+                up += e
+                dn += e
+            if v > up:
+                vm = v - up
+            elif v < -dn:
+                vm = v + dn
+            else:
+                vm = 0.0
+            xm += h * vm
             vl = vm
             # load = motor side + kinematic error, through the lost-motion play operator
             lp = xm + kea * sin(kew * xm + keph) if sin_ke else xm
@@ -287,16 +298,27 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
                 fb_prev = fbp
 
         # ---------------- accounting ----------------
-        i2 += cur * cur
-        pm = motor_torque * vm
-        work += pm
-        pe = pm + res15 * cur * cur
-        if pe < 0.0:
-            regen -= pe
-        av = vm if vm >= 0.0 else -vm
-        if av > pk_v:
-            pk_v = av
-        if rec is not None:
+        if accounting:
+            i2 += cur * cur
+            pm = motor_torque * vm
+            work += pm
+            pe = pm + res15 * cur * cur
+            if pe < 0.0:
+                regen -= pe
+            av = vm if vm >= 0.0 else -vm
+            if av > pk_v:
+                pk_v = av
+        if at is not None:
+            if k == next_at:
+                next_at = next(at, -1)
+                r_t.append((k0 + k) * dt)
+                r_c.append(d * c)
+                r_xm.append(xm)
+                r_xl.append(xl)
+                r_vm.append(vm)
+                r_i.append(cur)
+                r_vr.append(vref)
+        elif rec is not None:
             rec_count += 1
             if rec_count >= rec_every:
                 rec_count = 0

@@ -129,22 +129,31 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
         m = min(SIMULATION_CHUNK, n - k0)
         t_servo = dt * np.arange(k0 + 1, k0 + m + 1)  # relative to t[0]
         cmd_servo = (d * np.interp(t[0] + t_servo, t, cmd)).tolist()
-        rec: tuple[list, ...] = ([], [], [], [], [], [], [])
-        _kernel.run(p, state, cmd_servo, m, True, rec, 1)
         ts = np.concatenate(([last_t], t_servo))
-        # the lists to arrays with their dtype stated: numpy then skips its type discovery per item
-        recorded = [np.array(r, dtype=float) for r in rec[1:]]
-        cur = recorded[4]
-        charge = last_charge + np.concatenate(([0.0], np.cumsum(cur) * dt))
         stop = int(np.searchsorted(t, t[0] + ts[-1], side="right")) if k0 + m < n else len(t)
         rel = t[done:stop] - t[0]
-        for j, key in enumerate(keys):
-            out[key][done:stop] = np.interp(rel, ts, np.concatenate(([last[j]], recorded[j])))
-        charge_at[done:stop] = np.interp(rel, ts, charge)
+        if current_average:  # the charge needs every period's current
+            keep, record_at = np.arange(m + 1), None
+        else:
+            # np.interp reads only the two periods a sample falls between: record those (and the
+            # chunk's last, where the next chunk starts); the samples come out bit for bit the same
+            j = np.searchsorted(ts, rel, side="right") - 1
+            keep = np.unique(np.concatenate(([0, m], np.clip(j, 0, m), np.clip(j + 1, 0, m))))
+            record_at = (keep[1:] - 1).tolist()
+        rec: tuple[list, ...] = ([], [], [], [], [], [], [])
+        _kernel.run(p, state, cmd_servo, m, True, rec, 1, record_at=record_at, accounting=False)
+        ts = ts[keep]
+        # the lists to arrays with their dtype stated: numpy then skips its type discovery per item
+        recorded = [np.array(r, dtype=float) for r in rec[1:]]
+        for j_key, key in enumerate(keys):
+            out[key][done:stop] = np.interp(rel, ts, np.concatenate(([last[j_key]], recorded[j_key])))
+        if current_average:
+            charge = last_charge + np.concatenate(([0.0], np.cumsum(recorded[4]) * dt))
+            charge_at[done:stop] = np.interp(rel, ts, charge)
+            last_charge = float(charge[-1])
         done = stop
         last_t = float(ts[-1])
-        last = [float(rec[j + 1][-1]) for j in range(len(keys))]
-        last_charge = float(charge[-1])
+        last = [float(rec[j_key + 1][-1]) for j_key in range(len(keys))]
     if current_average:
         # the current recorded at the end of a servo period was applied during all of it
         out["current"][1:] = np.diff(charge_at) / np.diff(t)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import math
 
 import numpy as np
@@ -366,3 +367,63 @@ def test_the_direction_sign_follows_the_manuals_rotary_direction_table():
         assert sign == (1.0 if setting.fwd_turns_cw else -1.0)
     with pytest.raises(ValueError, match="rotary_direction"):
         ServoSettings(rotary_direction=2)
+
+
+def _every_period_interpolated(model, servo, t, cmd):
+    """simulate()'s samples the plain way: every servo period recorded, then interpolated."""
+    from fha_studio.physics import _kernel
+    simulate_module = importlib.import_module("fha_studio.physics.simulate")  # the name is the function
+    from fha_studio.physics.servo import kernel_params
+
+    p = kernel_params(model, servo)
+    n = math.ceil((t[-1] - t[0]) / p.dt - 1e-9) + 1
+    state = _kernel.KernelState()
+    simulate_module._initialise_at_rest(state, p, float(cmd[0]), True)
+    first = [p.direction * state.cprev, state.xm, state.xl, state.vm, state.current, state.vref]
+    t_servo = p.dt * np.arange(1, n + 1)
+    rec: tuple[list, ...] = ([], [], [], [], [], [], [])
+    _kernel.run(p, state, (p.direction * np.interp(t[0] + t_servo, t, cmd)).tolist(), n, True, rec, 1)
+    ts = np.concatenate(([0.0], t_servo))
+    keys = ("cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd")
+    return {k: np.interp(t - t[0], ts, np.concatenate(([first[j]], rec[j + 1]))) for j, k in enumerate(keys)}
+
+
+@pytest.mark.parametrize("case", ["rigid", "compliant", "quantised", "uneven"])
+def test_simulate_keeps_only_the_periods_its_samples_need_bit_for_bit(make_model, monkeypatch, case):
+    # simulate() records only the servo periods each sample falls between (and runs in chunks):
+    # the samples are exactly those of the whole per-period trace interpolated
+    simulate_module = importlib.import_module("fha_studio.physics.simulate")  # the name is the function
+
+    monkeypatch.setattr(simulate_module, "SIMULATION_CHUNK", 997)  # several chunks in 1.5 s
+    effects = Effects().with_effect("coulomb_friction", torque_nm=3.0).with_effect(
+        "gravity_load", amplitude_nm=8.0, phase_deg=20.0).with_effect(
+        "torque_ripple", amplitude_nm=0.5, cycles_per_motor_rev=2)
+    if case == "compliant":
+        effects = effects.with_effect("torsional_compliance").with_effect("lost_motion", width_arcsec=40.0)
+    model = make_model(CODE, 1.5, effects)
+    servo = ServoSettings.tuned_for(model, quantised_feedback=case == "quantised")
+    if case == "uneven":
+        t = np.cumsum(np.random.default_rng(4).uniform(3e-4, 2.1e-3, 1200))
+    else:
+        t = np.arange(0.0, 1.5, 1e-3)
+    cmd = 1.5 * np.sin(2.0 * t) + 0.3 * np.sin(9.0 * t)
+    got = simulate(model, servo, t, cmd)
+    expected = _every_period_interpolated(model, servo, t, cmd)
+    for key, values in expected.items():
+        assert np.array_equal(got[key], values), key
+
+
+def test_the_kernels_accounting_does_not_change_the_motion(make_model):
+    from fha_studio.physics import _kernel
+    from fha_studio.physics.servo import kernel_params
+
+    model = make_model(CODE, 1.5, Effects().with_effect("coulomb_friction", torque_nm=3.0))
+    p = kernel_params(model, ServoSettings.tuned_for(model))
+    cmd = (0.5 * np.sin(np.arange(3000) * 1e-3)).tolist()
+    states = [_kernel.KernelState(), _kernel.KernelState()]
+    for state, accounting in zip(states, (True, False), strict=True):
+        _kernel.run(p, state, cmd, len(cmd), True, accounting=accounting)
+    with_, without = states
+    assert (with_.xm, with_.vm, with_.integ, with_.current) == (without.xm, without.vm, without.integ,
+                                                                 without.current)
+    assert with_.i2_integral > 0 and without.i2_integral == 0.0
