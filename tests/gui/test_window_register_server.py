@@ -102,10 +102,10 @@ def _snapshot_count(url: str) -> int:
             return 0
 
 
-def _said(window) -> str:
-    """The message line's latest message ("" before the first)."""
-    latest = window.message_area.latest()
-    return latest.text if latest is not None else ""
+def _said_since(window, mark: int, words: str) -> str:
+    """The first message from the ``mark``-th on that holds ``words`` ("" while there is none):
+    a delivery before the mark may have been slow, and said so, too."""
+    return next((m.text for m in window.message_area.messages[mark:] if words in m.text), "")
 
 
 @contextlib.contextmanager
@@ -153,26 +153,31 @@ def test_a_server_that_hangs_then_stops_while_the_window_records(
     watch = GuiThreadWatch()
     try:
         # the server hangs: said as slow; the facts wait on this computer
+        mark = len(window.message_area.messages)
         with _hung(postgres_cluster, database):
             started = time.monotonic()
             window.state.enter_front_panel("system", 8, 1, "ben")
             window.state.enter_front_panel("tune", 4, 20, "cy")
             time_ceiling("two facts handed over while the server hangs", time.monotonic() - started, 2.0)
-            qtbot.waitUntil(lambda: "slow to answer" in _said(window), timeout=30000)
-            said = _said(window)
+            qtbot.waitUntil(lambda: bool(_said_since(window, mark, "slow to answer")), timeout=30000)
+            said = _said_since(window, mark, "slow to answer")
             assert said == (f"Register: the server is slow to answer ({where}); what this window records "
                             "waits on this computer meanwhile.")
             assert "fha-test-password" not in said
-        qtbot.waitUntil(lambda: "the server answered" in _said(window), timeout=30000)
-        assert _said(window) == f"Register: the server answered ({where}); 2 facts delivered."
+        qtbot.waitUntil(lambda: bool(_said_since(window, mark, "the server answered")), timeout=30000)
+        said = _said_since(window, mark, "the server answered")
+        assert said.startswith(f"Register: the server answered ({where}); ") and said.endswith(" delivered.")
+        with watch.paused():  # the test's own questions to the server
+            qtbot.waitUntil(lambda: _snapshot_count(url) == 3, timeout=30000)
 
         # the server stops: said once, the line says how many wait
         with watch.paused():
             postgres_cluster.stop()
         try:
+            mark = len(window.message_area.messages)
             window.state.enter_front_panel("tune", 4, 30, "dee")
             qtbot.waitUntil(lambda: recording.server.answers is False, timeout=30000)
-            said = _said(window)
+            said = _said_since(window, mark, "does not answer")
             assert said.startswith("Register: the server does not answer; what this window records waits on "
                                    "this computer and goes to the server when it answers again (the register "
                                    f"{where}: the server ")
@@ -184,9 +189,10 @@ def test_a_server_that_hangs_then_stops_while_the_window_records(
         finally:
             with watch.paused():
                 postgres_cluster.start()
+        mark = len(window.message_area.messages)
         recording.deliver_now()
         qtbot.waitUntil(lambda: recording.server.answers is True, timeout=30000)
-        assert _said(window).startswith(
+        assert _said_since(window, mark, "answers again").startswith(
             f"Register: the server answers again ({where}); what waited on this computer is on it now ("
         )
     finally:
@@ -208,9 +214,10 @@ def test_closing_while_the_server_hangs_ends_at_once_and_the_next_start_delivers
     window = make_window("--register", url, "--machine", "Line 3", "--axis", "table")
     window.state.enter_front_panel("system", 8, 1, "ana")
     qtbot.waitUntil(lambda: _snapshot_count(url) == 1, timeout=30000)
+    mark = len(window.message_area.messages)
     with _hung(postgres_cluster, database):
         window.state.enter_front_panel("tune", 4, 20, "ben")
-        qtbot.waitUntil(lambda: "slow to answer" in _said(window), timeout=30000)
+        qtbot.waitUntil(lambda: bool(_said_since(window, mark, "slow to answer")), timeout=30000)
         started = time.monotonic()
         window.shutdown()  # the window closes: the delivery under way is cut off
         time_ceiling("closing while the server hangs", time.monotonic() - started, 8.0)
@@ -250,7 +257,8 @@ def test_a_delivery_that_hangs_is_cut_off_and_made_again_on_a_new_connection(
     window = make_window("--register", url, "--machine", "Line 3", "--axis", "table")
     window.state.enter_front_panel("system", 8, 1, "ana")
     qtbot.waitUntil(lambda: window.window_register.server.answers is True, timeout=30000)
+    mark = len(window.message_area.messages)
     with _hung(postgres_cluster, urlsplit(url).path.lstrip("/")):
         window.state.enter_front_panel("tune", 4, 20, "ben")
-        qtbot.waitUntil(lambda: "the server answered" in _said(window), timeout=30000)
-        assert _snapshot_count(url) == 2
+        qtbot.waitUntil(lambda: bool(_said_since(window, mark, "the server answered")), timeout=30000)
+        qtbot.waitUntil(lambda: _snapshot_count(url) == 2, timeout=30000)  # the old one still hangs
