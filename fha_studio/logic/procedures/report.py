@@ -259,7 +259,7 @@ def _item(mode: str, number: int) -> str:
         return f"{mode} {number}"
 
 
-def _when(at_utc: str) -> str:
+def when_minutes(at_utc: str) -> str:
     """An ISO time as a person reads it on paper: '2026-11-30 03:56' (the column says UTC)."""
     text = str(at_utc or "")
     return text[:16].replace("T", " ") if len(text) >= 16 and text[10:11] == "T" else text
@@ -294,7 +294,7 @@ def render_html(report: CommissioningReport) -> str:
         ["Driver adjusted for", _e(d.get("adjusted_for", ""))],
         ["Driver version", _e(d.get("version", ""))],
         ["Commissioned by", _e(report.operator)],
-        ["Session started (UTC)", _e(_when(report.created_utc))],
+        ["Session started (UTC)", _e(when_minutes(report.created_utc))],
     ]
     out.append("<h2>Actuator and driver</h2>" + _table(["Item", "Value"], identity))
 
@@ -323,7 +323,7 @@ def render_html(report: CommissioningReport) -> str:
                 _e(r.expected),
                 "<span class='pass'>pass</span>" if r.passed else "<span class='fail'>FAIL</span>",
                 _e(r.who),
-                _e(_when(r.at_utc)),
+                _e(when_minutes(r.at_utc)),
                 _e(r.detail),
             ]
             for r in result.records
@@ -390,7 +390,7 @@ def render_html(report: CommissioningReport) -> str:
     if report.notes:
         out.append("<h2>Notes</h2>")
         rows = [
-            [_e(_when(n.get("at_utc", ""))), _e(n.get("who", "")), _e(n.get("text", ""))]
+            [_e(when_minutes(n.get("at_utc", ""))), _e(n.get("who", "")), _e(n.get("text", ""))]
             for n in report.notes
         ]
         out.append(_table(["When (UTC)", "Who", "Note"], rows))

@@ -30,8 +30,6 @@ from PySide6.QtWidgets import (
     QScrollArea,
     QSplitter,
     QStackedWidget,
-    QTableWidget,
-    QTableWidgetItem,
     QVBoxLayout,
     QWidget,
 )
@@ -42,6 +40,7 @@ from fha_studio.gui.pages.base import BasePage, PageHost, PageId
 from fha_studio.gui.pages.direction import DirectionPage
 from fha_studio.gui.pages.procedures.bench_watch import BenchWatch
 from fha_studio.gui.pages.procedures.dog_panel import SensorDogPanel
+from fha_studio.gui.pages.procedures.history import RecordHistory
 from fha_studio.gui.pages.procedures.live_panel import LiveCheckPanel
 from fha_studio.gui.pages.procedures.signer import ReportSigner
 from fha_studio.logic.bench.checks import BenchCheck
@@ -56,10 +55,9 @@ from fha_studio.logic.procedures import (
     StepInputError,
     load_all,
 )
-from fha_studio.logic.procedures.report import build_report, value_text
+from fha_studio.logic.procedures.report import build_report
 from fha_studio.logic.procedures.report_inputs import ReportInputs, collect_for_report
 from fha_studio.logic.register.report_signing import report_file_bytes
-from fha_studio.logic.register.words import when_text
 
 log = logging.getLogger(__name__)
 
@@ -251,10 +249,9 @@ class ProceduresPage(BasePage):
         middle_scroll.setWidget(middle)
         split.addWidget(middle_scroll)
 
-        self.history = QTableWidget(0, 5)
-        self.history.setObjectName("history")
-        self.history.setHorizontalHeaderLabels(["Step", "Value", "Result", "Who", "When (UTC)"])
-        split.addWidget(self.history)
+        self.record_history = RecordHistory()
+        self.history = self.record_history.table
+        split.addWidget(self.record_history)
         split.setSizes([260, 640, 360])
 
     # -- sessions -----------------------------------------------------------------------------
@@ -651,17 +648,7 @@ class ProceduresPage(BasePage):
             self.inputs.setCurrentIndex(self._pages["sensor_angle"])
 
     def _fill_history(self) -> None:
-        records = self.run.state.records if self.run else []
-        self.history.setRowCount(len(records))
-        for row, r in enumerate(records):
-            # the step as the checklist words it (its id is for files), the time as the report gives it
-            for column, text in enumerate(
-                (r.text, value_text(r), "pass" if r.passed else "FAIL", r.who, when_text(r.at_utc))
-            ):
-                item = QTableWidgetItem(text)
-                item.setToolTip(f"{r.section}: {r.text}" if column == 0 and r.section
-                                else (r.detail or text) if column == 1 else text)
-                self.history.setItem(row, column, item)
+        self.record_history.show_records(self.run.state.records if self.run else [])
 
     # -- settings (called by the main window) --------------------------------------------------
     def save_settings(self, settings) -> None:
