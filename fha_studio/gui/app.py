@@ -88,7 +88,7 @@ def _parser() -> argparse.ArgumentParser:
         metavar="NAME",
         help="the single-axis window records what it learns in the register under this axis (of "
         "--machine, else of this computer's bench); without it, under an axis named after the "
-        "actuator or the connection (the status bar's Register line names and changes it)",
+        "actuator or the connection (the toolbar's Register line names and changes it)",
     )
     parser.add_argument(
         "--machine-file",
