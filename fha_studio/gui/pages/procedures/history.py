@@ -35,6 +35,8 @@ from fha_studio.logic.register.words import when_text
 HEADERS = ("Step", "Value", "Result", "Who, when (UTC)")
 STEP_LINES = 2
 FAIL_COLOUR = "#b00000"
+EMPTY_TEXT = "No answer recorded yet: each one comes here in full."
+PICK_TEXT = "Select a record to read it in full."
 
 
 class _AtMostLines(QStyledItemDelegate):
@@ -127,7 +129,8 @@ class RecordHistory(QWidget):
     def _show_selected(self) -> None:
         rows = self.table.selectionModel().selectedRows()
         if not rows or not 0 <= rows[0].row() < len(self._records):
-            self.details.setText("")
+            hint = PICK_TEXT if self._records else EMPTY_TEXT
+            self.details.setText(f'<span style="color: #666;">{hint}</span>')
             return
         self.details.setText(record_html(self._records[rows[0].row()]))
 
