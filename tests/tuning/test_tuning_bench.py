@@ -19,9 +19,8 @@ import pytest
 from fha_studio.hardware.bench.capture import CaptureError
 from fha_studio.hardware.bench.waveform import Waveform, read_waveform, write_waveform
 from fha_studio.hardware.parameters import Mode, load_parameter_model
-from fha_studio.hardware.sim.cn2 import MonitorModel, VirtualBenchInstrument
+from fha_studio.hardware.sim.cn2 import MonitorModel, record_playback
 from fha_studio.hardware.sim.drive import SimDrive
-from fha_studio.hardware.sim.spd_cmd import VirtualAnalogOutput
 from fha_studio.logic.paramfile import dump_parameter_file
 from fha_studio.logic.tuning.bench_excitation import NotInSpeedMode, design_excitation
 from fha_studio.logic.tuning.bench_session import RoleSignal, bench_response_report, bench_tuner
@@ -57,10 +56,8 @@ def _bench_run(folder: Path, load: float, *, with_command: bool, periods: int = 
         assert drive.speed_mode
         drive.set_servo(True)  # the controller's servo-ON input
         drive.advance(0.05)
-        instrument = VirtualBenchInstrument.on_drive(drive, RATE_HZ, speed_command=with_command)
-        instrument.record(0.1)
-        VirtualAnalogOutput(drive).play(exc_path)  # the DAQ plays the file as written
-        instrument.record(excitation.waveform.duration_s + 0.1)
+        # the DAQ plays the file as written while the instrument records CN2
+        instrument = record_playback(drive, exc_path, RATE_HZ, speed_command=with_command)
         travelled = abs(np.degrees(drive.axis.output_pos_rad))
         assert travelled <= excitation.travel_bound_deg * 1.5 + 1e-3  # the bound shown before
         capture = instrument.write(folder / "capture.sr", "sr")

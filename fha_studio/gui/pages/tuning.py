@@ -38,6 +38,7 @@ from PySide6.QtWidgets import (
 from fha_studio import clock
 from fha_studio.gui.link_requests import Call, LinkInfo, LinkReply
 from fha_studio.gui.pages.base import BasePage
+from fha_studio.gui.pages.tuning_bench import BenchTuningPanel
 from fha_studio.gui.widgets import scrolling
 from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
@@ -57,6 +58,10 @@ FIGURE_WORDS = {"gain_margin_db": "Gain margin [dB]", "phase_margin_deg": "Phase
 def _item_words(item: Any) -> str:
     """A tune item as the front panel knows it (tune mode): its number, name and unit."""
     return f"{item.number} {item.name}" + (f" [{item.unit}]" if item.unit else "")
+
+
+def _dashed(colour: str) -> Any:
+    return pg.mkPen(colour, width=1, style=pg.QtCore.Qt.PenStyle.DashLine)
 
 
 class FrequencyAxis(pg.AxisItem):
@@ -167,6 +172,9 @@ class TuningPage(BasePage):
             "plant": (self.mag_plot.plot(pen=pg.mkPen("#c05000", width=2), name="plant (speed per torque)"),
                       self.phase_plot.plot(pen=pg.mkPen("#c05000", width=2)),
                       self.coh_plot.plot(pen=pg.mkPen("#c05000", width=2))),
+            # what the linearised loop predicts, beside a bench measurement
+            "predicted": (self.mag_plot.plot(pen=_dashed("#1f4e9c")),
+                          self.phase_plot.plot(pen=_dashed("#1f4e9c")), self.coh_plot.plot()),
         }
         self.markers: list[Any] = []
 
@@ -198,10 +206,12 @@ class TuningPage(BasePage):
         lower.setStretchFactor(1, 1)
         lower.setSizes([760, 560])
 
+        self.bench = BenchTuningPanel(self)
         panel = QWidget()
         layout = QVBoxLayout(panel)
         layout.addLayout(form)
         layout.addLayout(buttons)
+        layout.addWidget(self.bench)
         layout.addWidget(self.plan_label)
         layout.addWidget(self.warning_label)
         layout.addWidget(self.status_label)
@@ -229,6 +239,7 @@ class TuningPage(BasePage):
 
     def shutdown(self) -> None:
         self._timer.stop()
+        self.bench.shutdown()
 
     def release_held(self) -> None:
         self.cancel_countdown()
@@ -317,13 +328,22 @@ class TuningPage(BasePage):
     def show_result(self, result: dict[str, Any]) -> None:
         """Plot a measurement (tune measure's dict) and mark the resonances."""
         self.result = result
-        for key, name in (("closed", "frequency_response"), ("plant", "plant_response")):
-            data = result[name]
+        for key, name in (("closed", "frequency_response"), ("plant", "plant_response"),
+                          ("predicted", "predicted_response")):
+            # a bench measurement brings the prediction; a loop fitted to a move has no plant and no
+            # coherence (nothing was measured in frequency)
+            data = result.get(name) or {"freq_hz": [], "magnitude_db": [], "phase_deg": []}
             f = np.asarray(data["freq_hz"], float)
             mag, phase, coh = (self.curves[key][i] for i in range(3))
             mag.setData(f, np.asarray(data["magnitude_db"], float))
             phase.setData(f, np.asarray(data["phase_deg"], float))
-            coh.setData(f, np.asarray(data["coherence"], float))
+            coherence = np.asarray(data.get("coherence", []), float)
+            coh.setData(f if len(coherence) == len(f) else [], coherence if len(coherence) == len(f) else [])
+        # the prediction is in the legend while it is on the plot
+        legend, predicted = self.mag_plot.legend, self.curves["predicted"][0]
+        legend.removeItem(predicted)
+        if result.get("predicted_response"):
+            legend.addItem(predicted, "speed loop (predicted)")
         for marker in self.markers:
             self.mag_plot.removeItem(marker)
         self.markers = []
@@ -348,11 +368,14 @@ class TuningPage(BasePage):
             return "—" if v is None else f"{v:.3g} {unit}"
 
         self.status_label.setText("Measured.")
+        uncertainty = result.get("load_inertia_uncertainty_kgm2")  # a bench measurement says it
+        spread = f" ± {uncertainty:.2g}" if uncertainty and result.get("load_inertia_estimate_kgm2") else ""
         self.use_inertia_button.setEnabled(result.get("load_inertia_estimate_kgm2") is not None)
         self.result_label.setText(
             f"Resonance {fmt('resonance_hz', 'Hz')} (predicted {fmt('predicted_resonance_hz', 'Hz')}), "
             f"anti-resonance {fmt('antiresonance_hz', 'Hz')}; load inertia estimate "
-            f"{fmt('load_inertia_estimate_kgm2', 'kg·m²')}; gain margin {fmt('gain_margin_db', 'dB')}, "
+            f"{fmt('load_inertia_estimate_kgm2', 'kg·m²')}{spread}; "
+            f"gain margin {fmt('gain_margin_db', 'dB')}, "
             f"phase margin {fmt('phase_margin_deg', 'deg')}, crossover {fmt('crossover_hz', 'Hz')}, "
             f"bandwidth {fmt('bandwidth_hz', 'Hz')}")
 
@@ -372,8 +395,10 @@ class TuningPage(BasePage):
         parameters = self.session.parameter_model
         if not self._excitable:
             try:
-                tuner = Tuner(declared_model(code, load), self._offline_items(), parameters,
-                              DEFAULT_SERVO_RATE_HZ)
+                # the gains are for the axis at work, in position mode (speed mode is how the
+                # bench measures it: SPD-CMD drives the speed loop)
+                tuner = Tuner(declared_model(code, load), {**self._offline_items(), "control_mode": 0},
+                              parameters, DEFAULT_SERVO_RATE_HZ)
                 proposal = tuner.propose(aim)
             except ValueError as exc:
                 self.status_label.setText(f"No proposal: {exc}")
@@ -414,6 +439,8 @@ class TuningPage(BasePage):
             item = model.by_key(key)
             lines.append(f"  tune item {item.number} {item.name}: {proposal.present.items.get(key)} -> "
                          f"{proposal.proposed.items[key]} {item.unit}")
+        lines.append("Then capture on the bench (the controller's move, or the SPD-CMD excitation again) and "
+                     "Verify the proposal from the capture: measured against predicted.")
         return "\n".join(lines)
 
     def apply(self) -> None:

@@ -39,7 +39,9 @@ import numpy as np
 
 from fha_studio.hardware.bench import writers
 from fha_studio.hardware.bench.capture import SampleBlock, join_blocks, logic_dtype, pack_logic
+from fha_studio.hardware.bench.waveform import Waveform
 from fha_studio.hardware.parameters import AlarmTable, load_alarm_table, load_cn2
+from fha_studio.hardware.sim.spd_cmd import VirtualAnalogOutput
 from fha_studio.physics import ServoAxis
 
 if TYPE_CHECKING:
@@ -413,3 +415,16 @@ class VirtualBenchInstrument:
     def fastest_edges_hz(motor_rpm: float, counts_per_motor_turn: int) -> float:
         """The encoder's edge rate at a motor speed (to choose the sample rate)."""
         return abs(motor_rpm) / 60.0 * counts_per_motor_turn
+
+
+def record_playback(drive: SimDrive, wave: Waveform | str | os.PathLike[str], sample_rate_hz: float, *,
+                    speed_command: bool = True, margin_s: float = 0.1) -> VirtualBenchInstrument:
+    """A DAQ's output (:class:`.spd_cmd.VirtualAnalogOutput`) plays ``wave`` into a stepped
+    drive's SPD-CMD while the virtual instrument records its CN2 outputs (and SPD-CMD), from
+    ``margin_s`` before the file starts until ``margin_s`` after it ends: a bench capture of an
+    excitation, as a technician makes one on a real drive in speed mode."""
+    instrument = VirtualBenchInstrument.on_drive(drive, sample_rate_hz, speed_command=speed_command)
+    instrument.record(margin_s)
+    playback = VirtualAnalogOutput(drive).play(wave)
+    instrument.record(playback.end_s - drive.time_s + margin_s)
+    return instrument

@@ -71,7 +71,9 @@ class SpeedCommandInput:
         t = np.asarray(t_s, float)
         if self._source is None:
             return np.zeros(t.shape)
-        return np.asarray(np.clip(np.asarray(self._source(t), float), -SPD_CMD_LIMIT_V, SPD_CMD_LIMIT_V))
+        # np.minimum / np.maximum: np.clip costs several times more on a servo chunk's few values
+        volts = np.asarray(self._source(t), float)
+        return np.asarray(np.minimum(np.maximum(volts, -SPD_CMD_LIMIT_V), SPD_CMD_LIMIT_V))
 
 
 def spd_cmd_speeds(drive: _Drive, periods: int, added: list[float] | None = None) -> list[float] | None:
@@ -108,7 +110,7 @@ class WaveformPlayback:
     def __call__(self, t_s: np.ndarray) -> np.ndarray:
         volts = self.wave.volts
         index = np.floor((np.asarray(t_s, float) - self.start_s) * self.rate_hz + 1e-6).astype(np.int64)
-        out = volts[np.clip(index, 0, len(volts) - 1)]
+        out = volts[np.minimum(np.maximum(index, 0), len(volts) - 1)]
         return np.where(index < 0, 0.0, out)
 
 
