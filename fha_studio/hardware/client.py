@@ -14,7 +14,6 @@ The result types and errors live in ``api`` and ``errors`` and are re-exported h
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Iterable
 
 from fha_studio.hardware import protocol as p
@@ -56,6 +55,7 @@ from fha_studio.hardware.parameters import (
     load_parameter_model,
 )
 from fha_studio.hardware.protocol import Command, Reply
+from fha_studio.hardware.trace_readout import block_samples, read_out
 from fha_studio.hardware.transaction import (
     NOT_RETRIED,
     LinkSettings,
@@ -570,9 +570,7 @@ class DriveClient:
         channels = self._trace_channels
         if not channels:
             raise ValueError("read_trace_block: configure_trace first (the channels are not known)")
-        expect = min(p.TRACE_BLOCK_SAMPLES, count - block * p.TRACE_BLOCK_SAMPLES)
-        if block < 0 or expect <= 0:
-            raise ValueError(f"read_trace_block: block {block} is outside a capture of {count} samples")
+        expect = block_samples(block, count)
         if self.trace_encoding == "packed":
             return self._transact(Command.TRP, block, parse=_packed_block(expect, len(channels)))
         return self._transact(Command.TRB, block, parse=_trace_block(expect, len(channels)))
@@ -598,23 +596,8 @@ class DriveClient:
         """
         self._require(Command.TST, Command.TRB)
         with self._lock:
-            channels = self._trace_channels
-            if not channels:
-                raise ValueError("read_trace: configure_trace first (the channels are not known)")
-            status = self.trace_status()
-            if status.state is not p.TraceState.DONE:
-                raise CommandRejected(f"no finished capture (state {status.state.name.lower()})")
-            rows: list[tuple[int, ...]] = []
-            if progress is not None:
-                progress(0, status.count)
-            for block in range(math.ceil(status.count / p.TRACE_BLOCK_SAMPLES)):
-                if should_abort is not None and should_abort():
-                    raise ReadAborted(f"trace read-out stopped after {len(rows)} of {status.count} samples",
-                                      len(rows), status.count)
-                rows += self.read_trace_block(block, status.count)
-                if progress is not None:
-                    progress(len(rows), status.count)
-        return TraceCapture(channels, tuple(rows))
+            return read_out(self._trace_channels, self.trace_status, self.read_trace_block, should_abort,
+                            progress)
 
 
 # --- reply parsers (ValueError = malformed: the attempt is retried) ---------------------------------

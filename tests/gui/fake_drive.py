@@ -14,7 +14,6 @@ OWW is not this fake: it is ``tests.support.documented.DocumentedDrive`` behind 
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable, Iterable
 
@@ -31,7 +30,6 @@ from fha_studio.hardware.api import (
     Identity,
     IoState,
     LinkLost,
-    ReadAborted,
     SensorName,
     ServoOnRefused,
     TraceCapture,
@@ -50,6 +48,7 @@ from fha_studio.hardware.parameters import (
 )
 from fha_studio.hardware.protocol import Command, IoBit, rejected_text, servo_on_text
 from fha_studio.hardware.sim.constants import load_sim_constants
+from fha_studio.hardware.trace_readout import block_samples, read_out
 
 #: Every row of the protocol's table: what the simulated drive's full profile answers (the fake
 #: in the shared client suite).
@@ -427,9 +426,7 @@ class FakeDriveClient:
         self._check(Command.TRB)
         if not self._trace_channels:
             raise ValueError("read_trace_block: configure_trace first (the channels are not known)")
-        expect = min(p.TRACE_BLOCK_SAMPLES, count - block * p.TRACE_BLOCK_SAMPLES)
-        if block < 0 or expect <= 0:
-            raise ValueError(f"read_trace_block: block {block} is outside a capture of {count} samples")
+        expect = block_samples(block, count)
         first = block * p.TRACE_BLOCK_SAMPLES
         rows = self._trace_rows[first:first + expect] if self._trace_state is p.TraceState.DONE else []
         if not rows:
@@ -442,20 +439,5 @@ class FakeDriveClient:
         progress: Callable[[int, int], None] | None = None,
     ) -> TraceCapture:
         self._check(Command.TST, Command.TRB)
-        channels = self._trace_channels
-        if not channels:
-            raise ValueError("read_trace: configure_trace first (the channels are not known)")
-        status = self.trace_status()
-        if status.state is not p.TraceState.DONE:
-            raise CommandRejected(f"no finished capture (state {status.state.name.lower()})")
-        rows: list[tuple[int, ...]] = []
-        if progress is not None:
-            progress(0, status.count)
-        for block in range(math.ceil(status.count / p.TRACE_BLOCK_SAMPLES)):
-            if should_abort is not None and should_abort():
-                raise ReadAborted(f"trace read-out stopped after {len(rows)} of {status.count} samples",
-                                  len(rows), status.count)
-            rows += self.read_trace_block(block, status.count)
-            if progress is not None:
-                progress(len(rows), status.count)
-        return TraceCapture(channels, tuple(rows))
+        return read_out(self._trace_channels, self.trace_status, self.read_trace_block, should_abort,
+                        progress)
