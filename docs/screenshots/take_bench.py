@@ -14,61 +14,16 @@ temporary directory, never the user's.
 
 from __future__ import annotations
 
-import os
-import sys
-import tempfile
-import time
-from pathlib import Path
+from shots import ScreenshotRun, private_folder
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-TMP = tempfile.mkdtemp(prefix="fha-shots-")
-os.environ["XDG_CONFIG_HOME"] = f"{TMP}/config"
-os.environ["XDG_DATA_HOME"] = f"{TMP}/data"
-
-from PySide6.QtCore import QCoreApplication  # noqa: E402
-from PySide6.QtWidgets import QApplication  # noqa: E402
-
-OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
+TMP = private_folder("fha-shots-")
 CODE = "FHA-25C-50-S248"  # absolute: CN3 gives the position (DGR) while the servo is off
 URL = f"sim://{CODE}?paced=0&profile=documented"
 
 
 def main() -> int:
-    app = QApplication(sys.argv[:1])
-    QCoreApplication.setOrganizationName("FHA Studio Screenshots")
-    QCoreApplication.setApplicationName("fha-studio-screenshots")
-    from fha_studio.gui.link import SimPanelAction, SimPanelRequest
-    from fha_studio.gui.main_window import MainWindow
-
-    window = MainWindow()
-    window.resize(1366, 768)
-    window.show()
-
-    def wait_until(condition, what: str, timeout_s: float = 30.0) -> None:
-        end = time.monotonic() + timeout_s
-        while not condition():
-            if time.monotonic() > end:
-                raise TimeoutError(f"screenshot script: {what} did not come within {timeout_s:g} s")
-            app.processEvents()
-            time.sleep(0.01)
-
-    def settle(seconds: float = 0.3) -> None:
-        end = time.monotonic() + seconds
-        while time.monotonic() < end:
-            app.processEvents()
-            time.sleep(0.01)
-
-    def shot(name: str) -> None:
-        settle(0.3)
-        path = OUT / f"{name}.png"
-        window.grab().save(str(path))
-        print("saved", path)
-
-    def panel(action: SimPanelAction, value) -> None:
-        done: list = []
-        window.link.send(SimPanelRequest(action, value), done.append)
-        wait_until(lambda: done, f"the drive panel's {action.name}")
+    run = ScreenshotRun((1366, 768))
+    window, wait_until, settle, shot = run.window, run.wait_until, run.settle, run.shot
 
     window.connect_to(URL)
     wait_until(lambda: window.link.status is not None, "the drive's first status")
@@ -137,9 +92,7 @@ def main() -> int:
     shot("bench-demo")
     bench.start_button.click()
     wait_until(lambda: not bench.source.running, "the demo's end")
-    del panel
-    window._closing_confirmed = True
-    window.close()
+    run.close()
     return 0
 
 

@@ -9,60 +9,15 @@ data go to a temporary directory, never the user's.
 
 from __future__ import annotations
 
-import os
-import sys
-import tempfile
-import time
-from pathlib import Path
+from shots import ScreenshotRun, private_folder
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-TMP = tempfile.mkdtemp(prefix="fha-shots-")
-os.environ["XDG_CONFIG_HOME"] = f"{TMP}/config"
-os.environ["XDG_DATA_HOME"] = f"{TMP}/data"
-
-from PySide6.QtCore import QCoreApplication  # noqa: E402
-from PySide6.QtWidgets import QApplication  # noqa: E402
-
-OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
+TMP = private_folder("fha-shots-")
 URL = f"sim://FHA-25C-50-S248?paced=0&profile=documented&sensors=1&oww_clear_s=5&eeprom={TMP}/eeprom.json"
 
 
 def main() -> int:
-    app = QApplication(sys.argv[:1])
-    QCoreApplication.setOrganizationName("FHA Studio Screenshots")
-    QCoreApplication.setApplicationName("fha-studio-screenshots")
-    from fha_studio.gui.link import SimPanelAction, SimPanelRequest
-    from fha_studio.gui.main_window import MainWindow
-
-    window = MainWindow()
-    window.resize(1366, 740)
-    window.show()
-
-    def wait_until(condition, timeout_s: float = 20.0) -> None:
-        end = time.monotonic() + timeout_s
-        while not condition():
-            if time.monotonic() > end:
-                raise TimeoutError("screenshot script: a step did not finish")
-            app.processEvents()
-            time.sleep(0.01)
-
-    def settle(seconds: float = 0.3) -> None:
-        end = time.monotonic() + seconds
-        while time.monotonic() < end:
-            app.processEvents()
-            time.sleep(0.01)
-
-    def shot(name: str) -> None:
-        settle(0.2)
-        path = OUT / f"{name}.png"
-        window.grab().save(str(path))
-        print("saved", path)
-
-    def panel(action: str, value) -> None:
-        done = []
-        window.link.send(SimPanelRequest(SimPanelAction(action), value), done.append)
-        wait_until(lambda: done)
+    run = ScreenshotRun((1366, 740), settle_before_shot_s=0.2)
+    window, wait_until, settle, shot, panel = run.window, run.wait_until, run.settle, run.shot, run.panel
 
     window.connect_to(URL)
     wait_until(lambda: window.link.status is not None and window.link.status.absolute_counts is not None)
@@ -133,9 +88,7 @@ def main() -> int:
     window.show_page("direction")
     shot("rotary-direction-documented")
 
-    window._closing_confirmed = True
-    window.close()
-    window.shutdown()
+    run.close()
     return 0
 
 
