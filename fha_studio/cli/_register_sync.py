@@ -17,6 +17,7 @@ from typing import Any
 
 from fha_studio.cli import CliError
 from fha_studio.cli._values import whole
+from fha_studio.logic.register.sync import BATCH_FACTS
 from fha_studio.logic.register.words import when_text
 
 #: Exit status of a sync that stopped before it was done (run it again).
@@ -52,7 +53,7 @@ def add_actions(sub: argparse._SubParsersAction, common: argparse.ArgumentParser
     s.add_argument("--operator", default="", help="who syncs (the conflicts it finds say so)")
     s.add_argument("--progress", action="store_true", help="a line on stderr for each batch of facts moved")
     s.add_argument("--batch", type=whole(1, 100_000), metavar="N",
-                   help="facts moved in one transaction (default 1000; fewer on a slow link)")
+                   help=f"facts moved in one transaction (default {BATCH_FACTS}; fewer on a slow link)")
     s.set_defaults(func=_sync)
     c = sub.add_parser(
         "conflicts",
@@ -86,7 +87,7 @@ def _print_json(data: Any) -> None:
 
 def _sync(args) -> int:
     from fha_studio.logic.register import Register, RegisterError, register_location
-    from fha_studio.logic.register.sync import BATCH_FACTS, SyncProgress, sync_registers
+    from fha_studio.logic.register.sync import SyncProgress, sync_registers
 
     source = register_location(args.source or args.register)
     target = register_location(args.target)
