@@ -70,9 +70,10 @@ class ScreenshotRun:
     def settle(self, seconds: float = 0.3) -> None:
         """Runs the event loop for ``seconds`` (what was asked for is drawn)."""
         end = time.monotonic() + seconds
+        self.app.processEvents()
         while time.monotonic() < end:
-            self.app.processEvents()
             time.sleep(0.01)
+            self.app.processEvents()
 
     def shot(self, name: str, widget: Any = None) -> Path:
         """Saves ``widget`` (the main window unless given) as ``OUT/name.png``."""
