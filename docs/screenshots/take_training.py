@@ -10,25 +10,16 @@ to a temporary directory, never the user's.
 
 from __future__ import annotations
 
-import os
-import sys
-import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-TMP = tempfile.mkdtemp(prefix="fha-shots-")
-os.environ["XDG_CONFIG_HOME"] = f"{TMP}/config"
-os.environ["XDG_DATA_HOME"] = f"{TMP}/data"
+from shots import ScreenshotRun, private_folder
 
-from PySide6.QtCore import QCoreApplication  # noqa: E402
-from PySide6.QtWidgets import QApplication  # noqa: E402
-
-OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
+TMP = private_folder("fha-shots-")
 
 
 def wait(app, seconds: float, until=None) -> None:
+    """Runs the event loop for ``seconds``, or until ``until()`` says it is there."""
     end = time.monotonic() + seconds
     while time.monotonic() < end and not (until and until()):
         app.processEvents()
@@ -36,22 +27,13 @@ def wait(app, seconds: float, until=None) -> None:
 
 
 def main() -> int:
-    app = QApplication(sys.argv[:1])
-    QCoreApplication.setOrganizationName("FHA Studio Screenshots")
-    QCoreApplication.setApplicationName("fha-studio-screenshots")
+    run = ScreenshotRun((1366, 740), settle_before_shot_s=0.0)
+    app, window = run.app, run.window
     from fha_studio.gui.link import ReadParameters, Servo, WriteParameters
-    from fha_studio.gui.main_window import MainWindow
     from fha_studio.gui.training import ChooseScenarioDialog, RunningDialog, ScoreSheetDialog
 
-    window = MainWindow()
-    window.resize(1366, 740)
-    window.show()
-
     def shot(widget, name: str) -> None:
-        app.processEvents()
-        path = OUT / f"{name}.png"
-        widget.grab().save(str(path))
-        print("saved", path)
+        run.shot(name, widget)
 
     chooser = ChooseScenarioDialog(window)
     chooser.resize(1100, 600)
@@ -75,8 +57,8 @@ def main() -> int:
     window.link.send(Servo(True))
     wait(app, 0.5)
     page = window.show_page("jog")
-    page.speed_spin.setValue(5.0)
-    page._jog(+1)  # as if FWD were held: the brake still holds
+    page.motion.speed_spin.setValue(5.0)
+    page.motion._jog(+1)  # as if FWD were held: the brake still holds
     wait(app, 1.5)
     window.jog_page.release_held()
     wait(app, 0.8)
@@ -103,8 +85,7 @@ def main() -> int:
     shot(dialog, "training-score-sheet")
     dialog.save_pdf(Path(TMP) / "training-score-sheet.pdf")
     dialog.close()
-    window._closing_confirmed = True
-    window.close()
+    run.close()
     return 0
 
 
