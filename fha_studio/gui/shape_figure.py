@@ -109,11 +109,9 @@ class ShapeFigure(QWidget):
         height = side.height() * 0.62 * thickness
         return QRectF(side.left() + 14, side.center().y() - height / 2, side.width() - 40, height)
 
-    def _prism(self, painter, side, section, letters, outline: QPainterPath, length: str, dims) -> None:
-        box = self._side_box(side, 1.0)
-        path = QPainterPath()
-        path.addRect(box)
-        self._body(painter, path)
+    def _side_view(self, painter, box: QRectF, body: QPainterPath, length: str) -> None:
+        """A side view in ``box``: the body, the x axis through it, its length under it."""
+        self._body(painter, body)
         self._focus = box.center()
         self._axis(
             painter,
@@ -124,6 +122,12 @@ class ShapeFigure(QWidget):
         self._dimension(
             painter, QPointF(box.left(), box.bottom() + 8), QPointF(box.right(), box.bottom() + 8), length
         )
+
+    def _prism(self, painter, side, section, letters, outline: QPainterPath, length: str, dims) -> None:
+        box = self._side_box(side, 1.0)
+        path = QPainterPath()
+        path.addRect(box)
+        self._side_view(painter, box, path, length)
         self._body(painter, outline)
         centre = section.center()
         self._focus = outline.boundingRect().center()
@@ -252,20 +256,7 @@ class ShapeFigure(QWidget):
         path = QPainterPath()
         path.addPolygon(triangle)
         path.closeSubpath()
-        self._body(painter, path)
-        self._focus = box.center()
-        self._axis(
-            painter,
-            QPointF(box.left() - 8, box.center().y()),
-            QPointF(box.right() + 22, box.center().y()),
-            "x",
-        )
-        self._dimension(
-            painter,
-            QPointF(box.left(), box.bottom() + 8),
-            QPointF(box.right(), box.bottom() + 8),
-            letters["length_m"],
-        )
+        self._side_view(painter, box, path, letters["length_m"])
         self._dimension(
             painter,
             QPointF(box.left() - 8, box.center().y()),
