@@ -135,20 +135,12 @@ def sigrok_csv_bytes(block: SampleBlock, *, time: bool = False,
         f"; Samplerate: {rate_text(block.sample_rate_hz)}",
     ]
     labels = ["logic"] * len(block.logic_channels) + ["V DC"] * len(block.analog)
-    columns: list[np.ndarray] = []
-    formats: list[str] = []
+    times = None
     if time:
         unit, factor = _sigrok_time_unit(block.sample_rate_hz)
         labels.insert(0, unit)
-        columns.append(np.arange(1, block.samples + 1) / block.sample_rate_hz / factor)
-        formats.append("%.10g")
-    for name in block.logic_channels:
-        columns.append(block.bit(name).astype(np.uint8))
-        formats.append("%d")
-    for values in block.analog.values():
-        columns.append(values)
-        formats.append("%.6g")
-    return ("\n".join(head) + "\n" + ",".join(labels) + "\n").encode() + _rows(columns, formats)
+        times = np.arange(1, block.samples + 1) / block.sample_rate_hz / factor
+    return ("\n".join(head) + "\n" + ",".join(labels) + "\n").encode() + _rows(block, times)
 
 
 def _sigrok_time_unit(rate_hz: float) -> tuple[str, float]:
@@ -172,16 +164,9 @@ def csv_bytes(block: SampleBlock, *, semicolon: bool = False, time_unit: str = "
     ``semicolon``: ``;`` separated with decimal commas, as European-locale instruments write."""
     factor = {"s": 1.0, "ms": 1e-3}[time_unit]
     names = [f"time [{time_unit}]"] + [f"{n} [V]" for n in block.channels]
-    columns: list[np.ndarray] = [np.arange(block.samples) / block.sample_rate_hz / factor]
-    formats = ["%.10g"]
-    for name in block.logic_channels:
-        columns.append(block.bit(name).astype(np.uint8))
-        formats.append("%d")
-    for values in block.analog.values():
-        columns.append(values)
-        formats.append("%.6g")
     head = "".join(f"# {c}\n" for c in comments)
-    text = (head + ",".join(names) + "\n").encode() + _rows(columns, formats)
+    times = np.arange(block.samples) / block.sample_rate_hz / factor
+    text = (head + ",".join(names) + "\n").encode() + _rows(block, times)
     if semicolon:
         text = text.translate(bytes.maketrans(b",.", b";,"))
     return text
@@ -193,7 +178,16 @@ def write_csv(path: str | os.PathLike[str], block: SampleBlock, *, semicolon: bo
     return fileio.write_bytes(path, csv_bytes(block, semicolon=semicolon, time_unit=time_unit))
 
 
-def _rows(columns: list[np.ndarray], formats: list[str]) -> bytes:
+def _rows(block: SampleBlock, times: np.ndarray | None) -> bytes:
+    """A text row per sample: its time (when given), each logic channel 0/1, each analog one."""
+    columns: list[np.ndarray] = [] if times is None else [times]
+    formats: list[str] = [] if times is None else ["%.10g"]
+    for name in block.logic_channels:
+        columns.append(block.bit(name).astype(np.uint8))
+        formats.append("%d")
+    for values in block.analog.values():
+        columns.append(values)
+        formats.append("%.6g")
     out = io.BytesIO()
     if columns and columns[0].size:
         np.savetxt(out, np.column_stack([c.astype(np.float64) for c in columns]), fmt=formats, delimiter=",")
