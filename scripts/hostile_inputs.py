@@ -15,8 +15,9 @@ most two), its exit status is non-zero (below 128), there is no traceback and no
 half-written; a few cases are answers, not refusals (a read-only register answers a question; the
 GUI on a read-only register opens and says so), and their row says what was expected.
 
-Read-only registers are made as the tests make them (tests/support/read_only.py): as root, the
-command runs as uid 65534 (nobody) through setpriv on files root owns; otherwise with chmod.
+Read-only registers are made as the tests make them, with their helper (tests/support/read_only.py):
+the files chmod read-only, and as root the command runs without root's overrides of a file's mode
+(setpriv; still root, so it reads a checkout in a 0700 home).
 Settings, data and the journal of temporaries go to a temporary home, never the user's.
 The exit status of the script is 0 when every verdict is good.
 """
@@ -48,10 +49,10 @@ from pathlib import Path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CORPUS = ROOT / "tests" / "corpus"
-NOBODY = 65534
 ACTUATOR = "FHA-25C-50-US250"
 sys.path.insert(0, str(ROOT))
 
+from tests.support.read_only import seal, unseal, without_overrides  # noqa: E402
 
 # --- what a case is ---------------------------------------------------------------------------------
 
@@ -62,7 +63,7 @@ class Case:
     name: str
     args: list[str]  # fha-studio's arguments; {d} is the case's folder
     setup: Callable[[Path], dict[str, object]] | None = None
-    as_nobody: bool = False  # on a folder this user cannot write (a read-only register)
+    read_only: bool = False  # on a folder the command cannot write (a read-only register)
     answer: str = ""  # not a refusal: what is expected instead (exit 0)
     check: Callable[[Path, subprocess.CompletedProcess[str], dict[str, object]], str] | None = None
     killed: bool = False  # killed mid-write; the row is about what the next start leaves
@@ -89,49 +90,19 @@ class Row:
 # --- the folder each case runs in ---------------------------------------------------------------------
 
 
-def _base() -> Path:
-    base = Path(tempfile.mkdtemp(prefix="fha-hostile-"))
-    base.chmod(0o755)  # nobody must reach the read-only cases' folders
-    return base
+BASE = Path(tempfile.mkdtemp(prefix="fha-hostile-"))
+#: the home of a command on a read-only register: the one place it may write
+READ_ONLY_HOME = Path(tempfile.mkdtemp(prefix="fha-hostile-read-only-home-"))
 
 
-BASE = _base()
-AS_ROOT = os.geteuid() == 0
-NOBODY_HOME = Path(tempfile.mkdtemp(prefix="fha-hostile-nobody-"))
-if AS_ROOT:
-    os.chown(NOBODY_HOME, NOBODY, NOBODY)
-
-
-def _env(nobody: bool) -> dict[str, str]:
+def _env(read_only: bool) -> dict[str, str]:
     env = {k: v for k, v in os.environ.items() if not k.startswith("FHA_")}
     env.update(PYTHONPATH=str(ROOT), QT_QPA_PLATFORM="offscreen", PYTHONDONTWRITEBYTECODE="1")
-    if nobody:
-        home = str(NOBODY_HOME)
+    if read_only:
+        home = str(READ_ONLY_HOME)
         env.update(HOME=home, XDG_DATA_HOME=f"{home}/data", XDG_CONFIG_HOME=f"{home}/config",
                    XDG_CACHE_HOME=f"{home}/cache", XDG_RUNTIME_DIR=home)
     return env
-
-
-def _as_user(nobody: bool) -> list[str]:
-    if nobody and AS_ROOT:
-        return ["setpriv", f"--reuid={NOBODY}", f"--regid={NOBODY}", "--clear-groups"]
-    return []
-
-
-def _seal(folder: Path) -> None:
-    """The case's folder and its files: readable, not writable by the user the command runs as."""
-    for path in [folder, *folder.rglob("*")]:
-        if AS_ROOT:
-            os.chown(path, 0, 0)
-            path.chmod(0o755 if path.is_dir() else 0o644)
-        else:
-            path.chmod(0o555 if path.is_dir() else 0o444)
-
-
-def _unseal(folder: Path) -> None:
-    for path in [folder, *folder.rglob("*")]:
-        if path.is_dir():
-            path.chmod(0o755)
 
 
 # --- fixtures: registers, sessions, files ------------------------------------------------------------
@@ -309,25 +280,26 @@ def register_cases() -> list[Case]:
     R = ["register", "--register", "{d}/r.sqlite"]
     imp = [*R, "import", "{d}/one.json", "--machine", "Press 7", "--axis", "feed"]
     cases = []
-    for klass_name, setup, nobody in (("read-only", register_setup, True), ("damaged", damaged_setup, False)):
+    for klass_name, setup, read_only in (("read-only", register_setup, True),
+                                         ("damaged", damaged_setup, False)):
         cases += [
-            Case("1", f"{klass_name}: add-machine", [*R, "add-machine", "Press 8"], setup, nobody),
-            Case("1", f"{klass_name}: import", imp, setup, nobody),
+            Case("1", f"{klass_name}: add-machine", [*R, "add-machine", "Press 8"], setup, read_only),
+            Case("1", f"{klass_name}: import", imp, setup, read_only),
             Case("1", f"{klass_name}: report (HTML not written)",
-                 [*R, "report", "Press 7", "-o", "{d}/report.html"], setup, nobody),
+                 [*R, "report", "Press 7", "-o", "{d}/report.html"], setup, read_only),
         ]
         reads = [
             ("axes", [*R, "axes"]),
             ("find", [*R, "find", "rotary_direction"]),
             ("diff", [*R, "diff", "1", "2"]),
-            ("export", [*R, "export", "-o", "{home}/export.json" if nobody else "{d}/export.json"]),
+            ("export", [*R, "export", "-o", "{home}/export.json" if read_only else "{d}/export.json"]),
         ]
         for what, args in reads:
             if klass_name == "read-only":  # a read-only register answers questions
-                cases.append(Case("1", f"{klass_name}: {what}", args, setup, nobody,
+                cases.append(Case("1", f"{klass_name}: {what}", args, setup, read_only,
                                   answer="answers (a question needs no write)"))
             else:
-                cases.append(Case("1", f"{klass_name}: {what}", args, setup, nobody))
+                cases.append(Case("1", f"{klass_name}: {what}", args, setup, read_only))
     for what, args in (("add-machine", [*R, "add-machine", "Press 8"]), ("import", imp),
                        ("report", [*R, "report", "Press 7", "-o", "{d}/report.html"])):
         cases.append(Case("1", f"locked past the busy timeout: {what}", args, lock_setup))
@@ -593,20 +565,22 @@ def run_case(case: Case, number: int) -> Row:
     d.mkdir()
     d.chmod(0o755)
     state: dict[str, object] = case.setup(d) if case.setup else {}
-    values = {"d": str(d), "home": str(NOBODY_HOME), "pty": state.get("pty", ""), "url": state.get("url", "")}
+    values = {"d": str(d), "home": str(READ_ONLY_HOME), "pty": state.get("pty", ""),
+              "url": state.get("url", "")}
     args = [a.format(**values) if "{" in a and len(a) < 300 else a for a in case.args]
-    if case.as_nobody:
-        _seal(d)
+    if case.read_only:
+        seal(d)
     before = snapshot(d)
     try:
         if case.killed:
             done, seconds, notes = run_killed(args, d)
         else:
-            command = [*_as_user(case.as_nobody), sys.executable, "-m", "fha_studio", *args]
+            prefix = without_overrides() if case.read_only else []
+            command = [*prefix, sys.executable, "-m", "fha_studio", *args]
             started = time.monotonic()
             try:
-                done = subprocess.run(command, cwd=NOBODY_HOME if case.as_nobody else d,
-                                      env=_env(case.as_nobody), capture_output=True, text=True,
+                done = subprocess.run(command, cwd=READ_ONLY_HOME if case.read_only else d,
+                                      env=_env(case.read_only), capture_output=True, text=True,
                                       timeout=case.timeout, stdin=subprocess.DEVNULL)
             except subprocess.TimeoutExpired as exc:
                 done = subprocess.CompletedProcess(command, -1, "", f"TIMEOUT after {exc.timeout} s")
@@ -624,8 +598,8 @@ def run_case(case: Case, number: int) -> Row:
         holder = state.get("holder")
         if holder is not None:
             holder.communicate("")  # type: ignore[attr-defined]
-        if case.as_nobody and not AS_ROOT:
-            _unseal(d)
+        if case.read_only:
+            unseal(d)
     err = lines_of(done.stderr)
     traceback = "Traceback" in done.stderr
     problems = [*notes]
@@ -713,10 +687,8 @@ def main() -> int:
             print(mark, end="", file=sys.stderr, flush=True)
     finally:
         print(file=sys.stderr)
-        if AS_ROOT:
-            subprocess.run(["chmod", "-R", "u+w", str(BASE)], check=False)
         shutil.rmtree(BASE, ignore_errors=True)
-        shutil.rmtree(NOBODY_HOME, ignore_errors=True)
+        shutil.rmtree(READ_ONLY_HOME, ignore_errors=True)
         shutil.rmtree(HOME, ignore_errors=True)
     print(table(rows, options.markdown))
     bad = [r for r in rows if not r.good]

@@ -9,8 +9,9 @@
 - ``windows`` (Qt): ``torn_down``, the one teardown of the GUI tests' window factories.
 - ``clock``: ``FakeClock``, the one injected clock (the calendar and a count of seconds, moved
   together).
-- ``read_only``: ``ReadOnlyPlace``, files the program really cannot write (as uid 65534 where the
-  tests run as root, else by chmod), and the program run on them in a subprocess.
+- ``read_only``: ``ReadOnlyPlace``, files the program really cannot write (chmod, and where the
+  tests run as root the program without root's overrides of a file's mode, through setpriv), and
+  the program run on them in a subprocess; its pieces serve scripts/hostile_inputs.py too.
 
 No module here imports Qt at import time unless its name says it is for the GUI tests: the core
 tests run without Qt.

@@ -12,6 +12,9 @@ why.
 
 The program gets a home of its own (``HOME``, the XDG folders) that it may write, so its per-user
 data (the journal of temporaries, Qt's settings) goes there, never to the real one.
+
+:func:`without_overrides`, :func:`seal` and :func:`unseal` are the pieces, for the tests'
+:class:`ReadOnlyPlace` and for scripts/hostile_inputs.py alike (no pytest in them).
 """
 
 from __future__ import annotations
@@ -31,6 +34,36 @@ ROOT = Path(__file__).resolve().parents[2]
 OVERRIDES = "-dac_override,-dac_read_search,-fowner"
 
 
+class NoSetpriv(RuntimeError):
+    """Running as root, and no setpriv to run a program without root's overrides."""
+
+
+def without_overrides() -> list[str]:
+    """The prefix of a command that runs it so that a file's mode holds for it: as root, through
+    setpriv without the capabilities that write past the mode (still root: it reads a checkout in a
+    0700 home); as another user, nothing. NoSetpriv when root has no setpriv."""
+    if os.geteuid() != 0:
+        return []
+    setpriv = shutil.which("setpriv")
+    if setpriv is None:
+        raise NoSetpriv("running as root, and no setpriv to run the program without root's overrides")
+    return [setpriv, f"--bounding-set={OVERRIDES}", f"--inh-caps={OVERRIDES}", "--"]
+
+
+def seal(folder: Path) -> None:
+    """``folder`` and everything in it: readable, not writable (files 444, folders 555)."""
+    for path in folder.rglob("*"):
+        path.chmod(0o444 if path.is_file() else 0o555)
+    folder.chmod(0o555)
+
+
+def unseal(folder: Path) -> None:
+    """The folders writable again (so that they can be removed)."""
+    for path in [folder, *folder.rglob("*")]:
+        if path.is_dir():
+            path.chmod(0o755)
+
+
 class ReadOnlyPlace:
     """A folder (``folder``) whose files the program run by :meth:`run` can read but not write."""
 
@@ -44,9 +77,7 @@ class ReadOnlyPlace:
 
     def seal(self) -> None:
         """After the files are made (by this process): the program may no longer write them."""
-        for path in self.folder.rglob("*"):
-            path.chmod(0o444 if path.is_file() else 0o555)
-        self.folder.chmod(0o555)
+        seal(self.folder)
         if self.as_root:
             return  # root writes them still: the program runs without the capabilities (run)
         if any(os.access(p, os.W_OK) for p in [self.folder, *self.folder.rglob("*")]):
@@ -76,12 +107,10 @@ class ReadOnlyPlace:
         return self._run([*self._as_user(), sys.executable, *args], timeout)
 
     def _as_user(self) -> list[str]:
-        if not self.as_root:
-            return []
-        setpriv = shutil.which("setpriv")
-        if setpriv is None:
-            pytest.skip("running as root, and no setpriv to run the program without root's overrides")
-        return [setpriv, f"--bounding-set={OVERRIDES}", f"--inh-caps={OVERRIDES}", "--"]
+        try:
+            return without_overrides()
+        except NoSetpriv as exc:
+            pytest.skip(str(exc))
 
     def _run(self, command: list[str], timeout: float) -> subprocess.CompletedProcess[str]:
         return subprocess.run(command, cwd=self.home, env=self.env(), capture_output=True, text=True,
@@ -108,8 +137,6 @@ class ReadOnlyPlace:
         self.remove()
 
     def remove(self) -> None:
-        for path in [self.folder, *self.folder.rglob("*")]:
-            if path.is_dir():
-                path.chmod(0o755)
+        unseal(self.folder)
         shutil.rmtree(self.folder, ignore_errors=True)
         shutil.rmtree(self.home, ignore_errors=True)
