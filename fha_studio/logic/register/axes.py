@@ -15,7 +15,7 @@ from fha_studio.logic.register.connection import FACT_ID_MARKS, FACT_IDS, Connec
 from fha_studio.logic.register.guard import RegisterError
 from fha_studio.logic.register.records import CORRECTED_WORDS, Axis, Machine, utc_stamp
 
-_ORIGIN_PREFIX = "origin: "
+ORIGIN_PREFIX = "origin: "
 
 
 @guard.in_words
@@ -282,7 +282,7 @@ class Axes(Connection):
         +0.00°" or "origin sensor at +1.25°" (goes into its history as "origin: ...")."""
         current = self.axis(axis)
         with self._transaction():
-            self._axis_event(current.id, utc_stamp(at_utc), who, f"{_ORIGIN_PREFIX}{text}", {"origin": text})
+            self._axis_event(current.id, utc_stamp(at_utc), who, f"{ORIGIN_PREFIX}{text}", {"origin": text})
 
     def latest_origin(self, axis: Axis | str | int) -> dict[str, str] | None:
         """The latest origin recorded for the axis: {"text", "at_utc", "who"}; None when none was."""
@@ -290,11 +290,11 @@ class Axes(Connection):
         row = self._db.execute(
             "SELECT * FROM axis_event WHERE axis_id = ? AND text LIKE ?"
             " ORDER BY at_utc DESC, id DESC LIMIT 1",
-            (current.id, f"{_ORIGIN_PREFIX}%"),
+            (current.id, f"{ORIGIN_PREFIX}%"),
         ).fetchone()
         if row is None:
             return None
-        return {"text": row["text"][len(_ORIGIN_PREFIX) :], "at_utc": row["at_utc"], "who": row["who"]}
+        return {"text": row["text"][len(ORIGIN_PREFIX) :], "at_utc": row["at_utc"], "who": row["who"]}
 
     def axis(self, ref: Axis | str | int) -> Axis:
         """An axis by id, by ``MACHINE/AXIS``, or by its name alone when only one axis has it."""

@@ -6,8 +6,10 @@ holds, for a person to settle. Nothing is picked silently.
 What two sides can disagree on (:data:`SUBJECTS`):
 
 - ``parameters``: the latest known value of a parameter (a snapshot or a verified write) differs
-  between what each side recorded while apart;
-- ``origin``: the latest origin set on the axis differs;
+  between what each side recorded while apart, and both changed it (:func:`changed_apart`: a
+  value one side changed while the other only read again the value both held before is a later
+  change, not a conflict, unless that reading came after the change);
+- ``origin``: the latest origin set on the axis differs (the same rule);
 - ``axis``: a field of the axis (actuator, driver, serial number, load inertia, notes) holds
   different values in the two registers and neither side's change explains it.
 
@@ -28,6 +30,7 @@ from typing import Any
 
 from fha_studio import names
 from fha_studio.logic.register import guard, words
+from fha_studio.logic.register.axes import ORIGIN_PREFIX
 from fha_studio.logic.register.connection import FACT_ID_MARKS, FACT_IDS
 from fha_studio.logic.register.guard import RegisterError
 from fha_studio.logic.register.queries import Queries
@@ -48,7 +51,6 @@ FIELD_WORDS = {
 }
 #: How short a conflict's id may be given (its first characters; ``register conflicts`` shows 8).
 SHORTEST_REF = 4
-_ORIGIN = "origin: "
 _NAMESPACE = uuid.UUID("8a0f3a53-5b0e-4d6f-9a43-26c0ff11c7e1")
 
 
@@ -252,14 +254,19 @@ def latest_origin(rows: Iterable[Mapping[str, Any]]) -> dict[str, SideValue]:
     """The latest origin among axis entries (``text``, ``uid``, ``who``, ``at_utc``, ``recorded_in``)."""
     found: tuple[tuple[str, str], SideValue] | None = None
     for r in rows:
-        if not str(r["text"]).startswith(_ORIGIN):
+        if not str(r["text"]).startswith(ORIGIN_PREFIX):
             continue
         order = (str(r["at_utc"]), str(r["uid"]))
         if found is None or order > found[0]:
             found = (
                 order,
                 SideValue(
-                    r["text"][len(_ORIGIN) :], r["uid"], "axis entry", r["who"], r["at_utc"], r["recorded_in"]
+                    r["text"][len(ORIGIN_PREFIX) :],
+                    r["uid"],
+                    "axis entry",
+                    r["who"],
+                    r["at_utc"],
+                    r["recorded_in"],
                 ),
             )
     return {"origin": found[1]} if found else {}
@@ -301,6 +308,32 @@ def disagreement(a: Mapping[str, SideValue], b: Mapping[str, SideValue]) -> list
     return sorted(k for k in set(a) & set(b) if a[k].value != b[k].value)
 
 
+def changed_apart(
+    a: Mapping[str, SideValue], b: Mapping[str, SideValue], before: Mapping[str, SideValue]
+) -> list[str]:
+    """The items on which two sides' latest values while apart (``a``, ``b``) are a conflict.
+    ``before``: what both held before (the latest of the facts both registers have).
+
+    A side changed an item when its value is not the one both held before. Both changed it
+    (to different values): a conflict. Only one changed it: the other recorded the value both
+    held (a parameter read again, unchanged), so the change is no conflict when it is the later
+    of the two (it was made after the value it replaces was known, as any later change); when the
+    other side recorded the old value after the change, not knowing of it, the register's latest
+    value would silently undo the change: a conflict, for a person to look at."""
+    out = []
+    for key in disagreement(a, b):
+        held = before.get(key)
+        a_new = held is None or a[key].value != held.value
+        b_new = held is None or b[key].value != held.value
+        if a_new and b_new:
+            out.append(key)
+            continue
+        changed, kept = (a[key], b[key]) if a_new else (b[key], a[key])
+        if (kept.at_utc, kept.fact) > (changed.at_utc, changed.fact):
+            out.append(key)
+    return out
+
+
 @guard.in_words
 class Conflicts(Queries):
     """The conflicts a sync found, and their settlement."""
@@ -308,16 +341,16 @@ class Conflicts(Queries):
     def conflicts(
         self, axis: Axis | str | int | None = None, open_only: bool = True, machine: str | None = None
     ) -> list[Conflict]:
-        """The conflicts (of one axis, or one machine's), oldest first; only open ones unless
-        ``open_only`` is False."""
+        """The conflicts (of one axis, or one machine's), oldest first (then by their stable ids, the
+        same order in every register); only open ones unless ``open_only`` is False."""
         sql, args = "SELECT * FROM conflict", []
         if axis is not None:
             sql, args = sql + " WHERE axis_id = ?", [self.axis(axis).id]
-        rows = list(self._db.execute(sql + " ORDER BY at_utc, id", tuple(args)))
+        rows = list(self._db.execute(sql + " ORDER BY at_utc, uid", tuple(args)))
         if not rows:
             return []
         settled: dict[str, list[Resolution]] = {}
-        for r in self._db.execute("SELECT * FROM conflict_resolution ORDER BY at_utc, id"):
+        for r in self._db.execute("SELECT * FROM conflict_resolution ORDER BY at_utc, uid"):
             settled.setdefault(r["conflict_uid"], []).append(
                 Resolution(
                     r["uid"],
@@ -426,7 +459,11 @@ class Conflicts(Queries):
             if found.subject == "origin" and "origin" in side.values:
                 text = str(side.values["origin"].value)
                 self._axis_event(
-                    found.axis.id, now, who, f"{_ORIGIN}{text}{tag}", {"origin": text, "settles": found.uid}
+                    found.axis.id,
+                    now,
+                    who,
+                    f"{ORIGIN_PREFIX}{text}{tag}",
+                    {"origin": text, "settles": found.uid},
                 )
             elif found.subject == "axis":
                 current = self.axis(found.axis.id)

@@ -23,7 +23,9 @@ from fha_studio.logic.register.records import (
     utc_stamp,
 )
 
-#: Facts recorded at the same time are told in this order.
+#: Facts recorded at the same time are told in this order (facts of one kind at the same time by
+#: their stable ids: every register that holds them tells them in the same order, whatever order
+#: they reached it in).
 HISTORY_ORDER = (
     EventKind.AXIS,
     EventKind.SNAPSHOT,
@@ -169,8 +171,7 @@ class History(Conflicts):
             cutoff = utc_stamp(since)
             events = [e for e in events if e.at_utc >= cutoff]
         order = {kind: n for n, kind in enumerate(HISTORY_ORDER)}
-        return sorted(events, key=lambda e: (e.at_utc, order[e.kind], e.ref or 0))
-
+        return sorted(events, key=lambda e: (e.at_utc, order[e.kind], e.uid, e.ref or 0))
 
     def _with_receipts(self, events: list[Event], axis_id: int) -> list[Event]:
         """On a server with roles: when each fact reached the server and from which login (its

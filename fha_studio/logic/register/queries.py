@@ -60,12 +60,13 @@ class Queries(Facts):
         return row is not None
 
     def snapshots(self, axis: Axis | str | int) -> list[dict[str, Any]]:
-        """The axis's snapshots, oldest first: number, time, who, source, file, how many values."""
+        """The axis's snapshots, oldest first (then by their stable ids): number, time, who, source,
+        file, how many values."""
         current = self.axis(axis)
         rows = self._db.execute(
             "SELECT snapshot.*, COUNT(snapshot_value.key) AS count FROM snapshot"
             " LEFT JOIN snapshot_value ON snapshot_value.snapshot_id = snapshot.id"
-            " WHERE axis_id = ? GROUP BY snapshot.id ORDER BY at_utc, snapshot.id",
+            " WHERE axis_id = ? GROUP BY snapshot.id ORDER BY at_utc, snapshot.uid",
             (current.id,),
         )
         return [dict(r) for r in rows]

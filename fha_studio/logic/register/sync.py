@@ -12,7 +12,9 @@ A sync, in this order:
    of facts and sum of their ``uid_hash``; where those differ, the facts' stable ids say which
    facts one register lacks (:mod:`.identity`);
 4. before any fact moves: what the two disagree on, for an axis both changed while they were
-   apart, recorded in both as conflicts (:mod:`.conflicts`), nothing picked;
+   apart, recorded in both as conflicts (:mod:`.conflicts`), nothing picked (a value one side
+   changed after the other last recorded the value both held is a later change:
+   :func:`.conflicts.changed_apart`);
 5. the facts each lacks, in batches, each batch one transaction on the register it goes to (all
    the facts of an axis both changed in one batch, so that a sync stopped in the middle and run
    again finds the same conflicts, or none, never half of them). A fact is known by its stable id,
@@ -33,11 +35,13 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio.logic.register import guard
+from fha_studio.logic.register.axes import ORIGIN_PREFIX
 from fha_studio.logic.register.conflicts import (
     COMPARED_FIELDS,
     Conflict,
     ConflictSide,
     SideValue,
+    changed_apart,
     conflict_uid,
     disagreement,
     field_settings,
@@ -507,13 +511,18 @@ class _Sync:
             if any(sent.get(t) for t in _STATE_TABLES) and any(got.get(t) for t in _STATE_TABLES):
                 both_changed.add(key)
                 mine, theirs = self._state(self.s, sent), self._state(self.t, got)
-                for subject, pick in (("parameters", latest_parameters), ("origin", latest_origin)):
-                    a, b = pick(mine[subject]), pick(theirs[subject])
-                    items = disagreement(a, b)
-                    if items:
-                        found.append(
-                            (i, subject, self._sides({k: a[k] for k in items}, {k: b[k] for k in items}))
-                        )
+                picked = {
+                    subject: (pick(mine[subject]), pick(theirs[subject]))
+                    for subject, pick in (("parameters", latest_parameters), ("origin", latest_origin))
+                }
+                if any(disagreement(a, b) for a, b in picked.values()):
+                    before = self._held_before(i, sent, sorted(set(picked["parameters"][0])))
+                    for subject, (a, b) in picked.items():
+                        items = changed_apart(a, b, before[subject])
+                        if items:
+                            found.append(
+                                (i, subject, self._sides({k: a[k] for k in items}, {k: b[k] for k in items}))
+                            )
             fields = self._field_conflict(i, j, sent.get("axis_event", []), got.get("axis_event", []))
             if fields is not None:
                 found.append((i, "axis", fields))
@@ -567,41 +576,30 @@ class _Sync:
 
     def _state(self, side: _Side, new: Mapping[str, list[str]]) -> dict[str, list[dict[str, Any]]]:
         """What the new facts of a side say: parameter values, axis entries."""
-        values = side.rows_in(
-            "SELECT s.uid, s.at_utc, s.who, s.recorded_in, 'snapshot' AS kind, v.mode, v.number, v.key,"
-            " v.value"
-            " FROM snapshot s JOIN snapshot_value v ON v.snapshot_id = s.id WHERE s.uid IN ({})",
-            new.get("snapshot", []),
+        values = side.rows_in(f"{_SNAPSHOT_VALUES} WHERE s.uid IN ({{}})", new.get("snapshot", []))
+        values += side.rows_in(f"{_WRITTEN_VALUES} AND uid IN ({{}})", new.get("parameter_write", []))
+        values += _settled_values(
+            side.rows_in(f"{_SETTLEMENTS} AND r.uid IN ({{}})", new.get("conflict_resolution", []))
         )
-        values += side.rows_in(
-            "SELECT uid, at_utc, who, recorded_in, 'write' AS kind, mode, number, key,"
-            " COALESCE(read_back, new) AS value"
-            " FROM parameter_write WHERE verified = 1 AND uid IN ({})",
-            new.get("parameter_write", []),
-        )
-        for r in side.rows_in(
-            "SELECT r.uid, r.at_utc, r.who, r.recorded_in, r.settled_json FROM conflict_resolution r"
-            " JOIN conflict c ON c.uid = r.conflict_uid WHERE c.subject = 'parameters'"
-            " AND r.uid IN ({})",
-            new.get("conflict_resolution", []),
-        ):
-            for key, held in _json(r["settled_json"]).items():
-                if isinstance(held, dict) and isinstance(held.get("value"), int):
-                    values.append(
-                        {
-                            **r,
-                            "kind": "settled",
-                            "key": key,
-                            "value": held["value"],
-                            "mode": held.get("mode", ""),
-                            "number": held.get("number", 0),
-                        }
-                    )
-        entries = side.rows_in(
-            "SELECT uid, at_utc, who, recorded_in, text, data FROM axis_event WHERE uid IN ({})",
-            new.get("axis_event", []),
-        )
+        entries = side.rows_in(f"{_AXIS_ENTRIES} WHERE uid IN ({{}})", new.get("axis_event", []))
         return {"parameters": values, "origin": entries}
+
+    def _held_before(
+        self, i: int, new: Mapping[str, list[str]], keys: list[str]
+    ) -> dict[str, dict[str, SideValue]]:
+        """What both registers held for the axis (``i`` in the source) before either's new facts:
+        the latest of its facts both have (the source's facts but the ``new`` ones), parameters
+        ``keys`` and the origin."""
+        fresh = {uid for uids in new.values() for uid in uids}
+        side = self.s
+        values = side.rows_in(f"{_SNAPSHOT_VALUES} WHERE s.axis_id = ? AND v.key IN ({{}})", keys, (i,))
+        values += side.rows_in(f"{_WRITTEN_VALUES} AND axis_id = ? AND key IN ({{}})", keys, (i,))
+        values += _settled_values(side.rows(f"{_SETTLEMENTS} AND r.axis_id = ?", (i,)))
+        entries = side.rows(f"{_AXIS_ENTRIES} WHERE axis_id = ? AND text LIKE ?", (i, f"{ORIGIN_PREFIX}%"))
+        return {
+            "parameters": latest_parameters(r for r in values if r["uid"] not in fresh),
+            "origin": latest_origin(r for r in entries if r["uid"] not in fresh),
+        }
 
     def _field_conflict(
         self, i: int, j: int, sent: list[str], got: list[str]
@@ -762,6 +760,43 @@ class _Sync:
             ):
                 continue
             side.execute(f"UPDATE axis SET {key} = ? WHERE id = ?", (value.value, axis_id))
+
+
+#: A parameter's values as a snapshot holds them, as a verified write leaves them, as a person
+#: settled them (a conflict's kept side), for :func:`.conflicts.latest_parameters`; and the axis's
+#: entries (the origin among them).
+_SNAPSHOT_VALUES = (
+    "SELECT s.uid, s.at_utc, s.who, s.recorded_in, 'snapshot' AS kind, v.mode, v.number, v.key, v.value"
+    " FROM snapshot s JOIN snapshot_value v ON v.snapshot_id = s.id"
+)
+_WRITTEN_VALUES = (
+    "SELECT uid, at_utc, who, recorded_in, 'write' AS kind, mode, number, key,"
+    " COALESCE(read_back, new) AS value FROM parameter_write WHERE verified = 1"
+)
+_SETTLEMENTS = (
+    "SELECT r.uid, r.at_utc, r.who, r.recorded_in, r.settled_json FROM conflict_resolution r"
+    " JOIN conflict c ON c.uid = r.conflict_uid WHERE c.subject = 'parameters'"
+)
+_AXIS_ENTRIES = "SELECT uid, at_utc, who, recorded_in, text, data FROM axis_event"
+
+
+def _settled_values(settlements: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The parameter values that settlements kept, as rows of values."""
+    values = []
+    for r in settlements:
+        for key, held in _json(r["settled_json"]).items():
+            if isinstance(held, dict) and isinstance(held.get("value"), int):
+                values.append(
+                    {
+                        **r,
+                        "kind": "settled",
+                        "key": key,
+                        "value": held["value"],
+                        "mode": held.get("mode", ""),
+                        "number": held.get("number", 0),
+                    }
+                )
+    return values
 
 
 def _settled_fields(entries: list[dict[str, Any]]) -> set[str]:
