@@ -107,3 +107,25 @@ print('heavy:', sorted({{m.split('.')[0] for m in sys.modules if m.split('.')[0]
                             env=env, timeout=120)
     assert result.returncode == 0, result.stderr
     assert "heavy: []" in result.stdout, result.stdout[-500:]
+
+
+def test_the_command_line_starts_without_the_register_and_a_register_command_without_signing(tmp_path):
+    """Every command's parser is built at each start: the register's words for its help do not
+    load the register (its stores, a second of modules) nor the signing library; a register
+    question that signs nothing does not load the signing library either."""
+    register = tmp_path / "r.sqlite"
+    script = f"""
+import sys
+from fha_studio.cli import build_parser, main
+build_parser()
+print('help:', sorted(m for m in sys.modules if m.split('.')[0] == 'cryptography'
+                      or m.startswith(('fha_studio.logic.register.store', 'fha_studio.logic.register.keys'))))
+assert main(["register", "--register", {str(register)!r}, "add-machine", "Line 3"]) == 0
+assert main(["register", "--register", {str(register)!r}, "machines"]) == 0
+print('question:', sorted({{m.split('.')[0] for m in sys.modules if m.split('.')[0] == 'cryptography'}}))
+"""
+    env = {**os.environ, "XDG_DATA_HOME": str(tmp_path / "data"), "PYTHONPATH": str(ROOT)}
+    result = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True,
+                            env=env, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "help: []" in result.stdout and "question: []" in result.stdout, result.stdout[-500:]

@@ -17,7 +17,7 @@ from typing import Any
 
 from fha_studio.cli import CliError
 from fha_studio.cli._values import whole
-from fha_studio.logic.register.sync import BATCH_FACTS
+from fha_studio.logic.register.identity import BATCH_FACTS
 from fha_studio.logic.register.words import when_text
 
 #: Exit status of a sync that stopped before it was done (run it again).

@@ -42,6 +42,10 @@ UID_TABLES = (
 OLDER_UID_TABLES = {
     table: "updated_utc" if table == "procedure_run" else "at_utc" for table in UID_TABLES[:9]
 }
+#: Facts a sync moves in one transaction (with their snapshots' values): about a MB, a fraction of a
+#: second on either store (a sync stopped in the middle has that much to do again). Here, not in
+#: :mod:`.sync`, so that the command line's help says it without loading the register.
+BATCH_FACTS = 1000
 #: The columns every fact has for its identity, in this order (:meth:`fact_ids` gives the values).
 FACT_ID_COLUMNS = ("uid", "recorded_in", "recorded_utc", "uid_hash")
 

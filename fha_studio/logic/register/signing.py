@@ -19,14 +19,13 @@ import os
 import stat
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
-
-from cryptography.exceptions import InvalidSignature
-from cryptography.hazmat.primitives import serialization
-from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey, Ed25519PublicKey
+from typing import TYPE_CHECKING, Any
 
 from fha_studio import fileio
 from fha_studio.paths import user_data_dir
+
+if TYPE_CHECKING:  # the library is imported where a key is made, read or used (a tenth of a second)
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 #: The statement's format: what a signature signs.
 STATEMENT_FORMAT = "fha-report-signature/1"
@@ -52,10 +51,14 @@ def key_id_of(public_raw: bytes) -> str:
 
 
 def public_raw(key: Ed25519PrivateKey) -> bytes:
+    from cryptography.hazmat.primitives import serialization
+
     return key.public_key().public_bytes(serialization.Encoding.Raw, serialization.PublicFormat.Raw)
 
 
 def new_key() -> Ed25519PrivateKey:
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
+
     return Ed25519PrivateKey.generate()
 
 
@@ -66,6 +69,8 @@ def default_key_path(key_id: str) -> Path:
 def write_private_key(key: Ed25519PrivateKey, path: Path, passphrase: str = "") -> Path:
     """The private key as PEM at ``path``, mode 0600, encrypted when ``passphrase`` is given; an
     existing file is never overwritten (it may be someone's only key)."""
+    from cryptography.hazmat.primitives import serialization
+
     if passphrase:
         encryption: serialization.KeySerializationEncryption = serialization.BestAvailableEncryption(
             passphrase.encode("utf-8"))
@@ -102,6 +107,9 @@ def key_file_encrypted(path: Path) -> bool:
 def load_private_key(path: Path, passphrase: str = "") -> Ed25519PrivateKey:
     """The private key in ``path``; SigningError when the file is missing, is no Ed25519 key, or
     the passphrase is missing or wrong."""
+    from cryptography.hazmat.primitives import serialization
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
+
     try:
         info = os.stat(path)
     except OSError as exc:
@@ -161,6 +169,9 @@ def sign_bytes(key: Ed25519PrivateKey, content: bytes, signer: str, signed_utc: 
 
 def signature_holds(public_key_hex: str, signed: Signed) -> bool:
     """Whether ``signed.signature`` is the key's signature of its statement."""
+    from cryptography.exceptions import InvalidSignature
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PublicKey
+
     try:
         public = Ed25519PublicKey.from_public_bytes(bytes.fromhex(public_key_hex))
         public.verify(bytes.fromhex(signed.signature),

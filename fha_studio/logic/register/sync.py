@@ -51,13 +51,12 @@ from fha_studio.logic.register.conflicts import (
 )
 from fha_studio.logic.register.connection import FACT_IDS
 from fha_studio.logic.register.guard import RegisterError
-from fha_studio.logic.register.identity import UID_TABLES, uid_hash
+from fha_studio.logic.register.identity import BATCH_FACTS, UID_TABLES, uid_hash
 from fha_studio.logic.register.records import utc_stamp
 from fha_studio.logic.register.store import Register
 
-#: Facts moved in one transaction (with their snapshots' values): about a MB, a fraction of a
-#: second on either store (a sync stopped in the middle has that much to do again).
-BATCH_FACTS = 1000
+__all__ = ["BATCH_FACTS", "SyncProgress", "SyncResult", "sync_registers"]
+
 #: Ids in one ``IN (...)``.
 _IN_LIST = 500
 #: The facts that say what an axis holds (a conflict is about them).
