@@ -47,24 +47,24 @@ def fill(url: str, axes: int, per_day: int) -> tuple[list[str], int, float]:
     snapshot_at = at.format("m * interval '30 days' + interval '12 hours'")
     with psycopg.connect(url, autocommit=True) as db:
         db.execute("SET TIME ZONE 'UTC'")
-        # each fact its stable id, recorded in this register (as the register's own writes make them)
-        ids = f"gen_random_uuid()::text, '{register_id}', '2016-01-01T00:00:00.000000+00:00', 0"
+        # each fact its stable id, recorded in this register (as the register's own writes make
+        # them), and its uid_hash in the same INSERT (the register's facts are never updated)
+        number = "('x' || substr(uid, 1, 8))::bit(32)::bigint & 2147483647"
+        ids = f"uid, '{register_id}', '2016-01-01T00:00:00.000000+00:00', {number}"
         db.execute(
             "INSERT INTO parameter_write (axis_id, at_utc, who, mode, number, key, old, new, read_back,"
-            f" verified, {FACT_IDS}) SELECT a.id, {write_at}, 'bench', 'system', 8,"
-            " 'system_8', (d + a.id) %% 2, (d + a.id + 1) %% 2, (d + a.id + 1) %% 2, 1, "
-            f"{ids} FROM axis a, generate_series(0, %s) d, generate_series(0, %s) k",
+            f" verified, {FACT_IDS}) SELECT id, at, 'bench', 'system', 8, 'system_8', old, new, new, 1,"
+            f" {ids} FROM (SELECT a.id, {write_at} AS at, (d + a.id) %% 2 AS old, (d + a.id + 1) %% 2 AS new,"
+            " gen_random_uuid()::text AS uid FROM axis a, generate_series(0, %s) d,"
+            " generate_series(0, %s) k) f",
             (YEARS * 365 - 1, per_day - 1),
         )
         db.execute(
-            f"INSERT INTO snapshot (axis_id, at_utc, who, source, {FACT_IDS}) SELECT a.id,"
-            f" {snapshot_at}, 'bench', 'link', {ids}"
-            " FROM axis a, generate_series(0, %s) m",
+            f"INSERT INTO snapshot (axis_id, at_utc, who, source, {FACT_IDS}) SELECT id, at, 'bench',"
+            f" 'link', {ids} FROM (SELECT a.id, {snapshot_at} AS at, gen_random_uuid()::text AS uid"
+            " FROM axis a, generate_series(0, %s) m) f",
             (YEARS * 12 - 1,),
         )
-        for table in ("parameter_write", "snapshot"):
-            number = "('x' || substr(uid, 1, 8))::bit(32)::bigint & 2147483647"
-            db.execute(f"UPDATE {table} SET uid_hash = {number}")
         values = ", ".join(f"('{m}', {n}, '{k}')" for m, n, k, _ in ITEMS)
         db.execute(
             "INSERT INTO snapshot_value (snapshot_id, mode, number, key, value) SELECT s.id, i.mode,"
