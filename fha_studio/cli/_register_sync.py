@@ -32,7 +32,8 @@ def add_actions(sub: argparse._SubParsersAction, common: argparse.ArgumentParser
         help="sync two registers both ways (a laptop's file and the plant's server)",
         description="Brings two registers to the same facts, both ways: what each lacks of the other's "
         "facts is copied into it, each fact once (a sync run twice, or stopped and run again, moves each "
-        "fact once). Machines and axes are matched by their names (machine name, axis name). An axis "
+        "fact once); with --send-only, what --to lacks of --from's, and nothing back. Machines and axes "
+        "are matched by their names (machine name, axis name). An axis "
         "both registers changed while apart, on which they disagree, is a conflict in both, for a "
         f"person to settle (register conflicts, register resolve). Exit 0 when done, {STOPPED} when it "
         "stopped before (what it moved is kept: run it again).",
@@ -54,6 +55,9 @@ def add_actions(sub: argparse._SubParsersAction, common: argparse.ArgumentParser
     s.add_argument("--progress", action="store_true", help="a line on stderr for each batch of facts moved")
     s.add_argument("--batch", type=whole(1, 100_000), metavar="N",
                    help=f"facts moved in one transaction (default {BATCH_FACTS}; fewer on a slow link)")
+    s.add_argument("--send-only", action="store_true",
+                   help="only from --from to --to: nothing comes back (a laptop that delivers its facts "
+                   "without taking a copy of the plant's)")
     s.set_defaults(func=_sync)
     c = sub.add_parser(
         "conflicts",
@@ -111,7 +115,7 @@ def _sync(args) -> int:
 
     try:
         result = sync_registers(opened[0], opened[1], progress=progress, who=args.operator,
-                                batch_facts=args.batch or BATCH_FACTS)
+                                batch_facts=args.batch or BATCH_FACTS, send_only=args.send_only)
     except RegisterError as exc:
         print(f"fha-studio register: error: sync stopped: {exc}", file=sys.stderr)
         return STOPPED

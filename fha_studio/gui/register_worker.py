@@ -7,9 +7,11 @@ directory), and from there to the server whenever it answers:
 - :class:`QueueWorker`, in a thread of its own, writes each fact into that file as it comes (a
   local file takes it in milliseconds; once there a crash does not lose it);
 - :class:`DeliveryWorker`, in another thread, brings what the file has and the server lacks to
-  the server (``register sync``: each fact by its stable id, so a fact is on the server once,
-  however often a delivery is cut off and tried again). A server that cannot be reached is tried
-  again, at once after a new fact and at the latest every :data:`RETRY_MAX_S`;
+  the server (``register sync`` one way, :func:`deliver_by_sync`: each fact by its stable id, so a
+  fact is on the server once, however often a delivery is cut off and tried again; nothing of the
+  server's comes back, so the file holds what this computer recorded, not a copy of the plant's
+  register). A server that cannot be reached is tried again, at once after a new fact and at the
+  latest every :data:`RETRY_MAX_S`;
 - :class:`ServerWriter`, on the GUI thread, hands them the facts (typed queued signals) and says
   what the server does: ``sigState`` (a :class:`ServerState`), and ``sigSlow`` when a delivery
   takes longer than :data:`SLOW_S`.
@@ -153,14 +155,15 @@ class Closing(Exception):
 
 
 def deliver_by_sync(queue: Register, server: Register, answered: Callable[[], None]) -> int:
-    """The queue's facts to the server by ``register sync`` (each fact once, by its stable id;
-    what the server has and this computer's register lacks comes back the same way)."""
+    """The queue's facts to the server by ``register sync``, one way (each fact once, by its
+    stable id; what the server has stays there: a plant's years of facts are not copied to this
+    computer, and a delivery costs what the queue holds, not what the server holds)."""
     from fha_studio.logic.register.sync import SyncProgress, sync_registers
 
     def progress(_step: SyncProgress) -> None:
         answered()
 
-    return int(sync_registers(queue, server, progress, who=login_name()).sent)
+    return int(sync_registers(queue, server, progress, who=login_name(), send_only=True).sent)
 
 
 class DeliveryWorker(QObject):
@@ -244,7 +247,7 @@ class DeliveryWorker(QObject):
             self._queue = Register(self.path, create=False)
         if self._server is None:
             self._server = Register(self.url, busy_timeout_s=CONNECT_TIMEOUT_S)
-            self._server_socket = _socket_of(self._server)
+            self._server_socket = server_socket(self._server)
         return self._queue, self._server
 
     def _close_server(self) -> None:
@@ -262,10 +265,7 @@ class DeliveryWorker(QObject):
         """From any thread: a delivery under way gives up at once (its connection's socket is
         shut: a server that hangs, or a network that went away without a word, cannot hold the
         thread); the next delivery connects anew."""
-        fd = self._server_socket
-        if fd >= 0:
-            with contextlib.suppress(OSError), socket.socket(fileno=os.dup(fd)) as shared:
-                shared.shutdown(socket.SHUT_RDWR)
+        shut_socket(self._server_socket)
 
     @Slot()
     def stop(self) -> None:
@@ -282,13 +282,28 @@ class DeliveryWorker(QObject):
             thread.quit()
 
 
-def _socket_of(register: Register) -> int:
+def server_socket(register: Register) -> int:
     """The socket of a register's connection to its server (-1 when there is none)."""
     connection = getattr(getattr(register, "_db", None), "_conn", None)  # psycopg's Connection
     try:
         return int(connection.pgconn.socket) if connection is not None else -1
     except Exception:
         return -1
+
+
+def shut_socket(fd: int) -> None:
+    """From any thread: the connection on socket ``fd`` (-1: none) is shut, so that whatever waits
+    on it in another thread gives up at once (a server that hangs, or a network gone without a
+    word, cannot hold that thread)."""
+    if fd >= 0:
+        with contextlib.suppress(OSError), socket.socket(fileno=os.dup(fd)) as shared:
+            shared.shutdown(socket.SHUT_RDWR)
+
+
+def without_nothing_changed(problem: str) -> str:
+    """A register's error without what it adds for a command ("nothing was changed; try again
+    when it is back"), which a window that keeps its facts and asks again does not need."""
+    return re.sub(r": nothing was changed(; try again when it is back)?$", "", problem)
 
 
 class ServerWriter(RegisterWriter):
@@ -387,8 +402,7 @@ class ServerWriter(RegisterWriter):
                 )
             self.waiting = 0
         elif self.answers is not False:
-            # what the register's error adds ("nothing was changed; try again ...") is not so here
-            why = re.sub(r": nothing was changed(; try again when it is back)?$", "", state.problem)
+            why = without_nothing_changed(state.problem)
             self.sigSay.emit(
                 "Register: the server does not answer; what this window records waits on this "
                 f"computer and goes to the server when it answers again ({why}).", Level.WARNING

@@ -194,7 +194,8 @@ class WindowRegister(QObject):
             if self.register is not None:
                 rows = self.register.axes()
             elif self.server is not None and self.server.queue.exists():
-                # a server's: this computer's copy of it (the server is never asked on this thread)
+                # a server's: the axes this computer recorded for it (the server is never asked on
+                # this thread)
                 with Register(self.server.queue, read_only=True) as copy:
                     rows = copy.axes()
             else:
@@ -324,7 +325,7 @@ class WindowAxisDialog(QDialog):
         )
         if recording.server is not None:
             intro.setText(
-                intro.text() + " They go to the server through this computer's copy of it, "
+                intro.text() + " They go to the server through this computer's queue for it, "
                 f"{_html(str(recording.server.queue))}, which keeps them while the server does not answer."
             )
         intro.setWordWrap(True)

@@ -262,3 +262,25 @@ def test_a_delivery_that_hangs_is_cut_off_and_made_again_on_a_new_connection(
         window.state.enter_front_panel("tune", 4, 20, "ben")
         qtbot.waitUntil(lambda: bool(_said_since(window, mark, "the server answered")), timeout=30000)
         qtbot.waitUntil(lambda: _snapshot_count(url) == 2, timeout=30000)  # the old one still hangs
+
+
+def test_the_queue_delivers_one_way_and_holds_only_what_this_computer_recorded(
+    make_window, qtbot, postgres_cluster, fixed_clock
+):
+    """A window on a plant's register does not copy the plant's history to this computer: its
+    queue holds the axis it records and its facts, nothing of the server's other facts."""
+    from tests.register.test_sync import fill_offline
+
+    url = postgres_cluster.new_database()
+    fill_offline(url, "ben", fixed_clock, 0, "gripper", facts_per_axis=3)  # the plant's history
+    before = _facts(url)
+    window = make_window("--register", url, "--machine", "Line 3 positioner", "--axis", "table")
+    window.state.enter_front_panel("system", 8, 1, "ana")
+    qtbot.waitUntil(lambda: len(_facts(url)["snapshot"]) == len(before["snapshot"]) + 1, timeout=30000)
+    queue = _facts(register_worker.queue_path(url))
+    server = _facts(url)
+    assert sum(map(len, queue.values())) == 2  # the axis's entry (its actuator) and the snapshot
+    for table in UID_TABLES:
+        assert queue[table] <= server[table] and not queue[table] & before[table], table
+    with Register(register_worker.queue_path(url)) as copy:
+        assert [a.ref for a in copy.axes()] == ["Line 3 positioner/table"]

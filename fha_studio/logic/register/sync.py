@@ -23,6 +23,17 @@ A sync, in this order:
 An axis entry that set a field (an axis added, a field changed) sets it in the register it goes
 to too, the newest such entry counting (the port is each computer's own: it is only filled in
 where none is given).
+
+A sync that only sends (``send_only``: the GUI's queue for a server delivers so) moves facts,
+machines, axes and keys from the source to the target and nothing back: a window on a plant's
+register of years of facts does not copy them to this computer. It compares only what the source
+has (per group and per register a fact was recorded in), so it costs what the source holds, not
+what the target holds. What the two disagree on is found as in a sync both ways, with the
+target's facts that came while they were apart: for an axis and a table, those that reached the
+target after the last of the source's own facts there (the target's row ids say the order); where
+the source has sent none of that table yet, those recorded no earlier than the source's first
+fact being sent (what the target knew before is the history the source's facts add to, not a
+side of a conflict).
 """
 
 from __future__ import annotations
@@ -127,18 +138,20 @@ def sync_registers(
     progress: Progress | None = None,
     who: str = "",
     batch_facts: int = BATCH_FACTS,
+    send_only: bool = False,
 ) -> SyncResult:
     """Brings ``source`` and ``target`` (registers, or where they are: a file or a
-    ``postgresql://`` URL; a missing target file is made) to the same facts, both ways.
-    ``progress`` hears each committed batch (an exception it raises stops the sync there: what
-    was committed stays). ``who`` is who runs it (the conflicts it finds, the fields it fills say
-    so). Raises RegisterError, one line: a register that cannot be opened, a server gone in the
-    middle (what was moved before is kept; run it again)."""
+    ``postgresql://`` URL; a missing target file is made) to the same facts, both ways; with
+    ``send_only`` the target to every fact of the source, and nothing back into the source but
+    the conflicts found. ``progress`` hears each committed batch (an exception it raises stops the
+    sync there: what was committed stays). ``who`` is who runs it (the conflicts it finds, the
+    fields it fills say so). Raises RegisterError, one line: a register that cannot be opened, a
+    server gone in the middle (what was moved before is kept; run it again)."""
     opened: list[Register] = []
     try:
         s = source if isinstance(source, Register) else _opened(opened, source, create=False)
         t = target if isinstance(target, Register) else _opened(opened, target, create=True)
-        job = _Sync(_Side(s), _Side(t), progress, who, max(1, int(batch_facts)))
+        job = _Sync(_Side(s), _Side(t), progress, who, max(1, int(batch_facts)), send_only)
         try:
             return job.run()
         except RegisterError as exc:
@@ -243,20 +256,29 @@ class _Side:
 
 @dataclass
 class _Plan:
-    """What moves: per group and table, the uids the target lacks and those the source lacks."""
+    """What moves: per group and table, the uids the target lacks and those the source lacks;
+    and the target's facts that came while the two were apart (what a conflict is found among:
+    in a sync both ways, what the source lacks)."""
 
     send: dict[GroupKey, dict[str, list[str]]] = field(default_factory=dict)
     receive: dict[GroupKey, dict[str, list[str]]] = field(default_factory=dict)
+    theirs: dict[GroupKey, dict[str, list[str]]] = field(default_factory=dict)
 
 
 class _Sync:
-    def __init__(self, s: _Side, t: _Side, progress: Progress | None, who: str, batch_facts: int):
+    def __init__(
+        self, s: _Side, t: _Side, progress: Progress | None, who: str, batch_facts: int,
+        send_only: bool = False,
+    ):
         if s.id == t.id:
             raise RegisterError(
                 f"{s.shown} and {t.shown} are one register (the same id: one is a copy of the "
                 "other, which is no register of its own); sync the one with a new file instead"
             )
         self.s, self.t, self.progress, self.who, self.batch_facts = s, t, progress, who, batch_facts
+        self.send_only = send_only
+        #: the directions things move in: (from, to)
+        self.ways = ((s, t),) if send_only else ((s, t), (t, s))
         self.pairs: dict[int, int] = {}  # source axis id -> target axis id
         self.back: dict[int, int] = {}  # target axis id -> source axis id
         self.machine_names: dict[_Side, dict[int, str]] = {}
@@ -272,7 +294,7 @@ class _Sync:
         self._machines()
         self._axes()
         self._keys()
-        plan = self._compare()
+        plan = self._compare_sent() if self.send_only else self._compare()
         self.total += sum(
             len(u) for side in (plan.send, plan.receive) for g in side.values() for u in g.values()
         )
@@ -319,7 +341,7 @@ class _Sync:
         """One machine per name, in both."""
         for side in (self.s, self.t):
             side.read_entities()
-        for src, dst in ((self.s, self.t), (self.t, self.s)):
+        for src, dst in self.ways:
             missing = sorted(set(src.machines) - set(dst.machines))
             if not missing:
                 continue
@@ -343,19 +365,24 @@ class _Sync:
 
         names_s, names_t = by_name(self.s), by_name(self.t)
         pairs = {i: names_t[k] for k, i in names_s.items() if k in names_t}
-        # an axis renamed in one register is known by its former name in the other
+        # an axis renamed in one register is known by its former name in the other (sending
+        # only: the target's axes the source has under a former name, not every other one)
         for i, j in self._renamed(self.s, names_t, set(pairs.values()), set(pairs)):
             pairs[i] = j
-        for j, i in self._renamed(self.t, names_s, set(pairs), set(pairs.values())):
+        unpaired_s = {k: i for k, i in names_s.items() if i not in pairs}
+        for j, i in self._renamed(self.t, unpaired_s if self.send_only else names_s, set(pairs),
+                                  set(pairs.values())):
             pairs[i] = j
         self.pairs = pairs
         paired_t = set(pairs.values())
         self._add_axes(self.s, self.t, [r for i, r in self.s.axes.items() if i not in self.pairs])
-        self._add_axes(self.t, self.s, [r for j, r in self.t.axes.items() if j not in paired_t])
+        if not self.send_only:
+            self._add_axes(self.t, self.s, [r for j, r in self.t.axes.items() if j not in paired_t])
         names_s, names_t = by_name(self.s), by_name(self.t)
         self.pairs.update({i: names_t[k] for k, i in names_s.items() if k in names_t and i not in self.pairs})
         for i, j in self.pairs.items():
-            self._fill(self.s, i, self.t.axes[j])
+            if not self.send_only:
+                self._fill(self.s, i, self.t.axes[j])
             self._fill(self.t, j, self.s.axes[i])
 
     def _renamed(
@@ -363,8 +390,9 @@ class _Sync:
     ) -> Iterator[tuple[int, int]]:
         """(axis of ``side``, axis of the other register) for each axis of ``side`` not paired
         yet whose former name the other register's axis still has."""
+        machines = {m for m, _ in others}
         for i, r in side.axes.items():
-            if i in mine or (r["machine"], r["name"]) in others:
+            if i in mine or (r["machine"], r["name"]) in others or r["machine"] not in machines:
                 continue
             for old in self._former_names(side, i):
                 j = others.get((r["machine"], old))
@@ -405,11 +433,17 @@ class _Sync:
 
     def _keys(self) -> None:
         """Signing keys, revocations and signatures: each known by an id of its own."""
-        rows = {
-            side: {t: {r[k]: r for r in side.rows(f"SELECT * FROM {t}")} for t, k in _KEYED_TABLES}
-            for side in (self.s, self.t)
+        def held(side: _Side, table: str, key: str, only: list[str] | None = None) -> dict[str, Any]:
+            if only is None:
+                return {r[key]: r for r in side.rows(f"SELECT * FROM {table}")}
+            return {r[key]: r for r in side.rows_in(f"SELECT * FROM {table} WHERE {key} IN ({{}})", only)}
+
+        rows = {self.s: {t: held(self.s, t, k) for t, k in _KEYED_TABLES}}
+        # sending only: of the target's, those the source has
+        rows[self.t] = {
+            t: held(self.t, t, k, list(rows[self.s][t]) if self.send_only else None) for t, k in _KEYED_TABLES
         }
-        for src, dst in ((self.s, self.t), (self.t, self.s)):
+        for src, dst in self.ways:
             moving = {
                 t: [r for k, r in rows[src][t].items() if k not in rows[dst][t]] for t, _ in _KEYED_TABLES
             }
@@ -468,7 +502,94 @@ class _Sync:
                     plan.send.setdefault(key, {})[table] = send
                 if receive:
                     plan.receive.setdefault(key, {})[table] = receive
+        plan.theirs = plan.receive
         return plan
+
+    def _compare_sent(self) -> _Plan:
+        """What the target lacks of the source's facts, by each group's count and ``uid_hash``
+        sum per register the facts were recorded in (the target's rows of the source's groups
+        only); then the target's facts that came while they were apart, for the axes the source
+        changed."""
+        plan = _Plan()
+        self.back = {j: i for i, j in self.pairs.items()}
+        self.machine_names = {side: {i: n for n, i in side.machines.items()} for side in (self.s, self.t)}
+        for table in UID_TABLES:
+            g = "COALESCE(axis_id, -machine_id)" if table == "report" else "axis_id"
+            sql = f"SELECT {g} AS g, recorded_in, COUNT(*) AS n, SUM(uid_hash) AS h FROM {table}"
+            group_by = f" GROUP BY {g}, recorded_in"
+            mine = {
+                (self._group(self.s, int(r["g"])), r["recorded_in"]): (int(r["n"]), int(r["h"] or 0))
+                for r in self.s.rows(sql + group_by)
+            }
+            if not mine:
+                continue
+            there = {self._there(key) for key, _ in mine}
+            there.discard(None)
+            theirs = {
+                (self._group(self.t, int(r["g"])), r["recorded_in"]): (int(r["n"]), int(r["h"] or 0))
+                for r in self.t.rows_in(sql + f" WHERE {g} IN ({{}})" + group_by, sorted(there))
+            }
+            differ = {key for key in mine if theirs.get(key) != mine[key]}
+            self.already += sum(n for key, (n, _) in mine.items() if key not in differ)
+            for group, origin in sorted(differ, key=str):
+                one = f"SELECT uid, id FROM {table} WHERE {g} = ? AND recorded_in = ?"
+                held = self.s.rows(one, (self._here(group), origin))
+                target_group = self._there(group)
+                there_now = [] if target_group is None else self.t.rows(one, (target_group, origin))
+                got = {r["uid"] for r in there_now}
+                send = [r["uid"] for r in sorted(held, key=lambda r: int(r["id"])) if r["uid"] not in got]
+                self.already += len(held) - len(send)
+                if send:
+                    plan.send.setdefault(group, {}).setdefault(table, []).extend(send)
+        for key in plan.send:
+            if key[0] == "a" and key[1] in self.pairs and any(plan.send[key].get(t) for t in _STATE_TABLES):
+                came = self._came_meanwhile(key, plan.send[key])
+                if came:
+                    plan.theirs[key] = came
+        return plan
+
+    def _here(self, key: GroupKey) -> int:
+        """The group's value (an axis id, or minus a machine id) in the source."""
+        return int(key[1]) if key[0] == "a" else -self.s.machines[key[1]]
+
+    def _there(self, key: GroupKey) -> int | None:
+        """The group's value in the target (None: the target has no such axis or machine yet)."""
+        if key[0] == "a":
+            return self.pairs.get(key[1])
+        machine = self.t.machines.get(key[1])
+        return None if machine is None else -machine
+
+    def _came_meanwhile(self, key: GroupKey, sent: Mapping[str, list[str]]) -> dict[str, list[str]]:
+        """Of an axis the source changed, the target's facts (state tables) that came while the
+        two were apart: after the last of the source's own facts there, table by table (the
+        target's row ids say the order); with none there yet, those recorded no earlier than the
+        first fact the source sends now."""
+        axis_t = self.pairs[key[1]]
+        first = min(
+            (r["recorded_utc"] for t, uids in sent.items() if t in _STATE_TABLES
+             for r in self.s.rows_in(f"SELECT recorded_utc FROM {t} WHERE uid IN ({{}})", uids)),
+            default="",
+        )
+        came: dict[str, list[str]] = {}
+        for table in _STATE_TABLES:
+            others = f"SELECT uid, id FROM {table} WHERE axis_id = ? AND recorded_in != ?"
+            last = self.t.rows(
+                f"SELECT MAX(id) AS last FROM {table} WHERE axis_id = ? AND recorded_in = ?",
+                (axis_t, self.s.id),
+            )
+            mark = last[0]["last"] if last else None
+            if mark is not None:
+                rows = self.t.rows(others + " AND id > ?", (axis_t, self.s.id, int(mark)))
+            else:
+                rows = self.t.rows(others + " AND recorded_utc >= ?", (axis_t, self.s.id, first))
+            if not rows:
+                continue
+            uids = [r["uid"] for r in rows]
+            known = {r["uid"] for r in self.s.rows_in(f"SELECT uid FROM {table} WHERE uid IN ({{}})", uids)}
+            fresh = [r["uid"] for r in sorted(rows, key=lambda r: int(r["id"])) if r["uid"] not in known]
+            if fresh:
+                came[table] = fresh
+        return came
 
     def _uids(
         self, side: _Side, table: str, g: str, keys: list[GroupKey], groups: int
@@ -506,7 +627,7 @@ class _Sync:
         both_changed = set()
         for i, j in self.pairs.items():
             key: GroupKey = ("a", i)
-            sent, got = plan.send.get(key, {}), plan.receive.get(key, {})
+            sent, got = plan.send.get(key, {}), plan.theirs.get(key, {})
             if any(sent.get(t) for t in _STATE_TABLES) and any(got.get(t) for t in _STATE_TABLES):
                 both_changed.add(key)
                 mine, theirs = self._state(self.s, sent), self._state(self.t, got)
