@@ -27,11 +27,11 @@ def test_the_batch_size_is_said_as_the_code_has_it(capsys):
     assert f"each batch of facts ({BATCH_FACTS}, `--batch N`)" in " ".join(README.read_text("utf-8").split())
 
 
-def _read(where, who: str, clock, direction: int, axis: str = SHARED) -> None:
-    """The rotary direction of ``axis`` read as ``direction`` (one snapshot), in ``where``."""
+def _read(where, who: str, clock, values: dict[tuple[str, int], int], axis: str = SHARED) -> None:
+    """Parameters of ``axis`` read (one snapshot), in ``where``."""
     with Register(where) as reg:
         f.record_fact(reg, axis, f.axis_fact({"actuator_code": "FHA-25C-50-US250"}, who))
-        for fact in f.read_facts(MODEL, {("system", 8): direction}, who, "HA-655-2-200"):
+        for fact in f.read_facts(MODEL, values, who, "HA-655-2-200"):
             f.record_fact(reg, axis, fact)
     clock.advance(1)
 
@@ -68,21 +68,24 @@ def test_sending_only_moves_each_fact_once_and_nothing_back(tmp_path, fixed_cloc
 def test_what_both_changed_while_apart_is_a_conflict(tmp_path, fixed_clock, register_target):
     laptop = tmp_path / "laptop.sqlite"
     plant = register_target
-    _read(laptop, "ana", fixed_clock, 1)
+    direction, in_position = ("system", 8), ("tune", 4)
+    _read(laptop, "ana", fixed_clock, {direction: 1, in_position: 10})
     # the plant heard of the axis after the laptop's fact, before the laptop delivered it
-    _read(plant, "ben", fixed_clock, 0)
+    _read(plant, "ben", fixed_clock, {direction: 0, in_position: 10})
     (conflict,) = sync_registers(laptop, plant, send_only=True).conflicts
     assert conflict.subject == "parameters" and conflict.items() == ["rotary_direction"]
     assert {s.values["rotary_direction"].who for s in conflict.sides} == {"ana", "ben"}
-    # delivered since: what the plant hears later, the laptop did not know when it changed the axis
-    _read(plant, "cy", fixed_clock, 1)
-    _read(laptop, "ana", fixed_clock, 0)
+    # delivered since: what the plant hears later, the laptop did not know when it changed the
+    # axis (both changed the in-position range from the 10 both held)
+    _read(plant, "cy", fixed_clock, {in_position: 20})
+    _read(laptop, "ana", fixed_clock, {in_position: 30})
     result = sync_registers(laptop, plant, send_only=True)
     assert len(result.found_now) == 1 and len(result.conflicts) == 2
     newest = next(c for c in result.conflicts if c.uid in result.found_now)
-    assert {s.values["rotary_direction"].who for s in newest.sides} == {"ana", "cy"}
+    assert newest.items() == ["in_position_range"]
+    assert {s.values["in_position_range"].who for s in newest.sides} == {"ana", "cy"}
     # nothing came meanwhile: the laptop's next fact is the axis's newest, no conflict
-    _read(laptop, "ana", fixed_clock, 1)
+    _read(laptop, "ana", fixed_clock, {in_position: 40})
     assert sync_registers(laptop, plant, send_only=True).found_now == frozenset()
     with Register(laptop) as reg:  # the conflicts are in both; nothing else came back
         assert len(reg.conflicts()) == 2 and [s["who"] for s in reg.snapshots(SHARED)] == ["ana"] * 3
