@@ -81,6 +81,22 @@ def test_an_empty_file_is_no_register_to_ask_but_may_become_one(tmp_path):
         reg.add_machine("m")
 
 
+def test_a_refusal_names_a_register_deep_in_folders_whole_and_cuts_only_an_absurd_path(tmp_path):
+    folder = tmp_path / "Plant A hall 2" / "commissioning" / "Line 3 positioner" / "registers"
+    folder.mkdir(parents=True)
+    empty = folder / "line-3-positioner.sqlite"
+    empty.touch()
+    assert len(str(empty)) > 100
+    with pytest.raises(RegisterError) as refused:
+        Register(empty, create=False)
+    assert str(refused.value).startswith(f"{empty} is an empty file, not a register")
+    absurd = "/" + "x" * 250 + "/" + "y" * 250 + "/r.sqlite"
+    with pytest.raises(RegisterError) as refused:
+        Register(absurd, create=False)
+    said = str(refused.value)
+    assert "\n" not in said and f"… ({len(absurd)} characters)" in said and "r.sqlite" not in said
+
+
 #: What a read-only register answers and refuses, run as a user that cannot write it
 #: (tests/support/read_only.py): its axes, then each write's refusal, a line each.
 READ_ONLY_QUESTIONS = """

@@ -44,9 +44,16 @@ def append_only_refusal(where: str, said: str) -> RegisterError:
     return RegisterError(f"the register {where}: its history is {reason}: nothing was changed")
 
 
+#: The most of a path a refusal shows: a path as people make them, whole (its file's name is at
+#: its end: a cut at 80 characters took the name off a register in a folder a few levels down);
+#: a pasted 10 kB one is cut.
+PATH_SHOWN_MAX = 300
+
+
 def shown_path(path: str | os.PathLike[str]) -> str:
-    """A path as a refusal quotes it: at most 80 characters, anything unprintable escaped."""
-    return quoted(os.fspath(path), limit=80, always=False)
+    """A path as a refusal quotes it: at most PATH_SHOWN_MAX characters, anything unprintable
+    escaped."""
+    return quoted(os.fspath(path), limit=PATH_SHOWN_MAX, always=False)
 
 
 def check_before_opening(path: Path, create: bool) -> bool:
