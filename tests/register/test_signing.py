@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import stat
 
 import pytest
@@ -20,15 +21,24 @@ CODE = "FHA-25C-50-US250-B-L"
 ALL = ["receiving-inspection", "installation", "wiring", "sensor-adjustment", "rotary-direction"]
 
 
-@pytest.fixture
-def finished(tmp_path):
-    """A session with every procedure done (nothing open: it may be signed)."""
+@pytest.fixture(scope="module")
+def finished_once(tmp_path_factory):
+    """A session with every procedure done, walked once for the module (1-1.5 s a walk under load)."""
+    folder = tmp_path_factory.mktemp("finished")
     context = build_context(CODE)
     session = ProcedureSession(actuator_code=CODE, operator="T. Trainee", site="Line 3")
     session.driver = {"model": "HA-655-2-200", "adjusted_for": CODE, "version": "sim 1"}
-    session.save(tmp_path / "axis1.json")
+    session.save(folder / "axis1.json")
     for procedure_id in ALL:
         walk(ProcedureRun(session, load_procedure(procedure_id, context)))
+    return folder
+
+
+@pytest.fixture
+def finished(finished_once, tmp_path):
+    """A session with every procedure done (nothing open: it may be signed): the test's own copy
+    of what the walk left."""
+    shutil.copytree(finished_once, tmp_path, dirs_exist_ok=True)
     return tmp_path / "axis1.json"
 
 
