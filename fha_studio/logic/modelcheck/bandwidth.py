@@ -16,8 +16,8 @@ implied inertia). The residual of the rigid model tells where that starts:
   stays within GROWTH_LIMIT x the smallest unexplained torque of all longer windows, or within
   the practical floor.
 
-All kernels are applied to raw columns computed once, by FFT convolution, so the search costs a
-few full-rate passes, not one analysis per window.
+All kernels are applied to raw columns computed and transformed once (FFT convolution), so the
+search costs a few full-rate passes, not one analysis per window.
 """
 
 from __future__ import annotations
@@ -27,9 +27,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import fftconvolve
+from scipy.fft import irfft, next_fast_len, rfft
 
-from fha_studio.logic.modelcheck.linalg import gram
+from fha_studio.logic.modelcheck.linalg import gram, solve_normal
 from fha_studio.logic.modelcheck.signals import make_filter
 
 GROWTH_LIMIT = 1.5  # unexplained torque may grow this much over the best of the longer windows
@@ -86,12 +86,18 @@ def choose_bandwidth(
     windows = candidate_windows(shortest, longest, dt_s)
     if len(windows) == 1:
         return BandwidthChoice(windows[0], "the only window this recording supports", ())
-    raw = _raw_columns(pos_rad, current_a, dt_s, ratio, shortest)
+    raw = _raw_columns(pos_rad, current_a, dt_s, ratio, shortest)[1:-1]
+    # every window's kernel is applied to the same columns: their transform is taken once
+    m = len(raw)
+    size = next_fast_len(m + max(windows) - 3, real=True)
+    raw_f = rfft(raw, size, axis=0)
     profile = []
     for w in windows:
         f = make_filter(w, dt_s)
-        # smoothed columns on the valid part (the same samples as the SG derivatives)
-        cols = fftconvolve(raw[1:-1], f.smooth[::-1, None], mode="valid", axes=0)
+        # smoothed columns on the valid part (the same samples as the SG derivatives): the linear
+        # convolution with the reversed kernel, its samples where the kernel lies within the record
+        length = len(f.smooth)
+        cols = irfft(raw_f * rfft(f.smooth[::-1], size)[:, None], size, axis=0)[length - 1 : m]
         torque = kt_nm_per_a * cols[:, 0]
         accel = cols[:, 1] / dt_s**2
         y = torque - inertia_kgm2 * accel
@@ -173,7 +179,7 @@ def _heldout_rms(y: np.ndarray, x: np.ndarray, gap: int) -> float:
     for a, b in itertools.pairwise(cuts):
         lo, hi = max(0, a - gap), min(n, b + gap)
         g_out, xty_out = gram(xs[lo:hi], y[lo:hi])
-        beta = np.linalg.pinv(g_all - g_out, rcond=1e-10, hermitian=True) @ (xty - xty_out)
+        beta = solve_normal(g_all - g_out, xty - xty_out)
         r = y[a:b] - xs[a:b] @ beta
         sse += float(r @ r)
     return math.sqrt(sse / max(n, 1))

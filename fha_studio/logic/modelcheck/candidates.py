@@ -50,6 +50,13 @@ class ChannelContext:
     breakpoints_nm: tuple[float, ...] = ()
     nominal_inertia_kgm2: float = 0.0  # J_actuator + J_load declared (the nominal model's inertia)
     cache: dict[tuple[object, ...], np.ndarray] = field(default_factory=dict)
+    # > 1: a candidate that `decimates` builds only every rows_step-th sample of the valid part
+    rows_step: int = 1
+
+    def smooth(self, full_rate_column: np.ndarray) -> np.ndarray:
+        """A column computed on the whole record, smoothed onto the valid part (every rows_step-th
+        sample of it)."""
+        return self.sig.filt.apply_every(full_rate_column, self.rows_step)
 
     def full_sign_speed(self, memory: bool = False) -> np.ndarray:
         """Direction of motion on the whole record: 0 while standing, or (memory) the last direction."""
@@ -138,6 +145,9 @@ class Candidate:
     # why a fitted shape lies outside what the recording spans ("" when it does not): checked in
     # every re-fit, since the joint refinement of all parameters is not bounded
     shape_check: Callable[[tuple[float, ...], ChannelContext], str] | None = None
+    # build honours ChannelContext.rows_step (smooths with ctx.smooth only): a searched shape's
+    # columns are rebuilt at every trial, and the selection then computes only the rows it fits
+    decimates: bool = False
 
 
 def _amp_phase(beta: np.ndarray, cov: np.ndarray) -> tuple[float, float, float, float]:
@@ -190,7 +200,7 @@ def _inertia_cols(ctx, shape):
 def _periodic_motor_cols(ctx, shape):
     (cycles,) = shape
     angle = cycles * ctx.sig.ratio * ctx.sig.raw_pos_rad
-    return np.column_stack([ctx.sig.regressor(np.sin(angle)), ctx.sig.regressor(np.cos(angle))])
+    return np.column_stack([ctx.smooth(np.sin(angle)), ctx.smooth(np.cos(angle))])
 
 
 def _one(name: str, unit: str, scale: float = 1.0):
@@ -247,7 +257,7 @@ def _stribeck_cols(ctx, shape):
     # last slid against, the breakaway level (the servo's integrator holds it, see Coulomb friction)
     (v_s,) = shape
     v = ctx.sig.full_speed_rad_s
-    return ctx.sig.regressor(ctx.full_sign_speed(memory=True) * np.exp(-((v / v_s) ** 2)))[:, None]
+    return ctx.smooth(ctx.full_sign_speed(memory=True) * np.exp(-((v / v_s) ** 2)))[:, None]
 
 
 def _stribeck_params(beta, cov, shape, shape_cov, ctx):
@@ -383,6 +393,7 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         _amp_size,
         shape_grid=tuple((c,) for c in RIPPLE_CYCLES),
         shape_refine=True,
+        decimates=True,
         shape_names=("cycles_per_motor_rev",),
         look_elsewhere=True,
         shape_check=cycles_within(RIPPLE_CYCLES),
@@ -423,6 +434,7 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         lambda b, c: abs(float(b[0])),
         shape_grid=tuple((v,) for v in STRIBECK_SPEEDS_RAD_S),
         shape_refine=True,
+        decimates=True,
         shape_names=("velocity_rad_s",),
         shape_bounds=lambda s: ([0.5 * s[0]], [2.0 * s[0]]),
         shape_check=stribeck_within,
@@ -518,6 +530,7 @@ POSITION_CANDIDATES: tuple[Candidate, ...] = (
         _amp_size,
         shape_grid=tuple((c,) for c in KINEMATIC_CYCLES),
         shape_refine=True,
+        decimates=True,
         shape_names=("cycles_per_motor_rev",),
         look_elsewhere=True,
         shape_check=cycles_within(KINEMATIC_CYCLES),

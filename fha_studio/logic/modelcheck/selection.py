@@ -38,7 +38,9 @@ least squares; the final fit refines all parameters together (scipy.optimize.lea
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -57,6 +59,19 @@ MIN_SIGMAS = 3.0  # a named effect's size must stand this many jackknife sigmas 
 MIN_OFF_SHAPE_RATIO = 6.0
 MASKED_CV_FACTOR = 3.0  # a look-alike the record cannot rule out fits within this factor of the chosen
 OFF_SHAPE_GAP = 0.45  # off-shape frequencies keep this far (cycles per turn) from the chosen one
+
+
+# Two scores this close (relative) are a tie, settled by the candidates' order: candidates that span
+# the same columns (friction by direction = Coulomb friction + an offset) score alike up to rounding,
+# and the choice between them must not depend on the order of a sum.
+TIE_RELATIVE = 1e-9
+
+
+def _first_lowest(items: list[Any], key: Callable[[Any], float]) -> Any:
+    """The first item whose key is the lowest, or within TIE_RELATIVE of it."""
+    lowest = min(key(item) for item in items)
+    tolerance = TIE_RELATIVE * abs(lowest) if math.isfinite(lowest) else 0.0
+    return next(item for item in items if key(item) <= lowest + tolerance)
 
 
 # ----------------------------------------------------------------------------------- data types
@@ -142,6 +157,12 @@ class ChannelSelector:
         self.candidates = [c for c in candidates if not (c.needs_ratio and ctx.sig.ratio is None)]
         self.n = len(y)
         self._cols_cache: dict[tuple[str, tuple[float, ...]], np.ndarray] = {}
+        # the rows are every step-th sample of the valid part: a candidate that decimates builds
+        # only those (its searched shapes are rebuilt at every trial)
+        n_valid = len(ctx.sig.t_s)
+        step = int(index[1] - index[0]) if len(index) > 1 else 0
+        evenly = step > 0 and np.array_equal(index, np.arange(0, n_valid, step))
+        self._decimated = replace(ctx, rows_step=step) if evenly else None
         # detection limits by (candidate, the terms beside it with their shapes): substitutes() and
         # the report ask for the same ones
         self._limit_cache: dict[tuple[object, ...], tuple[float, tuple[float, ...]]] = {}
@@ -150,8 +171,11 @@ class ChannelSelector:
     def cols(self, cand: Candidate, shape: tuple[float, ...]) -> np.ndarray:
         key = (cand.id, tuple(round(s, 9) for s in shape))
         if key not in self._cols_cache:
-            full = cand.build(self.ctx, shape)
-            self._cols_cache[key] = np.asarray(full, dtype=float)[self.index]
+            if cand.decimates and self._decimated is not None:
+                self._cols_cache[key] = np.asarray(cand.build(self._decimated, shape), dtype=float)
+            else:
+                full = cand.build(self.ctx, shape)
+                self._cols_cache[key] = np.asarray(full, dtype=float)[self.index]
         return self._cols_cache[key]
 
     def design(self, terms: list[Term]) -> np.ndarray:
@@ -345,7 +369,7 @@ class ChannelSelector:
                     continue
                 tried.append((*self.try_add(cand, terms, replaced), replaced))
             good = [trial for trial in tried if trial[0].accepted]
-            best = min(good, key=lambda p: p[0].delta_bic) if good else None
+            best = _first_lowest(good, lambda p: p[0].delta_bic) if good else None
             chosen = best[0].id if best else None
             steps.append(SelectionStep("forward", len(phi), [tr for tr, _, _ in tried], chosen))
             if best is None:
@@ -377,7 +401,7 @@ class ChannelSelector:
                         "kept" if keep else "redundant given the others",
                     )
                 )
-            weakest = min(trials, key=lambda tr: -tr.delta_bic if not tr.accepted else math.inf)
+            weakest = _first_lowest(trials, lambda tr: -tr.delta_bic if not tr.accepted else math.inf)
             if not weakest.accepted:
                 terms = [t for t in terms if t.id != weakest.id]
                 steps.append(SelectionStep("backward", len(phi), trials, weakest.id))

@@ -23,6 +23,7 @@ bandwidth.py then lengthens it where the data say the rigid model stops explaini
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -74,6 +75,22 @@ class AnalysisFilter:
         if x.ndim == 2:
             return np.column_stack([self.apply(c) for c in x.T]) if x.shape[1] else x[self.half : -self.half]
         return np.convolve(x[1:-1], self.smooth[::-1], "valid")
+
+    def apply_every(self, x: np.ndarray, step: int) -> np.ndarray:
+        """apply(x)[::step], computed at those samples only: the kernel and the record split into
+        step phases, step convolutions each 1/step as long with 1/step of the kernel (a decimated
+        fit rebuilds a searched column at every trial; this is step times less work)."""
+        x = np.asarray(x, dtype=float)
+        if step == 1:
+            return self.apply(x)
+        if x.ndim == 2:
+            return np.column_stack([self.apply_every(c, step) for c in x.T])
+        a, g = x[1:-1], self.smooth
+        n_out = -(-(len(a) - len(g) + 1) // step)
+        out = np.zeros(n_out)
+        for phase in range(min(step, len(g))):
+            out += np.convolve(a[phase::step], g[phase::step][::-1], "valid")[:n_out]
+        return out
 
 
 def make_filter(window: int, dt_s: float) -> AnalysisFilter:
@@ -203,7 +220,7 @@ class Signals:
         """A regressor computed on the whole uniform record, smoothed onto the valid part."""
         return self.filt.apply(full_rate_column)
 
-    @property
+    @functools.cached_property
     def speed_f_rad_s(self) -> np.ndarray:
         """Speed for linear (viscous) terms: the central difference, smoothed with g (consistent)."""
         x = self.raw_pos_rad
@@ -212,9 +229,10 @@ class Signals:
         v[0], v[-1] = v[1], v[-2]
         return self.filt.apply(v)
 
-    @property
+    @functools.cached_property
     def full_speed_rad_s(self) -> np.ndarray:
-        """SG speed padded to the whole uniform record (edges held), for nonlinear regressors."""
+        """SG speed padded to the whole uniform record (edges held), for nonlinear regressors (once:
+        a searched Stribeck speed asks for it at every trial)."""
         h = self.filt.half
         return np.concatenate(
             [np.full(h, self.speed_rad_s[0]), self.speed_rad_s, np.full(h, self.speed_rad_s[-1])]
