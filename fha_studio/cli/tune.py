@@ -15,6 +15,9 @@ mode (a CSV of time and volts, a WAV, or one normalised cycle), its bounds state
 ``measure``. A drive that cannot be excited (a drive of the manual's commands, servo off, an
 alarm, parameter 0 not speed for SPD-CMD) gets one line saying what is needed and exit 4; nothing
 moves.
+
+Waiting is on what the drive reports (its trace's state and count: the drive's own time), never on
+the computer's clock; a stepped simulated drive (``sim://...&stepped=1``) is advanced between looks.
 """
 
 from __future__ import annotations
@@ -22,7 +25,6 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import time
 from typing import Any
 
 from fha_studio.cli import CliError
@@ -86,7 +88,8 @@ def run_measure(args: argparse.Namespace) -> int:
     from fha_studio.hardware.client import DriveClient
     from fha_studio.hardware.parameters import load_parameter_model
     from fha_studio.logic.tuning.measure import NotExcitable, check_excitable
-    from fha_studio.logic.tuning.session import measure_report, tuner_for
+    from fha_studio.logic.tuning.record import figure_words
+    from fha_studio.logic.tuning.session import drive_clock, measure_report, tuner_for
 
     model = _model(args)
     parameters = load_parameter_model("HA-655")
@@ -94,7 +97,8 @@ def run_measure(args: argparse.Namespace) -> int:
         try:
             check_excitable(client)
             tuner = tuner_for(client, parameters, model)
-            result = measure_report(client, tuner, time.sleep, time.monotonic, args.amplitude_rpm,
+            pace, now = drive_clock(client)
+            result = measure_report(client, tuner, pace, now, args.amplitude_rpm,
                                     announce=lambda s: print(s, file=sys.stderr))
         except NotExcitable as exc:
             print(f"fha-studio tune measure: {exc}", file=sys.stderr)
@@ -102,15 +106,15 @@ def run_measure(args: argparse.Namespace) -> int:
         except ValueError as exc:
             raise CliError(str(exc)) from None
 
-    def f(v: float | None, unit: str) -> str:
-        return "none found" if v is None else f"{v:.3g} {unit}"
+    def f(key: str, unit: str) -> str:
+        return figure_words(key, result[key], unit)
 
-    _emit(args, result, f"resonance {f(result['resonance_hz'], 'Hz')} (predicted "
-          f"{f(result['predicted_resonance_hz'], 'Hz')}), "
-          f"anti-resonance {f(result['antiresonance_hz'], 'Hz')}; "
-          f"load inertia {f(result['load_inertia_estimate_kgm2'], 'kg m^2')}; gain margin "
-          f"{f(result['gain_margin_db'], 'dB')}, phase margin {f(result['phase_margin_deg'], 'deg')}, "
-          f"crossover {f(result['crossover_hz'], 'Hz')}, bandwidth {f(result['bandwidth_hz'], 'Hz')}")
+    words = [f"resonance {f('resonance_hz', 'Hz')} (predicted {f('predicted_resonance_hz', 'Hz')})",
+             f"anti-resonance {f('antiresonance_hz', 'Hz')}",
+             f"load inertia {f('load_inertia_estimate_kgm2', 'kg m^2')}",
+             f"gain margin {f('gain_margin_db', 'dB')}", f"phase margin {f('phase_margin_deg', 'deg')}",
+             f"crossover {f('crossover_hz', 'Hz')}", f"bandwidth {f('bandwidth_hz', 'Hz')}"]
+    _emit(args, result, ", ".join(words))
     return 0
 
 
@@ -138,9 +142,13 @@ def run_propose(args: argparse.Namespace) -> int:
             print(f"warning: {proposal.warning}", file=sys.stderr)
         if args.apply:
             result["measured"] = _apply(args, client, parameters, tuner, proposal)
+    from fha_studio.logic.tuning.record import figure_words
+
     items = ", ".join(f"{k} {v}" for k, v in proposal.proposed.items.items())
+    figs = proposal.proposed
     _emit(args, result, f"proposed ({proposal.used_aim}): {items}; gain margin "
-          f"{proposal.proposed.gain_margin_db}, phase margin {proposal.proposed.phase_margin_deg}")
+          f"{figure_words('gain_margin_db', figs.gain_margin_db, 'dB')}, phase margin "
+          f"{figure_words('phase_margin_deg', figs.phase_margin_deg, 'deg')}")
     return 0
 
 
@@ -154,6 +162,7 @@ def _apply(args: argparse.Namespace, client: Any, parameters: Any, tuner: Any,
     from fha_studio.logic.tuning.move import MoveAlarm
     from fha_studio.logic.tuning.session import (
         backup_parameters,
+        drive_clock,
         measure_report,
         tuner_for,
         verify_move,
@@ -169,11 +178,12 @@ def _apply(args: argparse.Namespace, client: Any, parameters: Any, tuner: Any,
     except ValueError as exc:
         raise CliError(str(exc)) from None
     after = tuner_for(client, parameters, tuner.model)
-    report = measure_report(client, after, time.sleep, time.monotonic)
+    pace, now = drive_clock(client)
+    report = measure_report(client, after, pace, now)
     measured: dict[str, Any] = {**proposal.proposed.items, "gain_margin_db": report["gain_margin_db"],
                                 "phase_margin_deg": report["phase_margin_deg"], "backup": str(path)}
     try:
-        measured.update(verify_move(client, parameters, after, time.sleep).to_dict())
+        measured.update(verify_move(client, parameters, after, pace).to_dict())
     except MoveAlarm as exc:
         measured.update({"overshoot_pct": None, "settling_ms": None, "alarm": exc.code})
     return measured

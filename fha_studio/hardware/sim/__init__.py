@@ -15,6 +15,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.hardware.sim.eeprom import EepromError
 from fha_studio.hardware.sim.options import SimConfig, SimConfigError, config_from_url, parse_effects
@@ -22,6 +25,17 @@ from fha_studio.hardware.sim.reply import SimRefused, SimReply
 from fha_studio.hardware.sim.responder import SimResponder
 from fha_studio.hardware.sim.server import SimProtocolServer
 from fha_studio.hardware.sim.supervision import SimAlarmRecord
+
+
+def stepped_clock(client: Any) -> tuple[Callable[[float], None], Callable[[], float]] | None:
+    """The drive's own clock behind a client of ``sim://...?stepped=1``: (advance by seconds, the
+    drive's time), for a caller that waits on the drive (its time stands still otherwise); None
+    for any other drive, which runs by itself."""
+    port = getattr(getattr(getattr(client, "transaction", None), "transport", None), "inner", None)
+    drive = getattr(port, "sim_drive", None)
+    if not isinstance(drive, SimDrive) or not drive.config.stepped:
+        return None
+    return drive.advance, lambda: drive.clock_s
 
 
 def register_url_handler() -> None:
@@ -45,4 +59,5 @@ __all__ = [
     "config_from_url",
     "parse_effects",
     "register_url_handler",
+    "stepped_clock",
 ]

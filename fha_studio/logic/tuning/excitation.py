@@ -2,11 +2,16 @@
 
 The drive adds a PRBS of +/- the amplitude to the speed command (docs/protocol.md, EXG). For a
 linear loop the largest value any output can reach under an input bounded by A is A x the L1 norm
-of its impulse response (``sum |h|``, python-control's impulse response of the linearised loops):
-so the amplitude is chosen to keep the current within ``CURRENT_SHARE`` of the maximum current,
-and the angle travelled is at most A x the L1 norm from the added speed command to the position
-(the position loop holds the axis). The drive stops the excitation if the output ever travels
-farther than that bound (with a margin) from where it started.
+of its impulse response (``sum |h|``: the impulse response of the linearised loops, position loop
+closed, from the added speed command): so the amplitude is chosen to keep the current within
+``CURRENT_SHARE`` of the maximum current and the gear on its first slope, and the angle travelled
+is at most A x the L1 norm from the added speed command to the position (the position loop holds
+the axis). The drive stops the excitation if the output ever travels farther than that bound (with
+a margin) from where it started.
+
+Before each record the loop settles: the excitation runs until what its start set going has
+died away, i.e. until the impulse responses' tails beyond that time hold at most
+``SETTLE_TAIL`` of their L1 norms (a slow pole that its zero nearly cancels does not count).
 """
 
 from __future__ import annotations
@@ -14,7 +19,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import control
 import numpy as np
 
 from fha_studio.hardware.protocol import excitation_period_periods
@@ -31,6 +35,10 @@ SPEED_SHARE = 0.05
 TRAVEL_MARGIN = 2.0
 #: records (one PRBS period each) averaged
 RECORDS = 5
+#: before a record, what the excitation's start set going holds at most this share of the response
+SETTLE_TAIL = 0.005
+#: the impulse responses are followed this long at most (s)
+HORIZON_S = 30.0
 
 
 @dataclass(frozen=True)
@@ -54,12 +62,30 @@ class ExcitationPlan:
                 f"current at most {self.peak_current_a:.3g} A")
 
 
-def _l1(sys: object, dt: float, duration_s: float = 2.0) -> float:
-    t = np.arange(0.0, duration_s, dt)
-    resp = control.impulse_response(sys, T=t)
-    # python-control scales a discrete impulse response by 1/dt; the sum of |h[k]| is the bound
-    h = np.asarray(resp.outputs).reshape(-1) * dt
-    return float(np.sum(np.abs(h)))
+def _impulse(lm: LoopModel) -> np.ndarray:
+    """Position, current and gear torque after 1 rad/s added to the speed command for one period
+    (samples x 3), followed until the tails are negligible or ``HORIZON_S``."""
+    poly = lm.polynomials()
+    rate = lm.settings.servo_rate_hz
+    seconds = 2.0
+    while True:
+        h = poly.impulse(int(seconds * rate))
+        tail = np.abs(h[-int(0.1 * rate):]).sum(axis=0)
+        if seconds >= HORIZON_S or np.all(tail <= 1e-4 * np.abs(h).sum(axis=0)):
+            return h
+        seconds = min(4.0 * seconds, HORIZON_S)
+
+
+def _settle_s(h: np.ndarray, rate: float) -> float:
+    """The time after which each response's tail holds at most ``SETTLE_TAIL`` of its L1 norm."""
+    settle = 0.0
+    for column in np.abs(h).T:
+        total = column.sum()
+        if total <= 0.0:
+            continue
+        tail = total - np.cumsum(column)  # what comes after each sample
+        settle = max(settle, float(np.argmax(tail <= SETTLE_TAIL * total)) / rate)
+    return settle
 
 
 def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> ExcitationPlan:
@@ -75,24 +101,20 @@ def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> Excita
     hold = 1
     while hold < 8 and 0.4 * rate / (2 * hold) >= want_hz:
         hold *= 2
-    loop = lm.speed_loop()
-    per_a = _l1(loop[3, 0], dt)
+    h = _impulse(lm)
+    per_rad, per_a, per_nm = (float(v) for v in np.abs(h).sum(axis=0))
     top_rpm = min(CURRENT_SHARE * model.max_current_a / per_a / RPM,
                   SPEED_SHARE * (model.max_speed_rpm or 60.0))
-    if model.stiffness is not None:  # the gear stays on its first slope (K1, 1-9-2): linear
-        per_nm = _l1(loop[4, 0], dt)
+    if model.stiffness is not None and per_nm > 0.0:  # the gear stays on its first slope (K1, 1-9-2)
         top_rpm = min(top_rpm, GEAR_TORQUE_SHARE * model.stiffness.t1_nm / per_nm / RPM)
     amplitude = top_rpm if requested_rpm is None else float(requested_rpm)
     if not 0.0 < amplitude <= top_rpm * (1 + 1e-9):
         raise ValueError(f"excitation amplitude {amplitude:g} r/min: allowed 0 ... {top_rpm:.3g} r/min "
                          f"for this axis (current within {CURRENT_SHARE:.0%} of {model.max_current_a:g} A, "
                          f"speed within {SPEED_SHARE:.0%} of the maximum)")
-    travel = math.degrees(amplitude * RPM * _l1(lm.injection_to_position(), dt))
+    travel = math.degrees(amplitude * RPM * per_rad)
     period = excitation_period_periods(hold)
-    poles = np.abs(np.concatenate([control.poles(lm.position_closed_loop()), control.poles(loop)]))
-    slowest = float(np.max(poles[poles > 0])) if np.any(poles > 0) else 0.0
-    tau = -dt / math.log(slowest) if 0.0 < slowest < 1.0 else 0.0
-    settle = min(max(12.0 * tau, 0.3), 30.0)
+    settle = min(max(_settle_s(h, rate), 0.1), HORIZON_S)
     return ExcitationPlan(
         amplitude_rpm=amplitude, hold_periods=hold, period_samples=period, records=RECORDS,
         travel_bound_deg=travel, travel_limit_deg=TRAVEL_MARGIN * travel + 0.01,

@@ -3,20 +3,25 @@
 The drive adds its PRBS to the speed command (EXA / EXL / EXG, docs/protocol.md) while the
 position loop holds the axis; the drive-side trace records the speed command (monitor 109), the
 output speed (110, fine), the torque (108: Kt x the current, finer steps than the current's mA)
-and the position (100) at the servo rate (TDV 1), one
-PRBS period per capture. The excitation is renewed every ``RENEW_S`` like a held JOG (the drive
-stops it without a renewal after 100 ms: during a read-out on a real-time line it does, and the
-next record waits for the loop to settle again), and always stopped at the end (also on an error or
-a STOP: ``should_stop``).
+and the position (100) at the servo rate (TDV 1), one PRBS period per capture. Before a record the
+loop settles for the plan's ``settle_s``. The excitation is renewed at every look at the drive like
+a held JOG (the drive stops it without a renewal after 100 ms), and always stopped at the end (also
+on an error or a STOP: ``should_stop``).
 
-``wait(seconds)`` is the injected clock: ``time.sleep`` on a drive that runs in real time, the
-drive's own ``advance`` on a stepped simulated drive.
+Time is the drive's own, from what it reports: a capture's state and sample count (``TST``)
+measure the settling and each record, and ``pace(seconds)`` is called between two looks (a stepped
+simulated drive's ``advance``; nothing on a drive that runs by itself, whose link paces the looks).
+The read-out of a record holds the link without renewals: the excitation ran on through it when
+it took less than the watchdog's 100 ms of the drive's time. ``now()`` tells how long it took at
+most (the stepped drive's clock, or the computer's: a drive's time never runs faster than it),
+and a longer read-out lets the loop settle again before the next record.
 """
 
 from __future__ import annotations
 
 import contextlib
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -24,15 +29,15 @@ from typing import Any
 import numpy as np
 
 from fha_studio.hardware.parameters import MonitorItem
-from fha_studio.hardware.protocol import JOG_HOLD_S, Command, TraceState
+from fha_studio.hardware.protocol import JOG_HOLD_S, Command
 from fha_studio.logic.tuning.excitation import RPM, ExcitationPlan
+from fha_studio.logic.tuning.move import until_trace_done, wait_drive_time
 
 #: the channels of each capture
 CHANNELS = (MonitorItem.FEEDBACK_POSITION, MonitorItem.SPEED_COMMAND, MonitorItem.OUTPUT_SPEED_FINE,
             MonitorItem.OUTPUT_TORQUE)
 NEEDED = frozenset({Command.EXA, Command.EXL, Command.EXG, Command.TCH, Command.TAR, Command.TST,
                     Command.TRB, Command.IOS, Command.ALM, Command.MON})
-RENEW_S = 0.05
 #: the drive's excitation watchdog (as JOG's, protocol.JOG_HOLD_S)
 WATCHDOG_S = JOG_HOLD_S
 
@@ -78,30 +83,34 @@ def check_excitable(client: Any) -> None:
         raise NotExcitable("the servo is off: switch it on (nothing moves until the excitation starts)")
 
 
-def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, wait: Callable[[float], None],
-            now: Callable[[], float], should_stop: Callable[[], bool] = lambda: False,
+def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, pace: Callable[[float], None],
+            now: Callable[[], float] = time.monotonic, should_stop: Callable[[], bool] = lambda: False,
             output_ppr: int = 1) -> Records:
-    """Run ``plan`` on the drive and read the captures (see the module docstring). ``now()`` is
-    the drive's time as ``wait`` moves it: a read-out that took longer than the watchdog stopped
-    the excitation, so the next record waits for the loop to settle again."""
+    """Run ``plan`` on the drive and read the captures (see the module docstring)."""
     check_excitable(client)
-    channels = client.configure_trace(CHANNELS, divider=1)
     client.set_excitation(plan.amplitude_rpm, plan.travel_limit_deg)
-    period_s = plan.period_samples / servo_rate_hz
     records = []
-    renewed: float | None = None
+
+    def renew() -> None:
+        if should_stop():
+            client.excite(0)
+            client.stop()
+            raise Stopped("STOP: the excitation was stopped")
+        client.excite(plan.hold_periods)
+
+    running = False  # the excitation ran without a break since the loop settled
     try:
         for _ in range(plan.records):
-            client.excite(plan.hold_periods)
-            if renewed is None or now() - renewed >= WATCHDOG_S:
-                _hold(client, plan, plan.settle_s, wait, should_stop)
+            renew()
+            if not running:
+                wait_drive_time(client, plan.settle_s, servo_rate_hz, pace, look=renew)
+            channels = client.configure_trace(CHANNELS, divider=1)
             client.arm_trace(plan.period_samples)
-            _hold(client, plan, period_s, wait, should_stop)
-            while client.trace_status().state is not TraceState.DONE:
-                _hold(client, plan, RENEW_S, wait, should_stop)
-            renewed = now()
+            until_trace_done(client, pace, look=renew)
+            started = now()
             # the read-out holds the link: no renewals (on a real-time line the watchdog stops it)
             capture = client.read_trace(should_abort=should_stop)
+            running = now() - started < WATCHDOG_S
             cols = {item: np.asarray(capture.column(item), float) for item in channels}
             records.append((
                 cols[MonitorItem.SPEED_COMMAND] * 1e-4 * RPM,
@@ -114,17 +123,3 @@ def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, wait: Calla
         with contextlib.suppress(Exception):
             client.excite(0)
     return Records(tuple(records), servo_rate_hz)
-
-
-def _hold(client: Any, plan: ExcitationPlan, seconds: float, wait: Callable[[float], None],
-          should_stop: Callable[[], bool]) -> None:
-    left = seconds
-    while left > 1e-12:
-        if should_stop():
-            client.excite(0)
-            client.stop()
-            raise Stopped("STOP: the excitation was stopped")
-        step = min(RENEW_S, left)
-        wait(step)
-        left -= step
-        client.excite(plan.hold_periods)

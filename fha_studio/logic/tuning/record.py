@@ -26,12 +26,19 @@ class TuningRecord:
     after: Mapping[str, Any] | None = None
 
 
+#: a gain margin python-control cannot give: the loop's phase never reaches -180 deg
+NO_PHASE_CROSSING = "none (the phase never reaches -180 deg)"
+
+
+def figure_words(key: str, value: float | None, unit: str) -> str:
+    """A figure in words: the value and unit, or why there is none."""
+    if value is None:
+        return NO_PHASE_CROSSING if key == "gain_margin_db" else "none found"
+    return f"{value:.3g} {unit}"
+
+
 def _figures(result: Mapping[str, Any]) -> str:
-    parts = []
-    for key, words, unit in FIGURES:
-        value = result.get(key)
-        parts.append(f"{words} {'none found' if value is None else f'{value:.3g} {unit}'}")
-    return ", ".join(parts)
+    return ", ".join(f"{words} {figure_words(key, result.get(key), unit)}" for key, words, unit in FIGURES)
 
 
 def tuning_notes(records: Sequence[TuningRecord]) -> list[tuple[str, str]]:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import math
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -11,10 +11,10 @@ from fha_studio.hardware.parameters import Mode, ParameterModel
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
 from fha_studio.logic.drive_session import WriteEntry, read_parameters, write_parameters
 from fha_studio.logic.paramfile import dump_parameter_file
-from fha_studio.logic.tuning.excitation import RPM, plan_excitation
+from fha_studio.logic.tuning.excitation import plan_excitation
 from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
 from fha_studio.logic.tuning.measure import measure
-from fha_studio.logic.tuning.move import MoveFigures, measure_move
+from fha_studio.logic.tuning.move import VERIFY_MOVE_DEG, MoveFigures, measure_move
 from fha_studio.logic.tuning.propose import TUNE_KEYS, Tuner
 from fha_studio.logic.tuning.response import (
     FrequencyResponse,
@@ -26,8 +26,22 @@ from fha_studio.logic.tuning.response import (
 )
 from fha_studio.physics import AxisModel, Effects
 
-#: the verification move of a tuning: a proposal must settle a 90 deg move no slower than the defaults
-VERIFY_MOVE_DEG = 90.0
+__all__ = ["VERIFY_MOVE_DEG", "backup_parameters", "declared_model", "drive_clock", "drive_items",
+           "measure_report", "response_figures", "tuner_for", "verify_move", "write_tune_items"]
+
+
+def drive_clock(client: Any) -> tuple[Callable[[float], None], Callable[[], float]]:
+    """How to wait on the drive behind ``client``: (pace between two looks at it, the longest its
+    time can have run since a moment). A stepped simulated drive's own advance and clock; for a
+    drive that runs by itself nothing between looks (the link paces them) and the computer's
+    clock, which a drive's time never outruns."""
+    from fha_studio.hardware.sim import stepped_clock
+
+    return stepped_clock(client) or (_no_pace, time.monotonic)
+
+
+def _no_pace(_seconds: float) -> None:
+    """The link's own round trips pace the looks at a drive that runs by itself."""
 
 
 def declared_model(actuator: str, load_inertia_kgm2: float) -> AxisModel:
@@ -37,9 +51,10 @@ def declared_model(actuator: str, load_inertia_kgm2: float) -> AxisModel:
 
 
 def drive_items(client: Any, parameters: ParameterModel) -> dict[str, int]:
-    """The tune and parameter-mode items the loops depend on, read from the drive."""
+    """The tune and parameter-mode items the loops depend on, and the JOG acceleration the
+    verification move is made with, read from the drive."""
     keys = (*TUNE_KEYS, "electronic_gear_numerator", "electronic_gear_denominator", "rotary_direction",
-            "in_position_range", "control_mode")
+            "in_position_range", "control_mode", "jog_acceleration")
     out = {}
     for key in keys:
         item = parameters.by_key(key)
@@ -53,14 +68,16 @@ def tuner_for(client: Any, parameters: ParameterModel, model: AxisModel,
     return Tuner(model, items, parameters, DEFAULT_SERVO_RATE_HZ, quantised_feedback)
 
 
-def measure_report(client: Any, tuner: Tuner, wait: Callable[[float], None], now: Callable[[], float],
-                   amplitude_rpm: float | None = None, announce: Callable[[str], None] = lambda _s: None,
+def measure_report(client: Any, tuner: Tuner, pace: Callable[[float], None],
+                   now: Callable[[], float] = time.monotonic, amplitude_rpm: float | None = None,
+                   announce: Callable[[str], None] = lambda _s: None,
                    should_stop: Callable[[], bool] = lambda: False) -> dict[str, Any]:
-    """Excite, measure and analyse; the JSON of ``tune measure``."""
+    """Excite, measure and analyse; the JSON of ``tune measure``. ``pace`` and ``now``: as
+    ``measure.measure`` takes them (the drive's own time)."""
     lm: LoopModel = tuner.loop({})
     plan = plan_excitation(lm, amplitude_rpm)
     announce(plan.describe())
-    records = measure(client, plan, tuner.servo_rate_hz, wait, now, should_stop,
+    records = measure(client, plan, tuner.servo_rate_hz, pace, now, should_stop,
                       output_ppr=tuner.model.output_resolution_ppr)
     closed = estimate_response(records.closed_loop(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
     plant = estimate_response(records.plant(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
@@ -68,7 +85,7 @@ def measure_report(client: Any, tuner: Tuner, wait: Callable[[float], None], now
         **response_figures(tuner, lm, closed, plant, records.sample_rate_hz),
         "excitation": {"amplitude_rpm": plan.amplitude_rpm, "travel_bound_deg": plan.travel_bound_deg,
                        "travel_limit_deg": plan.travel_limit_deg, "hold_periods": plan.hold_periods,
-                       "records": plan.records},
+                       "records": plan.records, "travelled_deg": records.travel_deg()},
     }
 
 
@@ -132,22 +149,20 @@ def write_tune_items(client: Any, parameters: ParameterModel, items: dict[str, i
     return entries
 
 
-def verify_move(client: Any, parameters: ParameterModel, tuner: Tuner, wait: Callable[[float], None],
-                angle_deg: float = VERIFY_MOVE_DEG) -> MoveFigures:
-    """A 90 deg move at half the maximum speed, measured through the trace, at an acceleration
-    the axis can follow: at most half the torque-limited TM / (J_A + J_L) (FHA-C manual 2-4-4),
-    the test item "JOG acceleration" lowered for the move and put back after it (a faster profile
-    than the motor's torque makes every tuning overshoot: that is the profile, not the loop)."""
-    speed = 0.5 * (tuner.model.max_speed_rpm or 10.0)
+def verify_move(client: Any, parameters: ParameterModel, tuner: Tuner,
+                pace: Callable[[float], None]) -> MoveFigures:
+    """The verification move (``move.verification_move``: 90 deg at half the maximum speed, at an
+    acceleration the axis can follow), measured through the trace: the test item "JOG
+    acceleration" is lowered for the move when the axis could not follow it, and put back after."""
+    profile = tuner.move_profile()
     accel_item = parameters.by_key("jog_acceleration")
     present = int(client.read_parameter(accel_item.mode, accel_item.number))
-    followable = max(accel_item.minimum, math.floor(0.5 * tuner.model.max_acceleration_rad_s2() / RPM))
-    lowered = followable < present
+    lowered = profile.accel_rpm_s < present
     if lowered:
-        client.write_parameter(accel_item.mode, accel_item.number, followable)
+        client.write_parameter(accel_item.mode, accel_item.number, int(profile.accel_rpm_s))
     try:
-        return measure_move(client, angle_deg, speed, tuner.servo_rate_hz, tuner.model.output_resolution_ppr,
-                            tuner.items["in_position_range"], wait)
+        return measure_move(client, profile, tuner.servo_rate_hz, tuner.model.output_resolution_ppr,
+                            tuner.items["in_position_range"], pace)
     finally:
         if lowered:
             client.write_parameter(accel_item.mode, accel_item.number, present)
