@@ -54,7 +54,9 @@ MOVE_TIP = "Move the output by the angle (+ = FWD) at the speed, then hold"
 
 class HoldButton(QPushButton):
     """A hold-to-run button: `sigHeld` on press, `sigReleased` on release or when it loses the
-    mouse or the keyboard focus (so that a jog never outlives the finger on the button)."""
+    mouse or the keyboard focus, is hidden (its page left) or disabled, or its window is no longer
+    the active one (so that a jog, or the Tuning page's excitation, never outlives the finger on
+    the button)."""
 
     sigHeld = Signal()
     sigReleased = Signal()
@@ -92,6 +94,7 @@ class HoldButton(QPushButton):
             QEvent.Type.Hide,
             QEvent.Type.EnabledChange,
             QEvent.Type.Leave,  # dragging off the button stops, as letting go does
+            QEvent.Type.WindowDeactivate,  # another window or a dialog came to the front
         ):
             self.release()
         return super().event(event)

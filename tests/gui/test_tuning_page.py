@@ -1,17 +1,21 @@
-"""The Tuning page end to end on the embedded simulated drive (real client, protocol and trace):
-the excitation is shown before it starts, the countdown can be cancelled (nothing moves), the
-measured response is plotted with the gear's resonance marked, the proposal is applied through the
-session's write path (backup first) and measured again; a drive of the manual's commands gets a
-front-panel worksheet."""
+"""The Tuning page end to end on the embedded simulated drive (real client, protocol and trace; a
+stepped drive, whose time the measurement moves on itself): the excitation is shown before it
+starts, the countdown can be cancelled (nothing moves), the measured response is plotted with the
+gear's resonance marked, the proposal is applied through the session's write path (backup first)
+and measured again, and the commissioning report shows the tuning's plot, figures, who and when;
+hold-to-run ends the excitation when the button is let go or the page left; a drive of the
+manual's commands gets a front-panel worksheet."""
 
 from __future__ import annotations
 
 import pytest
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QImage
 
 from fha_studio.gui.pages.base import PageId
 
 CODE = "FHA-25C-50-US250"
-URL = f"sim://{CODE}?load_inertia=0.81&effects=torsional_compliance&paced=0"
+URL = f"sim://{CODE}?load_inertia=0.81&effects=torsional_compliance&paced=0&stepped=1"
 
 
 def _servo_on(window, qtbot) -> None:
@@ -20,7 +24,7 @@ def _servo_on(window, qtbot) -> None:
 
 
 @pytest.mark.slow
-def test_measure_propose_apply_end_to_end(make_window, qtbot):
+def test_measure_propose_apply_end_to_end(make_window, qtbot, tmp_path):
     window = make_window(connect=URL)
     page = window.show_page(PageId.TUNING)
     page.load_spin.setValue(0.81)
@@ -54,6 +58,36 @@ def test_measure_propose_apply_end_to_end(make_window, qtbot):
     assert page.table.item(len(page.proposal.proposed.items), 2) is not None
     ((note, _who),) = page.report_notes()  # the commissioning report's before / after
     assert "Applied" in note and "resonance" in note
+    procedures = window.show_page(PageId.PROCEDURES)
+    procedures.new_session(tmp_path / "axis1.json", CODE, operator="A. Tuner")
+    html, pdf = procedures.write_report(tmp_path / "report.html", tmp_path / "report.pdf")
+    text = html.read_text()
+    assert "Tuning 1 (" in text and "A. Tuner" in text and "before (dashed) and after (solid)" in text
+    (plot,) = [p for p in procedures.session.plots if p["title"].startswith("Tuning 1 (")]
+    image = QImage(plot["path"])
+    assert not image.isNull() and image.width() >= 1000
+    assert plot["path"] in text and pdf.stat().st_size > 20000
+
+
+@pytest.mark.parametrize("let_go", ["release", "leave the page"])
+def test_hold_to_run_excites_only_while_held(make_window, qtbot, let_go):
+    window = make_window(connect=URL)
+    page = window.show_page(PageId.TUNING)
+    page.load_spin.setValue(0.81)
+    _servo_on(window, qtbot)
+    with qtbot.waitSignal(window.link.sigResult, timeout=20000):
+        page.plan_button.click()
+    qtbot.waitUntil(page.hold_button.isEnabled, timeout=10000)
+    drive = window.link._worker._client.transaction.transport.inner.sim_drive
+    qtbot.mousePress(page.hold_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: drive.excitation.active, timeout=20000)
+    assert "let go to stop" in page.status_label.text()
+    if let_go == "release":
+        qtbot.mouseRelease(page.hold_button, Qt.MouseButton.LeftButton)
+    else:
+        window.show_page(PageId.JOG)  # the hold button hides: let go, as a jog's
+    qtbot.waitUntil(lambda: "Let go" in page.status_label.text(), timeout=20000)
+    assert not drive.excitation.active and page.result is None
 
 
 def test_documented_drive_gets_a_front_panel_worksheet(make_window, qtbot):

@@ -2,8 +2,10 @@
 load inertia from it, margins with the present gains, and proposed tune items.
 
 The work is the logic's (``logic/tuning``); it runs in the link thread (``Call``), STOP ends it
-(``link.abort_event``). The excitation is shown before it starts, and it starts only after a
-countdown the person can cancel. Applying the proposal goes through the session's write path
+(``link.abort_event``). The excitation is shown before it starts, and it starts either after a
+countdown the person can cancel, or while a hold-to-run button is held (``HoldButton``, as jog's:
+letting go, leaving the page or the window ends it, and so does a GUI that stops renewing the
+hold's lease, as a held jog's). Applying the proposal goes through the session's write path
 (backup before the first write, each write verified), then the response is measured again. A drive
 that cannot be excited (the manual's commands only) gets the proposal as a front-panel worksheet.
 """
@@ -13,11 +15,13 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 from functools import partial
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import Qt, QTimer, Signal
+from pyqtgraph import exporters
+from PySide6.QtCore import QBuffer, QIODevice, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
@@ -35,8 +39,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio import clock
+from fha_studio import clock, fileio
+from fha_studio.gui.link import JOG_LEASE_RENEW_MS, JOG_LEASE_S
 from fha_studio.gui.link_requests import Call, LinkInfo, LinkReply
+from fha_studio.gui.motion_controls import HoldButton
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.pages.tuning_bench import BenchTuningPanel
 from fha_studio.gui.widgets import scrolling
@@ -45,14 +51,23 @@ from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
 from fha_studio.logic.tuning.excitation import plan_excitation
 from fha_studio.logic.tuning.measure import NEEDED
 from fha_studio.logic.tuning.propose import AIMS, TUNE_KEYS, Proposal, Tuner
-from fha_studio.logic.tuning.record import TuningRecord, tuning_notes
-from fha_studio.logic.tuning.session import declared_model, measure_report, tuner_for
+from fha_studio.logic.tuning.record import TuningRecord, figure_words, tuning_notes
+from fha_studio.logic.tuning.session import declared_model, drive_clock, measure_report, tuner_for
 
 COUNTDOWN_S = 3
+HOLD_TIP = ("Hold (mouse or Space key) to run the excitation until the measurement is done; letting go, "
+            "leaving the page or the window ends it")
 FIGURE_ROWS = ("gain_margin_db", "phase_margin_deg", "overshoot_pct", "settling_ms")
 #: the table's words for the figures beside the tune items
 FIGURE_WORDS = {"gain_margin_db": "Gain margin [dB]", "phase_margin_deg": "Phase margin [deg]",
                 "overshoot_pct": "Overshoot of a move [%]", "settling_ms": "Settling time of a move [ms]"}
+
+
+def _cell(key: str, value: Any) -> str:
+    """A figure in the table: a gain margin without a phase crossing in words."""
+    if value is None:
+        return "none: phase never −180°" if key == "gain_margin_db" else "—"
+    return f"{value:g}"
 
 
 def _item_words(item: Any) -> str:
@@ -62,6 +77,62 @@ def _item_words(item: Any) -> str:
 
 def _dashed(colour: str) -> Any:
     return pg.mkPen(colour, width=1, style=pg.QtCore.Qt.PenStyle.DashLine)
+
+
+def tuning_plot_title(n: int, record: TuningRecord, who: str) -> str:
+    """The report's words over a tuning's plot: when, who, the aim and the figures before / after."""
+    def fig(result: Any, key: str, unit: str) -> str:
+        return figure_words(key, (result or {}).get(key), unit)
+
+    words = f"Tuning {n} ({record.at}, {record.who or who or 'operator not named'}): "
+    b, a = record.before, record.after
+    if a is None:
+        return (words + f"frequency response measured: resonance {fig(b, 'resonance_hz', 'Hz')}, gain margin "
+                f"{fig(b, 'gain_margin_db', 'dB')}, phase margin {fig(b, 'phase_margin_deg', 'deg')}")
+    return (words + f"before (dashed) and after (solid) the {record.aim} gains: gain margin "
+            f"{fig(b, 'gain_margin_db', 'dB')} -> {fig(a, 'gain_margin_db', 'dB')}, phase margin "
+            f"{fig(b, 'phase_margin_deg', 'deg')} -> {fig(a, 'phase_margin_deg', 'deg')}, bandwidth "
+            f"{fig(b, 'bandwidth_hz', 'Hz')} -> {fig(a, 'bandwidth_hz', 'Hz')}")
+
+
+def export_response_png(record: TuningRecord, title: str, path: Path) -> Path:
+    """Magnitude and phase of a tuning's measurements (the closed speed loop and the plant; before
+    dashed, after solid) drawn on white for paper and written as a PNG, whole or not at all."""
+    view = pg.GraphicsLayoutWidget()
+    view.setBackground("w")
+    view.resize(1100, 760)
+    view.addLabel(title, row=0, col=0, color="k", size="9pt")
+    mag = view.addPlot(row=1, col=0, title="Magnitude [dB]", axisItems={"bottom": FrequencyAxis("bottom")})
+    phase = view.addPlot(row=2, col=0, title="Phase [deg]", axisItems={"bottom": FrequencyAxis("bottom")})
+    phase.setLabel("bottom", "frequency", units="Hz")
+    mag.addLegend(offset=(-10, 10))
+    for plot in (mag, phase):
+        plot.setLogMode(x=True, y=False)
+        plot.showGrid(x=True, y=True, alpha=0.3)
+    phase.setXLink(mag)
+    for result, style, when in ((record.before, Qt.PenStyle.DashLine, "before"),
+                                (record.after, Qt.PenStyle.SolidLine, "after")):
+        if result is None:
+            continue
+        for key, colour, words in (("frequency_response", "#1f4e9c", "speed loop (closed)"),
+                                   ("plant_response", "#c05000", "plant (speed per torque)")):
+            data = result.get(key)
+            if not data:
+                continue
+            pen = pg.mkPen(colour, width=2, style=style)
+            f = np.asarray(data["freq_hz"], float)
+            mag.plot(f, np.asarray(data["magnitude_db"], float), pen=pen, name=f"{words}, {when}")
+            phase.plot(f, np.asarray(data["phase_deg"], float), pen=pen)
+    exporter = exporters.ImageExporter(view.ci)
+    exporter.parameters()["width"] = 1100
+    image = exporter.export(toBytes=True)
+    view.deleteLater()
+    buffer = QBuffer()
+    buffer.open(QIODevice.OpenModeFlag.WriteOnly)
+    if not image.save(buffer, "PNG"):
+        raise OSError(f"{path}: the tuning plot could not be made a PNG")
+    fileio.write_bytes(path, bytes(buffer.data().data()))
+    return path
 
 
 class FrequencyAxis(pg.AxisItem):
@@ -122,13 +193,23 @@ class TuningPage(BasePage):
         self.plan_button = QPushButton("Show the excitation")
         self.start_button = QPushButton(f"Start measuring ({COUNTDOWN_S} s countdown)")
         self.cancel_button = QPushButton("Cancel")
+        self.hold_button = HoldButton("Hold to measure")
+        self.hold_button.setToolTip(HOLD_TIP)
+        self.hold_button.setEnabled(False)
+        self.hold_button.sigHeld.connect(self.hold_started)
+        self.hold_button.sigReleased.connect(self._hold_released)
+        self._held = False  # read in the link thread: the hold's state and its lease
+        self._lease_s = 0.0
+        self._lease_timer = QTimer(self)
+        self._lease_timer.setInterval(JOG_LEASE_RENEW_MS)
+        self._lease_timer.timeout.connect(self._renew_lease)
         self.propose_button = QPushButton("Propose gains")
         self.apply_button = QPushButton("Apply proposed gains")
         self.use_inertia_button = QPushButton("Use the estimate as the load inertia")
         self.use_inertia_button.setEnabled(False)
         self.use_inertia_button.clicked.connect(self.use_inertia_estimate)
-        for b in (self.plan_button, self.start_button, self.cancel_button, self.propose_button,
-                  self.apply_button, self.use_inertia_button):
+        for b in (self.plan_button, self.start_button, self.cancel_button, self.hold_button,
+                  self.propose_button, self.apply_button, self.use_inertia_button):
             buttons.addWidget(b)
         self.start_button.setEnabled(False)
         self.cancel_button.setEnabled(False)
@@ -234,15 +315,21 @@ class TuningPage(BasePage):
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
         self.cancel_countdown()
+        self.hold_button.release()
         self.start_button.setEnabled(False)
+        self.hold_button.setEnabled(False)
         self.apply_button.setEnabled(False)
 
     def shutdown(self) -> None:
         self._timer.stop()
         self.bench.shutdown()
+        self.hold_button.release()
 
     def release_held(self) -> None:
+        """STOP (or the window letting go of what is held): a countdown ends, a held excitation
+        is let go."""
         self.cancel_countdown()
+        self.hold_button.release()
 
     # ----- excitation, countdown, measurement ----------------------------------------------------
     def _code(self) -> str:
@@ -276,6 +363,30 @@ class TuningPage(BasePage):
         self.plan_label.setText(reply.value.describe() + ". Servo on, the axis free to move that far; "
                                 "STOP ends it at once.")
         self.start_button.setEnabled(True)
+        self.hold_button.setEnabled(True)
+
+    # hold-to-run: the excitation runs while the button is held and the GUI renews the lease
+    def hold_started(self) -> None:
+        """The hold button went down: measure at once, for as long as it stays held."""
+        if self._held:
+            return
+        self._held = True
+        self._renew_lease()
+        self._lease_timer.start()
+        self.start_button.setEnabled(False)
+        self.measure(held=True)
+
+    def _renew_lease(self) -> None:
+        self._lease_s = time.monotonic()
+
+    def _hold_released(self) -> None:
+        self._held = False
+        self._lease_timer.stop()
+
+    def hold_let_go(self) -> bool:
+        """True once the hold is let go, or its lease is older than a held jog's may be (a GUI
+        that stopped renewing it): asked in the link thread between two looks at the drive."""
+        return not self._held or time.monotonic() - self._lease_s > JOG_LEASE_S
 
     def start_countdown(self) -> None:
         self._countdown = COUNTDOWN_S
@@ -300,21 +411,31 @@ class TuningPage(BasePage):
         self.cancel_button.setEnabled(False)
         self.measure()
 
-    def measure(self, then: Any = None) -> None:
+    def measure(self, then: Any = None, held: bool = False) -> None:
         code, load, amplitude = self._code(), self.load_spin.value(), self._amplitude()
-        stop = self.link.abort_event.is_set
-        self.status_label.setText("Measuring: the axis is excited …")
+        abort = self.link.abort_event.is_set
+        stop = (lambda: abort() or self.hold_let_go()) if held else abort
+        self.status_label.setText("Measuring while the button is held: let go to stop …" if held else
+                                  "Measuring: the axis is excited …")
 
         def run(client: Any) -> dict[str, Any]:
             tuner = tuner_for(client, self.session.parameter_model, declared_model(code, load))
-            return measure_report(client, tuner, time.sleep, time.monotonic, amplitude, should_stop=stop)
+            pace, now = drive_clock(client)
+            return measure_report(client, tuner, pace, now, amplitude, should_stop=stop)
 
-        self.link.send(Call(run), partial(self._measured, then))
+        self.link.send(Call(run), partial(self._measured, then, held))
 
-    def _measured(self, then: Any, reply: LinkReply[dict[str, Any]]) -> None:
+    def _measured(self, then: Any, held: bool, reply: LinkReply[dict[str, Any]]) -> None:
         self.start_button.setEnabled(True)
+        let_go = held and self.hold_let_go()
+        if held:
+            self.hold_button.release()
         if not reply.ok or reply.value is None:
-            self.status_label.setText(f"Measurement not done: {reply.error}")
+            if let_go:
+                self.status_label.setText("Let go: the excitation stopped, nothing measured (hold until "
+                                          "the measurement is done).")
+            else:
+                self.status_label.setText(f"Measurement not done: {reply.error}")
             return
         self.show_result(reply.value)
         if then is None:
@@ -364,8 +485,7 @@ class TuningPage(BasePage):
                 self.markers.append(line)
 
         def fmt(key: str, unit: str) -> str:
-            v = result.get(key)
-            return "—" if v is None else f"{v:.3g} {unit}"
+            return figure_words(key, result.get(key), unit)
 
         self.status_label.setText("Measured.")
         uncertainty = result.get("load_inertia_uncertainty_kgm2")  # a bench measurement says it
@@ -424,8 +544,7 @@ class TuningPage(BasePage):
         for col, figs in ((0, proposal.present), (1, proposal.proposed)):
             values = figs.to_dict()
             for row, key in enumerate((*TUNE_KEYS, *FIGURE_ROWS)):
-                value = values.get(key)
-                self.table.setItem(row, col, QTableWidgetItem("—" if value is None else f"{value:g}"))
+                self.table.setItem(row, col, QTableWidgetItem(_cell(key, values.get(key))))
         self.apply_button.setEnabled(self._excitable)
         self.worksheet.setPlainText(self.worksheet_text(proposal))
         self.status_label.setText(f"Proposed for the aim {proposal.used_aim}.")
@@ -477,6 +596,18 @@ class TuningPage(BasePage):
         """What the commissioning report says of the tunings of this session (before / after)."""
         return tuning_notes(self.records)
 
+    def report_plots(self, session_path: Path, who: str) -> list[tuple[str, Path]]:
+        """Each tuning of this session as a PNG beside the session (``<stem>-tuning<n>.png``): the
+        magnitude and phase before and after, its figures, who and when; (title, path) for the
+        report's plots. The same record gives the same file (rewritten once it has its after)."""
+        out = []
+        for n, record in enumerate(self.records, start=1):
+            path = session_path.with_name(f"{session_path.stem}-tuning{n}.png")
+            title = tuning_plot_title(n, record, who)
+            export_response_png(record, title, path)
+            out.append((title, path))
+        return out
+
     def _measured_after(self, result: dict[str, Any]) -> None:
         if self.records and self.proposal is not None:
             self.records[-1] = replace(self.records[-1], items=dict(self.proposal.proposed.items),
@@ -484,5 +615,5 @@ class TuningPage(BasePage):
                                        after=result)
         for row, key in enumerate((*TUNE_KEYS, *FIGURE_ROWS)):
             value = self.proposal.proposed.items.get(key) if key in TUNE_KEYS else result.get(key)
-            self.table.setItem(row, 2, QTableWidgetItem("—" if value is None else f"{value:g}"))
+            self.table.setItem(row, 2, QTableWidgetItem(_cell(key, value)))
         self.sigApplied.emit(result)

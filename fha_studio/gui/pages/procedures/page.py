@@ -416,8 +416,34 @@ class ProceduresPage(BasePage):
     def _collect_for_report(self) -> None:
         """Bring what the other pages know into the session before a report (what goes where:
         ``logic.procedures.report_inputs``)."""
-        if self.session is not None and collect_for_report(self.session, self._report_inputs()):
+        if self.session is None:
+            return
+        self._add_tuning_plots()
+        if collect_for_report(self.session, self._report_inputs()):
             self._refresh()
+
+    def _add_tuning_plots(self) -> None:
+        """The Tuning page's measurements as plots beside the session, as a scope plot goes in
+        (one file per tuning, its title updated once it has its after)."""
+        window = self.main_window
+        tuning = window.built_page(PageId.TUNING) if window is not None else None
+        if tuning is None or self.session is None or self.session.path is None:
+            return
+        from fha_studio.gui.pages.tuning import TuningPage  # plots: imported once it is built
+
+        if not isinstance(tuning, TuningPage):
+            return
+        try:
+            plots = tuning.report_plots(self.session.path, self.who)
+        except (OSError, ValueError) as exc:  # the report still goes out, with the notes
+            self._message(f"The tuning plots were not saved: {exc}")
+            return
+        by_path = {p["path"]: p for p in self.session.plots}
+        for title, path in plots:
+            if str(path) in by_path:
+                by_path[str(path)]["title"] = title
+            else:
+                self.session.add_plot(title, path)
 
     def _report_inputs(self) -> ReportInputs:
         """The drive's identity, the known parameter values, the Rotary direction page's check and
