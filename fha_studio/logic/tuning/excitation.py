@@ -2,11 +2,12 @@
 
 The drive adds a PRBS of +/- the amplitude to the speed command (docs/protocol.md, EXG). For a
 linear loop the largest value any output can reach under an input bounded by A is A x the L1 norm
-of its impulse response (``sum |h|``: the impulse response of the linearised loops, position loop
-closed, from the added speed command): so the amplitude is chosen to keep the current within
-``CURRENT_SHARE`` of the maximum current and the gear on its first slope, and the angle travelled
-is at most A x the L1 norm from the added speed command to the position (the position loop holds
-the axis). The drive stops the excitation if the output ever travels farther than that bound (with
+of its impulse response (``sum |h|``: the impulse response of the linearised loops from the added
+speed command): so the amplitude is chosen to keep the current within ``CURRENT_SHARE`` of the
+maximum current and the gear on its first slope (the speed loop's response: the position loop's
+reaction to an excitation this small is slow and small), and the angle travelled is at most A x the
+L1 norm from the added speed command to the position (the position loop closed: it holds the
+axis). The drive stops the excitation if the output ever travels farther than that bound (with
 a margin) from where it started.
 
 Before each record the loop settles: the excitation runs until what its start set going has
@@ -17,12 +18,12 @@ died away, i.e. until the impulse responses' tails beyond that time hold at most
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from fha_studio.hardware.protocol import excitation_period_periods
-from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
+from fha_studio.logic.tuning.linear import LoopModel, LoopPolynomials, two_mass_prediction
 
 RPM = 2.0 * math.pi / 60.0
 #: the excitation's current stays below this share of the maximum current (linear bound)
@@ -66,7 +67,10 @@ def _impulse(lm: LoopModel) -> np.ndarray:
     """Position, current and gear torque after 1 rad/s added to the speed command for one period
     (samples x 3), followed until the tails are negligible or ``HORIZON_S``."""
     poly = lm.polynomials()
-    rate = lm.settings.servo_rate_hz
+    return _followed(poly, lm.settings.servo_rate_hz)
+
+
+def _followed(poly: LoopPolynomials, rate: float) -> np.ndarray:
     seconds = 2.0
     while True:
         h = poly.impulse(int(seconds * rate))
@@ -102,7 +106,9 @@ def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> Excita
     while hold < 8 and 0.4 * rate / (2 * hold) >= want_hz:
         hold *= 2
     h = _impulse(lm)
-    per_rad, per_a, per_nm = (float(v) for v in np.abs(h).sum(axis=0))
+    per_rad = float(np.abs(h[:, 0]).sum())
+    speed_loop = LoopModel(model, replace(lm.settings, position_loop_gain_per_s=0.0)).polynomials()
+    per_a, per_nm = (float(v) for v in np.abs(_followed(speed_loop, rate)[:, 1:]).sum(axis=0))
     top_rpm = min(CURRENT_SHARE * model.max_current_a / per_a / RPM,
                   SPEED_SHARE * (model.max_speed_rpm or 60.0))
     if model.stiffness is not None and per_nm > 0.0:  # the gear stays on its first slope (K1, 1-9-2)
