@@ -13,9 +13,12 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+import numpy as np
+
 from fha_studio.logic.tuning.linear import two_mass_prediction
 from fha_studio.logic.tuning.move import MoveFigures
-from tests.tuning.test_tuning_cases import CASES, run_case
+from fha_studio.logic.tuning.response import COHERENCE_TRUSTED
+from tests.tuning.test_tuning_cases import CASES, Case, run_case
 
 
 def _move(m: object) -> str:
@@ -24,9 +27,23 @@ def _move(m: object) -> str:
     return str(m)
 
 
+def _worst(case: Case) -> str:
+    """The largest magnitude (dB) and phase (deg) gap to the linearisation at trusted bins."""
+    db = deg = 0.0
+    for which, key in (("closed", "frequency_response"), ("plant", "plant_response")):
+        data = case.measured[key]
+        f = np.asarray(data["freq_hz"])
+        ok = np.asarray(data["coherence"]) >= COHERENCE_TRUSTED
+        mag, phase = case.linear.response(which, f)
+        gap = (np.asarray(data["phase_deg"]) - phase + 180.0) % 360.0 - 180.0
+        db = max(db, float(np.max(np.abs(np.asarray(data["magnitude_db"]) - mag)[ok])))
+        deg = max(deg, float(np.max(np.abs(gap)[ok])))
+    return f"{db:.2f} dB / {deg:.1f} deg"
+
+
 def main(argv: list[str]) -> int:
     wanted = {a.rsplit("-", 1)[0] + "-" + a.rsplit("-", 1)[1] for a in argv}
-    print("case | resonance meas/pred Hz | load est/declared kg m^2 | GM dB / PM deg | "
+    print("case | response gap | resonance meas/pred Hz | load est/declared kg m^2 | GM dB / PM deg | "
           "settle before -> after (overshoot) | items | s")
     for code, ratio in CASES:
         if wanted and f"{code}-{ratio:g}" not in wanted:
@@ -38,7 +55,8 @@ def main(argv: list[str]) -> int:
         m, p = case.measured, case.proposal.proposed
         pred = two_mass_prediction(case.model).resonance_hz
         res = "none" if m["resonance_hz"] is None else f"{m['resonance_hz']:.1f}"
-        print(f"{code} {ratio:g}x | {res}/{pred:.1f} | {m['load_inertia_estimate_kgm2']:.4g}/"
+        load = m["load_inertia_estimate_kgm2"]
+        print(f"{code} {ratio:g}x | {_worst(case)} | {res}/{pred:.1f} | {load:.4g}/"
               f"{case.model.load_inertia_kgm2:.4g} | {p.gain_margin_db:.1f} / {p.phase_margin_deg:.1f} | "
               f"{_move(case.before)} -> {_move(case.after)} | "
               f"{'/'.join(str(v) for v in p.items.values())} | {took:.1f}", flush=True)

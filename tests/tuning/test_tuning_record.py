@@ -20,6 +20,9 @@ def test_a_tuning_becomes_a_note_with_before_and_after() -> None:
     assert who == "ana"
     assert "2026-12-04 02:30:00 UTC" in text and "resonance 53.6 Hz" in text
     assert "gain margin 20.4 dB" in text and "Applied (standard)" in text and "gain margin 13.3 dB" in text
+    # the items in the front panel's words, not a Python dictionary
+    assert "tune 0 Speed loop gain (Kv) 60 Hz" in text and "tune 0 Speed loop gain (Kv) 160 Hz" in text
+    assert "{" not in text and "speed_loop_gain" not in text
     session = ProcedureSession(actuator_code="FHA-25C-50-US250")
     inputs = ReportInputs(who="ana", parameter_model=load_parameter_model("HA-655"),
                           tuning_notes=tuning_notes([record]))

@@ -12,6 +12,7 @@ that cannot be excited (the manual's commands only) gets the proposal as a front
 
 from __future__ import annotations
 
+import html
 import time
 from dataclasses import replace
 from functools import partial
@@ -21,7 +22,7 @@ from typing import Any
 import numpy as np
 import pyqtgraph as pg
 from pyqtgraph import exporters
-from PySide6.QtCore import QBuffer, QIODevice, Qt, QTimer, Signal
+from PySide6.QtCore import QBuffer, QIODevice, QRectF, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
@@ -52,6 +53,7 @@ from fha_studio.logic.tuning.excitation import plan_excitation
 from fha_studio.logic.tuning.measure import NEEDED
 from fha_studio.logic.tuning.propose import AIMS, TUNE_KEYS, Proposal, Tuner
 from fha_studio.logic.tuning.record import TuningRecord, figure_words, tuning_notes
+from fha_studio.logic.tuning.response import COHERENCE_TRUSTED
 from fha_studio.logic.tuning.session import declared_model, drive_clock, measure_report, tuner_for
 
 COUNTDOWN_S = 3
@@ -64,9 +66,12 @@ FIGURE_WORDS = {"gain_margin_db": "Gain margin [dB]", "phase_margin_deg": "Phase
 
 
 def _cell(key: str, value: Any) -> str:
-    """A figure in the table: a gain margin without a phase crossing in words."""
+    """A figure in the table: a gain margin without a phase crossing, and a move in position as
+    its command arrives, in words."""
     if value is None:
         return "none: phase never −180°" if key == "gain_margin_db" else "—"
+    if key == "settling_ms" and value == 0:
+        return "0 (at arrival)"
     return f"{value:g}"
 
 
@@ -89,42 +94,65 @@ def tuning_plot_title(n: int, record: TuningRecord, who: str) -> str:
     if a is None:
         return (words + f"frequency response measured: resonance {fig(b, 'resonance_hz', 'Hz')}, gain margin "
                 f"{fig(b, 'gain_margin_db', 'dB')}, phase margin {fig(b, 'phase_margin_deg', 'deg')}")
-    return (words + f"before (dashed) and after (solid) the {record.aim} gains: gain margin "
-            f"{fig(b, 'gain_margin_db', 'dB')} -> {fig(a, 'gain_margin_db', 'dB')}, phase margin "
-            f"{fig(b, 'phase_margin_deg', 'deg')} -> {fig(a, 'phase_margin_deg', 'deg')}, bandwidth "
-            f"{fig(b, 'bandwidth_hz', 'Hz')} -> {fig(a, 'bandwidth_hz', 'Hz')}")
+    return (words + f"before (dashed) and after (solid) the {record.aim} gains;\nresonance "
+            f"{fig(b, 'resonance_hz', 'Hz')}; gain margin {fig(b, 'gain_margin_db', 'dB')} -> "
+            f"{fig(a, 'gain_margin_db', 'dB')}, phase margin {fig(b, 'phase_margin_deg', 'deg')} -> "
+            f"{fig(a, 'phase_margin_deg', 'deg')}, bandwidth {fig(b, 'bandwidth_hz', 'Hz')} -> "
+            f"{fig(a, 'bandwidth_hz', 'Hz')}")
+
+
+def _trusted_curve(data: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Frequency, magnitude and phase of a measured response at its trusted bins (coherence at
+    least 0.9; the others NaN, a gap in the curve), the phase unwrapped over those bins alone."""
+    f = np.asarray(data["freq_hz"], float)
+    mag = np.asarray(data["magnitude_db"], float).copy()
+    phase = np.asarray(data["phase_deg"], float).copy()
+    ok = np.asarray(data["coherence"], float) >= COHERENCE_TRUSTED
+    if ok.any():
+        kept = np.degrees(np.unwrap(np.radians(phase[ok])))
+        phase[ok] = kept - 360.0 * np.round(kept[0] / 360.0)  # the first trusted bin within +/-180 deg
+    mag[~ok] = np.nan
+    phase[~ok] = np.nan
+    return f, mag, phase
 
 
 def export_response_png(record: TuningRecord, title: str, path: Path) -> Path:
-    """Magnitude and phase of a tuning's measurements (the closed speed loop and the plant; before
-    dashed, after solid) drawn on white for paper and written as a PNG, whole or not at all."""
+    """Magnitude and phase of a tuning's measurements (the closed speed loop and the plant, at the
+    bins of coherence at least 0.9; before dashed, after solid) drawn on white for paper and written
+    as a PNG, whole or not at all."""
+    width, height = 1100, 760
     view = pg.GraphicsLayoutWidget()
     view.setBackground("w")
-    view.resize(1100, 760)
-    view.addLabel(title, row=0, col=0, color="k", size="9pt")
-    mag = view.addPlot(row=1, col=0, title="Magnitude [dB]", axisItems={"bottom": FrequencyAxis("bottom")})
-    phase = view.addPlot(row=2, col=0, title="Phase [deg]", axisItems={"bottom": FrequencyAxis("bottom")})
-    phase.setLabel("bottom", "frequency", units="Hz")
-    mag.addLegend(offset=(-10, 10))
+    head, _, figures = title.partition("\n")
+    view.addLabel(f"{html.escape(head)}<br>{html.escape(figures)}" if figures else html.escape(title),
+                  row=0, col=0, color="k", size="10pt")
+    legend = pg.LegendItem(colCount=2, labelTextColor="k")
+    view.addItem(legend, row=1, col=0)
+    mag = view.addPlot(row=2, col=0, title="Magnitude [dB]", axisItems={"bottom": FrequencyAxis("bottom")})
+    phase = view.addPlot(row=3, col=0, title="Phase [deg]", axisItems={"bottom": FrequencyAxis("bottom")})
+    phase.setLabel("bottom", "frequency (bins of coherence at least 0.9)", units="Hz")
     for plot in (mag, phase):
         plot.setLogMode(x=True, y=False)
         plot.showGrid(x=True, y=True, alpha=0.3)
+        for side in ("left", "bottom"):
+            plot.getAxis(side).setTextPen("k")
     phase.setXLink(mag)
     for result, style, when in ((record.before, Qt.PenStyle.DashLine, "before"),
                                 (record.after, Qt.PenStyle.SolidLine, "after")):
         if result is None:
             continue
-        for key, colour, words in (("frequency_response", "#1f4e9c", "speed loop (closed)"),
-                                   ("plant_response", "#c05000", "plant (speed per torque)")):
+        for key, colour, words in (("frequency_response", "#1f4e9c", "speed loop"),
+                                   ("plant_response", "#c05000", "plant")):
             data = result.get(key)
             if not data:
                 continue
             pen = pg.mkPen(colour, width=2, style=style)
-            f = np.asarray(data["freq_hz"], float)
-            mag.plot(f, np.asarray(data["magnitude_db"], float), pen=pen, name=f"{words}, {when}")
-            phase.plot(f, np.asarray(data["phase_deg"], float), pen=pen)
+            f, m, p = _trusted_curve(data)
+            legend.addItem(mag.plot(f, m, pen=pen, connect="finite"), f"{words}, {when}")
+            phase.plot(f, p, pen=pen, connect="finite")
+    view.ci.setGeometry(QRectF(0.0, 0.0, width, height))  # not shown: lay it out at the paper's size
     exporter = exporters.ImageExporter(view.ci)
-    exporter.parameters()["width"] = 1100
+    exporter.parameters()["width"] = width
     image = exporter.export(toBytes=True)
     view.deleteLater()
     buffer = QBuffer()
@@ -260,8 +288,9 @@ class TuningPage(BasePage):
         self.markers: list[Any] = []
 
         self.table = QTableWidget(len(TUNE_KEYS) + len(FIGURE_ROWS), 3)
-        self.table.setHorizontalHeaderLabels(["present", "proposed", "measured after"])
-        self.table.setToolTip("Tune mode items of the front panel, and the figures they give")
+        self.table.setHorizontalHeaderLabels(["present", "proposed", "measured\nafter"])
+        self.table.setToolTip("Tune mode items of the front panel, and the figures they give; a move that "
+                              "settles in 0 ms is within the in-position range as its command arrives")
         model = session.parameter_model
         self.table.setVerticalHeaderLabels(
             [*(_item_words(model.by_key(k)) for k in TUNE_KEYS), *(FIGURE_WORDS[k] for k in FIGURE_ROWS)])
@@ -594,7 +623,7 @@ class TuningPage(BasePage):
 
     def report_notes(self) -> list[tuple[str, str]]:
         """What the commissioning report says of the tunings of this session (before / after)."""
-        return tuning_notes(self.records)
+        return tuning_notes(self.records, self.session.parameter_model)
 
     def report_plots(self, session_path: Path, who: str) -> list[tuple[str, Path]]:
         """Each tuning of this session as a PNG beside the session (``<stem>-tuning<n>.png``): the

@@ -6,6 +6,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from fha_studio.hardware.parameters import ParameterModel, load_parameter_model
+
 FIGURES = (("resonance_hz", "resonance", "Hz"), ("antiresonance_hz", "anti-resonance", "Hz"),
            ("load_inertia_estimate_kgm2", "load inertia estimate", "kg·m²"),
            ("gain_margin_db", "gain margin", "dB"), ("phase_margin_deg", "phase margin", "deg"),
@@ -41,14 +43,32 @@ def _figures(result: Mapping[str, Any]) -> str:
     return ", ".join(f"{words} {figure_words(key, result.get(key), unit)}" for key, words, unit in FIGURES)
 
 
-def tuning_notes(records: Sequence[TuningRecord]) -> list[tuple[str, str]]:
-    """The records as the report's notes: (text, who)."""
+def items_words(items: Mapping[str, int], parameters: ParameterModel) -> str:
+    """Tune items as the front panel knows them: "tune 0 Speed loop gain (Kv) 60 Hz, ..."."""
+    words = []
+    for key, value in items.items():
+        try:
+            item = parameters.by_key(key)
+        except KeyError:
+            words.append(f"{key} {value}")
+            continue
+        unit = f" {item.unit}" if item.unit else ""
+        words.append(f"{item.mode} {item.number} {item.name} {value}{unit}")
+    return ", ".join(words)
+
+
+def tuning_notes(records: Sequence[TuningRecord],
+                 parameters: ParameterModel | None = None) -> list[tuple[str, str]]:
+    """The records as the report's notes: (text, who); the items in the front panel's words
+    (``parameters``: the drive's parameter model, the HA-655's when not given)."""
+    model = parameters or load_parameter_model("HA-655")
     notes = []
     for r in records:
-        items = dict(r.before.get("items", {}))
-        text = f"Tuning ({r.at}): measured with the items {items}: {_figures(r.before)}"
+        items = items_words(dict(r.before.get("items", {})), model)
+        text = f"Tuning ({r.at}): measured with {items}: {_figures(r.before)}"
         if r.after is not None:
-            text += (f". Applied ({r.aim}) {dict(r.items)}, measured again: {_figures(r.after)}")
+            text += (f". Applied ({r.aim}) {items_words(dict(r.items), model)}, measured again: "
+                     f"{_figures(r.after)}")
         if r.warning:
             text += f". Warning: {r.warning}"
         notes.append((text, r.who))
