@@ -19,6 +19,16 @@ EMPS_REFERENCE = {
 }
 
 
+#: The DFKI torque-limited simple pendulum's published parameters (README.md beside the files):
+#: measured geometry (0.676 kg with its centre of mass 0.45 m from the axis, g = 9.81) and the range
+#: of DFKI's own friction figures for the real pendulum.
+DFKI_REFERENCE = {
+    "gravity_nm": 0.676 * 9.81 * 0.45,
+    "coulomb_nm_low": 0.093,  # leaderboard simulation model
+    "coulomb_nm_high": 0.5 * 3.141592653589793 * 0.1839,  # their identification: F_c atan(100 q')
+}
+
+
 def real_recording(name: str) -> Recording:
     """One of the converted public recordings, e.g. ``emps_pulses`` (gzipped fha-recording/1)."""
     path = REAL / f"{name}.csv.gz"
