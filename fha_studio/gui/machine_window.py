@@ -9,11 +9,18 @@ stops every connected axis that can be stopped, not only the one on show.
 What happens on each axis goes into the register as it happens (``gui/axis_recorder.py``):
 parameter reads and verified writes, alarms, procedure checks, reports, recordings and model-check
 results. An axis is added through ``gui/axis_dialog.py``.
+
+A register file is written and asked on this thread. A register on a server never is: what the
+window records (the machine and its axes at the start, an axis added, the machine report, each
+axis's facts) goes through this computer's queue for the server (``gui/register_worker.py``), and
+what it asks (the Register dialog, the machine report's part from the register, a signature)
+through ``gui/register_questions.py``; a slow or absent server is said in the message line.
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from pathlib import Path
 
 from PySide6.QtCore import QSettings, Qt, Slot
@@ -41,11 +48,13 @@ from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.register_dialog import RegisterDialog
+from fha_studio.gui.register_questions import LocalQuestions, RegisterQuestions, ServerQuestions
 from fha_studio.gui.register_worker import ServerWriter
 from fha_studio.gui.widgets import StopButton
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures import ProcedureSession
 from fha_studio.logic.register import Register, RegisterError
+from fha_studio.logic.register.facts_from_session import MachineFact, MachineReportFact
 from fha_studio.logic.register.server import is_server_url
 
 log = logging.getLogger(__name__)
@@ -70,20 +79,28 @@ class MachineWindow(QMainWindow):
         self.register = register
         self.axis_windows: list[MainWindow] = []
         self.recorders: list[AxisRecorder] = []
-        #: a register on a server is written from threads of their own, never this one's
+        #: a register on a server is written and asked from threads of their own, never this one's
         self.server_writer: ServerWriter | None = None
+        #: the register's questions (a file's answered on this thread, a server's from another)
+        self.questions: RegisterQuestions | None = None
         if register is not None and is_server_url(register.location):
             self.server_writer = ServerWriter(str(register.location), self)
-            self.server_writer.sigSay.connect(
-                lambda text, level: self.current_window.show_message(text, level)
-            )
+            self.server_writer.sigSay.connect(self._say)
+            self.server_writer.sigNotRecorded.connect(self._machine_not_recorded)
+            self.questions = ServerQuestions(str(register.location), self)
+        elif register is not None:
+            self.questions = LocalQuestions(register, self)
+        if self.questions is not None:
+            self.questions.sigSay.connect(self._say)
         self._shut_down = False
         self._closing_confirmed = False
         self._register_dialog: RegisterDialog | None = None
         self._build_toolbar()
         self._build_body(open_client)
         not_recorded = None
-        if register is not None:
+        if self.server_writer is not None:
+            self._record_machine()  # a line says it if the queue cannot take it
+        elif register is not None:
             try:
                 project.save_to(register, who=self.operator)
             except (RegisterError, OSError) as exc:  # read-only, locked, damaged: said, not raised
@@ -95,6 +112,23 @@ class MachineWindow(QMainWindow):
                 f"Register: the machine was not recorded ({not_recorded}).", Level.WARNING
             )
         self.resize(1366, 740)
+
+    def _record_machine(self) -> None:
+        """The machine and its axes into the queue for the server (from its thread)."""
+        assert self.server_writer is not None
+        fact = MachineFact(self.project.to_json(), self.operator)
+        self.server_writer.record_machine(self.project.name, [fact])
+
+    @Slot(str, str, str)
+    def _machine_not_recorded(self, machine: str, what: str, why: str) -> None:
+        if machine == self.project.name:
+            self._say(f"Register: the {what} was not recorded ({why}).", Level.WARNING)
+
+    @Slot(str, object)
+    def _say(self, text: str, level: Level) -> None:
+        """A line about the register, in the message line of the axis on show."""
+        if self.axis_windows:
+            self.current_window.show_message(text, level)
 
     # -- building -------------------------------------------------------------------------------------
     def _build_toolbar(self) -> None:
@@ -225,11 +259,15 @@ class MachineWindow(QMainWindow):
         serial_number: str = "",
     ) -> MainWindow:
         """A new axis of the machine, with its pages, in the register too; shown. Raises
-        MachineError or the catalogue's ModelCodeError (ValueErrors) and adds nothing then."""
+        MachineError or the catalogue's ModelCodeError (ValueErrors) and adds nothing then (a
+        register file that refuses it too; a register on a server hears of it through this
+        computer's queue, and a server that refuses it is said in the message line)."""
         axis = self.project.add_axis(
             name, actuator_code, driver_model, port_url, load_inertia_kgm2, notes, serial_number
         )
-        if self.register is not None:
+        if self.server_writer is not None:
+            self._record_machine()
+        elif self.register is not None:
             try:
                 self.project.save_to(self.register, who=self.operator)
             except (RegisterError, OSError):
@@ -389,27 +427,66 @@ class MachineWindow(QMainWindow):
                 axis.session_file = session.path
         return out
 
-    def write_machine_report(self, html_path: str | Path, pdf_path: str | Path | None = None):
-        """Writes the machine report (HTML, and PDF when a path is given); records it."""
-        from fha_studio.gui.pages.procedures.report_pdf import write_pdf
-        from fha_studio.logic.machine_report import build_machine_report, render_machine_html
-
+    def write_machine_report(
+        self,
+        html_path: str | Path,
+        pdf_path: str | Path | None = None,
+        done: Callable[[Path, Path | None, str], None] | None = None,
+    ):
+        """Writes the machine report (HTML, and PDF when a path is given); records it. With a
+        register file (or none) at once: returns (html, pdf). With a register on a server its part
+        is asked from the server first (the window does not wait): returns None, and ``done``
+        hears (html, pdf, why the register's part is missing: "" when it is there) once they are
+        written; OSError or ValueError from writing them are said in the message line then."""
         html_path = Path(html_path)
         html_path.parent.mkdir(parents=True, exist_ok=True)
         for target in (html_path, pdf_path):
             if target is not None:
                 fileio.check_output_path(target)  # before the work: a target that cannot be written
-        report = build_machine_report(self.project, self.sessions(), self.register)
+        sessions = self.sessions()
+        if self.questions is None or not self.questions.on_server:
+            html, pdf = self._machine_report_files(html_path, pdf_path, sessions, self.register)
+            if done is not None:
+                done(html, pdf, "")
+            return html, pdf
+        from fha_studio.logic.machine_report import RegisterExcerpt
+
+        refs = [f"{self.project.name}/{axis.name}" for axis in self.project]
+
+        def written(excerpt: RegisterExcerpt | None, why: str = "") -> None:
+            try:
+                html, pdf = self._machine_report_files(html_path, pdf_path, sessions, excerpt, why)
+            except (OSError, ValueError) as exc:
+                self._say(f"The machine report was not written: {exc}", Level.WARNING)
+                return
+            if done is not None:
+                done(html, pdf, why)
+
+        self.questions.ask(
+            "what the register knows of the machine's axes",
+            lambda register: RegisterExcerpt.of(register, refs),
+            written,
+            lambda why: written(None, why),
+        )
+        return None
+
+    def _machine_report_files(self, html_path: Path, pdf_path: str | Path | None, sessions, register,
+                              register_problem: str = "") -> tuple[Path, Path | None]:
+        from fha_studio.gui.pages.procedures.report_pdf import write_pdf
+        from fha_studio.logic.machine_report import build_machine_report, render_machine_html
+
+        report = build_machine_report(self.project, sessions, register, register_problem)
         html = render_machine_html(report)
         fileio.write_text(html_path, html)  # whole or not at all
         pdf = write_pdf(html, pdf_path, report.title, html_path.parent) if pdf_path is not None else None
-        if self.register is not None:
-            # a machine report is not signed itself: each axis's report is
+        # a machine report is not signed itself: each axis's report is
+        warnings = sum(s.open_warnings for s in report.summaries)
+        if self.server_writer is not None:
+            fact = MachineReportFact(self.project.name, pdf or html_path, warnings, self.operator)
+            self.server_writer.record_machine(self.project.name, [fact])
+        elif self.register is not None:
             self.register.record_report(
-                pdf or html_path,
-                machine=self.project.name,
-                open_warnings=sum(s.open_warnings for s in report.summaries),
-                who=self.operator,
+                pdf or html_path, machine=self.project.name, open_warnings=warnings, who=self.operator
             )
         return html_path, pdf
 
@@ -418,11 +495,11 @@ class MachineWindow(QMainWindow):
         """Opens the register's questions for this machine, on the axis on show (not modal: the
         pages stay usable); returns the dialog."""
 
-        if self.register is None:
+        if self.questions is None:
             return None
         if self._register_dialog is None:
             self._register_dialog = RegisterDialog(
-                self.register, self.project.name, self.current_axis.name, self
+                self.questions, self.project.name, self.current_axis.name, self
             )
         else:
             self._register_dialog.refresh(self.current_axis.name)
@@ -436,13 +513,20 @@ class MachineWindow(QMainWindow):
         path, _ = QFileDialog.getSaveFileName(self, "Machine report (PDF)", str(base), "PDF (*.pdf)")
         if not path:
             return
+        def written(html: Path, pdf: Path | None, why: str) -> None:
+            missing = f" (without what the register knows: {why})" if why else ""
+            self._say(f"Machine report written: {pdf} and {html}{missing}",
+                      Level.WARNING if why else Level.INFO)
+
         try:
-            html, pdf = self.write_machine_report(Path(path).with_suffix(".html"), path)
+            self.write_machine_report(Path(path).with_suffix(".html"), path, written)
         except (OSError, ValueError) as exc:
             QMessageBox.warning(self, "Machine report", f"The machine report was not written: {exc}")
             return
         QSettings().setValue("machine/report_dir", str(Path(path).parent))
-        self.current_window.show_message(f"Machine report written: {pdf} and {html}")
+        if self.questions is not None and self.questions.on_server:
+            self._say("Machine report: asking the register on the server what it knows of the axes…",
+                      Level.INFO)
 
     # -- closing --------------------------------------------------------------------------------------
     def closeEvent(self, event) -> None:
@@ -481,5 +565,7 @@ class MachineWindow(QMainWindow):
         for window in self.axis_windows:
             window._closing_confirmed = True
             window.shutdown()
+        if self.questions is not None:
+            self.questions.shutdown()  # a question the server did not answer yet is dropped
         if self.server_writer is not None:
             self.server_writer.shutdown()  # the facts handed over are in this computer's queue

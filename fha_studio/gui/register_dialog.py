@@ -1,10 +1,16 @@
 """The register's questions in the GUI, for one machine: the history of an axis, what differs
 between two axes (or two snapshots), which axes have a parameter value, what is still open.
 
-The same questions as ``fha-studio register history|diff|find|open``, in the same words.
+The same questions as ``fha-studio register history|diff|find|open``, in the same words. They
+are asked through :mod:`fha_studio.gui.register_questions`: a register file answers at once; a
+register on a server from a thread of its own, the dialog saying "Asking the server…" meanwhile
+and one line when no answer comes (each table keeps what it showed before).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
 
 from PySide6.QtCore import Qt, Slot
 from PySide6.QtWidgets import (
@@ -23,7 +29,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from fha_studio.logic.register import Register, RegisterError
+from fha_studio.gui.register_questions import LocalQuestions, RegisterQuestions, shown_location
+from fha_studio.logic.register import Register
 from fha_studio.logic.register.words import (
     KIND_WORDS,
     SOURCE_WORDS,
@@ -61,18 +68,38 @@ class RegisterDialog(QDialog):
     """History, compare, find and open items of one machine's axes."""
 
     def __init__(
-        self, register: Register, machine: str, axis: str | None = None, parent: QWidget | None = None
+        self,
+        register: Register | RegisterQuestions,
+        machine: str,
+        axis: str | None = None,
+        parent: QWidget | None = None,
     ):
+        """``register``: an open register file (asked on this thread), or the questions of a
+        window (a server's are asked from a thread of their own)."""
         super().__init__(parent)
         self.setObjectName("registerDialog")
         self.setWindowTitle(f"Register — {machine}")
-        self.register = register
+        self.questions = (
+            register if isinstance(register, RegisterQuestions) else LocalQuestions(register, self)
+        )
         self.machine = machine
+        #: the latest question of each kind: an answer to an older one is not shown
+        self._latest: dict[str, int] = {}
+        self._asked = 0
         self.resize(1100, 620)
         layout = QVBoxLayout(self)
-        where = QLabel(f"Register file: {register.path}")
-        where.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
-        layout.addWidget(where)
+        head = QHBoxLayout()
+        kind = "Register on the server" if self.questions.on_server else "Register file"
+        self.where_label = QLabel(f"{kind}: {shown_location(self.questions.location)}")
+        self.where_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        head.addWidget(self.where_label, 1)
+        #: "Asking the server…" while a question waits; one line when an answer did not come
+        self.status_label = QLabel("")
+        self.status_label.setObjectName("registerStatus")
+        self.status_label.setWordWrap(True)
+        head.addWidget(self.status_label, 2)
+        layout.addLayout(head)
+        self.questions.sigBusy.connect(self._on_busy)
         self.tabs = QTabWidget()
         layout.addWidget(self.tabs, 1)
         self.tabs.addTab(self._history_tab(), "&History")
@@ -160,12 +187,51 @@ class RegisterDialog(QDialog):
         v.addWidget(self.open_table, 1)
         return tab
 
+    # -- asking ---------------------------------------------------------------------------------------
+    def _ask(self, kind: str, what: str, question: Callable[[Register], Any],
+             answered: Callable[[Any], None], failed: Callable[[str], None] | None = None) -> None:
+        """Asks the register; only the answer to the latest question of ``kind`` is shown (a
+        person who chose another axis meanwhile sees that axis's)."""
+        self._asked += 1
+        number = self._latest[kind] = self._asked
+
+        def take(value: Any) -> None:
+            if self._latest.get(kind) == number:
+                answered(value)
+
+        def refused(why: str) -> None:
+            if self._latest.get(kind) == number:
+                (failed or self._say)(why)
+
+        self.questions.ask(what, question, take, refused)
+
+    def _say(self, why: str) -> None:
+        self.status_label.setText(f"Not answered: {why}.")
+        self.status_label.setStyleSheet("color: #b00020;")
+
+    @Slot(bool)
+    def _on_busy(self, busy: bool) -> None:
+        if busy:
+            self.status_label.setText("Asking the server…")
+            self.status_label.setStyleSheet("")
+        elif self.status_label.text() == "Asking the server…":
+            self.status_label.setText("")
+
     # -- filling ------------------------------------------------------------------------------------
     @Slot()
     def refresh(self, axis: str | None = None) -> None:
         """Reads the register again (another window may have written to it)."""
-        axes = self.register.axes(self.machine)
         chosen = axis or self.history_axis.currentData()
+        machine = self.machine
+
+        def axes_and_snapshots(reg: Register) -> tuple[list[Any], dict[str, list[Any]]]:
+            axes = reg.axes(machine)
+            return axes, {a.ref: reg.snapshots(a) for a in axes}
+
+        self._ask("axes", f"the axes of {machine}", axes_and_snapshots,
+                  lambda answer: self._fill_axes(answer[0], answer[1], chosen))
+
+    def _fill_axes(self, axes: list[Any], snapshots: dict[str, list[Any]], chosen: str | None) -> None:
         self.history_axis.blockSignals(True)
         self.history_axis.clear()
         for a in axes:
@@ -174,12 +240,12 @@ class RegisterDialog(QDialog):
             max(0, self.history_axis.findData(f"{self.machine}/{chosen}"), self.history_axis.findData(chosen))
         )
         self.history_axis.blockSignals(False)
-        self._fill_compare_choices(axes, chosen)
+        self._fill_compare_choices(axes, snapshots, chosen)
         self._show_history()
         self._show_compare()
         self._show_open()
 
-    def _fill_compare_choices(self, axes, chosen: str | None) -> None:
+    def _fill_compare_choices(self, axes, snapshots: dict[str, list[Any]], chosen: str | None) -> None:
         current = next((a for a in axes if chosen in (a.name, a.ref)), axes[0] if axes else None)
         # the twin: the next axis with the same actuator, else the next axis
         twin = next(
@@ -196,7 +262,7 @@ class RegisterDialog(QDialog):
             for a in axes:
                 combo.addItem(f"{a.name}: latest known values", a.ref)
             for a in axes:
-                for s in self.register.snapshots(a):
+                for s in snapshots.get(a.ref, []):
                     source = SOURCE_WORDS.get(s["source"], s["source"])
                     combo.addItem(
                         f"{a.name}: snapshot {s['id']} ({source}, {when_text(s['at_utc'])})", str(s["id"])
@@ -211,20 +277,23 @@ class RegisterDialog(QDialog):
         if not ref:
             _fill(self.history_table, [])
             return
-        events = self.register.history(ref)
-        rows = [[when_text(e.at_utc), KIND_WORDS[e.kind], e.who, e.text] for e in reversed(events)]
-        _fill(self.history_table, rows)  # newest first
+
+        def show(events: list[Any]) -> None:
+            rows = [[when_text(e.at_utc), KIND_WORDS[e.kind], e.who, e.text] for e in reversed(events)]
+            _fill(self.history_table, rows)  # newest first
+
+        self._ask("history", f"the history of {ref}", lambda reg: reg.history(ref), show)
 
     @Slot()
     def _show_compare(self) -> None:
         a_ref, b_ref = self.compare_a.currentData(), self.compare_b.currentData()
         if not a_ref or not b_ref:
             return
-        try:
-            a, b = self.register.parameter_set(a_ref), self.register.parameter_set(b_ref)
-        except RegisterError as exc:
-            self.compare_label.setText(str(exc))
-            return
+        self._ask("compare", "the values to compare",
+                  lambda reg: (reg.parameter_set(a_ref), reg.parameter_set(b_ref)),
+                  lambda sets: self._fill_compare(*sets), self.compare_label.setText)
+
+    def _fill_compare(self, a, b) -> None:
         differences = Register.diff(a, b)
         driver = a.axis.driver_model or b.axis.driver_model
         held = len(set(a.values) | set(b.values))
@@ -285,30 +354,40 @@ class RegisterDialog(QDialog):
                     self.find_label.setText(f"Nothing searched: {why}.")
                     _fill(self.find_table, [])
                     return
-        found = self.register.find(key, value, machine=self.machine)
         name = item.name if item is not None else key
         wanted = f" = {value_text(key, value)}" if value is not None else ""
-        axes = "axis has" if len(found) == 1 else "axes have"
-        self.find_label.setText(f"{len(found)} {axes} {name}{wanted} (the latest known value of each).")
-        rows = [
-            [
-                f.axis.name,
-                value_text(key, f.value.value, f.axis.driver_model),
-                SOURCE_WORDS[f.value.source],
-                when_text(f.value.at_utc),
+        machine = self.machine
+
+        def show(found: list[Any]) -> None:
+            axes = "axis has" if len(found) == 1 else "axes have"
+            self.find_label.setText(f"{len(found)} {axes} {name}{wanted} (the latest known value of each).")
+            rows = [
+                [
+                    f.axis.name,
+                    value_text(key, f.value.value, f.axis.driver_model),
+                    SOURCE_WORDS[f.value.source],
+                    when_text(f.value.at_utc),
+                ]
+                for f in found
             ]
-            for f in found
-        ]
-        _fill(self.find_table, rows)
+            _fill(self.find_table, rows)
+
+        self._ask("find", f"which axes have {name}{wanted}",
+                  lambda reg: reg.find(key, value, machine=machine), show,
+                  lambda why: self.find_label.setText(f"Not searched: {why}."))
 
     @Slot()
     def _show_open(self) -> None:
-        items = self.register.open_items(self.machine)
-        self.open_label.setText(
-            "Nothing open: every check passed and every report is signed."
-            if not items
-            else f"{len(items)} open item(s): checks not done or failed, reports missing or not signed, "
-            "conflicts between registers to settle."
-        )
-        rows = [[i.axis.name, i.kind if i.kind in ("report", "conflict") else "check", i.text] for i in items]
-        _fill(self.open_table, rows)
+        def show(items: list[Any]) -> None:
+            self.open_label.setText(
+                "Nothing open: every check passed and every report is signed."
+                if not items
+                else f"{len(items)} open item(s): checks not done or failed, reports missing or not signed, "
+                "conflicts between registers to settle."
+            )
+            rows = [[i.axis.name, i.kind if i.kind in ("report", "conflict") else "check", i.text]
+                    for i in items]
+            _fill(self.open_table, rows)
+
+        machine = self.machine
+        self._ask("open", f"what is open on {machine}", lambda reg: reg.open_items(machine), show)

@@ -39,7 +39,12 @@ from fha_studio.gui.link import _forget_dummy_thread
 from fha_studio.gui.messages import Level
 from fha_studio.gui.register_writer import RegisterWriter, facts_text, write_fact
 from fha_studio.logic.register import Register, RegisterError, guard
-from fha_studio.logic.register.facts_from_session import AxisFact, Fact
+from fha_studio.logic.register.facts_from_session import (
+    AxisFact,
+    Fact,
+    MachineLevelFact,
+    record_machine_fact,
+)
 from fha_studio.logic.register.server import problem, shown_url
 from fha_studio.paths import user_data_dir
 
@@ -77,6 +82,14 @@ class RecordRequest:
 
     axis: str
     facts: tuple[Fact, ...]
+
+
+@dataclass(frozen=True)
+class MachineRequest:
+    """A machine's own facts (the machine and its axes, its report), in order, for the queue."""
+
+    machine: str
+    facts: tuple[MachineLevelFact, ...]
 
 
 @dataclass(frozen=True)
@@ -131,6 +144,18 @@ class QueueWorker(QObject):
         if written:
             self.sigQueued.emit(written)
 
+    @Slot(object)
+    def record_machine(self, request: MachineRequest) -> None:
+        written = 0
+        for fact in request.facts:
+            problem = self._problem if self._queue is None else _machine_fact_written(self._queue, fact)
+            if problem:
+                self.sigNotRecorded.emit(request.machine, fact.what, problem)
+                break  # what comes after it (a report of an axis not added) waits for nothing
+            written += 1
+        if written:
+            self.sigQueued.emit(written)
+
     @Slot()
     def stop(self) -> None:
         """Closes the file and ends the thread (after every fact queued before it)."""
@@ -141,6 +166,16 @@ class QueueWorker(QObject):
         thread = self.thread()
         if thread is not None:
             thread.quit()
+
+
+def _machine_fact_written(queue: Register, fact: MachineLevelFact) -> str:
+    """Writes a machine's fact into the queue; "" when it was, else why not (one line)."""
+    try:
+        record_machine_fact(queue, fact)
+        return ""
+    except (RegisterError, OSError, ValueError) as exc:
+        log.warning("register: %s not recorded: %s", fact.what, exc)
+        return str(exc)
 
 
 #: Brings the facts the queue's register has and the server's lacks to the server; returns how
@@ -318,6 +353,7 @@ class ServerWriter(RegisterWriter):
     sigSay = Signal(str, object)  # text, messages.Level
     sigChanged = Signal()  # answers or waiting changed
     _sigRecord = Signal(object)  # RecordRequest, queued into the queue's thread
+    _sigRecordMachine = Signal(object)  # MachineRequest, queued into the queue's thread
     _sigDeliver = Signal()  # queued into the delivery's thread
     _sigStop = Signal()  # queued into the queue's thread, after the facts
     _sigStopDelivery = Signal()  # queued into the delivery's thread
@@ -343,6 +379,7 @@ class ServerWriter(RegisterWriter):
         self._queue_thread.started.connect(self._queue_worker.start)
         self._delivery_thread.started.connect(self._delivery.start)
         self._sigRecord.connect(self._queue_worker.record)
+        self._sigRecordMachine.connect(self._queue_worker.record_machine)
         self._sigStop.connect(self._queue_worker.stop)
         self._sigDeliver.connect(self._delivery.deliver)
         self._sigStopDelivery.connect(self._delivery.stop)
@@ -370,6 +407,12 @@ class ServerWriter(RegisterWriter):
     def record(self, axis: str, facts: Sequence[Fact]) -> None:
         if not self._shut_down and facts:
             self._sigRecord.emit(RecordRequest(axis, tuple(facts)))
+
+    def record_machine(self, machine: str, facts: Sequence[MachineLevelFact]) -> None:
+        """Records a machine's own facts (the machine and its axes, its report) in order; one the
+        queue cannot take is said (``sigNotRecorded``, naming the machine)."""
+        if not self._shut_down and facts:
+            self._sigRecordMachine.emit(MachineRequest(machine, tuple(facts)))
 
     def deliver_now(self) -> None:
         """Tries the server now (a person asked, or a fact is waiting)."""

@@ -34,6 +34,7 @@ from fha_studio import names
 from fha_studio.gui.axis_recorder import OPERATOR_KEY, AxisRecorder, login_name
 from fha_studio.gui.link import LinkInfo
 from fha_studio.gui.messages import Level
+from fha_studio.gui.register_questions import shown_location
 from fha_studio.gui.register_writer import DirectWriter, RegisterWriter, facts_text
 from fha_studio.logic.register import Register, RegisterError, register_location
 from fha_studio.logic.register.server import is_server_url
@@ -58,13 +59,6 @@ RECENT_MAX = 12
 LINE_WIDTH_SHARE = 0.3
 #: ... and never more than this [px].
 LINE_WIDTH_MAX_PX = 460
-
-
-def shown_location(location: Path | str) -> str:
-    """The register as messages name it: the file's path, or the server's URL without password."""
-    from fha_studio.logic.register.server import is_server_url, shown_url
-
-    return shown_url(str(location)) if is_server_url(location) else str(location)
 
 
 class WindowRegister(QObject):

@@ -11,8 +11,8 @@ from __future__ import annotations
 import contextlib
 import html
 import re
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
 from typing import Any
 
 from fha_studio.catalog import DEFAULT_ACTUATOR
@@ -52,6 +52,51 @@ class MachineReport:
     summaries: tuple[AxisSummary, ...]
     axis_reports: tuple[CommissioningReport | None, ...]  # None: the axis has no session yet
     problems: tuple[str, ...] = ()  # session files that could not be read, one line each
+
+
+@dataclass(frozen=True)
+class RegisterExcerpt:
+    """What the machine report asks a register of each axis, asked all at once (by a thread of
+    its own for a register on a server, so that the window never waits for it), answering as the
+    register does: ValueError for an axis it does not have."""
+
+    origins: Mapping[str, Any] = field(default_factory=dict)
+    values: Mapping[str, Any] = field(default_factory=dict)
+    checks: Mapping[str, tuple[int, int]] = field(default_factory=dict)
+    open_conflicts: Mapping[str, list[Any]] = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, register: Any, refs: Iterable[str]) -> RegisterExcerpt:
+        """The answers of ``register`` for the axes ``refs`` (``MACHINE/AXIS``)."""
+        origins, values, checks, conflicts = {}, {}, {}, {}
+        for ref in refs:
+            try:
+                origins[ref] = register.latest_origin(ref)
+                values[ref] = register.current_values(ref)
+                checks[ref] = register.check_counts(ref)
+                conflicts[ref] = register.conflicts(ref)
+            except ValueError:  # an axis the register does not have
+                for found in (origins, values, checks, conflicts):
+                    found.pop(ref, None)
+        return cls(origins, values, checks, conflicts)
+
+    def _known(self, ref: str, answers: Mapping[str, Any]) -> Any:
+        if ref not in answers:
+            raise ValueError(f"the register has no axis {ref}")
+        return answers[ref]
+
+    def latest_origin(self, ref: str) -> Any:
+        return self._known(ref, self.origins)
+
+    def current_values(self, ref: str) -> Any:
+        return self._known(ref, self.values)
+
+    def check_counts(self, ref: str) -> tuple[int, int]:
+        passed, failed = self._known(ref, self.checks)
+        return int(passed), int(failed)
+
+    def conflicts(self, ref: str) -> list[Any]:
+        return list(self._known(ref, self.open_conflicts))
 
 
 def direction_text(value: int | None) -> str:
@@ -119,12 +164,17 @@ def build_machine_report(
     project: MachineProject,
     sessions: Mapping[str, ProcedureSession | None] | None = None,
     register: Any = None,
+    register_problem: str = "",
 ) -> MachineReport:
     """The report of ``project``. ``sessions`` maps axis names to their procedure sessions (an
     axis not in it: its ``session_file`` is read, when it has one); ``register`` (optional) gives
-    values and origins recorded there."""
+    values and origins recorded there (a :class:`Register`, or a :class:`RegisterExcerpt` of
+    one); ``register_problem``: why the register was not asked (one line; the report says it)."""
     sessions = dict(sessions or {})
     summaries, reports, problems = [], [], []
+    if register_problem:
+        problems.append(f"what the register knows of the axes (values read, origins, checks, conflicts) is "
+                        f"not in this report: {register_problem}")
     for axis in project:
         session = sessions.get(axis.name)
         if axis.name not in sessions and axis.session_file is not None:

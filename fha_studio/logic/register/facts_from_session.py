@@ -6,6 +6,8 @@ saved, a model check run. The functions here say what each is in the register: a
 write, an alarm, a check with its verdict or a note without one, the axis's origin, a report with
 its signature and open warnings. Each fact is a frozen dataclass with ``what`` (its name in the
 line that says it was not recorded); :func:`record_fact` writes one into a :class:`Register`.
+A machine window's own facts (the machine and its axes, the machine report) are a machine's, not
+an axis's: :func:`record_machine_fact`.
 
 The GUI's ``AxisRecorder`` only hears the events and hands what they carry to these functions;
 the procedure session itself goes in through :func:`~fha_studio.logic.register.importers.record_session`.
@@ -200,6 +202,30 @@ Fact = (
     | RecordingFact
     | ModelCheckFact
 )
+
+
+@dataclass(frozen=True)
+class MachineFact:
+    """A machine and its axes as a machine window holds them (``MachineProject.to_json()``, a
+    copy: recorded later, in another thread, it is unchanged): put into the register."""
+
+    data: Mapping[str, Any]
+    who: str
+    what: str = "machine and its axes"
+
+
+@dataclass(frozen=True)
+class MachineReportFact:
+    """A machine report file written (not signed itself: each axis's report is)."""
+
+    machine: str
+    path: Path
+    open_warnings: int
+    who: str
+    what: str = "machine report"
+
+
+MachineLevelFact = MachineFact | MachineReportFact
 
 
 # -- events into facts -------------------------------------------------------------------------------
@@ -437,3 +463,16 @@ def record_fact(register: Register, axis: str, fact: Fact) -> None:
     """Writes ``fact`` into ``register`` for ``axis`` ("MACHINE/AXIS"); the register's errors
     (RegisterError, OSError) are the caller's to say."""
     WRITERS[type(fact)](register, axis, fact)
+
+
+def record_machine_fact(register: Register, fact: MachineLevelFact) -> None:
+    """Writes a machine's own fact into ``register``; the register's errors (RegisterError,
+    ValueError, OSError) are the caller's to say."""
+    if isinstance(fact, MachineFact):
+        from fha_studio.logic.machine import MachineProject
+
+        MachineProject.from_json(dict(fact.data)).save_to(register, who=fact.who)
+    else:
+        register.record_report(
+            fact.path, machine=fact.machine, open_warnings=fact.open_warnings, who=fact.who
+        )
