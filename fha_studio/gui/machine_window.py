@@ -236,6 +236,7 @@ class MachineWindow(QMainWindow):
         window.state.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
         if self.register is not None:
             window.signing_register = self.register.location  # the sign step finds the keys there
+            window.register_questions = self.questions  # and asks a server from another thread
             self.recorders.append(
                 AxisRecorder(
                     self.server_writer or self.register,

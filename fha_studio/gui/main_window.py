@@ -7,7 +7,7 @@ import logging
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol, cast
 
-from PySide6.QtCore import QSettings, Qt, Slot
+from PySide6.QtCore import QObject, QSettings, Qt, Slot
 from PySide6.QtGui import QAction, QKeySequence, QShortcut
 from PySide6.QtWidgets import (
     QLabel,
@@ -96,6 +96,9 @@ class MainWindow(QMainWindow, PageLookup):
         #: the register where the Procedures page's sign step finds the signer's key (the
         #: machine window's; None: the user's register by the usual rule)
         self.signing_register: Path | str | None = None
+        #: that register's questions when they are not asked on this thread (a server's
+        #: ``RegisterQuestions``, gui/register_questions.py; None: the sign step asks the register)
+        self.register_questions: QObject | None = None
         #: the register this window records into when it is a window of its own (a
         #: ``WindowRegister``; a machine window's axes are recorded by the machine window)
         self.window_register: WindowPart | None = None

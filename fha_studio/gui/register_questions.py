@@ -32,7 +32,7 @@ from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
 from fha_studio.gui.link import _forget_dummy_thread
 from fha_studio.gui.messages import Level
-from fha_studio.gui.register_worker import (
+from fha_studio.gui.register_connection import (
     CLOSE_WAIT_MS,
     CONNECT_TIMEOUT_S,
     server_socket,

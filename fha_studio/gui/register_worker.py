@@ -24,9 +24,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import logging
-import os
 import re
-import socket
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -37,6 +35,13 @@ from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 from fha_studio.gui.axis_recorder import login_name
 from fha_studio.gui.link import _forget_dummy_thread
 from fha_studio.gui.messages import Level
+from fha_studio.gui.register_connection import (
+    CLOSE_WAIT_MS,
+    CONNECT_TIMEOUT_S,
+    server_socket,
+    shut_socket,
+    without_nothing_changed,
+)
 from fha_studio.gui.register_writer import RegisterWriter, facts_text, write_fact
 from fha_studio.logic.register import Register, RegisterError, guard
 from fha_studio.logic.register.facts_from_session import (
@@ -61,10 +66,6 @@ SLOW_S = 5.0
 #: ... and one that takes longer than this [s] is cut off and tried again on a new connection (a
 #: network gone without a word leaves a connection waiting for hours).
 GIVE_UP_S = 60.0
-#: Closing waits at most this long [ms] for each thread (the facts are in the file by then).
-CLOSE_WAIT_MS = 10000
-#: A connection to the server waits at most this long [s] for the server's first answer.
-CONNECT_TIMEOUT_S = 5.0
 
 
 def queue_path(url: str) -> Path:
@@ -315,30 +316,6 @@ class DeliveryWorker(QObject):
         thread = self.thread()
         if thread is not None:
             thread.quit()
-
-
-def server_socket(register: Register) -> int:
-    """The socket of a register's connection to its server (-1 when there is none)."""
-    connection = getattr(getattr(register, "_db", None), "_conn", None)  # psycopg's Connection
-    try:
-        return int(connection.pgconn.socket) if connection is not None else -1
-    except Exception:
-        return -1
-
-
-def shut_socket(fd: int) -> None:
-    """From any thread: the connection on socket ``fd`` (-1: none) is shut, so that whatever waits
-    on it in another thread gives up at once (a server that hangs, or a network gone without a
-    word, cannot hold that thread)."""
-    if fd >= 0:
-        with contextlib.suppress(OSError), socket.socket(fileno=os.dup(fd)) as shared:
-            shared.shutdown(socket.SHUT_RDWR)
-
-
-def without_nothing_changed(problem: str) -> str:
-    """A register's error without what it adds for a command ("nothing was changed; try again
-    when it is back"), which a window that keeps its facts and asks again does not need."""
-    return re.sub(r": nothing was changed(; try again when it is back)?$", "", problem)
 
 
 class ServerWriter(RegisterWriter):

@@ -34,7 +34,7 @@ from fha_studio import names
 from fha_studio.gui.axis_recorder import OPERATOR_KEY, AxisRecorder, login_name
 from fha_studio.gui.link import LinkInfo
 from fha_studio.gui.messages import Level
-from fha_studio.gui.register_questions import shown_location
+from fha_studio.gui.register_questions import ServerQuestions, shown_location
 from fha_studio.gui.register_writer import DirectWriter, RegisterWriter, facts_text
 from fha_studio.logic.register import Register, RegisterError, register_location
 from fha_studio.logic.register.server import is_server_url
@@ -86,8 +86,13 @@ class WindowRegister(QObject):
         #: the register file, open on the GUI thread (None for a server's, or one that failed)
         self.register: Register | None = None
         self.writer: RegisterWriter | None = None
+        #: a server's questions (the signer's key, the axes it has), asked from their own thread
+        self.questions: ServerQuestions | None = None
         if is_server_url(self.location):
             self.writer = self._server_writer(str(self.location))
+            self.questions = ServerQuestions(str(self.location), self)
+            self.questions.sigSay.connect(window.show_message)
+            window.register_questions = self.questions
         else:
             try:
                 self.register = Register(self.location)
@@ -262,6 +267,9 @@ class WindowRegister(QObject):
         if self.recorder is not None:
             self.recorder.stop()  # a reply the link sent before it ended is not recorded any more
             self.recorder = None
+        if self.questions is not None:
+            self.questions.shutdown()  # a question the server did not answer yet is dropped
+            self.questions = None
         if self.writer is not None:
             self.writer.shutdown()  # a server's: the facts handed over are in this computer's queue
             self.writer = None
@@ -370,6 +378,27 @@ class WindowAxisDialog(QDialog):
         self.machine_combo.currentTextChanged.connect(self._offer_axes)
         self._offer_axes(self.machine_combo.currentText())
         self.resize(560, self.sizeHint().height())
+        if recording.questions is not None:  # the server's axes too, when it answers
+            recording.questions.ask(
+                "the machines and axes of the register",
+                lambda reg: [(a.machine, a.name) for a in reg.axes()],
+                self._offer_known,
+                lambda _why: None,  # the message line says a server that does not answer
+            )
+
+    def _offer_known(self, axes: list[tuple[str, str]]) -> None:
+        """The server's machines and axes beside those offered already."""
+        for machine, axis in axes:
+            names_there = self._known.setdefault(machine, [])
+            if axis not in names_there:
+                names_there.append(axis)
+        text = self.machine_combo.currentText()
+        self.machine_combo.blockSignals(True)
+        self.machine_combo.clear()
+        self.machine_combo.addItems(sorted(self._known))
+        self.machine_combo.setCurrentText(text)
+        self.machine_combo.blockSignals(False)
+        self._offer_axes(text)
 
     @Slot(str)
     def _offer_axes(self, machine: str) -> None:

@@ -85,7 +85,7 @@ def test_a_machine_window_on_a_server_that_hangs_and_stops(
     watch = GuiThreadWatch()
     reports: list[tuple] = []
     try:
-        with _hung(postgres_cluster, urlsplit(url).path.lstrip("/")):
+        with _hung(postgres_cluster, urlsplit(url).path.lstrip("/"), postmaster=True):
             started = time.monotonic()
             window.add_axis("tilt", ACTUATOR)  # into the queue: the server hears of it later
             written = window.write_machine_report(tmp_path / "line3.html", None,

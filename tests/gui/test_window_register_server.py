@@ -109,8 +109,10 @@ def _said_since(window, mark: int, words: str) -> str:
 
 
 @contextlib.contextmanager
-def _hung(cluster, database: str):
-    """The server's processes serving ``database`` stop answering (SIGSTOP) until the block ends."""
+def _hung(cluster, database: str, postmaster: bool = False):
+    """The server's processes serving ``database`` stop answering (SIGSTOP) until the block ends;
+    with ``postmaster`` the server itself too (a new connection waits for it, as for a server
+    whose network went away)."""
     import psycopg
 
     with psycopg.connect(cluster.url("postgres", "postgres", SUPER_PASSWORD), autocommit=True) as db:
@@ -118,6 +120,8 @@ def _hung(cluster, database: str):
             "SELECT pid FROM pg_stat_activity WHERE datname = %s AND pid <> pg_backend_pid()", (database,)
         )]
     assert pids, "no connection of the window's to the server"
+    if postmaster:
+        pids.append(int((cluster.data / "postmaster.pid").read_text().split()[0]))
 
     def answer_again() -> None:
         for pid in pids:

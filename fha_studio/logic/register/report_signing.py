@@ -5,13 +5,18 @@ The report's HTML is reproducible from the session, so the signature is made onc
 person signs, and kept in the session file; every report written from that session carries it.
 Nothing is half-done: the key is checked against the register before anything is written; the
 register's record comes before the session file (a failure on the way leaves the session
-unsigned, as it was)."""
+unsigned, as it was).
+
+A window on a register on a server asks the server from another thread: :class:`KnownKeys` holds
+a person's keys as the server gave them, :func:`session_signature` and :func:`file_signature`
+make a signature without recording it (the session unchanged), and the window records it
+(``record_signature``) before it keeps it in the session."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
@@ -32,7 +37,29 @@ from fha_studio.logic.register.signing import (
 )
 
 
-def usable_key(register: Keys, key: Ed25519PrivateKey, person: str) -> SigningKey:
+class KeyRecords(Protocol):
+    """What signing asks a register of the keys (a :class:`Keys`, or :class:`KnownKeys`)."""
+
+    def signing_keys(self, person: str | None = None) -> list[SigningKey]: ...
+
+    def signing_key(self, key_id: str) -> SigningKey | None: ...
+
+
+class KnownKeys:
+    """A person's keys as the register gave them (asked once, by another thread): answers as the
+    register would about them."""
+
+    def __init__(self, keys: Iterable[SigningKey]):
+        self._keys = list(keys)
+
+    def signing_keys(self, person: str | None = None) -> list[SigningKey]:
+        return [k for k in self._keys if person is None or k.person == person.strip()]
+
+    def signing_key(self, key_id: str) -> SigningKey | None:
+        return next((k for k in self._keys if k.key_id == key_id), None)
+
+
+def usable_key(register: KeyRecords, key: Ed25519PrivateKey, person: str) -> SigningKey:
     """The register's record of ``key``, when ``person`` may sign with it (else RegisterError)."""
     key_id = key_id_of(public_raw(key))
     known = register.signing_key(key_id)
@@ -45,7 +72,7 @@ def usable_key(register: Keys, key: Ed25519PrivateKey, person: str) -> SigningKe
     return known
 
 
-def private_key_file_for(register: Keys, person: str) -> Path | None:
+def private_key_file_for(register: KeyRecords, person: str) -> Path | None:
     """The private key file of ``person``'s newest usable key in the user's keys folder; None
     when the person has no key in the register. SigningError when the person has keys but none
     of them is on this computer."""
@@ -72,20 +99,54 @@ def sign_session(
     as :func:`report_file_bytes` writes it, is recorded in the register and kept in the session
     (saved). SignError while checks are open; RegisterError when the key is not ``who``'s usable
     key in the register; on either the session is as it was."""
+    signed, entry = session_signature(register, session, who, key, context)
+    register.record_signature(signed)
+    keep_signature(session, entry)
+    return signed
+
+
+def session_signature(
+    register: KeyRecords,
+    session: ProcedureSession,
+    who: str,
+    key: Ed25519PrivateKey,
+    context: Mapping[str, Any] | None = None,
+) -> tuple[Signed, dict[str, Any]]:
+    """The signature of the session's report as ``who`` with ``key``, and the session's
+    signature entry that carries it, neither recorded nor kept (the session is as it was).
+    SignError while checks are open; RegisterError when the key is not ``who``'s usable key."""
     known = usable_key(register, key, who)
     before = dict(session.signature)
     try:
         sign(session, who, context, key_id=known.key_id, save=False)
         content = render_html(build_report(session, context)).encode("utf-8")
         signed = sign_bytes(key, content, known.person, session.signature["at_utc"])
-        register.record_signature(signed)
-        session.signature.update(sha256=signed.sha256, ed25519=signed.signature)
-        if session.path is not None:
-            session.save()
-    except BaseException:
+        entry = {**session.signature, "sha256": signed.sha256, "ed25519": signed.signature}
+    finally:
         session.signature = before
-        raise
-    return signed
+    return signed, entry
+
+
+def keep_signature(session: ProcedureSession, entry: Mapping[str, Any]) -> None:
+    """The session carries the signature (its file saved)."""
+    session.signature = dict(entry)
+    if session.path is not None:
+        session.save()
+
+
+def still_signs(session: ProcedureSession, entry: Mapping[str, Any], context: Mapping[str, Any] | None,
+                signed: Signed) -> bool:
+    """Whether ``signed`` (made by :func:`session_signature`) still covers the session's report
+    with ``entry`` (a session changed since it was made does not)."""
+    import hashlib
+
+    before = dict(session.signature)
+    session.signature = dict(entry)
+    try:
+        content = render_html(build_report(session, context)).encode("utf-8")
+    finally:
+        session.signature = before
+    return hashlib.sha256(content).hexdigest() == signed.sha256
 
 
 def carried_signature(session: ProcedureSession) -> Signed | None:
@@ -122,7 +183,12 @@ def sign_report_file(
 
 def sign_other_file(register: Keys, key: Ed25519PrivateKey, who: str, path: str | Path) -> Signed:
     """Sign a file that cannot carry its signature (the report's PDF): recorded in the register."""
-    known = usable_key(register, key, who)
-    signed = sign_bytes(key, fileio.read_bytes(path), known.person, clock.utc_iso())
+    signed = file_signature(register, key, who, path)
     register.record_signature(signed, path)
     return signed
+
+
+def file_signature(register: KeyRecords, key: Ed25519PrivateKey, who: str, path: str | Path) -> Signed:
+    """The signature of a file as ``who`` with ``key`` (their usable key), not recorded."""
+    known = usable_key(register, key, who)
+    return sign_bytes(key, fileio.read_bytes(path), known.person, clock.utc_iso())

@@ -76,6 +76,7 @@ class ProceduresPage(BasePage):
     sigStepChanged = Signal()  # the current step or the run's state changed
     sigLiveDone = Signal(object)  # Observation of a live check (after it was recorded or shown)
     sigReportWritten = Signal(object, object)  # HTML path, PDF path (or None): a report was written
+    sigSigned = Signal(bool)  # a signing asked of a register on a server ended: signed or not
 
     def __init__(self, gui_session, main_window: PageHost | None = None):
         super().__init__()
@@ -89,7 +90,11 @@ class ProceduresPage(BasePage):
         self.run: ProcedureRun | None = None
         # the sign step's key: in the machine window's register (else the user's), its private
         # key in the user's keys folder
-        self.signer = ReportSigner(lambda: getattr(self.main_window, "signing_register", None))
+        self.signer = ReportSigner(
+            lambda: getattr(self.main_window, "signing_register", None),
+            lambda: getattr(self.main_window, "register_questions", None),
+            self._message,
+        )
         # a move on the Scope's Bench tab answers the steps that take it (CN2, servo on)
         self.bench_watch = BenchWatch(self)
         self._build()
@@ -514,15 +519,28 @@ class ProceduresPage(BasePage):
 
     def sign(self, who: str = "", passphrase: str | None = None) -> bool:
         """Sign the report as ``who`` (else the operator), with their key when the register keeps
-        one (``passphrase``: its passphrase; None asks for it when the key is encrypted)."""
+        one (``passphrase``: its passphrase; None asks for it when the key is encrypted). A
+        register on a server is asked from another thread: False at once, "Signing: asking…" in
+        the message line, and the answer there when it comes (``sigSigned`` then)."""
         if self.session is None:
             return False
         self._collect_for_report()
         ask = self._ask_passphrase if passphrase is None else (lambda _path: passphrase)
+        session = self.session
+
+        def done(said: str, signed: bool) -> None:
+            if self.session is session:  # still the session on show
+                self._message(said)
+                self._refresh()
+            self.sigSigned.emit(signed)
+
         try:
-            said = self.signer.sign(self.session, who or self.who, self.context, ask)
+            said = self.signer.sign(session, who or self.who, self.context, ask, done)
         except ValueError as exc:  # open checks, a key that cannot be used, a wrong passphrase
             self._message(str(exc))
+            return False
+        if said is None:
+            self._message("Signing: asking the register on the server for the signer's key…")
             return False
         self._message(said)
         self._refresh()
