@@ -88,17 +88,18 @@ class RegisterDialog(QDialog):
         self._asked = 0
         self.resize(1100, 620)
         layout = QVBoxLayout(self)
-        head = QHBoxLayout()
         kind = "Register on the server" if self.questions.on_server else "Register file"
         self.where_label = QLabel(f"{kind}: {shown_location(self.questions.location)}")
         self.where_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
-        head.addWidget(self.where_label, 1)
+        layout.addWidget(self.where_label)
         #: "Asking the server…" while a question waits; one line when an answer did not come
+        #: (its line kept for a server's, so that the tables do not jump; none for a file's)
         self.status_label = QLabel("")
         self.status_label.setObjectName("registerStatus")
         self.status_label.setWordWrap(True)
-        head.addWidget(self.status_label, 2)
-        layout.addLayout(head)
+        self.status_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.status_label.setVisible(self.questions.on_server)
+        layout.addWidget(self.status_label)
         self.questions.sigBusy.connect(self._on_busy)
         self.tabs = QTabWidget()
         layout.addWidget(self.tabs, 1)
@@ -206,16 +207,19 @@ class RegisterDialog(QDialog):
         self.questions.ask(what, question, take, refused)
 
     def _say(self, why: str) -> None:
-        self.status_label.setText(f"Not answered: {why}.")
-        self.status_label.setStyleSheet("color: #b00020;")
+        self._status(f"Not answered: {why}.", "color: #b00020;")
+
+    def _status(self, text: str, style: str = "") -> None:
+        self.status_label.setText(text)
+        self.status_label.setStyleSheet(style)
+        self.status_label.setVisible(bool(text) or self.questions.on_server)
 
     @Slot(bool)
     def _on_busy(self, busy: bool) -> None:
         if busy:
-            self.status_label.setText("Asking the server…")
-            self.status_label.setStyleSheet("")
+            self._status("Asking the server…", "color: #8a5a00; font-weight: bold;")
         elif self.status_label.text() == "Asking the server…":
-            self.status_label.setText("")
+            self._status("")
 
     # -- filling ------------------------------------------------------------------------------------
     @Slot()

@@ -304,7 +304,7 @@ class ServerQuestions(RegisterQuestions):
     def _server_away(self, what: str, why: str) -> None:
         if self.answers is not False:
             self.sigSay.emit(
-                f"Register: the server does not answer; {what} was not asked "
+                f"Register: the server does not answer: no answer about {what} "
                 f"({without_nothing_changed(why)}).", Level.WARNING
             )
         self.answers, self._said_slow = False, False
@@ -319,8 +319,8 @@ class ServerQuestions(RegisterQuestions):
         self._said_slow = True
         what = next(iter(self._pending.values())).what
         self.sigSay.emit(
-            f"Register: the server is slow to answer ({shown_url(self.url)}); {what} is still being "
-            "asked.", Level.WARNING
+            f"Register: the server is slow to answer ({shown_url(self.url)}); still waiting for {what}.",
+            Level.WARNING
         )
 
     @Slot()

@@ -105,7 +105,7 @@ def test_a_machine_window_on_a_server_that_hangs_and_stops(
             assert "is not in this report" in html.read_text(encoding="utf-8")
             # said on the axis on show (the new one: adding an axis shows it)
             said = _said_since(window.current_window, 0, "does not answer")
-            assert said.startswith("Register: the server does not answer; ")
+            assert said.startswith("Register: the server does not answer: no answer about ")
         # answering again: the axis added and the machine report are on the server, once
         qtbot.waitUntil(lambda: _axes(url) == ["table", "tilt"] and _machine_reports(url) == 1, timeout=30000)
         dialog.refresh()
