@@ -288,3 +288,11 @@ def test_the_queue_delivers_one_way_and_holds_only_what_this_computer_recorded(
         assert queue[table] <= server[table] and not queue[table] & before[table], table
     with Register(register_worker.queue_path(url)) as copy:
         assert [a.ref for a in copy.axes()] == ["Line 3 positioner/table"]
+    # the naming dialog offers the server's axes all the same, asked from another thread
+    from fha_studio.gui.window_register import WindowAxisDialog
+
+    dialog = WindowAxisDialog(window.window_register, window)
+    qtbot.waitUntil(lambda: "gripper" in dialog._known.get("Line 3 positioner", []), timeout=30000)
+    dialog.machine_combo.setCurrentText("Line 3 positioner")
+    assert [dialog.axis_combo.itemText(i) for i in range(dialog.axis_combo.count())] == ["table", "gripper"]
+    dialog.reject()
