@@ -500,7 +500,12 @@ class MachineWindow(QMainWindow):
             return None
         if self._register_dialog is None:
             self._register_dialog = RegisterDialog(
-                self.questions, self.project.name, self.current_axis.name, self
+                self.questions,
+                self.project.name,
+                self.current_axis.name,
+                self,
+                writer=self.server_writer,  # a settlement on a server goes through this computer's queue
+                operator=lambda: self.operator,
             )
         else:
             self._register_dialog.refresh(self.current_axis.name)

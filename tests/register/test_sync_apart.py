@@ -62,8 +62,9 @@ def test_a_change_made_after_the_other_side_was_known_is_no_conflict(tmp_path, r
     sync_registers(ana, plant)
     (conflict,) = sync_registers(ben, plant).conflicts
     assert (conflict.subject, conflict.items()) == ("parameters", ["in_position_range"])
-    assert sorted((s.values["in_position_range"].value, s.values["in_position_range"].who)
-                  for s in conflict.sides) == [(30, "ana"), (40, "ben")]
+    assert sorted(
+        (s.values["in_position_range"].value, s.values["in_position_range"].who) for s in conflict.sides
+    ) == [(30, "ana"), (40, "ben")]
     sync_registers(ana, plant)
     for where in (ana, ben, plant):
         assert [c.uid for c in _open(where)] == [conflict.uid]

@@ -101,6 +101,17 @@ class Resolution:
 
 
 @dataclass(frozen=True)
+class HeldWords:
+    """What one side of a conflict held for one item, for people."""
+
+    value: str  # in the item's words: "1: reversed: FWD turns CCW", "25 pulse"
+    source: str  # the fact that says it: "parameters read", "verified write", "axis entry"
+    who: str
+    when: str  # UTC, "2026-12-05 08:12:40"
+    where: str  # the register it was recorded in
+
+
+@dataclass(frozen=True)
 class Conflict:
     """An axis changed in two registers while apart, on which they disagree."""
 
@@ -127,24 +138,37 @@ class Conflict:
     def items(self) -> list[str]:
         return sorted({k for side in self.sides for k in side.values})
 
+    def item_name(self, key: str) -> str:
+        """An item in the manual's words: ``parameter 8 Rotary direction``, ``origin``, ``actuator``."""
+        return item_name(self.subject, key, self.sides, self.axis.driver_model)
+
+    def held_words(self, key: str, side: ConflictSide) -> HeldWords | None:
+        """What ``side`` held for ``key``, in words (None: nothing recorded)."""
+        held = side.values.get(key)
+        if held is None:
+            return None
+        return HeldWords(
+            value_words(self.subject, key, held, self.axis.driver_model),
+            _KIND_WORDS.get(held.kind, held.kind),
+            held.who,
+            words.when_text(held.at_utc),
+            held.where or side.register,
+        )
+
     def lines(self) -> list[str]:
         """The conflict for people: what it is about, then each side's values (numbered: the
         number ``--keep`` takes)."""
-        driver = self.axis.driver_model
         out = []
         for key in self.items():
-            out.append(f"  {item_name(self.subject, key, self.sides, driver)}:")
+            out.append(f"  {self.item_name(key)}:")
             for n, side in enumerate(self.sides, 1):
-                held = side.values.get(key)
+                held = self.held_words(key, side)
                 if held is None:
                     out.append(f"    {n}. {side_name(side)}: (nothing recorded)")
                     continue
-                by = ", ".join(t for t in (held.who, words.when_text(held.at_utc)) if t)
-                from_what = f" — {_KIND_WORDS.get(held.kind, held.kind)}" if held.kind else ""
-                out.append(
-                    f"    {n}. {value_words(self.subject, key, held, driver)}{from_what}"
-                    f"{f' ({by})' if by else ''}, in {held.where or side.register}"
-                )
+                by = ", ".join(t for t in (held.who, held.when) if t)
+                from_what = f" — {held.source}" if held.source else ""
+                out.append(f"    {n}. {held.value}{from_what}{f' ({by})' if by else ''}, in {held.where}")
         return out
 
     def summary(self) -> str:
@@ -413,6 +437,37 @@ class Conflicts(Queries):
             )
         return found[0]
 
+    def conflict_record(self, uid: str) -> dict[str, Any]:
+        """The conflict with stable id ``uid`` as this register holds it (its columns, the axis by
+        ``MACHINE/AXIS``), for a register that lacks it: :meth:`take_conflict`."""
+        row = self._db.execute(
+            "SELECT conflict.*, machine.name AS machine_name, axis.name AS axis_name FROM conflict"
+            " JOIN axis ON axis.id = conflict.axis_id JOIN machine ON machine.id = axis.machine_id"
+            " WHERE conflict.uid = ?",
+            (uid,),
+        ).fetchone()
+        if row is None:
+            raise RegisterError(f"no conflict {names.quoted(uid, 40)} in the register")
+        columns = row.keys()  # a row's keys (iterating a row gives its values)
+        record = {k: row[k] for k in columns if k not in ("id", "axis_id", "machine_name", "axis_name")}
+        return {**record, "axis": f"{row['machine_name']}/{row['axis_name']}"}
+
+    def take_conflict(self, record: Mapping[str, Any]) -> None:
+        """A conflict another register found (:meth:`conflict_record`), the same fact with the same
+        stable id, into this register (its axis there already); nothing when it is here. So a
+        settlement can be recorded in a register that did not hold the conflict (this computer's
+        queue for a server, which the server's facts do not come back to)."""
+        axis = self.axis(str(record["axis"]))
+        columns = ("at_utc", "who", "subject", "sides_json", *FACT_IDS.split(", "))
+        with self._transaction() as db:
+            if db.execute("SELECT 1 FROM conflict WHERE uid = ?", (record["uid"],)).fetchone():
+                return
+            db.execute(
+                f"INSERT INTO conflict (axis_id, {', '.join(columns)})"
+                f" VALUES (?, {', '.join('?' * len(columns))})",
+                (axis.id, *(record[c] for c in columns)),
+            )
+
     def resolve_conflict(
         self, ref: str, keep: int, who: str = "", note: str = "", at_utc: str | None = None
     ) -> Resolution:
@@ -425,7 +480,8 @@ class Conflicts(Queries):
             last = found.resolutions[-1]
             by = f" by {last.who}" if last.who else ""
             raise RegisterError(
-                f"conflict {found.short} was settled{by} at {words.when_text(last.at_utc)} (kept {last.kept})"
+                f"conflict {found.short} was settled{by} at {words.when_text(last.at_utc)} UTC"
+                f" (kept {last.kept})"
             )
         if isinstance(keep, bool) or not isinstance(keep, int) or not 1 <= keep <= len(found.sides):
             raise RegisterError(

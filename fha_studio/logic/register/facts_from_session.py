@@ -26,7 +26,7 @@ from fha_studio.logic.absolute import CHECK_TITLES, DgrCheckRecord
 from fha_studio.logic.procedures.report import build_report
 from fha_studio.logic.procedures.session import ProcedureSession
 from fha_studio.logic.register.importers import record_session
-from fha_studio.logic.register.store import Register
+from fha_studio.logic.register.store import Register, RegisterError
 
 #: A parameter of a snapshot as the register takes it: (mode, number, key, wire value).
 ParameterRow = tuple[str, int, str, int]
@@ -187,6 +187,29 @@ class ModelCheckFact:
     what: str = "model check"
 
 
+@dataclass(frozen=True)
+class SettlementFact:
+    """A person's settlement of a conflict between registers (the register dialog): the side kept
+    (1, 2, as the conflict numbers them) and why. ``conflict``: the conflict as the register it
+    was read from holds it (``Register.conflict_record``), for a register that lacks it (this
+    computer's queue for a server: the settlement goes there, and from there to the server)."""
+
+    conflict_uid: str
+    keep: int
+    who: str
+    note: str = ""
+    conflict: tuple[tuple[str, Any], ...] = ()
+    what: str = "settlement of a conflict"
+
+
+def settlement_fact(
+    conflict_uid: str, keep: int, who: str, note: str = "", record: Mapping[str, Any] | None = None
+) -> SettlementFact:
+    """A settlement of conflict ``conflict_uid``, with the conflict as the register it was read
+    from holds it (``Register.conflict_record``: for a register that lacks it)."""
+    return SettlementFact(conflict_uid, keep, who, note, tuple(sorted((record or {}).items())))
+
+
 Fact = (
     AxisFact
     | ActuatorFact
@@ -201,6 +224,7 @@ Fact = (
     | ReportFact
     | RecordingFact
     | ModelCheckFact
+    | SettlementFact
 )
 
 
@@ -440,6 +464,15 @@ def _model_check(register: Register, axis: str, f: ModelCheckFact) -> None:
     register.record_model_check(axis, f.summary, recording_file=f.recording_file, who=f.who)
 
 
+def _settlement(register: Register, axis: str, f: SettlementFact) -> None:
+    if f.conflict:
+        register.take_conflict(dict(f.conflict))
+    found = register.conflict(f.conflict_uid)
+    if found.axis.ref != register.axis(axis).ref:
+        raise RegisterError(f"conflict {found.short} is of {found.axis.ref}, not of {axis}")
+    register.resolve_conflict(f.conflict_uid, f.keep, who=f.who, note=f.note)
+
+
 #: How each kind of fact is written (``tests/register/test_facts_from_session.py`` checks every
 #: kind has its row).
 WRITERS: dict[type, Callable[[Register, str, Any], None]] = {
@@ -456,6 +489,7 @@ WRITERS: dict[type, Callable[[Register, str, Any], None]] = {
     ReportFact: _report,
     RecordingFact: _recording,
     ModelCheckFact: _model_check,
+    SettlementFact: _settlement,
 }
 
 

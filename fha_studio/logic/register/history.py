@@ -211,7 +211,8 @@ def _conflict_events(conflicts: list[Conflict]) -> list[Event]:
     for c in conflicts:
         hint = f" — settle it: fha-studio register resolve {c.short} --keep 1 or 2" if c.open else ""
         out.append(Event(c.at_utc, EventKind.CONFLICT, c.who, f"conflict {c.short}: {c.summary()}{hint}",
-                         c.id, {"conflict": c.short, "subject": c.subject, "open": c.open}, c.uid))
+                         c.id, {"conflict": c.short, "subject": c.subject, "open": c.open,
+                                **({"hint": hint} if hint else {})}, c.uid))
         for r in c.resolutions:
             side = c.sides[r.kept - 1] if 0 < r.kept <= len(c.sides) else None
             kept = "; ".join(
