@@ -33,6 +33,23 @@ from fha_studio.recording import Recording, read_recording, write_recording
 
 CODE = "FHA-25C-50-US250"
 
+# CPU seconds of the same 20 s cases on a012ce5, before the speed work of issue 24 (best of 3, runs
+# interleaved with the version after it on this 2-core machine at load 8-10; after: 1.01-1.07,
+# 0.72-0.79, 1.13-1.26, 1.01-1.11, 0.73-0.80, 0.44-0.56). Load inflates every figure alike.
+BEFORE_CPU_S = {
+    ("torque: coulomb + gravity", True): (1.60, 1.67),
+    ("torque: coulomb + gravity", False): (1.02, 1.10),
+    ("torque + load_pos: + wind-up", True): (1.54, 1.70),
+    ("torque + load_pos: + wind-up", False): (1.20, 1.32),
+    ("no current: closed loop", True): (0.93, 0.98),
+    ("no current: closed loop", False): (0.72, 1.06),
+}
+
+
+def _before(name: str, resim: bool) -> str:
+    low, high = BEFORE_CPU_S[(name, resim)]
+    return f"  [a012ce5: {low:.2f}-{high:.2f} s]"
+
 
 def _command(duration_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Back-and-forth moves repeated to fill duration_s at 1 kHz."""
@@ -75,7 +92,7 @@ def main() -> None:
                 print(
                     f"  {name:30s} resim={'on ' if resim else 'off'}  read {t1 - t0:5.2f} s  "
                     f"check {t2 - t1:5.2f} s  (cpu {c2 - c0:5.2f} s)  "
-                    f"bandwidth {result.bandwidth_hz:5.1f} Hz  named: {named}"
+                    f"bandwidth {result.bandwidth_hz:5.1f} Hz  named: {named}{_before(name, resim)}"
                 )
 
     # a bench capture: no current column, read through the closed loop identified from the recording
@@ -88,7 +105,8 @@ def main() -> None:
         cpu = time.process_time() - c0
         named = ", ".join(e.id for e in result.effects) or "none"
         on = "on " if resim else "off"
-        print(f"  {'no current: closed loop':30s} resim={on}  (cpu {cpu:5.2f} s)  named: {named}")
+        name = "no current: closed loop"
+        print(f"  {name:30s} resim={on}  (cpu {cpu:5.2f} s)  named: {named}{_before(name, resim)}")
 
     print(f"cost against length (torque + friction, re-simulation on; it covers at most {RESIM_MAX_S:g} s):")
     for duration in (5.0, 10.0, 20.0, 40.0, 80.0):
