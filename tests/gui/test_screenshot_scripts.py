@@ -28,14 +28,26 @@ def _environment_set(tree: ast.Module) -> dict[str, int]:
     return found
 
 
-def _first_qt_line(tree: ast.Module) -> int:
-    """The first line that imports Qt or the GUI at module level (the settings' place is fixed then)."""
+def _first_qt_line(tree: ast.Module) -> int | None:
+    """The first line that imports Qt or the GUI at module level (the settings' place is fixed then);
+    None for a module that imports Qt only inside its functions (docs/screenshots/shots.py)."""
     for node in tree.body:
         if isinstance(node, ast.Import | ast.ImportFrom):
             names = [node.module or ""] if isinstance(node, ast.ImportFrom) else [a.name for a in node.names]
             if any(n.startswith(("PySide6", "fha_studio.gui")) for n in names):
                 return node.lineno
-    raise AssertionError("no Qt import")
+    return None
+
+
+def _sets_both_in_a_function(tree: ast.Module) -> bool:
+    """Whether a function of the module sets both folders to a temporary one (shots.py's
+    private_folder, which its scripts call before they start Qt)."""
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef):
+            inner = ast.Module(body=node.body, type_ignores=[])
+            if {"XDG_CONFIG_HOME", "XDG_DATA_HOME"} <= set(_environment_set(inner)):
+                return True
+    return False
 
 
 def test_every_screenshot_script_keeps_the_users_settings_and_data_out_of_it():
@@ -48,6 +60,10 @@ def test_every_screenshot_script_keeps_the_users_settings_and_data_out_of_it():
         tree = ast.parse(text)
         where = _environment_set(tree)
         first_qt = _first_qt_line(tree)
+        if first_qt is None:  # Qt started by a function: the folders must be set by one too
+            if not _sets_both_in_a_function(tree):
+                wrong.append(f"{path.relative_to(ROOT)}: starts Qt without setting both folders first")
+            continue
         for name in ("XDG_CONFIG_HOME", "XDG_DATA_HOME"):
             if where.get(name, first_qt) >= first_qt:
                 wrong.append(f"{path.relative_to(ROOT)}: {name} is not a temporary directory before Qt")
