@@ -10,7 +10,7 @@ HA-655), from what bench instruments give on CN2.
 - *Verify the proposal from the capture*: a capture made after typing the worksheet's items,
   compared with what the loop predicts for them.
 
-The analysis runs in a thread of its own (``_Worker``): the GUI thread never waits for it.
+The analysis runs in a thread of its own (``_AnalysisWorker``): the GUI thread never waits for it.
 """
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ GUESSES = {"speed_monitor": ("spd_mon", "spd-mon", "spdmon", "speed_monitor"),
 NOT_RECORDED = "(not recorded)"
 
 
-class _Worker(QObject):
+class _AnalysisWorker(QObject):
     """Runs an analysis in its own thread."""
 
     sigDone = Signal(str, object)  # what was asked, its result
@@ -149,7 +149,7 @@ class BenchTuningPanel(QGroupBox):
 
         self._thread = QThread(self)
         self._thread.setObjectName("bench tuning")
-        self._worker = _Worker()
+        self._worker = _AnalysisWorker()
         self._worker.moveToThread(self._thread)
         self.sigRequest.connect(self._worker.run)
         self._worker.sigDone.connect(self._done)
