@@ -1,6 +1,7 @@
 """What a small screen hides: toolbar actions pushed behind the toolbar's chevron, tabs behind
 scroll arrows, and text cut short (a label, button, group title or progress bar's text wider
-than the room it has). Used by the fit tests of the main window and its dialogs."""
+than the room it has; a wrapped label's lines taller than it is). Used by the fit tests of the
+main window and its dialogs."""
 
 from __future__ import annotations
 
@@ -81,14 +82,33 @@ def hidden_actions(top: QWidget) -> list[str]:
     return found
 
 
+def _cut_wrapped(label: QLabel, room: int, metrics: QFontMetrics) -> list[str]:
+    """A word-wrapped label is cut when its lines need more height than it has, or when a word
+    (a long path, a URL) is wider than its width (Qt does not break inside a word)."""
+    found = []
+    need = label.heightForWidth(label.width())
+    if need > label.height() + 1:
+        text = " ".join(_plain_lines(label))
+        found.append(f"{_name(label)}: {text[:80]!r} needs {need} px of height, has {label.height()}")
+    for line in _plain_lines(label):
+        for word in line.split():
+            width = metrics.horizontalAdvance(word)
+            if width > room + 1:
+                found.append(f"{_name(label)}: the word {word[:80]!r} needs {width} px, has {room}")
+    return found
+
+
 def cut_texts(top: QWidget) -> list[str]:
     """Texts wider than the room their widget gives them, one line each."""
     found = []
     for label in top.findChildren(QLabel):
-        if not _shown(label, top) or not label.text() or label.wordWrap():
+        if not _shown(label, top) or not label.text():
             continue
         room = label.contentsRect().width() - 2 * label.margin() - 2 * max(label.indent(), 0)
         metrics = QFontMetrics(label.font())
+        if label.wordWrap():
+            found += _cut_wrapped(label, room, metrics)
+            continue
         for line in _plain_lines(label):
             width = metrics.horizontalAdvance(line)
             if width > room + 1:

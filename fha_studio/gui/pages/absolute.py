@@ -46,6 +46,7 @@ from PySide6.QtWidgets import (
 from fha_studio.gui.link import SERVO_ON_NOTE, Call, DriveStatus, LinkInfo, LinkReply
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import data_dir
+from fha_studio.gui.widgets import scrolling
 from fha_studio.hardware.api import CommandNotSupported, CommandRejected, ServoOnRefused
 from fha_studio.hardware.protocol import ABSOLUTE_COUNTS_PER_TURN, Command
 from fha_studio.logic import absolute as ab
@@ -123,10 +124,12 @@ class AbsolutePage(BasePage):
         split = QSplitter(Qt.Orientation.Vertical)
         self.tabs = QTabWidget()
         self.tabs.setObjectName("dgrChecks")
-        self.tabs.addTab(self._build_encoder(), "Encoder check")
-        self.tabs.addTab(self._build_direction(), "Rotary direction (1-10)")
-        self.tabs.addTab(self._build_dogs(), "Sensor dogs (4-7-2)")
-        self.tabs.addTab(self._build_origin(), "Absolute origin (OWW)")
+        # each check scrolls where the records below leave it too little height (1024 x 600):
+        # its wrapped steps are never squeezed under its buttons
+        self.tabs.addTab(scrolling(self._build_encoder(), 0), "Encoder check")
+        self.tabs.addTab(scrolling(self._build_direction(), 0), "Rotary direction (1-10)")
+        self.tabs.addTab(scrolling(self._build_dogs(), 0), "Sensor dogs (4-7-2)")
+        self.tabs.addTab(scrolling(self._build_origin(), 0), "Absolute origin (OWW)")
         split.addWidget(self.tabs)
         self.history = QTableWidget(0, 5)
         self.history.setObjectName("dgrHistory")
