@@ -279,6 +279,7 @@ class LinkWorker(QObject):
             adjusted_for=ident.adjusted_for if ident else "",
             firmware=ident.firmware if ident else "",
             capabilities=caps.describe(),
+            capabilities_summary=caps.summary(),
             can_move=caps.can_move,
             can_monitor=caps.can_monitor,
             can_parameters=caps.parameters,

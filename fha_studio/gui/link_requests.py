@@ -50,6 +50,7 @@ class LinkInfo:
     adjusted_for: str = ""
     firmware: str = ""
     capabilities: str = ""  # the client's plain description of what the drive supports
+    capabilities_summary: str = ""  # the same in a few words (the status bar's)
     can_move: bool = True  # jog/move/servo extension commands are there
     can_monitor: bool = True
     can_parameters: bool = True

@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Protocol, cast
 from PySide6.QtCore import QObject, QSettings, Qt, Slot
 from PySide6.QtGui import QAction, QKeySequence, QShortcut
 from PySide6.QtWidgets import (
-    QLabel,
     QMainWindow,
     QMessageBox,
     QPushButton,
@@ -44,7 +43,7 @@ from fha_studio.gui.pages.parameters import ParametersPage
 from fha_studio.gui.pages.registry import PAGES, PageEntry
 from fha_studio.gui.session import Session, new_axis_state
 from fha_studio.gui.state import AxisState
-from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton
+from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton, WrappingLabel
 from fha_studio.hardware.protocol import BAUDRATE
 from fha_studio.logic.commissioning import CommissioningState
 
@@ -63,6 +62,9 @@ CAPS_WIDTH_PX = 420
 #: ... but never more than this share of the window's width, so that a narrow screen (1024 px)
 #: still leaves room for the message line.
 CAPS_WIDTH_SHARE = 0.25
+#: What the status bar's margins, spacing and size grip take of its width [px] (more than they
+#: take: a message wrapped a little early keeps its words whole).
+STATUS_BAR_SPACING_PX = 72
 
 
 class WindowPart(Protocol):
@@ -255,10 +257,10 @@ class MainWindow(QMainWindow, PageLookup):
         self.link_lamp = Lamp("Link")
         self.servo_lamp = Lamp("Servo", AMBER)
         self.alarm_lamp = Lamp("Alarm", RED)
-        self.caps_label = QLabel("")
+        # the link's state in a few words (whole, wrapped; what it means in the tooltip): it never
+        # takes the room of the messages, which a person must see
+        self.caps_label = WrappingLabel("")
         self.caps_label.setObjectName("capabilities")
-        # the capabilities are a summary (full text in the tooltip): they never take the room of
-        # the messages, which a person must see
         self.caps_label.setMaximumWidth(CAPS_WIDTH_PX)
         self.message_area = MessageArea(self)
         bar.addWidget(self.message_area, 1)
@@ -267,13 +269,27 @@ class MainWindow(QMainWindow, PageLookup):
         bar.addPermanentWidget(self.caps_label)
 
     def _set_caps(self, text: str) -> None:
-        """The link summary at the right of the status bar, elided to its room; full in the tooltip."""
+        """The link summary at the right of the status bar, wrapped to its room (a word longer
+        than the room, a long URL, shortened in its middle); whole in the tooltip."""
         self._caps_text = text
         width = self._caps_width()
         self.caps_label.setMaximumWidth(width)
         metrics = self.caps_label.fontMetrics()
-        self.caps_label.setText(metrics.elidedText(text, Qt.TextElideMode.ElideRight, width - 8))
+        room = width - 8
+        self.caps_label.setText(" ".join(
+            metrics.elidedText(word, Qt.TextElideMode.ElideMiddle, room) for word in text.split(" ")
+        ))
         self.caps_label.setToolTip(text)
+        self._fit_message_line()
+
+    def _fit_message_line(self) -> None:
+        """The message line wraps at the room the status bar leaves it beside the lamps and the
+        link's state (known from the window's width, not from a passing layout)."""
+        text = self.message_area.text_label
+        lamps = (self.link_lamp, self.servo_lamp, self.alarm_lamp)
+        beside = (self.message_area.log_button, *lamps, self.caps_label)
+        room = self.width() - sum(w.sizeHint().width() for w in beside) - STATUS_BAR_SPACING_PX
+        text.set_wrap_width(max(text.minimumWidth(), room))
 
     def _caps_width(self) -> int:
         return max(120, min(CAPS_WIDTH_PX, int(self.width() * CAPS_WIDTH_SHARE)))
@@ -285,6 +301,7 @@ class MainWindow(QMainWindow, PageLookup):
             tooltip = self.caps_label.toolTip()
             self._set_caps(text)
             self.caps_label.setToolTip(tooltip)  # a connected drive's tooltip says more than the text
+        self._fit_message_line()
 
     # -- settings -------------------------------------------------------------------------------
     def _restore_layout(self) -> None:
@@ -363,7 +380,7 @@ class MainWindow(QMainWindow, PageLookup):
             return False
         self.link.open(url, baud_rate)
         self.link_lamp.set_state(None)
-        self._set_caps(f"connecting to {url} …")
+        self._set_caps(f"Connecting to {url} …")
         return True
 
     @Slot()
@@ -418,8 +435,9 @@ class MainWindow(QMainWindow, PageLookup):
         where = "embedded simulated drive" if info.is_simulated else info.url
         model = info.driver_model or "driver model unknown"
         self.link_lamp.setToolTip(f"Link: connected to {where} ({model})")
-        first = (info.capabilities or "capabilities unknown").split(". ")[0].rstrip(".")
-        self._set_caps(f"{model} · {where} · {first}.")
+        summary = info.capabilities_summary or "what it supports is unknown"
+        # a drive that does not say its model (a real HA-655) is named by where it is
+        self._set_caps(" · ".join(([info.driver_model] if info.driver_model else []) + [where, summary]))
         self.caps_label.setToolTip(f"{model} · {where}\n{info.capabilities}")
         self.disconnect_action.setEnabled(True)
         self.servo_action.setEnabled(info.can_move)
@@ -453,15 +471,19 @@ class MainWindow(QMainWindow, PageLookup):
         self.servo_action.setChecked(False)
         self.setWindowTitle("FHA Studio — not connected")
         if lost:
+            why = _without_prefix(reason, "link lost: ")
             self.link_lamp.set_state(True, RED)
-            self.link_lamp.setToolTip(f"Link: LOST — {reason}")
-            self._set_caps(f"LINK LOST: {reason}. Check the cable and power, then Connect… (Ctrl+K)")
+            self.link_lamp.setToolTip(f"Link: LOST — {why}")
+            # the reason is the message line's (it can be long); here what to do
             self.caps_label.setStyleSheet("color: #b00020; font-weight: bold;")
-            self.show_message(f"Link lost: {reason}. Check the cable and power, then Connect… (Ctrl+K).",
+            self._set_caps("LINK LOST. Check the cable and power, then Connect… (Ctrl+K)")
+            self.caps_label.setToolTip(f"Link lost: {why}")
+            self.show_message(f"Link lost: {why}. Check the cable and power, then Connect… (Ctrl+K).",
                               Level.ERROR)
         else:
-            self._set_caps(f"Not connected ({reason}). Connect… (Ctrl+K)")
             self.caps_label.setStyleSheet("")
+            because = "" if reason == "not connected" else f" ({reason})"
+            self._set_caps(f"Not connected{because}. Connect… (Ctrl+K)")
 
     @Slot(object)
     def _on_status(self, status: DriveStatus) -> None:
@@ -501,8 +523,9 @@ class MainWindow(QMainWindow, PageLookup):
             return
         if isinstance(request, Open):
             self.show_message(f"Could not connect: {result.error}", Level.ERROR)
-            self._set_caps(f"Could not connect: {result.error}")
             self.caps_label.setStyleSheet("color: #b00020; font-weight: bold;")
+            self._set_caps("Could not connect: see the message at the left. Connect… (Ctrl+K)")
+            self.caps_label.setToolTip(f"Could not connect: {result.error}")
             self.link_lamp.set_state(True, RED)
         elif not isinstance(request, JogLease | SimPanelRequest):  # the panel says its own
             self.show_message(f"{request.words} failed: {result.error}", Level.ERROR)
@@ -540,6 +563,12 @@ class MainWindow(QMainWindow, PageLookup):
         self.training.shutdown()
         if self.window_register is not None:
             self.window_register.shutdown()
+
+
+def _without_prefix(text: str, prefix: str) -> str:
+    """``text`` without ``prefix`` (any case) in front: the link says "link lost: ..." and the
+    window puts its own words before it."""
+    return text[len(prefix):] if text.lower().startswith(prefix) else text
 
 
 class LazyPage(QWidget):

@@ -1,7 +1,8 @@
-"""The message area: one visible line at the bottom of the main window for every outcome a
-person caused (STOP sent or not, a write failed, a backup saved), and the log of all of them with
-their time. QStatusBar's temporary messages are covered by permanent widgets and vanish after a
-few seconds; a technician who presses STOP must see what happened, so nothing here is temporary.
+"""The message area: a line at the bottom of the main window (more when the message is long: it
+is never cut) for every outcome a person caused (STOP sent or not, a write failed, a backup
+saved), and the log of all of them with their time. QStatusBar's temporary messages are covered
+by permanent widgets and vanish after a few seconds; a technician who presses STOP must see what
+happened, so nothing here is temporary.
 """
 
 from __future__ import annotations
@@ -16,7 +17,6 @@ from PySide6.QtWidgets import (
     QDialogButtonBox,
     QFrame,
     QHBoxLayout,
-    QLabel,
     QPushButton,
     QTableWidget,
     QTableWidgetItem,
@@ -25,6 +25,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio import clock
+from fha_studio.gui.widgets import WrappingLabel
 
 #: Most messages kept in the log (oldest dropped first).
 MESSAGE_LOG_LENGTH = 500
@@ -69,7 +70,7 @@ class MessageArea(QFrame):
         self.messages: list[Message] = []
         layout = QHBoxLayout(self)
         layout.setContentsMargins(4, 0, 4, 0)
-        self.text_label = QLabel("")
+        self.text_label = WrappingLabel("")  # a long message takes a second line, never cut
         self.text_label.setObjectName("messageText")
         self.text_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         self.text_label.setMinimumWidth(200)
@@ -82,7 +83,8 @@ class MessageArea(QFrame):
 
     @Slot(str)
     def show_message(self, text: str, level: Level = Level.INFO) -> Message:
-        """Show ``text`` (one line; the full text is in the tooltip and the log) and keep it."""
+        """Show ``text`` whole (wrapped when it is longer than the line; also in the tooltip and the
+        log) and keep it."""
         message = Message(clock.now_s(), level, " ".join(str(text).split()))
         self.messages.append(message)
         del self.messages[:-MESSAGE_LOG_LENGTH]

@@ -66,6 +66,49 @@ class Lamp(QLabel):
         painter.end()
 
 
+class WrappingLabel(QLabel):
+    """A word-wrapped label that asks its layout for the height its text needs, also in a layout
+    that does not ask for height-for-width (the status bar): a long message takes another line
+    instead of being cut. Its preferred width is that of the text on one line (up to its maximum
+    width). It wraps at ``wrap_width_px`` when its owner sets it (a stretched label, whose room
+    the owner knows), else at its preferred width: never at a width a layout gives it for a
+    moment, since a window grows with its minimum height and does not shrink back."""
+
+    #: Least width it asks for [px]; a layout may still give it more (a stretch).
+    MINIMUM_WIDTH_PX = 120
+
+    def __init__(self, text: str = "", parent: QWidget | None = None):
+        super().__init__(text, parent)
+        self.setWordWrap(True)
+        self.wrap_width_px: int | None = None
+
+    def setText(self, text: str) -> None:
+        super().setText(text)
+        self.updateGeometry()
+
+    def set_wrap_width(self, width_px: int | None) -> None:
+        """Wrap at ``width_px`` (None: at the preferred width)."""
+        if width_px != self.wrap_width_px:
+            self.wrap_width_px = width_px
+            self.updateGeometry()
+
+    def _one_line_width(self) -> int:
+        margins = self.contentsMargins()
+        room = margins.left() + margins.right() + 2 * self.margin() + 2
+        return self.fontMetrics().horizontalAdvance(self.text()) + room
+
+    def _height(self) -> int:
+        width = self.wrap_width_px or min(self._one_line_width(), self.maximumWidth())
+        height = self.heightForWidth(max(width, 1))
+        return height if height > 0 else super().sizeHint().height()
+
+    def sizeHint(self) -> QSize:
+        return QSize(min(self._one_line_width(), self.maximumWidth()), self._height())
+
+    def minimumSizeHint(self) -> QSize:
+        return QSize(min(self._one_line_width(), self.MINIMUM_WIDTH_PX, self.maximumWidth()), self._height())
+
+
 class StopButton(QPushButton):
     """The big red STOP. Always enabled: stopping is never refused.
 

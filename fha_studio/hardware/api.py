@@ -95,6 +95,13 @@ _LEVEL_SENTENCES = {
         "no absolute position (DGR is refused, e.g. an incremental encoder). Use the drive's front panel."
     ),
 }
+#: The same in a few words, for the window's status bar (the sentences above in its tooltip).
+_LEVEL_SUMMARIES = {
+    CapabilityLevel.TRACE: "traces at the servo rate",
+    CapabilityLevel.POLLING: "signals polled, no traces",
+    CapabilityLevel.ABSOLUTE_POSITION: "the manual's commands only (DGR, OWW)",
+    CapabilityLevel.NOTHING: "nothing to read over CN3: use the front panel",
+}
 
 
 @dataclass(frozen=True)
@@ -142,6 +149,10 @@ class Capabilities:
 
     def supports(self, command: Command) -> bool:
         return command in self.commands
+
+    def summary(self) -> str:
+        """What the drive gives, in a few words (``describe`` says it whole)."""
+        return _LEVEL_SUMMARIES[self.level]
 
     def describe(self) -> str:
         """Plain-language sentences for the user: what this drive gives and what it does not."""

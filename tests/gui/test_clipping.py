@@ -106,3 +106,45 @@ def test_every_page_shows_its_controls_and_its_text_whole(window, qtbot, size):
                 qtbot.wait(20)  # let the page lay out
                 problems |= {f"{page_id}: {p}" for p in hidden_actions(window) + cut_texts(window)}
     assert not problems, "\n".join(sorted(problems))
+
+
+def test_every_status_message_reads_whole(make_window, qtbot):
+    """What the status bar says is read whole at 1366 x 740 (a 1366 x 768 screen), 1280 x 720 and
+    1024 x 600: the longest message (STOP on a drive without a stop command, the link lost) and the
+    link's state (servo on: CN3 silent) wrap onto another line instead of being cut, side by side
+    without overlapping, and the window still fits the small screen."""
+    from fha_studio.gui.link import SERVO_ON_NOTE, SimPanelRequest
+    from fha_studio.gui.widgets import StopButton
+    from tests.gui.fit import cut_texts
+
+    window = make_window(connect="sim://FHA-25C-50-S248?paced=0&profile=documented")
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
+                          timeout=10000):
+        window.sim_panel.servo_check.setChecked(True)  # the controller's servo-ON (CN2)
+    qtbot.waitUntil(lambda: SERVO_ON_NOTE in window.caps_label.text(), timeout=10000)
+    window.stop_axis()  # nothing can be sent: the message says what stops the axis
+    assert StopButton.NO_STOP_TEXT in window.message_area.text_label.text()
+
+    def problems(size: tuple[int, int]) -> list[str]:
+        bar = window.statusBar()
+        found = cut_texts(bar)
+        text, caps = window.message_area.text_label, window.caps_label
+        if text.geometry().translated(text.parentWidget().pos()).intersects(caps.geometry()):
+            found.append("the message overlaps the link's state")
+        if window.height() > size[1]:
+            found.append(f"the window is {window.height()} px high")
+        return found
+
+    for state in ("servo on", "link lost"):
+        if state == "link lost":
+            window.link._worker._client.transaction.transport.inner.close()  # the cable is pulled
+            qtbot.waitUntil(lambda: "LINK LOST" in window.caps_label.text(), timeout=10000)
+            assert "Link lost:" in window.message_area.text_label.text()
+        for size in ((1366, 740), (1280, 720), (1024, 600)):
+            window.resize(*size)
+            qtbot.waitUntil(lambda size=size: window.width() == size[0], timeout=10000)
+            try:
+                qtbot.waitUntil(lambda size=size: not problems(size), timeout=3000)  # the bar lays out anew
+            except qtbot.TimeoutError:
+                found = "\n".join(problems(size))
+                raise AssertionError(f"{state}, {size[0]} x {size[1]}:\n{found}") from None
