@@ -56,7 +56,7 @@ def temporary_name(target: Path) -> Path:
     return target.with_name(f".{target.name}.{secrets.token_hex(4)}.tmp")
 
 
-def _started_ticks(pid: int) -> int | None:
+def started_ticks(pid: int) -> int | None:
     """The kernel's start time of process ``pid`` (clock ticks since boot), None where it is not
     told (not Linux, no such process)."""
     try:
@@ -67,7 +67,7 @@ def _started_ticks(pid: int) -> int | None:
         return None
 
 
-def _alive(pid: int, started: int | None) -> bool:
+def process_alive(pid: int, started: int | None) -> bool:
     """Whether the writer ``pid`` (started at ``started`` ticks, if known) is still running: a
     zombie is dead, and so is another process that has since been given the same pid."""
     if pid <= 0:
@@ -111,7 +111,7 @@ def note(temporary: Path) -> Note:
     cannot be written gives a note that notes nothing: the write goes on without it."""
     pid = os.getpid()
     content = json.dumps({
-        "pid_started_ticks": _started_ticks(pid),
+        "pid_started_ticks": started_ticks(pid),
         "temporary": os.fspath(temporary.absolute()),
         "noted_utc": clock.utc_iso(),
     })
@@ -152,7 +152,7 @@ def sweep() -> list[Path]:
         try:
             content = _read_note(entry.path) or {}
             started = content.get("pid_started_ticks")
-            if _alive(int(found.group(1)), started if isinstance(started, int) else None):
+            if process_alive(int(found.group(1)), started if isinstance(started, int) else None):
                 continue
             temporary = content.get("temporary")
             if isinstance(temporary, str) and temporary:

@@ -10,46 +10,15 @@ directory, never the user's.
 
 from __future__ import annotations
 
-import os
 import subprocess
-import sys
-import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-TMP = Path(tempfile.mkdtemp(prefix="fha-machine-shots-"))
-os.environ["XDG_CONFIG_HOME"] = str(TMP / "config")
-os.environ["XDG_DATA_HOME"] = str(TMP / "data")
-os.environ.pop("FHA_STUDIO_REGISTER", None)
+from shots import OUT, ScreenshotRun, private_folder
 
-from PySide6.QtCore import QCoreApplication, QEventLoop, QTimer  # noqa: E402
-from PySide6.QtGui import QColor, QImage, QPainter  # noqa: E402
-from PySide6.QtWidgets import QApplication  # noqa: E402
-
-OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
-
-
-def settle(ms: int) -> None:
-    """Runs the event loop for ``ms`` milliseconds."""
-    loop = QEventLoop()
-    QTimer.singleShot(ms, loop.quit)
-    loop.exec()
-
-
-def wait_until(condition, timeout_s: float = 20.0) -> None:
-    left_ms = int(timeout_s * 1000)
-    while not condition():
-        if left_ms <= 0:
-            raise TimeoutError("the GUI did not get there in time")
-        settle(50)
-        left_ms -= 50
+TMP = Path(private_folder())
 
 
 def main() -> int:
-    app = QApplication(sys.argv[:1])  # noqa: F841 - kept alive for the whole run
-    QCoreApplication.setOrganizationName("FHA Studio Screenshots")
-    QCoreApplication.setApplicationName("fha-studio-screenshots")
     from fha_studio.gui.machine_window import MachineWindow
     from fha_studio.logic.machine import MachineProject
     from fha_studio.logic.register import Register
@@ -65,16 +34,19 @@ def main() -> int:
     tilt = "sim://FHA-32C-100-S248-B?paced=0&profile=documented&oww_clear_s=1"
     project.add_axis("tilt", "FHA-32C-100-S248-B", port_url=tilt, load_inertia_kgm2=4.0)
     register = Register(TMP / "register.sqlite")
-    window = MachineWindow(project, register)
+    run = ScreenshotRun((1366, 740), make_window=lambda: MachineWindow(project, register))
+    window, wait_until, settle, shot = run.window, run.wait_until, run.settle, run.shot
+    from PySide6.QtGui import QColor, QImage, QPainter
+
     window.operator_edit.setText("A. Technician")
-    window.resize(1366, 740)
-    window.show()
     window.connect_all()
-    wait_until(lambda: all(w.link.connected for w in window.axis_windows))
+    wait_until(lambda: all(w.link.connected for w in window.axis_windows), "every axis connected")
     table, twin, _ = window.axis_windows
-    wait_until(lambda: len(table.state.drive_values) >= 14 and len(twin.state.drive_values) >= 14)
+    wait_until(lambda: len(table.state.drive_values) >= 14 and len(twin.state.drive_values) >= 14,
+               "the two full drives' values")
     table.session.write([("system", 8, 1)])
-    wait_until(lambda: any(e.kind == "write" for e in register.history("Line 3 positioner/table")))
+    wait_until(lambda: any(e.kind == "write" for e in register.history("Line 3 positioner/table")),
+               "the table's write in the register")
     page = table.show_page("procedures")
     page.operator_edit.setText("A. Technician")
     page.new_session(TMP / "table.fha-session.json")
@@ -89,25 +61,20 @@ def main() -> int:
     tilt_window.state.enter_front_panel("system", 8, 0, "A. Technician")
     dgr = tilt_window.show_page("absolute")
     dgr.who_edit.setText("A. Technician")
-    wait_until(lambda: dgr.origin_button.isEnabled())
+    wait_until(lambda: dgr.origin_button.isEnabled(), "the tilt's OWW button")
     dgr.origin_button.click()
-    wait_until(lambda: bool(dgr.records))
+    wait_until(lambda: bool(dgr.records), "the tilt's origin recorded")
 
     window.select_axis("table twin")
     twin.show_page("parameters")
-    settle(800)
-    OUT.mkdir(parents=True, exist_ok=True)
-    path = OUT / "machine-axes.png"
-    window.grab().save(str(path))
-    print("saved", path)
+    settle(0.8)
+    shot("machine-axes")
 
     window.select_axis("table")
     dialog = window.show_register()
     dialog.tabs.setCurrentIndex(1)  # compare: the table against its twin
-    settle(500)
-    path = OUT / "machine-register.png"
-    dialog.grab().save(str(path))
-    print("saved", path)
+    settle(0.5)
+    shot("machine-register", dialog)
     dialog.close()
 
     _html, pdf = window.write_machine_report(TMP / "machine.html", TMP / "machine.pdf")
@@ -131,11 +98,10 @@ def main() -> int:
     target = OUT / "machine-report.png"
     sheet.save(str(target))
     print("saved", target)
-    window.shutdown()
-    window.close()
+    run.close()
     register.close()
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(main())

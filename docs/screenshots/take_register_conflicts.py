@@ -12,30 +12,14 @@ settings and data go to a temporary directory, never the user's.
 
 from __future__ import annotations
 
-import os
 import sys
-import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-TMP = Path(tempfile.mkdtemp(prefix="fha-conflict-shots-"))
-os.environ["XDG_CONFIG_HOME"] = str(TMP / "config")
-os.environ["XDG_DATA_HOME"] = str(TMP / "data")
-os.environ.pop("FHA_STUDIO_REGISTER", None)
+from shots import ScreenshotRun, private_folder
 
-from PySide6.QtCore import QCoreApplication, QEventLoop, QTimer  # noqa: E402
-from PySide6.QtWidgets import QApplication  # noqa: E402
-
-OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
+TMP = Path(private_folder())
 SIZE = tuple(int(n) for n in (sys.argv[2] if len(sys.argv) > 2 else "1280x720").split("x"))
 M = "Line 3 positioner"
-
-
-def settle(ms: int) -> None:
-    loop = QEventLoop()
-    QTimer.singleShot(ms, loop.quit)
-    loop.exec()
 
 
 def laptop(path: Path, who: str, direction: int, in_position: int, at: str, origin: str) -> None:
@@ -66,9 +50,6 @@ def laptop(path: Path, who: str, direction: int, in_position: int, at: str, orig
 
 
 def main() -> int:
-    app = QApplication(sys.argv[:1])  # noqa: F841 - kept alive for the whole run
-    QCoreApplication.setOrganizationName("FHA Studio Screenshots")
-    QCoreApplication.setApplicationName("fha-studio-screenshots")
     from fha_studio.gui.register_dialog import RegisterDialog
     from fha_studio.logic.register import Register
     from fha_studio.logic.register.sync import sync_registers
@@ -79,9 +60,9 @@ def main() -> int:
     laptop(ben, "Ben Okafor", 0, 25, "2026-12-05T09:30:05Z", "+0.00°")
     sync_registers(ana, ben, who="Ben Okafor")
     register = Register(ben)
-    dialog = RegisterDialog(register, M, "table", operator=lambda: "Carla Reviewer")
-    dialog.resize(*SIZE)
-    dialog.show()
+    run = ScreenshotRun((SIZE[0], SIZE[1]), make_window=lambda: RegisterDialog(
+        register, M, "table", operator=lambda: "Carla Reviewer"))
+    dialog = run.window
     parameters = next(c for c in register.conflicts() if c.subject == "parameters")
     dialog.show_conflict(parameters.short)
     c = dialog.current_conflict()
@@ -89,15 +70,12 @@ def main() -> int:
     ana_side = next(n for n, s in enumerate(c.sides, 1) if s.values["rotary_direction"].who == "Ana Lima")
     dialog.keep_group.button(ana_side).click()
     dialog.settle_note.setText("checked on the machine: the table turns CCW on FWD, as Ana read")
-    settle(500)
-    OUT.mkdir(parents=True, exist_ok=True)
-    path = OUT / "register-conflicts.png"
-    dialog.grab().save(str(path))
-    print("saved", path)
-    dialog.close()
+    run.settle(0.5)
+    run.shot("register-conflicts")
+    run.close()
     register.close()
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(main())

@@ -10,49 +10,22 @@ Settings and data go to a temporary directory, never the user's.
 
 from __future__ import annotations
 
-import os
-import sys
-import tempfile
-import time
-from pathlib import Path
+from shots import ScreenshotRun, private_folder
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-TMP = tempfile.mkdtemp(prefix="fha-shots-")
-os.environ["XDG_CONFIG_HOME"] = f"{TMP}/config"
-os.environ["XDG_DATA_HOME"] = f"{TMP}/data"
-
-from PySide6.QtCore import QCoreApplication  # noqa: E402
-from PySide6.QtWidgets import QApplication  # noqa: E402
-
-OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "screenshots"
+TMP = private_folder()
 CODE = "FHA-25C-50-US250"
 URL = f"sim://{CODE}?paced=0&profile=documented"
 LOAD = 0.81
 
 
 def main() -> int:
-    app = QApplication(sys.argv[:1])
-    QCoreApplication.setOrganizationName("FHA Studio Screenshots")
-    QCoreApplication.setApplicationName("fha-studio-screenshots")
-    from fha_studio.gui.main_window import MainWindow
+    run = ScreenshotRun((1366, 740), settle_before_shot_s=0.0)
+    window, wait_until = run.window, run.wait_until
     from fha_studio.hardware.sim.cn2 import record_playback
     from fha_studio.hardware.sim.drive import SimDrive
 
-    window = MainWindow()
-    window.resize(int(os.environ.get("FHA_SHOT_WIDTH", 1366)), int(os.environ.get("FHA_SHOT_HEIGHT", 740)))
-    window.show()
     window.connect_to(URL)
-
-    def until(condition, seconds: float) -> None:
-        end = time.monotonic() + seconds
-        while not condition():
-            if time.monotonic() > end:
-                raise SystemExit("the Tuning page did not get there in time")
-            app.processEvents()
-            time.sleep(0.02)
-
-    until(lambda: window.link.connected, 20)
+    wait_until(lambda: window.link.connected, "the connection", 20.0)
     page = window.show_page("tuning")
     page.actuator_edit.setText(CODE)
     page.load_spin.setValue(LOAD)
@@ -69,18 +42,15 @@ def main() -> int:
     analysed: list[object] = []
     bench.sigAnalysed.connect(analysed.append)
     bench.analyse()
-    until(lambda: bool(analysed), 120)
+    wait_until(lambda: analysed, "the capture's analysis", 120.0)
     proposed: list[object] = []
     page.sigProposed.connect(proposed.append)
     page.propose()
-    until(lambda: bool(proposed), 120)
-    app.processEvents()
-    path = OUT / "tuning-bench.png"
-    window.grab().save(str(path))
-    print("saved", path)
-    window.close()
+    wait_until(lambda: proposed, "the proposed gains", 120.0)
+    run.shot("tuning-bench")
+    run.close()
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(main())

@@ -1,73 +1,126 @@
-"""The screenshot scripts run the real windows: they must not write into the user's settings and
-data (the tests' rule, tests/gui/conftest.py), and none may wait for ever."""
+"""The screenshot scripts run the real windows: they take one set-up (docs/screenshots/shots.py),
+which keeps the user's settings and data out of them (the tests' rule, tests/gui/conftest.py) and
+removes its temporary folder when a script ends, also when it fails or is killed; none may wait
+for ever."""
 
 from __future__ import annotations
 
 import ast
 import importlib.util
+import json
 import os
+import signal
 import tempfile
 from pathlib import Path
 
 import pytest
 
+from tests.support.processes import Child
+
 ROOT = Path(__file__).resolve().parents[2]
-SCRIPTS = sorted([*ROOT.joinpath("docs", "screenshots").glob("*.py"), *ROOT.joinpath("scripts").glob("*.py")])
+SHOTS = ROOT / "docs" / "screenshots"
+SCRIPTS = sorted(SHOTS.glob("take*.py"))
+#: What shots.py does for every script, and no script does on its own.
+OWN_SET_UP = ("mkdtemp", "TemporaryDirectory", "QApplication(", "XDG_CONFIG_HOME", "XDG_DATA_HOME",
+              "setOrganizationName")
 
 
-def _environment_set(tree: ast.Module) -> dict[str, int]:
-    """Module-level ``os.environ["NAME"] = ...`` from a temporary directory: NAME -> line."""
-    temporary = any(isinstance(n, ast.Attribute) and n.attr == "mkdtemp" for n in ast.walk(tree))
-    found = {}
-    for node in tree.body:
-        if isinstance(node, ast.Assign) and temporary:
-            for target in node.targets:
-                if (isinstance(target, ast.Subscript) and ast.unparse(target.value) == "os.environ"
-                        and isinstance(target.slice, ast.Constant)):
-                    found[target.slice.value] = node.lineno
-    return found
-
-
-def _first_qt_line(tree: ast.Module) -> int | None:
-    """The first line that imports Qt or the GUI at module level (the settings' place is fixed then);
-    None for a module that imports Qt only inside its functions (docs/screenshots/shots.py)."""
+def _first_line_importing(tree: ast.Module, prefixes: tuple[str, ...]) -> int | None:
     for node in tree.body:
         if isinstance(node, ast.Import | ast.ImportFrom):
             names = [node.module or ""] if isinstance(node, ast.ImportFrom) else [a.name for a in node.names]
-            if any(n.startswith(("PySide6", "fha_studio.gui")) for n in names):
+            if any(n.startswith(prefixes) for n in names):
                 return node.lineno
     return None
 
 
-def _sets_both_in_a_function(tree: ast.Module) -> bool:
-    """Whether a function of the module sets both folders to a temporary one (shots.py's
-    private_folder, which its scripts call before they start Qt)."""
+def _private_folder_line(tree: ast.Module) -> int | None:
+    """The module-level statement that calls ``private_folder()``."""
     for node in tree.body:
-        if isinstance(node, ast.FunctionDef):
-            inner = ast.Module(body=node.body, type_ignores=[])
-            if {"XDG_CONFIG_HOME", "XDG_DATA_HOME"} <= set(_environment_set(inner)):
-                return True
-    return False
+        value = getattr(node, "value", None)
+        calls = [c for c in ast.walk(value) if isinstance(c, ast.Call)] if value is not None else []
+        if any(ast.unparse(c.func).endswith("private_folder") for c in calls):
+            return node.lineno
+    return None
 
 
-def test_every_screenshot_script_keeps_the_users_settings_and_data_out_of_it():
-    assert any(path.name == "scope_screenshots.py" for path in SCRIPTS)
+def test_every_screenshot_script_takes_the_one_set_up():
+    """Each script's folder, application and window come from shots.py: private_folder() at module
+    level before anything of Qt or FHA Studio is imported, nothing of that set-up of its own."""
+    assert len(SCRIPTS) >= 10 and not list(ROOT.joinpath("scripts").glob("*screenshot*"))
     wrong = []
     for path in SCRIPTS:
         text = path.read_text(encoding="utf-8")
-        if "QApplication(" not in text:
-            continue
         tree = ast.parse(text)
-        where = _environment_set(tree)
-        first_qt = _first_qt_line(tree)
-        if first_qt is None:  # Qt started by a function: the folders must be set by one too
-            if not _sets_both_in_a_function(tree):
-                wrong.append(f"{path.relative_to(ROOT)}: starts Qt without setting both folders first")
-            continue
-        for name in ("XDG_CONFIG_HOME", "XDG_DATA_HOME"):
-            if where.get(name, first_qt) >= first_qt:
-                wrong.append(f"{path.relative_to(ROOT)}: {name} is not a temporary directory before Qt")
+        name = path.relative_to(ROOT)
+        own = [what for what in OWN_SET_UP if what in text]
+        if own:
+            wrong.append(f"{name}: its own {', '.join(own)} (shots.py has it)")
+        folder = _private_folder_line(tree)
+        first = _first_line_importing(tree, ("PySide6", "fha_studio", "tests"))
+        if folder is None:
+            wrong.append(f"{name}: no private_folder() at module level")
+        elif first is not None and first < folder:
+            wrong.append(f"{name}: line {first} imports Qt or FHA Studio before private_folder()")
     assert not wrong, "\n".join(wrong)
+
+
+#: A screenshot script in short: its folder, then a step that fails or a wait that is killed.
+SCRIPT = """
+import os, sys, time
+sys.path.insert(0, sys.argv[1])
+from shots import private_folder
+folder = private_folder()
+print(folder, flush=True)
+env = os.environ
+print(env["XDG_CONFIG_HOME"], env["XDG_DATA_HOME"], "FHA_STUDIO_REGISTER" in env, flush=True)
+if sys.argv[2] == "fails":
+    raise RuntimeError("a step failed")
+time.sleep(120)
+"""
+
+
+def _script(tmp_path: Path, how: str) -> Child:
+    env = {"TMPDIR": str(tmp_path), "FHA_STUDIO_REGISTER": str(tmp_path / "the-users.sqlite")}
+    return Child.python("-c", SCRIPT, SHOTS, how, text=True, env=env)
+
+
+def test_a_screenshot_scripts_folder_goes_when_the_script_fails_or_is_terminated(tmp_path):
+    with _script(tmp_path, "fails") as failing:
+        folder = Path(failing.first_line("a failing screenshot script", expect=str(tmp_path)))
+        # the settings and the data in it, no register of the user's
+        assert failing.first_line("its folders").split() == [f"{folder}/config", f"{folder}/data", "False"]
+        assert failing.proc.wait(timeout=60) == 1
+    assert not folder.exists()
+    with _script(tmp_path, "waits") as terminated:
+        folder = Path(terminated.first_line("a waiting screenshot script", expect=str(tmp_path)))
+        assert (folder / "owner.json").exists()
+        terminated.proc.send_signal(signal.SIGTERM)
+        assert terminated.proc.wait(timeout=60) == 128 + signal.SIGTERM
+    assert not folder.exists()
+    assert not list(tmp_path.glob("fha-shots-*"))
+
+
+def test_the_next_screenshot_script_removes_what_a_killed_one_left(tmp_path, monkeypatch):
+    monkeypatch.syspath_prepend(str(SHOTS))
+    from shots import UNOWNED_STALE_S, sweep_left_folders
+
+    with _script(tmp_path, "waits") as killed:
+        left = Path(killed.first_line("a screenshot script", expect=str(tmp_path)))
+        killed.proc.kill()
+        killed.proc.wait(timeout=60)
+    running = tmp_path / "fha-shots-running"  # a script running now: this process
+    running.mkdir()
+    running.joinpath("owner.json").write_text(json.dumps({"pid": os.getpid(), "pid_started_ticks": None}))
+    old, young = tmp_path / "fha-shots-old", tmp_path / "fha-shots-young"  # before the owner's note
+    for folder in (old, young):
+        folder.mkdir()
+    then = old.stat().st_mtime - UNOWNED_STALE_S - 60
+    os.utime(old, (then, then))
+    other = tmp_path / "fha-bench-1"  # not a screenshot script's
+    other.mkdir()
+    assert sorted(sweep_left_folders(str(tmp_path))) == sorted([left, old])
+    assert running.exists() and young.exists() and other.exists()
 
 
 class _StuckDrive:
@@ -90,14 +143,23 @@ class _StuckDrive:
 
 
 def test_the_model_check_screenshots_give_up_on_a_move_that_does_not_end(monkeypatch, tmp_path):
-    for name in ("XDG_CONFIG_HOME", "XDG_DATA_HOME"):  # the script sets them on import: put back after
-        monkeypatch.setenv(name, os.environ.get(name, ""))
+    # the script's set-up on import changes the environment, the signals and sys.path: put back after
+    for name in ("XDG_CONFIG_HOME", "XDG_DATA_HOME", "FHA_STUDIO_REGISTER"):
+        if name in os.environ:
+            monkeypatch.setenv(name, os.environ[name])
+        else:
+            monkeypatch.delenv(name, raising=False)
+    handlers = {number: signal.getsignal(number) for number in (signal.SIGTERM, signal.SIGHUP)}
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
-    path = ROOT / "docs" / "screenshots" / "take_modelcheck.py"
-    spec = importlib.util.spec_from_file_location("take_modelcheck", path)
-    assert spec is not None and spec.loader is not None
-    script = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(script)
+    monkeypatch.syspath_prepend(str(SHOTS))
+    try:
+        spec = importlib.util.spec_from_file_location("take_modelcheck", SHOTS / "take_modelcheck.py")
+        assert spec is not None and spec.loader is not None
+        script = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(script)
+    finally:
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
     assert script.MOVE_DEADLINE_S >= 10.0
     with pytest.raises(TimeoutError, match=r"the move by 90° had not ended after 0 s .*no screenshots taken"):
         script.back_and_forth(_StuckDrive(), deadline_s=0.0)
