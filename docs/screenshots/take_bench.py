@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from shots import ScreenshotRun, private_folder
 
-TMP = private_folder("fha-shots-")
+TMP = private_folder()
 CODE = "FHA-25C-50-S248"  # absolute: CN3 gives the position (DGR) while the servo is off
 URL = f"sim://{CODE}?paced=0&profile=documented"
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from shots import ScreenshotRun, private_folder
 
-TMP = private_folder("fha-shots-")
+TMP = private_folder()
 URL = f"sim://FHA-25C-50-S248?paced=0&profile=documented&sensors=1&oww_clear_s=5&eeprom={TMP}/eeprom.json"
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from shots import OUT, ScreenshotRun, private_folder
 
-TMP = private_folder("fha-report-")
+TMP = private_folder()
 CODE = "FHA-25C-50-US250"
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from shots import ScreenshotRun, private_folder
 
-TMP = private_folder("fha-shots-")
+TMP = private_folder()
 
 
 def wait(app, seconds: float, until=None) -> None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import ast
 import importlib.util
+import inspect
 import json
 import os
 import signal
@@ -34,20 +35,25 @@ def _first_line_importing(tree: ast.Module, prefixes: tuple[str, ...]) -> int | 
     return None
 
 
-def _private_folder_line(tree: ast.Module) -> int | None:
-    """The module-level statement that calls ``private_folder()``."""
+def _private_folder_call(tree: ast.Module) -> ast.Call | None:
+    """The module-level call of ``private_folder``."""
     for node in tree.body:
         value = getattr(node, "value", None)
         calls = [c for c in ast.walk(value) if isinstance(c, ast.Call)] if value is not None else []
-        if any(ast.unparse(c.func).endswith("private_folder") for c in calls):
-            return node.lineno
+        for call in calls:
+            if ast.unparse(call.func).endswith("private_folder"):
+                return call
     return None
 
 
-def test_every_screenshot_script_takes_the_one_set_up():
+def test_every_screenshot_script_takes_the_one_set_up(monkeypatch):
     """Each script's folder, application and window come from shots.py: private_folder() at module
     level before anything of Qt or FHA Studio is imported, nothing of that set-up of its own."""
     assert len(SCRIPTS) >= 10 and not list(ROOT.joinpath("scripts").glob("*screenshot*"))
+    monkeypatch.syspath_prepend(str(SHOTS))
+    from shots import private_folder
+
+    signature = inspect.signature(private_folder)
     wrong = []
     for path in SCRIPTS:
         text = path.read_text(encoding="utf-8")
@@ -56,12 +62,18 @@ def test_every_screenshot_script_takes_the_one_set_up():
         own = [what for what in OWN_SET_UP if what in text]
         if own:
             wrong.append(f"{name}: its own {', '.join(own)} (shots.py has it)")
-        folder = _private_folder_line(tree)
+        call = _private_folder_call(tree)
         first = _first_line_importing(tree, ("PySide6", "fha_studio", "tests"))
-        if folder is None:
+        if call is None:
             wrong.append(f"{name}: no private_folder() at module level")
-        elif first is not None and first < folder:
+            continue
+        if first is not None and first < call.lineno:
             wrong.append(f"{name}: line {first} imports Qt or FHA Studio before private_folder()")
+        try:  # called as shots.py defines it
+            signature.bind(*(ast.literal_eval(a) for a in call.args),
+                           **{k.arg: ast.literal_eval(k.value) for k in call.keywords if k.arg})
+        except (TypeError, ValueError) as exc:
+            wrong.append(f"{name}: line {call.lineno}: {ast.unparse(call)}: {exc}")
     assert not wrong, "\n".join(wrong)
 
 
