@@ -156,3 +156,6 @@ EFFECT_PARAMETER_RANGES: dict[str, Range] = {
 
 CURRENT_PROBE_A_PER_V = Range("current probe scale", 1e-6, 1000.0, "A/V",
                               "current probes and shunt amplifiers give 1 mA/V ... 1000 A/V")
+LOAD_ENCODER_COUNTS = Range("load encoder counts per turn", 4.0, 2.0**32, "counts",
+                            "a quadrature encoder counts at least 4 per turn; 32-bit absolute encoders "
+                            "count 4294967296")

@@ -14,7 +14,7 @@ from fha_studio import fileio
 from fha_studio.cli import CliError
 from fha_studio.cli._bench_common import finite, parameter_values
 from fha_studio.cli._values import in_range, output_path
-from fha_studio.plausible import CURRENT_PROBE_A_PER_V
+from fha_studio.plausible import CURRENT_PROBE_A_PER_V, LOAD_ENCODER_COUNTS
 
 ORDER = 45
 
@@ -80,6 +80,13 @@ def add_import(commands: argparse._SubParsersAction) -> None:
         help="the current probe's amperes per volt (with --signal current_probe=...)",
     )
     p.add_argument(
+        "--load-encoder-counts",
+        type=in_range(LOAD_ENCODER_COUNTS),
+        metavar="COUNTS",
+        help="an external encoder on the output flange (--signal load_encoder_a=... and load_encoder_b=...): "
+        "its counts per output turn, x4; the recording then has load_pos",
+    )
+    p.add_argument(
         "-o",
         "--output",
         required=True,
@@ -103,11 +110,20 @@ def run_import(args: argparse.Namespace) -> int:
 
     if args.current_scale is not None and not any(t.startswith("current_probe=") for t in args.signal):
         raise CliError("--current-scale without --signal current_probe=FILE[#CHANNEL]")
+    if args.load_encoder_counts is not None and not any(t.startswith("load_encoder_a=") for t in args.signal):
+        raise CliError("--load-encoder-counts without --signal load_encoder_a=FILE[#CHANNEL]")
+    load_counts = None if args.load_encoder_counts is None else round(args.load_encoder_counts)
     try:
         signals = [parse_signal(text) for text in args.signal]
         axis = AxisFacts.for_actuator(args.actuator)
         settings = DriveSettings.from_values(parameter_values(args.parameters), args.parameters)
-        result = import_bench(signals, axis, settings, current_scale_a_per_v=args.current_scale)
+        result = import_bench(
+            signals,
+            axis,
+            settings,
+            current_scale_a_per_v=args.current_scale,
+            load_counts_per_turn=load_counts,
+        )
     except BenchImportError as exc:
         raise CliError(str(exc)) from None
     summary = result.summary
@@ -131,6 +147,12 @@ def run_import(args: argparse.Namespace) -> int:
         print(
             f"encoder: {encoder['counts']} counts, {encoder['glitches']} glitches, "
             f"{encoder['illegal_transitions']} illegal transitions{z}"
+        )
+    load = summary.get("load_encoder")
+    if load is not None:
+        print(
+            f"load encoder: {load['counts']} counts of {load['counts_per_output_turn']} per output turn, "
+            f"{load['glitches']} glitches, {load['illegal_transitions']} illegal transitions"
         )
     if summary["command_counts"] is not None:
         print(f"command: {summary['command_counts']} counts")

@@ -17,7 +17,11 @@ between servo periods):
 - IN-POS (|command - feedback| within the in-position range), ALARM, and the alarm code on
   ALM-A ... ALM-D (the 4 bits of the alarm table's code, ``resources/drive/ha655-alarms.toml``);
 - the encoder outputs count up on a FWD command, or on CW rotation of the flange, as
-  ``resources/drive/ha655-cn2.toml`` says (``[encoder_outputs]``).
+  ``resources/drive/ha655-cn2.toml`` says (``[encoder_outputs]``);
+- optionally an external encoder on the output flange (not on CN2: the bench's own, LOAD_A/LOAD_B,
+  x4 at :attr:`Cn2Settings.load_counts_per_turn` counts per output turn, counting up as the
+  encoder outputs do), which sees the load after the gear's wind-up, kinematic error and lost
+  motion.
 
 :class:`VirtualBenchInstrument` runs a servo axis and samples those outputs like a logic analyzer
 with one analog input: whole captures (:meth:`~VirtualBenchInstrument.record`), a stream of
@@ -51,6 +55,8 @@ LOGIC_CHANNELS = ("ENC_A", "ENC_B", "ENC_Z", "CMD_A", "CMD_B", "IN_POS", "ALARM"
                   "ALM_D")
 #: The alarm code lines, bit 0 (ALM-A) ... bit 3 (ALM-D) of the code written D C B A.
 ALM_CHANNELS = ("ALM_A", "ALM_B", "ALM_C", "ALM_D")
+#: an external encoder on the output flange, when the bench has one
+LOAD_CHANNELS = ("LOAD_A", "LOAD_B")
 ANALOG_CHANNELS = ("SPD_MON",)
 RAD_S_PER_RPM = 2.0 * math.pi / 60.0
 #: One sample per edge at least: the instrument refuses a rate at which its own edges would merge.
@@ -78,6 +84,15 @@ class Cn2Settings:
     multiplication: int = 4  # parameter 2
     speed_conversion_rpm: float = 3000.0  # parameter 9
     monitor: MonitorModel = field(default_factory=MonitorModel)
+    #: an external encoder on the output flange (x4 counts per output turn), or None
+    load_counts_per_turn: int | None = None
+    #: SPD-MON on the instrument's analog input (False: a logic analyzer without one wired)
+    speed_monitor: bool = True
+
+    @property
+    def logic_channels(self) -> tuple[str, ...]:
+        """Every line sampled by default: CN2's, and the load's encoder where there is one."""
+        return LOGIC_CHANNELS + (LOAD_CHANNELS if self.load_counts_per_turn else ())
 
 
 @dataclass
@@ -88,11 +103,12 @@ class Truth:
     command_pulses: list[np.ndarray] = field(default_factory=list)
     command_counts: list[np.ndarray] = field(default_factory=list)
     motor_rpm: list[np.ndarray] = field(default_factory=list)
+    load_counts: list[np.ndarray] = field(default_factory=list)  # the external encoder's, if any
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {
             name: np.concatenate(getattr(self, name)) if getattr(self, name) else np.zeros(0)
-            for name in ("encoder_counts", "command_pulses", "command_counts", "motor_rpm")
+            for name in ("encoder_counts", "command_pulses", "command_counts", "motor_rpm", "load_counts")
         }
 
 
@@ -111,12 +127,15 @@ class Cn2Signals:
         gear: tuple[int, int] = (1, 1),
         alarm_table: AlarmTable | None = None,
         encoder_counts_cw: bool = False,
-        logic_channels: tuple[str, ...] = LOGIC_CHANNELS,
+        logic_channels: tuple[str, ...] | None = None,
         speed_command: Callable[[np.ndarray], np.ndarray] | None = None,
     ):
         """``direction``: +1 when a FWD command turns the flange CW (parameter 8); the encoder
         outputs count up on a FWD command unless ``encoder_counts_cw`` (then on CW rotation).
-        ``logic_channels``: the ones sampled, in this order (an instrument's selection)."""
+        ``logic_channels``: the ones sampled, in this order (an instrument's selection; None:
+        ``settings.logic_channels``)."""
+        if logic_channels is None:
+            logic_channels = settings.logic_channels
         self.rate = float(sample_rate_hz)
         #: SPD-CMD's volts at the drive's times, recorded as ``SPD_CMD`` (None: not probed)
         self.speed_command = speed_command
@@ -128,12 +147,14 @@ class Cn2Signals:
         self.gear_numerator, self.gear_denominator = gear
         self.alarm_table = alarm_table or load_alarm_table("HA-655")
         self.encoder_counts_cw = encoder_counts_cw
-        unknown = [c for c in logic_channels if c not in LOGIC_CHANNELS]
+        known = settings.logic_channels
+        unknown = [c for c in logic_channels if c not in known]
         if unknown:
-            raise ValueError(f"no CN2 output {', '.join(unknown)} (there are {', '.join(LOGIC_CHANNELS)})")
+            raise ValueError(f"no CN2 output {', '.join(unknown)} (there are {', '.join(known)})")
         self.logic_channels = tuple(logic_channels)
         self.next_sample = 0
-        self._last: tuple[float, float, float, float, float] | None = None  # t, pos, cmd, vel, controller
+        # t, pos, cmd, vel, controller, load at the last trace point
+        self._last: tuple[float, float, float, float, float, float] | None = None
         self._sign = 0
         self._last_pulses: int | None = None
         wc = 2.0 * math.pi * settings.monitor.bandwidth_hz
@@ -152,12 +173,14 @@ class Cn2Signals:
         cmd = trace["cmd_pos"] * self.direction
         vel = trace["vel"] * self.direction
         sent = trace["controller_pos"]  # the controller's command, already in the command frame
+        load = trace["load_pos"] * self.direction  # the flange, in the command's sense as pos
         if self._last is not None:
             t = np.concatenate(([self._last[0]], t))
             pos = np.concatenate(([self._last[1]], pos))
             cmd = np.concatenate(([self._last[2]], cmd))
             vel = np.concatenate(([self._last[3]], vel))
             sent = np.concatenate(([self._last[4]], sent))
+            load = np.concatenate(([self._last[5]], load))
         if t.size == 0:
             return self._empty(), {}
         if self._last is None and self.next_sample == 0:
@@ -167,7 +190,9 @@ class Cn2Signals:
         ts = k / self.rate
         first = self.next_sample
         self.next_sample = last_index + 1
-        self._last = (float(t[-1]), float(pos[-1]), float(cmd[-1]), float(vel[-1]), float(sent[-1]))
+        self._last = (
+            float(t[-1]), float(pos[-1]), float(cmd[-1]), float(vel[-1]), float(sent[-1]), float(load[-1])
+        )
         if k.size == 0:
             return self._empty(), {}
         p = np.interp(ts, t, pos)
@@ -191,6 +216,36 @@ class Cn2Signals:
         cmd_a, cmd_b = self._command_levels(edges if self.s.pulse_form == 2 else pulses)
         in_pos = np.abs(cmd_counts - counts) <= self.in_position_range
         motor_rpm = v / RAD_S_PER_RPM * self.ratio
+        m = self.s.monitor
+        levels = {"ENC_A": enc_a, "ENC_B": enc_b, "ENC_Z": enc_z, "CMD_A": cmd_a, "CMD_B": cmd_b,
+                  "IN_POS": in_pos}
+        levels.update(self._alarm_levels(int(alarm), k.size))
+        truth = {
+            "encoder_counts": outputs,
+            "command_pulses": pulses,
+            "command_counts": pulses * self.gear_numerator / self.gear_denominator,
+            "motor_rpm": motor_rpm,
+        }
+        if self.s.load_counts_per_turn:
+            turns = np.interp(ts, t, load) / (2.0 * math.pi)
+            load_counts = np.floor(turns * self.s.load_counts_per_turn + 0.5).astype(np.int64)
+            if self.encoder_counts_cw and self.direction < 0:
+                load_counts = -load_counts  # counted up as the encoder outputs are
+            self._check_steps(load_counts, "load encoder's edges")
+            levels["LOAD_A"], levels["LOAD_B"] = _quadrature_levels(load_counts)
+            truth["load_counts"] = load_counts
+        logic = pack_logic([levels[name] for name in self.logic_channels])
+        analog = {}
+        if self.s.speed_monitor:
+            analog["SPD_MON"] = self._speed_monitor_volts(motor_rpm)
+        if self.speed_command is not None:  # the instrument's second input on CN2-31/32
+            command = self.speed_command(ts) + self._rng.normal(0.0, m.noise_v, ts.size)
+            analog["SPD_CMD"] = np.asarray(command, np.float32)
+        block = SampleBlock(self.rate, self.logic_channels, logic, analog, first)
+        return block, truth
+
+    def _speed_monitor_volts(self, motor_rpm: np.ndarray) -> np.ndarray:
+        """SPD-MON: parameter 9's scale, the monitor's first-order bandwidth, offset and noise."""
         volts = motor_rpm / self.s.speed_conversion_rpm * 10.0
         b, a = self._filter
         # scipy.signal takes a second of CPU to import: only a drive whose CN2 is sampled pays it
@@ -200,23 +255,9 @@ class Cn2Signals:
             self._zi = _signal.lfilter_zi(b, a) * volts[0]
         volts, self._zi = _signal.lfilter(b, a, volts, zi=self._zi)
         m = self.s.monitor
-        volts = volts + m.offset_v + self._rng.normal(0.0, m.noise_v, volts.size)
-        levels = {"ENC_A": enc_a, "ENC_B": enc_b, "ENC_Z": enc_z, "CMD_A": cmd_a, "CMD_B": cmd_b,
-                  "IN_POS": in_pos}
-        levels.update(self._alarm_levels(int(alarm), k.size))
-        logic = pack_logic([levels[name] for name in self.logic_channels])
-        analog = {"SPD_MON": volts.astype(np.float32)}
-        if self.speed_command is not None:  # the instrument's second input on CN2-31/32
-            command = self.speed_command(ts) + self._rng.normal(0.0, m.noise_v, ts.size)
-            analog["SPD_CMD"] = np.asarray(command, np.float32)
-        block = SampleBlock(self.rate, self.logic_channels, logic, analog, first)
-        truth = {
-            "encoder_counts": outputs,
-            "command_pulses": pulses,
-            "command_counts": pulses * self.gear_numerator / self.gear_denominator,
-            "motor_rpm": motor_rpm,
-        }
-        return block, truth
+        noisy = volts + m.offset_v + self._rng.normal(0.0, m.noise_v, volts.size)
+        out: np.ndarray = noisy.astype(np.float32)
+        return out
 
     def _alarm_levels(self, code: int, n: int) -> dict[str, np.ndarray]:
         """ALARM (on while an alarm is active) and ALM-A ... D: the table's 4-bit code (a code the
@@ -234,7 +275,8 @@ class Cn2Signals:
             self.logic_channels,
             np.zeros(0, logic_dtype(max(1, len(self.logic_channels)))),
             {name: np.zeros(0, np.float32)
-             for name in ("SPD_MON", *(("SPD_CMD",) if self.speed_command is not None else ()))},
+             for name in (*(("SPD_MON",) if self.s.speed_monitor else ()),
+                          *(("SPD_CMD",) if self.speed_command is not None else ()))},
             self.next_sample,
         )
 
@@ -276,7 +318,7 @@ class Cn2Signals:
 
 def signals_of_axis(axis: ServoAxis, sample_rate_hz: float, settings: Cn2Settings, *,
                     alarm_table: AlarmTable | None = None,
-                    logic_channels: tuple[str, ...] = LOGIC_CHANNELS,
+                    logic_channels: tuple[str, ...] | None = None,
                     speed_command: Callable[[np.ndarray], np.ndarray] | None = None) -> Cn2Signals:
     """The CN2 outputs of a servo axis (its resolution, ratio, in-position range, direction and
     electronic gear) at an instrument's rate, with the driver's alarm table and CN2; with
@@ -298,8 +340,15 @@ def signals_of_axis(axis: ServoAxis, sample_rate_hz: float, settings: Cn2Setting
     )
 
 
-def settings_of_drive(drive: SimDrive, monitor: MonitorModel | None = None) -> Cn2Settings:
-    """The simulated drive's parameters 1, 2 and 9 and its resolution, as CN2 shows them."""
+def settings_of_drive(
+    drive: SimDrive,
+    monitor: MonitorModel | None = None,
+    load_counts_per_turn: int | None = None,
+    speed_monitor: bool = True,
+) -> Cn2Settings:
+    """The simulated drive's parameters 1, 2 and 9 and its resolution, as CN2 shows them (and the
+    bench's external encoder on the output flange, if it has one; SPD-MON unless ``speed_monitor``
+    is False)."""
     model = drive.axis.model
     return Cn2Settings(
         counts_per_motor_turn=round(model.output_resolution_ppr / (model.ratio or 1)),
@@ -307,6 +356,8 @@ def settings_of_drive(drive: SimDrive, monitor: MonitorModel | None = None) -> C
         multiplication=drive.memory.value("two_phase_pulse_multiplication"),
         speed_conversion_rpm=float(drive.memory.value("speed_conversion_factor")),
         monitor=monitor or MonitorModel(),
+        load_counts_per_turn=load_counts_per_turn,
+        speed_monitor=speed_monitor,
     )
 
 
@@ -375,20 +426,28 @@ class VirtualBenchInstrument:
     @classmethod
     def on_drive(
         cls, drive: SimDrive, sample_rate_hz: float, monitor: MonitorModel | None = None,
-        *, speed_command: bool = False,
+        *, speed_command: bool = False, load_counts_per_turn: int | None = None, speed_monitor: bool = True,
     ) -> VirtualBenchInstrument:
         """The instrument on a stepped simulated drive's CN2: its parameters 1, 2 and 9, its
         resolution, its alarm (code); the drive's time advances as the instrument records. With
-        ``speed_command`` an analog input on SPD-CMD (CN2-31/32) too: channel ``SPD_CMD``."""
-        settings = settings_of_drive(drive, monitor)
+        ``speed_command`` an analog input on SPD-CMD (CN2-31/32) too: channel ``SPD_CMD``;
+        ``load_counts_per_turn``: an external encoder on the output flange (LOAD_A/LOAD_B);
+        ``speed_monitor``: False for a logic analyzer with no analog input on SPD-MON."""
+        settings = settings_of_drive(drive, monitor, load_counts_per_turn, speed_monitor)
         return cls(drive.axis, sample_rate_hz, settings, alarm=lambda: drive.alarm, advance=drive.advance,
                    alarm_table=drive.alarm_table,
                    speed_command=drive.speed_command_input.volts if speed_command else None)
 
     def record(self, seconds: float) -> SampleBlock:
         """Run for ``seconds`` and keep what was sampled; returns everything kept so far."""
-        self._blocks.extend(self.stream(seconds))
+        self.keep(seconds, 0.01)
         return self.capture()
+
+    def keep(self, seconds: float, block_s: float = 0.05) -> None:
+        """Run for ``seconds`` and keep what was sampled (a capture made piece by piece, between
+        the caller's commands, without joining what it holds at every piece; in blocks of
+        ``block_s``, longer than a live stream's: fewer, larger array operations)."""
+        self._blocks.extend(self.stream(seconds, block_s))
 
     def capture(self) -> SampleBlock:
         """Everything recorded so far, as one block."""

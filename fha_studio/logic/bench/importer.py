@@ -13,7 +13,10 @@ them at :data:`OUTPUT_RATE_HZ` (or the capture's rate if lower):
   code (D C B A, ON = 1; 13 = 1101, the encoder alarms), the summary naming each code that came,
   when, and the alarms of the HA-655's table it can be;
 - ``in_pos`` (1 = on), ``alarm`` (1 = on) and ``current`` [A] = probe volts x A per V, the mean
-  over each interval, only where a probe measured it.
+  over each interval, only where a probe measured it;
+- ``load_pos`` [deg, output]: an external encoder on the output flange (roles ``load_encoder_a``,
+  ``load_encoder_b``; not a CN2 signal: the bench's own), counted x4 at the counts per output turn
+  the technician states: the load after the gear's wind-up, kinematic error and lost motion.
 
 Each column's source (file, channel, scale) is named in the recording's metadata
 (``source_<column>``). The recording is an ``fha-recording/2`` file when it has no current.
@@ -50,6 +53,8 @@ ROLES = (
     "alm_c",
     "alm_d",
     "current_probe",
+    "load_encoder_a",
+    "load_encoder_b",
 )
 #: The alarm code lines ALM-A ... ALM-D (ON = 1): bit 0 ... bit 3 of the 4-bit code written D C B A.
 ALM_ROLES = ("alm_a", "alm_b", "alm_c", "alm_d")
@@ -162,6 +167,7 @@ class Decoded:
     z: decode.ZCheck | None = None
     command: decode.CommandPulseResult | None = None
     speed: decode.SpeedResult | None = None
+    load_encoder: decode.QuadratureResult | None = None
 
 
 @dataclass(frozen=True)
@@ -183,8 +189,11 @@ def import_bench(
     current_scale_a_per_v: float | None = None,
     output_rate_hz: float = OUTPUT_RATE_HZ,
     loader: Loader | None = None,
+    load_counts_per_turn: int | None = None,
 ) -> BenchImport:
-    """Decode the mapped signals and make the recording; BenchImportError for bad input."""
+    """Decode the mapped signals and make the recording; BenchImportError for bad input.
+    ``load_counts_per_turn``: the external load encoder's counts per output turn (x4), needed with
+    the roles ``load_encoder_a`` and ``load_encoder_b``."""
     load = loader or _read
     roles: dict[str, SignalSpec] = {}
     for spec in signals:
@@ -199,11 +208,21 @@ def import_bench(
         raise BenchImportError(
             "--signal current_probe needs --current-scale A_PER_V (the probe's amperes per volt)"
         )
-    for need, other in (("encoder_a", "encoder_b"), ("encoder_b", "encoder_a")):
+    for need, other in (
+        ("encoder_a", "encoder_b"),
+        ("encoder_b", "encoder_a"),
+        ("load_encoder_a", "load_encoder_b"),
+        ("load_encoder_b", "load_encoder_a"),
+    ):
         if need in roles and other not in roles:
             raise BenchImportError(
                 f"--signal {need} without {other}: the encoder is counted from both phases"
             )
+    if "load_encoder_a" in roles and not load_counts_per_turn:
+        raise BenchImportError(
+            "--signal load_encoder_a needs --load-encoder-counts COUNTS (the load encoder's counts per "
+            "output turn, x4)"
+        )
     if "encoder_z" in roles and "encoder_a" not in roles:
         raise BenchImportError(
             "--signal encoder_z needs encoder_a and encoder_b (Z is checked against counts)"
@@ -279,7 +298,10 @@ def import_bench(
             )
         except decode.DecodeError as exc:
             raise BenchImportError(str(exc)) from None
-    decoded = Decoded(rate, n, encoder, z, command, speed)
+    load_encoder = None
+    if "load_encoder_a" in roles:
+        load_encoder = decode.quadrature_lines(lines("load_encoder_a", "load_encoder_b"))
+    decoded = Decoded(rate, n, encoder, z, command, speed, load_encoder)
     return _make(
         decoded,
         roles,
@@ -288,6 +310,7 @@ def import_bench(
         settings,
         current_scale_a_per_v,
         output_rate_hz,
+        load_counts_per_turn,
         {role: analog(role) for role in ("current_probe",) if role in roles},
         {role: lines(role) for role in ("in_position", "alarm", *ALM_ROLES) if role in roles},
     )
@@ -341,6 +364,7 @@ def _make(
     settings: DriveSettings,
     current_scale: float | None,
     output_rate_hz: float,
+    load_counts_per_turn: int | None,
     analog: Mapping[str, np.ndarray],
     logic: Mapping[str, Lines],
 ) -> BenchImport:
@@ -369,6 +393,12 @@ def _make(
         columns["pos"] = turns[idx] * 360.0
         sources["pos"] = f"{src('speed_monitor')} integrated (no encoder mapped)"
         notes.append("pos is the speed monitor integrated: no encoder was mapped")
+    if decoded.load_encoder is not None and load_counts_per_turn:
+        columns["load_pos"] = decoded.load_encoder.steps.sample(idx) * (360.0 / load_counts_per_turn)
+        sources["load_pos"] = (
+            f"{src('load_encoder_a')} and {src('load_encoder_b')}, x4, {load_counts_per_turn} counts per "
+            "output turn (an external encoder on the output flange)"
+        )
     if decoded.command is not None:
         columns["cmd_pos"] = decoded.command.count_steps.sample(idx) * deg_per_count
         line_b = f" and {src('command_b')}" if "command_b" in roles else ""
@@ -405,7 +435,9 @@ def _make(
         extra=extra,
     )
     recording = make_recording(metadata, **columns)
-    summary = _summary(decoded, roles, channel_of, axis, settings, current_scale, sources, len(idx))
+    summary = _summary(
+        decoded, roles, channel_of, axis, settings, current_scale, sources, len(idx), load_counts_per_turn
+    )
     if alarm_codes or "alm_code" in columns:
         summary["alarm_codes"] = alarm_codes
     return BenchImport(recording, summary, decoded, notes)
@@ -444,6 +476,7 @@ def _summary(
     current_scale: float | None,
     sources: Mapping[str, str],
     rows: int,
+    load_counts_per_turn: int | None = None,
 ) -> dict[str, Any]:
     per_role: dict[str, dict[str, Any]] = {}
     for role, spec in roles.items():
@@ -462,6 +495,8 @@ def _summary(
             unit = "motor r/min per V"
         elif role == "current_probe":
             scale, unit = current_scale, "A per V"
+        elif role in ("load_encoder_a", "load_encoder_b"):
+            scale, unit = float(load_counts_per_turn or 0), "counts per output turn (x4), on the load"
         else:
             scale, unit = None, "logic, high = on"
         per_role[role] = {
@@ -489,6 +524,13 @@ def _summary(
             "z_pulses": decoded.z.pulses if decoded.z else None,
             "z_count_errors": decoded.z.count_errors if decoded.z else None,
             "counts_per_motor_turn": axis.counts_per_motor_turn,
+        }
+    if decoded.load_encoder is not None:
+        summary["load_encoder"] = {
+            "counts": decoded.load_encoder.total_counts,
+            "glitches": decoded.load_encoder.glitches,
+            "illegal_transitions": decoded.load_encoder.illegal_transitions,
+            "counts_per_output_turn": load_counts_per_turn,
         }
     if decoded.command is not None:
         final = float(decoded.command.count_steps.final)

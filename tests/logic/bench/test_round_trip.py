@@ -189,3 +189,39 @@ def test_the_simulated_drive_on_the_documented_profile_through_the_instrument(tm
         assert float(np.max(np.abs(recording.vel_rpm - expected))) < 0.01 * peak
     finally:
         drive.close()
+
+
+def test_an_encoder_on_the_load_gives_the_flange_after_the_gear(tmp_path):
+    """A bench with an encoder on the output flange (LOAD_A/LOAD_B, not a CN2 signal): its counts
+    come back exact, and the recording's load_pos is the flange after the gear's lost motion (here
+    a dead band of 200 arcsec: load_pos - pos turns by it at the reversal), with its source."""
+    from fha_studio.physics import Effects
+
+    model = AxisModel.from_actuator(get_actuator(CODE), load_inertia_kgm2=0.3)
+    axis = ServoAxis(model.with_effects(Effects().with_effect("lost_motion", width_arcsec=200.0)))
+    axis.servo_on()
+    counts = 1 << 19
+    settings = Cn2Settings(load_counts_per_turn=counts, speed_monitor=False)
+    instrument = VirtualBenchInstrument(axis, 200e3, settings)
+    instrument.keep(0.03)
+    axis.move_by_pulses(3000, speed_rad_s=5 * RPM)
+    instrument.keep(0.3)
+    axis.move_by_pulses(-3000, speed_rad_s=5 * RPM)
+    instrument.keep(0.3)
+    path = instrument.write(tmp_path / "bench.sr", "sr")
+    roles = {"encoder_a": "ENC_A", "encoder_b": "ENC_B"}
+    roles |= {"load_encoder_a": "LOAD_A", "load_encoder_b": "LOAD_B"}
+    signals = [SignalSpec(role, str(path), channel) for role, channel in roles.items()]
+    facts, drive = AxisFacts.for_actuator(CODE), _settings(0, 4, (1, 1))
+    with pytest.raises(BenchImportError, match="--load-encoder-counts"):
+        import_bench(signals, facts, drive)
+    result = import_bench(signals, facts, drive, load_counts_per_turn=counts)
+    truth = instrument.truth.arrays()
+    assert "SPD_MON" not in instrument.capture().analog  # a logic analyzer without its analog input
+    assert np.array_equal(result.decoded.load_encoder.counts, truth["load_counts"] - truth["load_counts"][0])
+    assert result.summary["load_encoder"]["counts_per_output_turn"] == counts
+    rec = result.recording
+    assert rec.metadata.extra["source_load_pos"].startswith(f"{path}#LOAD_A and {path}#LOAD_B")
+    twist_arcsec = (rec.load_pos_deg - rec.pos_deg) * 3600.0
+    # after the first move the flange lags half the band behind; after the return it leads by it
+    assert np.ptp(twist_arcsec) == pytest.approx(200.0, abs=8.0)
