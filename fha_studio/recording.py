@@ -46,6 +46,7 @@ imports no Qt.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import os
 import re
@@ -198,6 +199,12 @@ class Recording:
     def pos_deg(self) -> np.ndarray:
         """Output position from the motor encoder [deg]."""
         return self.channels["pos"]
+
+    def with_declared_load(self, load_inertia_kgm2: float) -> Recording:
+        """The same recording with the axis's declared load inertia (a bench capture declares none:
+        the technician knows it)."""
+        metadata = dataclasses.replace(self.metadata, load_inertia_kgm2=float(load_inertia_kgm2))
+        return dataclasses.replace(self, metadata=metadata)
 
     @property
     def has_current(self) -> bool:

@@ -12,7 +12,8 @@ import math
 
 from fha_studio import fileio
 from fha_studio.cli import CliError
-from fha_studio.cli._values import output_path
+from fha_studio.cli._values import in_range, output_path
+from fha_studio.plausible import LOAD_INERTIA_KGM2
 
 ORDER = 40
 
@@ -40,6 +41,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="Savitzky-Golay window in samples, which sets the analysis bandwidth (default: chosen from "
         "the recording); refused outside what the recording supports",
     )
+    p.add_argument(
+        "--load-inertia",
+        type=in_range(LOAD_INERTIA_KGM2),
+        metavar="KGM2",
+        help="the axis's declared load inertia [kg m^2], for a recording that declares none (a bench "
+        "capture made by 'bench import') or instead of the one it declares",
+    )
     p.add_argument("--no-resim", action="store_true", help="skip the closed-loop re-simulation")
     p.set_defaults(func=run)
 
@@ -52,6 +60,8 @@ def run(args: argparse.Namespace) -> int:
         rec = read_recording(args.recording)
     except RecordingError as exc:
         raise CliError(str(exc)) from None
+    if args.load_inertia is not None:
+        rec = rec.with_declared_load(args.load_inertia)
     try:
         result = run_modelcheck(rec, window=args.window, resimulate=not args.no_resim)
     except ModelCheckError as exc:

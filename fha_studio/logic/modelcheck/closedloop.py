@@ -1,29 +1,22 @@
-"""The model check of a recording without current: the torque read through the closed loop.
+"""The model check of a recording without current: what the closed loop lets it see.
 
 A bench capture of an HA-655 gives the command, the encoder position (and SPD-MON, IN-POS) but no
-current. The disturbance then shows in the following error and the speed response, through the
-loop that fought it. The HA-655's position mode (docs/physics.md, "Servo") is
-
-    speed command = Kp (cmd - pos) + FF cmd',  Kt i = Kt Kv (e + integral(e) / Tv),  e = speed command - speed
-
-and the plant J a = Kt i - d (d: what the effects take). Integrated once, every term is a column
-the recording holds (the following error and its integral, the command's speed and the command,
-the speed and the position), so for one Tv the loop torque is linear in (g Kp, g FF, g) with
-g = Kt Kv, plus one constant (the integrator's state at the start):
-
-    -J a = -g Kp E1 - g FF E2 - g E3 - c + d,   E1 = eps + int(eps)/Tv, E2 = cmd' + cmd/Tv, E3 = -(v + pos/Tv)
-
-These loop columns are the nuisance ("base") columns of the same selection the torque channel uses
-(selection.py, consistency.py); Tv is found by a one-dimensional search. The tune items' units are
-not documented on the HA-655, so the loop comes from the recording and is compared with the panel's
-values when the caller knows them, not taken from them.
+current. The disturbance then shows in the following error, through the loop that fought it: the
+loop is identified from the recording (loopfit.py: the following error its linear model leaves,
+Kp, FF, g = Kt Kv and Tv fitted), and the candidate effects are seen through it. The tune items'
+units are not documented on the HA-655, so the loop comes from the recording and is compared with
+the panel's values when the caller knows them, not taken from them.
 
 What cannot be identified this way, said in the report: a constant load torque and the part of
-friction that differs by direction are held by the speed loop's integral (the constant column);
-an inertia error trades off against the loop's gain scale g (the columns are -J a itself); viscous
-friction trades off against the loop's speed gain and feed-forward (tried on the simulated drive: a
-viscous drag of 5 N m s/rad came out as a 13 % larger Kv and no friction); every torque in N m
-rests on the declared inertia; a torque-constant error has no current to act on.
+friction that differs by direction are held by the speed loop's integral (they leave no trace in
+the following error); an inertia error trades off against the loop's gain scale g (J and g appear
+only as g / J); viscous friction trades off against the speed loop's gain and the lag of the
+drive's speed detection (a lag tau reads as viscous friction -g tau / Tv, which no recording of
+command and position separates from a real one: on the simulated drive a viscous drag of 1 N m
+s/rad came out as a 5 % larger Kv and no friction); every torque in N m rests on the declared
+inertia; a torque-constant error has no current to act on. Without an encoder on the load, the
+gear's kinematic error, lost motion and wind-up are not seen either: the motor's encoder sits
+before the gear.
 """
 
 from __future__ import annotations
@@ -32,11 +25,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from fha_studio.logic.modelcheck.axis import DeclaredAxis, ModelCheckError, rms
 from fha_studio.logic.modelcheck.candidates import TORQUE, TORQUE_CANDIDATES, ChannelContext
-from fha_studio.logic.modelcheck.linalg import ols
+from fha_studio.logic.modelcheck.loopfit import LoopFit, LoopParams
 from fha_studio.logic.modelcheck.signals import ARCSEC_PER_RAD, Signals, build_signals, window_for_bandwidth
 from fha_studio.physics import ServoSettings
 from fha_studio.recording import Recording
@@ -44,8 +36,6 @@ from fha_studio.recording import Recording
 #: without a current the torque is only as good as the acceleration: a fixed analysis bandwidth,
 #: well under the speed loop's and over what friction and gravity change at
 ANALYSIS_BANDWIDTH_HZ = 25.0
-#: Tv searched between these (s); beyond the top the loop has no integral action worth the name
-TV_RANGE_S = (0.002, 2.0)
 #: effects a recording without a torque measurement cannot show (see the module text)
 NOT_IDENTIFIABLE = (
     "inertia_error",
@@ -67,25 +57,38 @@ class Loop:
     torque_per_speed_error_nm_s_per_rad: float  # g = Kt Kv, resting on the declared inertia
     speed_gain_a_s_per_rad: float  # Kv = g / Kt
     panel: ServoSettings | None = None
+    inertia_kgm2: float = 1.0  # the declared inertia g rests on
+    explains: bool = True  # the loop model explains the following error (loopfit.LoopFit.explains)
+    speed_lag_s: float = 0.0  # the lag of the speed the loop sees (the drive's speed detection)
+    command_lead_s: float = 0.0  # the drive acts on the command this much earlier than recorded
 
-    def servo(self) -> ServoSettings:
-        """The identified loop as servo settings, for the re-simulation."""
+    def servo(self, servo_rate_hz: float = 5000.0) -> ServoSettings:
+        """The identified loop as servo settings, for the re-simulation: whole encoder pulses, their
+        difference per period (half a period late) low-passed to the identified speed lag."""
+        dt = 1.0 / servo_rate_hz
+        rest = self.speed_lag_s - 0.5 * dt  # what the filter adds: (1 - alpha) / alpha periods
+        filter_hz = 0.0 if rest <= 0 else -math.log(dt / (rest + dt)) / (2.0 * math.pi * dt)
         return ServoSettings(
             position_loop_gain_per_s=max(self.position_gain_per_s, 1e-3),
             speed_loop_gain_a_s_per_rad=max(self.speed_gain_a_s_per_rad, 1e-9),
             speed_loop_integral_time_s=self.integral_time_s,
             feed_forward_gain=min(max(self.feed_forward, 0.0), 1.0),
             quantised_feedback=True,  # a drive's loops see whole encoder pulses
+            servo_rate_hz=servo_rate_hz,
+            speed_filter_hz=filter_hz,
         )
 
     @property
     def plausible(self) -> bool:
-        """A loop that can be: positive gains, an integral within the searched range, FF 0..1.5."""
-        return (
-            self.position_gain_per_s > 0
-            and self.integral_time_s < TV_RANGE_S[1] * 0.99
-            and -0.5 <= self.feed_forward <= 1.5
+        """A loop that can be: every parameter inside the range searched (one at its edge was not
+        found, only pushed there) and the loop model explaining the following error."""
+        p = LoopParams(
+            self.position_gain_per_s,
+            self.feed_forward,
+            self.torque_per_speed_error_nm_s_per_rad,
+            self.integral_time_s,
         )
+        return self.explains and p.inside(self.inertia_kgm2)
 
     def lines(self) -> list[str]:
         if not self.plausible:
@@ -100,7 +103,7 @@ class Loop:
             f"Kv {self.speed_gain_a_s_per_rad:.3g} A s/rad "
             f"(Kt Kv {self.torque_per_speed_error_nm_s_per_rad:.3g} N m s/rad on the declared inertia), "
             f"Tv {1000.0 * self.integral_time_s:.3g} ms, "
-            f"feed-forward {self.feed_forward:.2f}"
+            f"feed-forward {self.feed_forward:.2f}, the speed it sees {1000.0 * self.speed_lag_s:.2g} ms late"
         )
         if self.panel is None:
             return [text + " (no panel values given to compare)."]
@@ -120,29 +123,6 @@ class Loop:
             f"({pct(self.integral_time_s, p.speed_loop_integral_time_s)}), "
             f"feed-forward {p.feed_forward_gain:.2f}.",
         ]
-
-
-@dataclass
-class LoopColumns:
-    """The smoothed loop columns on the analysis samples, combined for any Tv."""
-
-    eps: np.ndarray
-    int_eps: np.ndarray
-    cmd_speed: np.ndarray
-    cmd: np.ndarray
-    speed: np.ndarray
-    pos: np.ndarray
-
-    def base(self, tv_s: float, rows: np.ndarray | slice = slice(None)) -> np.ndarray:
-        k = 1.0 / tv_s
-        return np.column_stack(
-            [
-                self.eps[rows] + k * self.int_eps[rows],
-                self.cmd_speed[rows] + k * self.cmd[rows],
-                -(self.speed[rows] + k * self.pos[rows]),
-                np.ones_like(self.eps[rows]),
-            ]
-        )
 
 
 def closed_loop_signals(rec: Recording, axis: DeclaredAxis) -> Signals:
@@ -172,91 +152,88 @@ def closed_loop_signals(rec: Recording, axis: DeclaredAxis) -> Signals:
         raise ModelCheckError(str(exc)) from None
 
 
-def loop_columns(sig: Signals) -> LoopColumns:
-    assert sig.cmd_pos_rad is not None
-    f = sig.filt
-    dt = f.dt_s
-    cmd = sig.cmd_pos_rad - sig.cmd_pos_rad[0]
-    pos = sig.raw_pos_rad - sig.raw_pos_rad[0]
-    eps = cmd - pos
-    int_eps = np.concatenate([[0.0], np.cumsum(0.5 * (eps[1:] + eps[:-1])) * dt])
-    return LoopColumns(
-        eps=f.apply(eps),
-        int_eps=f.apply(int_eps),
-        cmd_speed=f.apply(np.gradient(cmd, dt)),
-        cmd=f.apply(cmd),
-        speed=sig.speed_f_rad_s,
-        pos=f.apply(pos),
-    )
+#: breakaway fading speeds (rad/s) among the loop fit's proxies
+PROXY_STRIBECK_SPEEDS_RAD_S = (0.03, 0.15)
 
 
-def best_integral_time(cols: LoopColumns, y: np.ndarray, index: np.ndarray, extra: np.ndarray) -> float:
-    """Tv (s) that lets the loop columns (and ``extra``, the effects in the model) explain y best."""
-
-    def rss(log_tv: float) -> float:
-        x = np.column_stack([cols.base(math.exp(log_tv), index), extra])
-        return ols(y, x)[1]
-
-    lo, hi = (math.log(v) for v in TV_RANGE_S)
-    grid = np.linspace(lo, hi, 13)
-    scores = [rss(g) for g in grid]
-    k = int(np.argmin(scores))
-    a, b = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
-    sol = minimize_scalar(rss, bounds=(a, b), method="bounded", options={"xatol": 1e-3})
-    return float(math.exp(sol.x if sol.fun <= scores[k] else grid[k]))
-
-
-def friction_proxies(ctx: ChannelContext, index: np.ndarray) -> np.ndarray:
-    """Friction and gravity columns: Tv is searched with them in the model, so that it is not bent to
-    fit them (a gravity load is nearly linear in the position over a part of a turn, as the
-    integral's position term is)."""
+def friction_proxies(ctx: ChannelContext, with_load: bool = True) -> np.ndarray:
+    """Friction (Coulomb, breakaway) and gravity columns (analysis rate): the loop is fitted with
+    them beside it, so that it is not bent to explain them (a missing one biases the loop's gain:
+    on the simulated drive, breakaway left out made Kt Kv 26 % small). ``with_load``: False when
+    the load's torque is measured (an output torque sensor): friction only."""
     by_id = {c.id: c for c in CANDIDATES_WITHOUT_CURRENT}
-    columns = [
-        by_id[i].build(ctx, by_id[i].shape_grid[0])[index] for i in ("coulomb_friction", "gravity_load")
-    ]
-    return np.column_stack([*columns, ctx.sig.speed_f_rad_s[index]])
+    columns = [by_id["coulomb_friction"].build(ctx, ())]
+    columns += [by_id["stribeck_friction"].build(ctx, (v,)) for v in PROXY_STRIBECK_SPEEDS_RAD_S]
+    if with_load:
+        columns.append(by_id["gravity_load"].build(ctx, ()))
+    return np.column_stack(columns)
 
 
-def decode_loop(beta: np.ndarray, tv_s: float, kt_nm_per_a: float, panel: ServoSettings | None) -> Loop:
-    """The loop from the base coefficients of -J a (see the module text); ModelCheckError when the
-    fit is not a loop (a gain of the wrong sign)."""
-    g = -float(beta[2])
-    if not g > 0:
-        raise ModelCheckError(
-            "the closed loop could not be identified from the recording (the speed loop's gain comes "
-            "out negative): is cmd_pos the command in the same direction as pos?"
-        )
+#: the recording that would separate two effects when the torque is read through the loop (the
+#: with-current tests ask for steady-speed levels, which the loop's integral hides here)
+SEPARATING_WITHOUT_CURRENT: dict[frozenset[str], str] = {
+    frozenset({"coulomb_friction", "stribeck_friction"}): (
+        "record the current (or an output torque sensor) through slow constant-speed runs: without a "
+        "torque measurement a friction's level at a steady speed is held by the loop's integral, and "
+        "breakaway shows only in how the axis breaks loose; starts from standstill to several low "
+        "speeds help"
+    ),
+}
+
+
+def loop_of(fit: LoopFit, kt_nm_per_a: float, panel: ServoSettings | None, inertia_kgm2: float) -> Loop:
+    """The loop to report from its fit."""
+    p = fit.params
     return Loop(
-        position_gain_per_s=float(beta[0]) / float(beta[2]),
-        feed_forward=float(beta[1]) / float(beta[2]),
-        integral_time_s=tv_s,
-        torque_per_speed_error_nm_s_per_rad=g,
-        speed_gain_a_s_per_rad=g / kt_nm_per_a,
+        position_gain_per_s=p.kp,
+        feed_forward=p.ff,
+        integral_time_s=p.tv,
+        torque_per_speed_error_nm_s_per_rad=p.g,
+        speed_gain_a_s_per_rad=p.g / kt_nm_per_a,
         panel=panel,
+        inertia_kgm2=inertia_kgm2,
+        explains=fit.explains,
+        speed_lag_s=p.lag,
+        command_lead_s=p.lead,
     )
 
 
-def not_identifiable_lines(axis: DeclaredAxis, sensor: bool = False) -> list[str]:
+def not_identifiable_lines(axis: DeclaredAxis, sensor: bool = False, load_encoder: bool = True) -> list[str]:
     """What a recording without current cannot show; ``sensor``: it has an output torque sensor,
-    which measures the load's side (then only the gear is read through the loop)."""
+    which measures the load's side (then only the gear is read through the loop); ``load_encoder``:
+    it has the load's position (else the gear's own errors are not seen either)."""
+    viscous = (
+        "viscous friction reads like the lag of the drive's speed detection (a lag makes the loop "
+        "push as a drag would pull), so it trades off against the loop's gains"
+    )
+    gear = (
+        []
+        if load_encoder
+        else [
+            "Without an encoder on the load the gear's kinematic error, lost motion and wind-up cannot be "
+            "seen: the motor's encoder sits before the gear. Map an encoder on the output flange "
+            "(bench import: --signal load_encoder_a=... --signal load_encoder_b=... --load-encoder-counts)."
+        ]
+    )
     if sensor:
         j_gear = axis.nominal_inertia_kgm2 - axis.model.load_inertia_kgm2
         return [
             "Without a current the gear is read through the closed loop, the load on the torque sensor: "
             "a constant drag in the gear and the part of its friction that differs by direction are held "
-            "by the speed loop's integral and leave no trace in the following error; viscous friction "
-            "trades off against the speed loop's gain and feed-forward. Record the current to see them.",
+            f"by the speed loop's integral and leave no trace in the following error; {viscous}. Record "
+            "the current to see them.",
             f"The gear's torques, in N m, rest on the declared actuator inertia ({j_gear:.4g} kg m^2); "
             "the load's are measured.",
+            *gear,
         ]
     return [
         "Without a torque measurement (no current, no torque column) these cannot be seen: a constant "
         "load torque and the part of friction that differs by direction are held by the speed loop's "
         "integral and leave no trace in the following error; an inertia error trades off against the "
-        "loop's gain scale, and viscous friction against the speed loop's gain and feed-forward. "
-        "Record the current (or an output torque sensor) to see them.",
+        f"loop's gain scale; {viscous}. Record the current (or an output torque sensor) to see them.",
         "Every torque above, in N m, rests on the declared inertia "
         f"({axis.nominal_inertia_kgm2:.4g} kg m^2): an inertia off by x % scales them all by x %.",
+        *gear,
     ]
 
 
@@ -274,12 +251,9 @@ __all__ = [
     "NOT_IDENTIFIABLE",
     "TORQUE",
     "Loop",
-    "LoopColumns",
-    "best_integral_time",
     "closed_loop_signals",
-    "decode_loop",
     "following_error_gap_arcsec",
     "friction_proxies",
-    "loop_columns",
+    "loop_of",
     "not_identifiable_lines",
 ]

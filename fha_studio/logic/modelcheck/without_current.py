@@ -3,38 +3,51 @@ closed loop (closedloop.py), then the same naming, consistency and position chan
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from fha_studio.logic.modelcheck import workflow as wf
-from fha_studio.logic.modelcheck.axis import DeclaredAxis
-from fha_studio.logic.modelcheck.candidates import CHANNEL_UNITS, POSITION, TORQUE, ChannelContext
+from fha_studio.logic.modelcheck.axis import DeclaredAxis, rms
+from fha_studio.logic.modelcheck.candidates import CHANNEL_UNITS, POSITION, TORQUE, Candidate, ChannelContext
 from fha_studio.logic.modelcheck.closedloop import (
     CANDIDATES_WITHOUT_CURRENT,
-    best_integral_time,
+    SEPARATING_WITHOUT_CURRENT,
     closed_loop_signals,
-    decode_loop,
-    following_error_gap_arcsec,
     friction_proxies,
-    loop_columns,
+    loop_of,
     not_identifiable_lines,
 )
 from fha_studio.logic.modelcheck.consistency import RESIM_TOLERANCE_OF_FLOOR, Refused, settle
 from fha_studio.logic.modelcheck.excitation import excitation_of
-from fha_studio.logic.modelcheck.linalg import ols
-from fha_studio.logic.modelcheck.resimulation import resimulate as resimulate_axis
+from fha_studio.logic.modelcheck.loopfit import (
+    LoopFit,
+    LoopModel,
+    LoopParams,
+    oe_channel,
+    through_loop,
+)
 from fha_studio.logic.modelcheck.result import (
     ABSENT,
     CHECKED,
     ChannelReport,
     ChannelStatus,
     ModelCheckResult,
+    Resimulation,
     Structure,
 )
-from fha_studio.logic.modelcheck.selection import ChannelSelector
+from fha_studio.logic.modelcheck.selection import ChannelSelector, FittedTerm
+from fha_studio.logic.modelcheck.signals import Signals
 from fha_studio.physics import ServoSettings
 from fha_studio.recording import Recording
 
+#: a breakaway's fading speed is searched below this share of the fastest recorded speed: well within
+#: the speeds the axis ran at, where its curve flattens and is told from the loop's lag
+STRIBECK_TOP_SHARE = 0.25
 FOLLOWING_ERROR_FLOOR_ARCSEC = 1.0  # a re-simulated following error this much worse is worse
+#: rows of the selection (the with-current path's TARGET_DECIMATED keeps more: its torque channel
+#: has the bandwidth of the current; the following error here is smoothed to 25 Hz)
+TARGET_DECIMATED = 1000
 
 
 def run_without_current(
@@ -44,7 +57,9 @@ def run_without_current(
     model = axis.model
     sig = closed_loop_signals(rec, axis)
     n = len(sig.t_s)
-    step = max(1, min(n // wf.TARGET_DECIMATED, (sig.filt.window - 2) // 2))
+    # the following error the loop leaves is smooth (the analysis bandwidth): decimated to about
+    # TARGET_DECIMATED rows, never below two per smoothing window half-width
+    step = max(1, min(n // TARGET_DECIMATED, (sig.filt.window - 2) // 2))
     index = np.arange(0, n, step)
     floor_t = max(wf.TORQUE_FLOOR_MIN_NM, wf.TORQUE_FLOOR_FRACTION_OF_MAX * (model.max_torque_nm or 0.0))
     j = axis.nominal_inertia_kgm2
@@ -52,8 +67,8 @@ def run_without_current(
     # is measured, and judged on its own channel (workflow.sensor_steps)
     sensor = wf.sensor_torque_nm(rec, sig)
     j_gear = j - model.load_inertia_kgm2
-    y = -(j * sig.accel_rad_s2) if sensor is None else -(j_gear * sig.accel_rad_s2 + sensor)
-    cols = loop_columns(sig)
+    j_loop = j if sensor is None else j_gear
+    loop_model = LoopModel(sig, j_loop, sensor, index)
     ctx = ChannelContext(sig, TORQUE, nominal_inertia_kgm2=j)
     excitation = excitation_of(sig)
     candidates = tuple(
@@ -61,45 +76,52 @@ def run_without_current(
         for c in CANDIDATES_WITHOUT_CURRENT
         if c.id not in excitation.excluded() and (sensor is None or c.motor_side)
     )
-    tv = best_integral_time(cols, y[index], index, friction_proxies(ctx, index))
-    sel = ChannelSelector(
-        ctx, y[index], candidates, index, floor_t, CHANNEL_UNITS[TORQUE], base=cols.base(tv, index)
-    )
+    candidates = tuple(_within_speeds(c, sig) for c in candidates)
+    raw = {c.id: c for c in candidates}
+    fit = loop_model.fit(friction_proxies(ctx, with_load=sensor is None))
+    sel = _selector(loop_model, fit.params, ctx, candidates, index, floor_t)
     terms, steps = sel.select()
-    # Tv once more with the chosen effects in the model; the selection again if it moved
+    # the loop once more with the chosen effects beside it (the proxies only approach them); the
+    # selection again if it moved
     if terms:
-        tv2 = best_integral_time(cols, y[index], index, sel.design(terms)[:, sel.base.shape[1] :])
-        if abs(np.log(tv2 / tv)) > 0.1:
-            tv = tv2
-            sel = ChannelSelector(
-                ctx, y[index], candidates, index, floor_t, CHANNEL_UNITS[TORQUE], base=cols.base(tv, index)
-            )
+        beside = np.column_stack([raw[t.id].build(ctx, t.shape) for t in terms])
+        refit = loop_model.fit(beside, start=fit.params)
+        if refit.params.moved(fit.params):
+            fit = refit
+            sel = _selector(loop_model, fit.params, ctx, candidates, index, floor_t)
             terms, steps = sel.select()
     max_torque = model.max_torque_nm or model.peak_torque_nm
     settled = settle(sel, terms, max_torque_nm=max_torque, actuator=axis.code)
-    loop = decode_loop(settled.base_beta, tv, axis.kt_nm_per_a, servo)
-    # the loop's torque (Kt x the current it commanded), estimated: what the current would have shown
-    loop_torque = -(cols.base(tv) @ settled.base_beta)
-    sig.torque_f_nm = loop_torque
+    updated_model, updated_fit = _with_effects(loop_model, fit, settled.fitted, raw, ctx)
+    # the torques: what the nominal model needs, the effects found, and what the loop shows beyond
+    # them (the following error it leaves, in N m at its most sensitive frequency)
+    effects_nm = np.zeros(n)
+    for ft in settled.fitted:
+        effects_nm += raw[ft.id].build(ctx, ft.shape) @ ft.beta
+    shown = np.interp(np.arange(n), index, sel.y - settled.fit)
+    inertial = j * sig.accel_rad_s2
+    sig.torque_f_nm = inertial + effects_nm
+    h = sig.filt.half
+    eps = None if sig.cmd_pos_rad is None else sig.cmd_pos_rad[h:-h] - sig.pos_rad
     residual = {
         "t_s": sig.t_s,
-        "torque_measured_nm": loop_torque,
-        "torque_nominal_nm": -y,
-        "torque_residual_nm": loop_torque + y,
+        "torque_measured_nm": inertial + effects_nm + shown,
+        "torque_nominal_nm": inertial,
+        "torque_residual_nm": effects_nm + shown,
         "speed_rad_s": sig.speed_rad_s,
         "accel_rad_s2": sig.accel_rad_s2,
         "pos_rad": sig.pos_rad,
-        "following_error_rad": cols.eps,
+        "following_error_rad": eps,
     }
     name = TORQUE if sensor is None else wf.GEAR
     channel = wf.ChannelStep(
         name,
         ctx,
-        y,
-        candidates,
+        sel.y,
+        tuple(sel.candidates),
         floor_t,
         base=sel.base,
-        torque_nm=loop_torque,
+        torque_nm=sig.torque_f_nm,
         bursts=False,
         torque_is_cause=False,
         max_torque_nm=max_torque,
@@ -136,7 +158,7 @@ def run_without_current(
         )
     ]
     status = {
-        name: ChannelStatus(name, CHECKED, "", float(np.max(np.abs(loop_torque))), "N m"),
+        name: ChannelStatus(name, CHECKED, "", float(np.max(np.abs(sig.torque_f_nm))), "N m"),
         "current": ChannelStatus(
             "current",
             ABSENT,
@@ -145,7 +167,7 @@ def run_without_current(
     }
     if sensor is not None:
         load = wf.sensor_steps(
-            wf._torque_step(sig, axis, y, floor_t, index, excitation), sensor, model, sig, gear=False
+            wf._torque_step(sig, axis, sel.y, floor_t, index, excitation), sensor, model, sig, gear=False
         )[0]
         chosen.append(wf._select(load, index))
         status[load.channel] = ChannelStatus(load.channel, CHECKED, "", float(np.max(np.abs(load.y))), "N m")
@@ -155,30 +177,26 @@ def run_without_current(
     found = wf.Findings()
     for s in chosen:
         wf._name(s, sig, index, step, found)
+    _separating_without_current(found)
     updated = wf._updated_model(model, found.effects)
-    resim = None
-    if resimulate:
-        # each model through the loop identified beside it: the nominal one with the loop that
-        # explains the recording alone, the updated one with the loop fitted together with its effects
-        nominal_beta, _ = ols(sel.y, sel.base)
-        nominal_loop = decode_loop(nominal_beta, tv, axis.kt_nm_per_a, servo)
-        resim = resimulate_axis(sig, axis, model, updated, loop.servo(), wf.RESIM_MAX_S)
-        if found.effects:
-            first = resimulate_axis(sig, axis, model, model, nominal_loop.servo(), wf.RESIM_MAX_S)
-            resim.pos_nominal_deg, resim.torque_nominal_nm = first.pos_nominal_deg, first.torque_nominal_nm
-        resim.command = "cmd_pos through the identified loop"
-        fe_nominal, fe_updated = following_error_gap_arcsec(resim)
-        resim.following_error_rms_nominal_arcsec = fe_nominal
-        resim.following_error_rms_updated_arcsec = fe_updated
-        if (
-            found.effects
-            and fe_updated > fe_nominal + RESIM_TOLERANCE_OF_FLOOR * FOLLOWING_ERROR_FLOOR_ARCSEC
-        ):
-            _refuse(
-                found,
-                f"its re-simulation follows worse than the nominal model's "
-                f"({fe_nominal:.3g} -> {fe_updated:.3g} arcsec rms of following error)",
-            )
+    # the re-simulation: each model through the loop that explains the recording best beside it,
+    # the nominal one alone, the updated one with the effects it names (their sizes held)
+    nominal_fit = loop_model.fit(np.zeros((n, 0)), start=fit.params)
+    named = [ft for ft in settled.fitted if ft.id in {e.id for e in found.effects}]
+    if len(named) < len(settled.fitted):
+        updated_model, updated_fit = _with_effects(loop_model, fit, named, raw, ctx)
+    if not named:
+        updated_model, updated_fit = loop_model, nominal_fit
+    loop = loop_of(updated_fit, axis.kt_nm_per_a, servo, j_loop)
+    resim = _resimulation(sig, loop_model, nominal_fit, updated_model, updated_fit, residual, effects_nm)
+    fe_nominal = resim.following_error_rms_nominal_arcsec or 0.0
+    fe_updated = resim.following_error_rms_updated_arcsec or 0.0
+    if found.effects and fe_updated > fe_nominal + RESIM_TOLERANCE_OF_FLOOR * FOLLOWING_ERROR_FLOOR_ARCSEC:
+        _refuse(
+            found,
+            f"its re-simulation follows worse than the nominal model's "
+            f"({fe_nominal:.3g} -> {fe_updated:.3g} arcsec rms of following error)",
+        )
     wf._hold_to_the_set(found, None, floor_t)
     if found.effects and not loop.plausible:
         _refuse(found, "the closed loop is not pinned down by this recording")
@@ -200,13 +218,13 @@ def run_without_current(
         gap=found.gaps,
         nominal_model=model,
         updated_model=updated,
-        resimulation=resim,
+        resimulation=resim if resimulate else None,
         notes=[*loop.lines(), *notes],
         channel_status=status,
         window_reason="fixed without a current: the acceleration sets what the loop's torque can show",
         refused=found.refused,
         not_seen=[
-            *not_identifiable_lines(axis, sensor is not None),
+            *not_identifiable_lines(axis, sensor is not None, rec.load_pos_deg is not None),
             *_saturation(sig, axis),
             *excitation.lines(),
         ],
@@ -251,3 +269,102 @@ def _refuse(found: wf.Findings, why: str) -> None:
         )
     found.effects.clear()
     found.ambiguities.clear()
+
+
+def _selector(
+    loop_model: LoopModel,
+    p: LoopParams,
+    ctx: ChannelContext,
+    candidates: tuple[Candidate, ...],
+    index: np.ndarray,
+    floor_t: float,
+) -> ChannelSelector:
+    """The selection on the following error the loop ``p`` leaves (in N m, see loopfit.oe_channel):
+    the candidates seen through the loop, the loop's own parameters and its start fitted beside them."""
+    y, base, _ = oe_channel(loop_model, p, index)
+    seen = through_loop(candidates, loop_model, p)
+    return ChannelSelector(ctx, y[index], seen, index, floor_t, CHANNEL_UNITS[TORQUE], base=base)
+
+
+
+def _resimulation(
+    sig: Signals,
+    nominal: LoopModel,
+    nominal_fit: LoopFit,
+    updated: LoopModel,
+    updated_fit: LoopFit,
+    residual: dict[str, np.ndarray],
+    effects_nm: np.ndarray,
+) -> Resimulation:
+    """The recorded command through each model's loop (loopfit.LoopModel.simulate): the positions
+    against the measured one, and the torques each model puts on the axis."""
+    ref = np.degrees(float(sig.cmd_pos_rad[0])) if sig.cmd_pos_rad is not None else 0.0
+    measured = np.degrees(nominal.pos) + ref
+    pos_nominal = np.degrees(nominal.simulate(nominal_fit.params)) + ref
+    pos_updated = np.degrees(updated.simulate(updated_fit.params)) + ref
+    torque = residual["torque_measured_nm"]
+    inertial = residual["torque_nominal_nm"]
+    d_nom = (measured - pos_nominal) * 3600.0
+    d_upd = (measured - pos_updated) * 3600.0
+    return Resimulation(
+        t_s=sig.t_s,
+        torque_measured_nm=torque,
+        torque_nominal_nm=inertial,
+        torque_updated_nm=inertial + effects_nm,
+        pos_measured_deg=measured,
+        pos_nominal_deg=pos_nominal,
+        pos_updated_deg=pos_updated,
+        rms_nominal_nm=rms(torque - inertial),
+        rms_updated_nm=rms(torque - inertial - effects_nm),
+        command="cmd_pos through the loop identified beside each model",
+        following_error_rms_nominal_arcsec=rms(d_nom - np.mean(d_nom)),
+        following_error_rms_updated_arcsec=rms(d_upd - np.mean(d_upd)),
+    )
+
+
+def _with_effects(
+    loop_model: LoopModel,
+    fit: LoopFit,
+    fitted: list[FittedTerm],
+    raw: dict[str, Candidate],
+    ctx: ChannelContext,
+) -> tuple[LoopModel, LoopFit]:
+    """The loop model with the fitted effects' torques acting (their sizes held), and the loop that
+    explains the recording best with them, from ``fit``."""
+    torque = np.zeros(loop_model.n)
+    for ft in fitted:
+        torque += raw[ft.id].build(ctx, ft.shape) @ ft.beta
+    if not fitted:
+        return loop_model, fit
+    model = loop_model.with_torque(torque)
+    return model, model.fit(np.zeros((loop_model.n, 0)), start=fit.params)
+
+
+def _within_speeds(cand: Candidate, sig: Signals) -> Candidate:
+    """A breakaway's fading speed searched well below the fastest recorded speed only: without a
+    torque measurement the friction's level at a steady speed is held by the loop's integral, and a
+    friction that changes across the recorded speeds reads like the loop's lag (viscous friction,
+    see closedloop.py): such a breakaway would be Coulomb friction read another way."""
+    if cand.id != "stribeck_friction":
+        return cand
+    top = STRIBECK_TOP_SHARE * float(np.percentile(np.abs(sig.speed_rad_s), 99.0))
+    grid = tuple(s for s in cand.shape_grid if s[0] <= top) or (cand.shape_grid[0],)
+
+    def bounds(s: tuple[float, ...]) -> tuple[list[float], list[float]]:
+        lo, hi = cand.shape_bounds(s)
+        return [min(lo[0], top)], [max(min(hi[0], top), min(lo[0], top) * 1.001)]
+
+    return replace(cand, shape_grid=grid, shape_bounds=bounds)
+
+
+def _separating_without_current(found: wf.Findings) -> None:
+    """The recordings that would separate look-alikes when the torque is read through the loop."""
+    for i, amb in enumerate(found.ambiguities):
+        test = SEPARATING_WITHOUT_CURRENT.get(frozenset({amb.chosen, amb.alternative}))
+        if test is None:
+            continue
+        old = amb.separating_test
+        found.ambiguities[i] = replace(amb, separating_test=test)
+        for e in found.effects:
+            if amb.alternative in e.alternatives and old in e.advice:
+                e.advice = e.advice.replace(old, test)

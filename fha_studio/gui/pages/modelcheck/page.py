@@ -5,7 +5,6 @@ with their parameters, the gap on held-out data, and the re-simulation with the 
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import time
 from pathlib import Path
@@ -365,9 +364,7 @@ class ModelCheckPage(BasePage):
         declared = self.state.load_inertia_kgm2
         recorded = recording.metadata.load_inertia_kgm2
         if recorded is None or abs(declared - recorded) > 1e-12:
-            recording = dataclasses.replace(
-                recording, metadata=dataclasses.replace(recording.metadata, load_inertia_kgm2=declared)
-            )
+            recording = recording.with_declared_load(declared)
         return recording
 
     def run(self) -> None:
