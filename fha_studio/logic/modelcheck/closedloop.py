@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fha_studio.logic.modelcheck.axis import DeclaredAxis, ModelCheckError, rms
+from fha_studio.logic.modelcheck.axis import DeclaredAxis, ModelCheckError
 from fha_studio.logic.modelcheck.candidates import TORQUE, TORQUE_CANDIDATES, ChannelContext
 from fha_studio.logic.modelcheck.loopfit import LoopFit, LoopParams
 from fha_studio.logic.modelcheck.signals import ARCSEC_PER_RAD, Signals, build_signals, window_for_bandwidth
@@ -237,14 +237,6 @@ def not_identifiable_lines(axis: DeclaredAxis, sensor: bool = False, load_encode
     ]
 
 
-def following_error_gap_arcsec(resim) -> tuple[float, float]:
-    """RMS of measured - re-simulated position (the following error's difference, the command being
-    the same), nominal and updated model (arcsec)."""
-    d_nom = (resim.pos_measured_deg - resim.pos_nominal_deg) * 3600.0
-    d_upd = (resim.pos_measured_deg - resim.pos_updated_deg) * 3600.0
-    return rms(d_nom - np.mean(d_nom)), rms(d_upd - np.mean(d_upd))
-
-
 __all__ = [
     "ARCSEC_PER_RAD",
     "CANDIDATES_WITHOUT_CURRENT",
@@ -252,7 +244,6 @@ __all__ = [
     "TORQUE",
     "Loop",
     "closed_loop_signals",
-    "following_error_gap_arcsec",
     "friction_proxies",
     "loop_of",
     "not_identifiable_lines",
