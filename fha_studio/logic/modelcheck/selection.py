@@ -430,13 +430,22 @@ class ChannelSelector:
             return beta0, {}
         n_lin = x.shape[1]
 
-        def resid(p):
-            shapes = {i: (float(p[n_lin + j]),) for j, i in enumerate(shaped)}
-            return y - design_for(shapes) @ p[:n_lin]
+        def shapes_of(p) -> dict[int, tuple[float, ...]]:
+            return {i: (float(p[j]),) for j, i in enumerate(shaped)}
 
-        p0 = start if start is not None else np.concatenate([beta0, [terms[i].shape[0] for i in shaped]])
-        sol = least_squares(resid, p0, diff_step=1e-6, x_scale="jac", max_nfev=max_nfev)
-        return sol.x[:n_lin], {i: (float(sol.x[n_lin + j]),) for j, i in enumerate(shaped)}
+        # the shapes refined with the coefficients solved linearly at each step (variable
+        # projection): the same optimum, and a Jacobian of the shapes alone (its SVD, not one over
+        # every coefficient, is what a step costs)
+        def resid(p):
+            xs = design_for(shapes_of(p))
+            b, _ = ols(y, xs)
+            return y - xs @ b
+
+        s0 = start[n_lin:] if start is not None else [terms[i].shape[0] for i in shaped]
+        sol = least_squares(resid, s0, diff_step=1e-6, x_scale="jac", max_nfev=max_nfev)
+        shapes = shapes_of(sol.x)
+        beta, _ = ols(y, design_for(shapes))
+        return beta, shapes
 
     def final_fit(self, terms: list[Term]) -> tuple[list[FittedTerm], np.ndarray, np.ndarray, int]:
         """Refine every parameter together (least squares); uncertainties by block jackknife."""
