@@ -422,7 +422,8 @@ def through_loop(cands: tuple[Candidate, ...], model: LoopModel, p: LoopParams) 
         def build(ctx, shape, _build=c.build):
             return -scale * model.disturbance_response(p, np.asarray(_build(ctx, shape), dtype=float))
 
-        return replace(c, build=build)
+        # the loop's response needs the whole record: never built at the fitted rows only
+        return replace(c, build=build, decimates=False)
 
     return tuple(wrap(c) for c in cands)
 
