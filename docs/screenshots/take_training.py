@@ -60,8 +60,8 @@ def main() -> int:
     page.motion.speed_spin.setValue(5.0)
     page.motion._jog(+1)  # as if FWD were held: the brake still holds
     wait(app, 1.5)
-    window.jog_page.release_held()
-    wait(app, 0.8)
+    window.link.jog_release()  # _jog pressed no button: releasing the buttons would not end it
+    wait(app, 10, lambda: not window.link.moving)
     window.link.send(Servo(False))
     wait(app, 0.5)
     shot(window, "training-session")
