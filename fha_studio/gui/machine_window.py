@@ -200,6 +200,7 @@ class MachineWindow(QMainWindow):
         right = QVBoxLayout()
         self.banner = QLabel("")
         self.banner.setObjectName("axisBanner")
+        self.banner.setWordWrap(True)  # a long port (a socket:// or sim:// URL) takes a second line
         self.banner.setStyleSheet(
             "background: #1d3f6e; color: white; font-size: 12pt; font-weight: bold;"
             " padding: 6px; border-radius: 4px;"

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from PySide6 import QtGui
 from PySide6.QtCore import Qt
-from PySide6.QtGui import QFontMetrics, QTextDocument
+from PySide6.QtGui import QFontMetrics, QTextDocument, QTextLayout, QTextOption
 from PySide6.QtWidgets import (
     QAbstractButton,
     QCheckBox,
@@ -82,19 +82,27 @@ def hidden_actions(top: QWidget) -> list[str]:
     return found
 
 
-def _cut_wrapped(label: QLabel, room: int, metrics: QFontMetrics) -> list[str]:
+def _cut_wrapped(label: QLabel, room: int) -> list[str]:
     """A word-wrapped label is cut when its lines need more height than it has, or when a word
-    (a long path, a URL) is wider than its width (Qt does not break inside a word)."""
+    (a long path, a URL) is wider than its width and cannot be broken."""
     found = []
     need = label.heightForWidth(label.width())
     if need > label.height() + 1:
         text = " ".join(_plain_lines(label))
         found.append(f"{_name(label)}: {text[:80]!r} needs {need} px of height, has {label.height()}")
-    for line in _plain_lines(label):
-        for word in line.split():
-            width = metrics.horizontalAdvance(word)
+    for line in _plain_lines(label):  # laid out as the label wraps it (between words)
+        layout = QTextLayout(line, label.font())
+        option = QTextOption()
+        option.setWrapMode(QTextOption.WrapMode.WordWrap)
+        layout.setTextOption(option)
+        layout.beginLayout()
+        while (row := layout.createLine()).isValid():
+            row.setLineWidth(room)
+            width = row.naturalTextWidth()
             if width > room + 1:
-                found.append(f"{_name(label)}: the word {word[:80]!r} needs {width} px, has {room}")
+                text = line[row.textStart():row.textStart() + row.textLength()]
+                found.append(f"{_name(label)}: {text[:80]!r} cannot wrap: needs {width:.0f} px, has {room}")
+        layout.endLayout()
     return found
 
 
@@ -107,7 +115,7 @@ def cut_texts(top: QWidget) -> list[str]:
         room = label.contentsRect().width() - 2 * label.margin() - 2 * max(label.indent(), 0)
         metrics = QFontMetrics(label.font())
         if label.wordWrap():
-            found += _cut_wrapped(label, room, metrics)
+            found += _cut_wrapped(label, room)
             continue
         for line in _plain_lines(label):
             width = metrics.horizontalAdvance(line)

@@ -148,3 +148,40 @@ def test_every_status_message_reads_whole(make_window, qtbot):
             except qtbot.TimeoutError:
                 found = "\n".join(problems(size))
                 raise AssertionError(f"{state}, {size[0]} x {size[1]}:\n{found}") from None
+
+
+def test_the_machine_window_fits_with_every_axis_and_says_it_whole(qtbot, tmp_path):
+    """A machine window on a 1366 x 768 screen (1366 x 740, and 1280 x 720) with a full drive and
+    one of the manual's commands (its simulated controller's panel shown), both on long ports:
+    whichever axis is chosen the window keeps its size, and the banner, the pages' controls and
+    the status bar are whole."""
+    from fha_studio.gui.machine_window import MachineWindow
+    from fha_studio.logic.machine import MachineProject
+    from tests.gui.fit import cut_texts, hidden_actions
+    from tests.support.windows import torn_down
+
+    project = MachineProject("Line 3 positioner", site="Plant A, hall 2")
+    project.add_axis("table", "FHA-25C-50-US250",
+                     port_url=f"sim://FHA-25C-50-US250?paced=0&eeprom={tmp_path}/table.eeprom.json")
+    project.add_axis("tilt", "FHA-32C-100-S248-B",
+                     port_url=f"sim://FHA-32C-100-S248-B?profile=documented&paced=0&eeprom={tmp_path}/tilt.json")
+    with torn_down(lambda window: [axis.link for axis in window.axis_windows]) as windows:
+        window = MachineWindow(project, None)
+        windows.append(window)
+        window.show()
+        window.connect_all()
+        qtbot.waitUntil(lambda: all(w.link.connected for w in window.axis_windows), timeout=15000)
+        problems = []
+        for size in ((1366, 740), (1280, 720)):
+            for name in ("table", "tilt"):
+                window.resize(*size)
+                qtbot.waitUntil(lambda size=size: window.size().toTuple() == size, timeout=3000)
+                window.select_axis(name)
+                qtbot.wait(50)  # let the chosen axis lay out
+                hint = window.minimumSizeHint()
+                if hint.width() > size[0] or hint.height() > size[1]:
+                    problems.append(f"{name}: the window needs {hint.width()} x {hint.height()}")
+                    continue
+                found = hidden_actions(window) + cut_texts(window)
+                problems += [f"{name}, {size[0]} x {size[1]}: {p}" for p in found]
+        assert not problems, "\n".join(problems)
