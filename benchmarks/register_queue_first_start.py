@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -89,7 +90,14 @@ def measure(url: str, axes: int, per_day: int) -> None:
     made_s = time.perf_counter() - t0
     window.state.enter_front_panel("tune", 4, 21, "first")
     t1 = time.perf_counter()
-    first_s = wait_until(lambda: on_server(url, "first") == 1)
+    try:
+        first_s = wait_until(lambda: on_server(url, "first") == 1)
+    except TimeoutError:
+        print(f"the first fact was not on the server after {WAIT_S:.0f} s; the queue holds "
+              f"{megabytes(server.queue):.0f} MB; the window said:")
+        for message in window.message_area.messages:
+            print(f"  {message.text}")
+        raise
     ended_s = wait_until(lambda: server.answers is True and busy[-1:] == [False]) + first_s
     size_mb = megabytes(server.queue)
     window.state.enter_front_panel("tune", 4, 22, "second")
@@ -114,6 +122,7 @@ def main() -> None:
     axes = numbers[0] if numbers else 1000
     per_day = numbers[1] if len(numbers) > 1 else 1
     with contextlib.ExitStack() as stack:
+        stack.callback(shutil.rmtree, TMP, ignore_errors=True)  # this computer's queue with it
         if not url:
             from tests.support.postgres import throwaway_cluster
 
