@@ -178,6 +178,7 @@ class QuestionWorker(QObject):
                 said = f"the register {shown_url(self.url)}: {exc}"
             if gone:
                 self._close()  # opened again for the next question
+                said = without_nothing_changed(said)  # a question changes nothing anyway
             self.sigAnswer.emit(Answer(question.number, problem=said, server_problem=gone))
             return
         self.sigAnswer.emit(Answer(question.number, value))
@@ -304,8 +305,7 @@ class ServerQuestions(RegisterQuestions):
     def _server_away(self, what: str, why: str) -> None:
         if self.answers is not False:
             self.sigSay.emit(
-                f"Register: the server does not answer: no answer about {what} "
-                f"({without_nothing_changed(why)}).", Level.WARNING
+                f"Register: the server does not answer: no answer about {what} ({why}).", Level.WARNING
             )
         self.answers, self._said_slow = False, False
 
