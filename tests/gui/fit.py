@@ -106,6 +106,18 @@ def _cut_wrapped(label: QLabel, room: int) -> list[str]:
     return found
 
 
+def _cut_inside_a_word(label: QLabel) -> list[str]:
+    """A label shortened with an ellipsis (the whole text in its tooltip) must not end inside a
+    word: "NOT LIVE: servo on (controller): th…" says nothing; cut between words it still does."""
+    text, whole = label.text(), label.toolTip()
+    shown = text[:-1]
+    if not (text.endswith("…") and shown and whole.startswith(shown) and len(whole) > len(shown)):
+        return []
+    if shown[-1].isalnum() and whole[len(shown)].isalnum():
+        return [f"{_name(label)}: {text[-40:]!r} ends inside a word of {whole[:80]!r}"]
+    return []
+
+
 def cut_texts(top: QWidget) -> list[str]:
     """Texts wider than the room their widget gives them, one line each."""
     found = []
@@ -117,6 +129,7 @@ def cut_texts(top: QWidget) -> list[str]:
         if label.wordWrap():
             found += _cut_wrapped(label, room)
             continue
+        found += _cut_inside_a_word(label)
         for line in _plain_lines(label):
             width = metrics.horizontalAdvance(line)
             if width > room + 1:

@@ -112,7 +112,8 @@ def test_every_status_message_reads_whole(make_window, qtbot):
     """What the status bar says is read whole at 1366 x 740 (a 1366 x 768 screen), 1280 x 720 and
     1024 x 600: the longest message (STOP on a drive without a stop command, the link lost) and the
     link's state (servo on: CN3 silent) wrap onto another line instead of being cut, side by side
-    without overlapping, and the window still fits the small screen."""
+    without overlapping, and the window still fits the small screen. The scope's indicator says
+    as much as its room holds, never a word cut in two."""
     from fha_studio.gui.link import SERVO_ON_NOTE, SimPanelRequest
     from fha_studio.gui.widgets import StopButton
     from tests.gui.fit import cut_texts
@@ -124,10 +125,13 @@ def test_every_status_message_reads_whole(make_window, qtbot):
     qtbot.waitUntil(lambda: SERVO_ON_NOTE in window.caps_label.text(), timeout=10000)
     window.stop_axis()  # nothing can be sent: the message says what stops the axis
     assert StopButton.NO_STOP_TEXT in window.message_area.text_label.text()
+    window.state.set_actuator("FHA-25C-50-S248", acknowledged=True)  # its ratio scales DGR's counts
+    scope = window.show_page("scope").view  # its indicator says why nothing is live
+    scope.start_live()
+    qtbot.waitUntil(lambda: "servo on (controller)" in scope.indicator_text(), timeout=10000)
 
     def problems(size: tuple[int, int]) -> list[str]:
-        bar = window.statusBar()
-        found = cut_texts(bar)
+        found = cut_texts(window.statusBar()) + cut_texts(scope.toolbar)
         text, caps = window.message_area.text_label, window.caps_label
         if text.geometry().translated(text.parentWidget().pos()).intersects(caps.geometry()):
             found.append("the message overlaps the link's state")

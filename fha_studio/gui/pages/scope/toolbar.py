@@ -24,6 +24,27 @@ INDICATOR_WIDTH_PX = 270
 _INDICATOR_PADDING_PX = 20
 
 
+def indicator_words(text: str, metrics: QFontMetrics, room_px: int) -> str:
+    """``text`` as the indicator shows it in ``room_px`` (the whole text is the tooltip's): whole;
+    else up to a colon that still gives a reason ("NOT LIVE: servo on (controller)" of "NOT LIVE:
+    servo on (controller): the drive does not answer ..."); else as many whole words as fit, with
+    an ellipsis; never a word cut in two."""
+    if metrics.horizontalAdvance(text) <= room_px:
+        return text
+    at = text.rfind(": ")
+    while at > 0:
+        head = text[:at]
+        if ": " in head and metrics.horizontalAdvance(head) <= room_px:
+            return head
+        at = text.rfind(": ", 0, at)
+    words = text.split(" ")
+    for count in range(len(words) - 1, 0, -1):
+        head = " ".join(words[:count]).rstrip(",;:·") + "…"
+        if metrics.horizontalAdvance(head) <= room_px:
+            return head
+    return metrics.elidedText(text, Qt.TextElideMode.ElideRight, room_px)
+
+
 def _button(text: str, checkable: bool = False) -> QToolButton:
     """A toolbar button as wide as its text (a push button is at least 80 px): the whole row
     fits a 1280 px window, as the main window's toolbar buttons do."""
@@ -177,8 +198,8 @@ class ScopeToolbar(QWidget):
         self._indicator_text = text
         font = QFont(self.indicator.font())
         font.setBold(True)
-        self.indicator.setText(QFontMetrics(font).elidedText(text, Qt.TextElideMode.ElideRight,
-                                                             INDICATOR_WIDTH_PX - _INDICATOR_PADDING_PX))
+        room = INDICATOR_WIDTH_PX - _INDICATOR_PADDING_PX
+        self.indicator.setText(indicator_words(text, QFontMetrics(font), room))
         self.indicator.setToolTip(text)
         self.indicator.setStyleSheet(INDICATOR_STYLE[kind])
         return True
