@@ -6,6 +6,8 @@ import datetime as _dt
 import gc
 import json
 import os
+import shutil
+import tempfile
 import threading
 import time
 
@@ -21,6 +23,13 @@ pytest_plugins = ["tests.support.links", "tests.support.processes", "tests.suppo
 
 # GUI tests run headless; the environment can override (e.g. xcb under xvfb-run).
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+# Nothing the test process or its children do touches the user's own data or settings, not even
+# a session fixture set up before the per-test folders below (_user_data_elsewhere, the GUI's
+# settings fixture): the whole session starts in folders of its own, removed at its end.
+_SESSION_USER_FOLDERS = tempfile.mkdtemp(prefix="fha-tests-user-")
+for _variable in ("XDG_DATA_HOME", "XDG_CONFIG_HOME"):
+    os.environ[_variable] = os.path.join(_SESSION_USER_FOLDERS, _variable.lower())
 
 # FHA_TEST_TRAVEL_DAYS=400 (or -400) runs the whole session with the calendar moved that far
 # (time.time, datetime.now, date.today; the monotonic clock is untouched): a test that holds only
@@ -50,6 +59,7 @@ def pytest_collection_finish(session):
 
 def pytest_unconfigure(config):
     global _travel
+    shutil.rmtree(_SESSION_USER_FOLDERS, ignore_errors=True)
     if _travel is not None:
         _travel.stop()
         _travel = None
