@@ -1,4 +1,4 @@
-"""Issue 25's "Done when" on the simulated drive, for FHA-17C-100, FHA-25C-50 and FHA-40C-160 with a
+"""Tuning's acceptance cases on the simulated drive, for FHA-17C-100, FHA-25C-50 and FHA-40C-160 with a
 load of 0, 1, 3 and 10 x the actuator's own inertia (FHA-C manual 2-1 allows about 3 x):
 
 - the measured response (closed loop and plant) within 1 dB and 5 deg of the simulated loop's own

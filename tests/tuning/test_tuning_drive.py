@@ -1,6 +1,6 @@
 """Tuning on the simulated drive over the client and the protocol (EXA/EXL/EXG and the trace at
 the servo rate): the command line's contract, STOP and the watchdog, waiting on the drive's own
-time, and the refusals (exit 4, nothing moves). The twelve cases of issue 25's "Done when" are in
+time, and the refusals (exit 4, nothing moves). The twelve acceptance cases are in
 test_tuning_cases.py."""
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ ran (docs/physics.md, "Servo": speed command = Kp (cmd - pos) + FF cmd', current
     D(s) = J Tv s^3 + g (Tv s + 1)(s + Kp),   g = Kt Kv (on the declared inertia J).
 
 The loop is identified by *output error*: the position the model gives for the recorded command
-against the measured one (``LoopModel.fit``, least squares over Kp, FF, g and Tv, the disturbance
+against the measured one (``RecordedLoop.fit``, least squares over Kp, FF, g and Tv, the disturbance
 columns and the start's free response solved linearly at every step). The tempting alternative,
 the loop's torque written from the measured signals (equation error), multiplies every timing
 detail of the drive (its servo period, its speed detection's lag, the integration rule) by the
@@ -176,7 +176,7 @@ class LoopFit:
         return self.rms_arcsec <= EXPLAINED_SHARE * self.following_error_rms_arcsec
 
 
-class LoopModel:
+class RecordedLoop:
     """The recording's command and position (smoothed like the analysis) and the loop's responses."""
 
     def __init__(
@@ -353,11 +353,11 @@ class LoopModel:
         k = disturbances.shape[1]
         return LoopFit(best[1], best[0], self._following_error_rms(), beta[:k])
 
-    def with_torque(self, torque_nm: np.ndarray) -> LoopModel:
+    def with_torque(self, torque_nm: np.ndarray) -> RecordedLoop:
         """The same recording with ``torque_nm`` (analysis rate) acting on the axis beside what is
         measured: a model whose effects are fixed."""
         known = torque_nm if self.known is None else self.known + torque_nm
-        return LoopModel(self.sig, self.j, known, self.rows)
+        return RecordedLoop(self.sig, self.j, known, self.rows)
 
     def simulate(self, p: LoopParams) -> np.ndarray:
         """The position (rad, analysis rate, relative to the first command) the loop gives, its
@@ -413,7 +413,7 @@ def pushed_standstills(sig: Signals) -> list[tuple[int, int]]:
     return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
 
 
-def through_loop(cands: tuple[Candidate, ...], model: LoopModel, p: LoopParams) -> tuple[Candidate, ...]:
+def through_loop(cands: tuple[Candidate, ...], model: RecordedLoop, p: LoopParams) -> tuple[Candidate, ...]:
     """The candidates with their columns passed through H and scaled by 1 / max |H| (N m), with
     the sign of a torque that holds the position back."""
     scale = 1.0 / model.disturbance_scale(p)
@@ -429,11 +429,11 @@ def through_loop(cands: tuple[Candidate, ...], model: LoopModel, p: LoopParams) 
 
 
 def oe_channel(
-    model: LoopModel, p: LoopParams, index: np.ndarray
+    model: RecordedLoop, p: LoopParams, index: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """The following error the loop leaves, scaled to N m (1 / max |H|), at the analysis rate; the
     nuisance columns on the decimated rows (the loop's own parameters linearised, so that they are
-    fitted with the effects, then LoopModel.nuisance); and the scale (N m per rad)."""
+    fitted with the effects, then RecordedLoop.nuisance); and the scale (N m per rad)."""
     scale = 1.0 / model.disturbance_scale(p)
     y = (model.pos - model.response(p)) * scale
     v = p.vector()

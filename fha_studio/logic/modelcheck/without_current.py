@@ -22,8 +22,8 @@ from fha_studio.logic.modelcheck.consistency import RESIM_TOLERANCE_OF_FLOOR, Re
 from fha_studio.logic.modelcheck.excitation import excitation_of
 from fha_studio.logic.modelcheck.loopfit import (
     LoopFit,
-    LoopModel,
     LoopParams,
+    RecordedLoop,
     oe_channel,
     through_loop,
 )
@@ -68,7 +68,7 @@ def run_without_current(
     sensor = wf.sensor_torque_nm(rec, sig)
     j_gear = j - model.load_inertia_kgm2
     j_loop = j if sensor is None else j_gear
-    loop_model = LoopModel(sig, j_loop, sensor, index)
+    loop_model = RecordedLoop(sig, j_loop, sensor, index)
     ctx = ChannelContext(sig, TORQUE, nominal_inertia_kgm2=j)
     excitation = excitation_of(sig)
     candidates = tuple(
@@ -272,7 +272,7 @@ def _refuse(found: wf.Findings, why: str) -> None:
 
 
 def _selector(
-    loop_model: LoopModel,
+    loop_model: RecordedLoop,
     p: LoopParams,
     ctx: ChannelContext,
     candidates: tuple[Candidate, ...],
@@ -289,14 +289,14 @@ def _selector(
 
 def _resimulation(
     sig: Signals,
-    nominal: LoopModel,
+    nominal: RecordedLoop,
     nominal_fit: LoopFit,
-    updated: LoopModel,
+    updated: RecordedLoop,
     updated_fit: LoopFit,
     residual: dict[str, np.ndarray],
     effects_nm: np.ndarray,
 ) -> Resimulation:
-    """The recorded command through each model's loop (loopfit.LoopModel.simulate): the positions
+    """The recorded command through each model's loop (loopfit.RecordedLoop.simulate): the positions
     against the measured one, and the torques each model puts on the axis."""
     ref = np.degrees(float(sig.cmd_pos_rad[0])) if sig.cmd_pos_rad is not None else 0.0
     measured = np.degrees(nominal.pos) + ref
@@ -323,12 +323,12 @@ def _resimulation(
 
 
 def _with_effects(
-    loop_model: LoopModel,
+    loop_model: RecordedLoop,
     fit: LoopFit,
     fitted: list[FittedTerm],
     raw: dict[str, Candidate],
     ctx: ChannelContext,
-) -> tuple[LoopModel, LoopFit]:
+) -> tuple[RecordedLoop, LoopFit]:
     """The loop model with the fitted effects' torques acting (their sizes held), and the loop that
     explains the recording best with them, from ``fit``."""
     torque = np.zeros(loop_model.n)
