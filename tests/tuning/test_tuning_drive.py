@@ -14,7 +14,7 @@ from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import load_parameter_model
 from fha_studio.logic.tuning.excitation import plan_excitation
 from fha_studio.logic.tuning.measure import NotExcitable, measure
-from fha_studio.logic.tuning.session import declared_model, measure_report, tuner_for
+from fha_studio.logic.tuning.session import declared_model, tuner_for
 
 PARAMETERS = load_parameter_model("HA-655")
 CODE = "FHA-25C-50-US250"
@@ -28,20 +28,6 @@ def _url(code: str, load: float, extra: str = "") -> str:
 
 def _sim(client: DriveClient):  # the embedded drive behind the client's port
     return client.transaction.transport.inner.sim_drive
-
-
-def test_measure_report_has_the_contract_keys() -> None:
-    with DriveClient.open(_url(CODE, 0.81)) as client:
-        drive = _sim(client)
-        client.servo(True)
-        tuner = tuner_for(client, PARAMETERS, declared_model(CODE, 0.81))
-        result = measure_report(client, tuner, drive.advance, lambda: drive.clock_s)
-    for key in ("resonance_hz", "antiresonance_hz", "load_inertia_estimate_kgm2", "gain_margin_db",
-                "phase_margin_deg", "crossover_hz", "bandwidth_hz"):
-        assert key in result
-    assert set(result["frequency_response"]) == {"freq_hz", "magnitude_db", "phase_deg", "coherence"}
-    assert result["load_inertia_estimate_kgm2"] == pytest.approx(0.81, rel=0.1)
-    json.dumps(result)
 
 
 def test_stp_and_servo_off_end_the_excitation() -> None:
@@ -83,3 +69,42 @@ def test_cli_exit_4_when_the_drive_cannot_be_excited(extra: str, capsys: pytest.
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1
     assert ("servo is off" in err[0]) or ("front-panel" in err[0])
+
+
+def test_cli_measure_runs_to_completion_with_the_contract(tmp_path, monkeypatch,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    """``tune measure`` as a script runs it, to the end: the servo switched on by the controller (the
+    simulated drive's CN2 servo-ON input, as on a real axis: the command line never switches it
+    on), the excitation stated on stderr before it starts, bounded by --amplitude-rpm, waited for
+    on the stepped drive's own time; exit 0, one line of figures, the contract's JSON."""
+    opened = DriveClient.open.__func__
+    drives = []
+
+    def open_under_servo(cls, url, *args, **kwargs):
+        client = opened(cls, url, *args, **kwargs)
+        drives.append(_sim(client))
+        drives[-1].set_servo(True)
+        return client
+
+    monkeypatch.setattr(DriveClient, "open", classmethod(open_under_servo))
+    out = tmp_path / "measure.json"
+    code = cli_main(["tune", "measure", "--url", _url(CODE, 0.81), "--actuator", CODE,
+                     "--load-inertia", "0.81", "--amplitude-rpm", "0.3", "--json", str(out)])
+    said, err = capsys.readouterr()
+    assert code == 0, err
+    (drive,) = drives
+    assert said.count("\n") == 1 and said.startswith("resonance ") and "load inertia" in said
+    assert "excitation:" in err and "0.3 r/min" in err and "travels at most" in err
+    result = json.loads(out.read_text())
+    for key in ("resonance_hz", "antiresonance_hz", "load_inertia_estimate_kgm2", "gain_margin_db",
+                "phase_margin_deg", "crossover_hz", "bandwidth_hz"):
+        assert key in result, key
+    response = result["frequency_response"]
+    assert set(response) == {"freq_hz", "magnitude_db", "phase_deg", "coherence"}
+    assert len({len(v) for v in response.values()}) == 1 and len(response["freq_hz"]) > 100
+    assert result["excitation"]["amplitude_rpm"] == pytest.approx(0.3)
+    # the two-mass resonance of the gear's spring and the load, and the load found again (10 %)
+    assert result["resonance_hz"] == pytest.approx(result["predicted_resonance_hz"], rel=0.1)
+    assert result["load_inertia_estimate_kgm2"] == pytest.approx(0.81, rel=0.1)
+    assert result["phase_margin_deg"] > 0 and result["bandwidth_hz"] > 0
+    assert not drive.excitation.active  # ended with the command
