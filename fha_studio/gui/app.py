@@ -125,13 +125,17 @@ def _machine_window(args):
     from fha_studio.gui.machine_window import MachineWindow
     from fha_studio.logic.machine import MachineError, MachineProject
     from fha_studio.logic.register import Register, RegisterError, register_location
+    from fha_studio.logic.register.server import is_server_url
 
+    location = register_location(args.register)
+    if is_server_url(location):
+        return _machine_window_on_server(args, str(location))
     try:
         # a machine file is read (and refused) before the register is opened: a refused file
         # leaves no new register behind; it is put into the register (made when missing), while
         # a machine by name must be there
         project = MachineProject.load(args.machine_file) if args.machine_file else None
-        register = Register(register_location(args.register), create=bool(args.machine_file))
+        register = Register(location, create=bool(args.machine_file))
         try:
             if project is None:
                 project = MachineProject.from_register(register, args.machine)
@@ -149,6 +153,27 @@ def _machine_window(args):
         )
         raise SystemExit(2)
     return MachineWindow(project, register)
+
+
+def _machine_window_on_server(args, url: str):
+    """The machine window on a plant's register on a server, shown at once whether the server
+    answers or not (a laptop on a shop floor without the plant's network): the machine of a file,
+    or the one named as this computer's queue for the server knows it (perhaps no axis yet), whose
+    axes the window asks the server for from a thread of its own. SystemExit(2) with one line for a
+    machine file or a name that is refused."""
+    from fha_studio.gui.machine_window import MachineWindow
+    from fha_studio.gui.register_worker import machine_known_here
+    from fha_studio.logic.machine import MachineError, MachineProject
+
+    try:
+        if args.machine_file:
+            project = MachineProject.load(args.machine_file)
+        else:
+            project = machine_known_here(url, args.machine) or MachineProject(args.machine)
+    except (MachineError, ValueError) as exc:
+        print(f"fha-studio: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
+    return MachineWindow(project, server_url=url, ask_for_axes=not args.machine_file)
 
 
 def single_axis_window(args: argparse.Namespace):

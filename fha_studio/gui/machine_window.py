@@ -15,6 +15,11 @@ window records (the machine and its axes at the start, an axis added, the machin
 axis's facts) goes through this computer's queue for the server (``gui/register_worker.py``), and
 what it asks (the Register dialog, the machine report's part from the register, a signature)
 through ``gui/register_questions.py``; a slow or absent server is said in the message line.
+Nor does the window wait for the server to start: opened by the machine's name
+(``server_url``, ``ask_for_axes``) it shows at once the axes this computer's queue for the server
+knows (none for a machine never opened here), asks the server for the machine's axes from the
+questions' thread and adds those it lacks when the answer comes; while the server is not reachable
+it says so, and that what it records is queued on this computer.
 """
 
 from __future__ import annotations
@@ -23,7 +28,7 @@ import logging
 from collections.abc import Callable
 from pathlib import Path
 
-from PySide6.QtCore import QSettings, Qt, Slot
+from PySide6.QtCore import QSettings, Qt, QTimer, Slot
 from PySide6.QtGui import QAction, QColor
 from PySide6.QtWidgets import (
     QFileDialog,
@@ -48,7 +53,12 @@ from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.register_dialog import RegisterDialog
-from fha_studio.gui.register_questions import LocalQuestions, RegisterQuestions, ServerQuestions
+from fha_studio.gui.register_questions import (
+    LocalQuestions,
+    RegisterQuestions,
+    ServerQuestions,
+    shown_location,
+)
 from fha_studio.gui.register_worker import ServerWriter
 from fha_studio.gui.widgets import StopButton
 from fha_studio.logic.machine import MachineAxis, MachineProject
@@ -61,6 +71,9 @@ log = logging.getLogger(__name__)
 
 #: Width of the axis list [px].
 AXIS_LIST_WIDTH_PX = 230
+#: The machine's axes are asked of a server that did not answer again after this long [s] (at
+#: once when a delivery finds it answering).
+AXES_RETRY_S = 30.0
 
 
 class MachineWindow(QMainWindow):
@@ -72,22 +85,32 @@ class MachineWindow(QMainWindow):
         register: Register | None = None,
         open_client: OpenClient | None = None,
         parent: QWidget | None = None,
+        server_url: str | None = None,
+        ask_for_axes: bool = False,
     ):
+        """``register``: an open register file (or one on a server, whose location only is used
+        here). ``server_url``: instead, a register on a server that this window never opens on its
+        own thread. ``ask_for_axes``: the machine's axes are asked of the server (the project
+        holds those this computer knew, perhaps none) and those it lacks are added when the answer
+        comes."""
         super().__init__(parent)
         self.setObjectName("machineWindow")
         self.project = project
         self.register = register
+        #: the register: its file or its server's URL (None: the window records nothing)
+        self.location: Path | str | None = register.location if register is not None else server_url
         self.axis_windows: list[MainWindow] = []
         self.recorders: list[AxisRecorder] = []
         #: a register on a server is written and asked from threads of their own, never this one's
         self.server_writer: ServerWriter | None = None
         #: the register's questions (a file's answered on this thread, a server's from another)
         self.questions: RegisterQuestions | None = None
-        if register is not None and is_server_url(register.location):
-            self.server_writer = ServerWriter(str(register.location), self)
+        if self.location is not None and is_server_url(self.location):
+            self.server_writer = ServerWriter(str(self.location), self)
             self.server_writer.sigSay.connect(self._say)
             self.server_writer.sigNotRecorded.connect(self._machine_not_recorded)
-            self.questions = ServerQuestions(str(register.location), self)
+            self.server_writer.sigState.connect(self._on_server_state)
+            self.questions = ServerQuestions(str(self.location), self)
         elif register is not None:
             self.questions = LocalQuestions(register, self)
         if self.questions is not None:
@@ -95,11 +118,18 @@ class MachineWindow(QMainWindow):
         self._shut_down = False
         self._closing_confirmed = False
         self._register_dialog: RegisterDialog | None = None
+        #: the machine's axes are still to be had from the server (asked, or to be asked again)
+        self.axes_wanted = ask_for_axes and self.questions is not None and self.questions.on_server
+        self._asking_axes = False
+        self._axes_retry = QTimer(self)
+        self._axes_retry.setSingleShot(True)
+        self._axes_retry.timeout.connect(self.ask_for_axes)
         self._build_toolbar()
         self._build_body(open_client)
         not_recorded = None
         if self.server_writer is not None:
-            self._record_machine()  # a line says it if the queue cannot take it
+            if len(project):  # a machine not known here is not made on the server by opening it
+                self._record_machine()  # a line says it if the queue cannot take it
         elif register is not None:
             try:
                 project.save_to(register, who=self.operator)
@@ -112,6 +142,81 @@ class MachineWindow(QMainWindow):
                 f"Register: the machine was not recorded ({not_recorded}).", Level.WARNING
             )
         self.resize(1366, 740)
+        if self.axes_wanted:
+            self.ask_for_axes()
+
+    # -- the machine's axes from a server ---------------------------------------------------------
+    @Slot()
+    def ask_for_axes(self) -> None:
+        """Asks the server for the machine's axes (from the questions' thread); the window goes on."""
+        if not self.axes_wanted or self._asking_axes or self.questions is None or self._shut_down:
+            return
+        self._axes_retry.stop()
+        self._asking_axes = True
+        name = self.project.name
+        if self._server_answers() is None:
+            known = (f"the {_axes_text(len(self.project))} this computer knew are shown meanwhile"
+                     if len(self.project) else "none is shown until it answers")
+            self._say(f"Register: asking the plant's register ({shown_location(self.location or '')}) "
+                      f"for the axes of {name} ({known}); what this window records is queued on this "
+                      "computer and goes to the server when it answers.", Level.INFO)
+        self.questions.ask(
+            f"the axes of {name}",
+            lambda register: (register.machine(name), register.axes(name)),
+            self._axes_answered,
+            self._axes_not_answered,
+        )
+
+    def _axes_answered(self, answer) -> None:
+        self._asking_axes, self.axes_wanted = False, False
+        _machine, rows = answer
+        known = {axis.name for axis in self.project}
+        added = []
+        for row in rows:
+            if row.name in known:
+                continue
+            try:
+                axis = self.project.add_axis(
+                    row.name, row.actuator_code, row.driver_model, row.port_url,
+                    row.load_inertia_kgm2 or 0.0, row.notes, row.serial_number,
+                )
+            except ValueError as exc:  # a port another axis here has: said, the others still come
+                self._say(f"Register: the server's axis {row.name} is not shown: {exc}", Level.WARNING)
+                continue
+            self._add_axis_window(axis)
+            added.append(axis.name)
+        if added:
+            self._say(f"Register: the plant's register has {_axes_text(len(added))} of {self.project.name} "
+                      f"this computer did not know: {', '.join(added)}.", Level.INFO)
+        elif not len(self.project):
+            self._say(f"Register: the machine {self.project.name} has no axes in the register: "
+                      "Add axis… to add its first.", Level.WARNING)
+
+    def _axes_not_answered(self, why: str) -> None:
+        self._asking_axes = False
+        if self._shut_down or self.questions is None:
+            return
+        if self._server_answers() is False:  # the server is away: asked again later
+            shown = (f"the {_axes_text(len(self.project))} shown are those this computer knew"
+                     if len(self.project) else "the machine's axes come when it answers")
+            self._say(f"Register: the plant's register is not reachable ({why}); {shown}, and what "
+                      "this window records is queued on this computer until the server answers.",
+                      Level.WARNING)
+            self._axes_retry.start(int(AXES_RETRY_S * 1000))
+            return
+        self.axes_wanted = False  # the server answered: it does not have the machine
+        more = "" if len(self.project) else " Add axis… adds its first axis."
+        self._say(f"Register: {why}.{more}", Level.WARNING)
+
+    def _server_answers(self) -> bool | None:
+        """Whether the server answered the last question (None: none asked yet, or no server)."""
+        return self.questions.answers if isinstance(self.questions, ServerQuestions) else None
+
+    @Slot(object)
+    def _on_server_state(self, state) -> None:
+        """A delivery found the server answering: the axes still wanted are asked at once."""
+        if state.reachable and self.axes_wanted and not self._asking_axes:
+            self.ask_for_axes()
 
     def _record_machine(self) -> None:
         """The machine and its axes into the queue for the server (from its thread)."""
@@ -126,9 +231,19 @@ class MachineWindow(QMainWindow):
 
     @Slot(str, object)
     def _say(self, text: str, level: Level) -> None:
-        """A line about the register, in the message line of the axis on show."""
+        """A line about the register, in the message line of the axis on show (in the place of
+        the pages while there is no axis)."""
         if self.axis_windows:
             self.current_window.show_message(text, level)
+        else:
+            self.no_axes_label.setText(f"{self._no_axes_text()}\n\n{text}")
+            self.no_axes_label.setStyleSheet(
+                "color: #8a5a00; font-size: 11pt;" if level == Level.WARNING else "font-size: 11pt;"
+            )
+
+    def _no_axes_text(self) -> str:
+        return (f"Machine {self.project.name}: no axis yet. Its axes come from the register, or "
+                "Add axis… adds one.")
 
     # -- building -------------------------------------------------------------------------------------
     def _build_toolbar(self) -> None:
@@ -159,7 +274,7 @@ class MachineWindow(QMainWindow):
             "The register: an axis's history, compare axes or snapshots, find a value, open items"
         )
         self.register_action.triggered.connect(self.show_register)
-        self.register_action.setEnabled(self.register is not None)
+        self.register_action.setEnabled(self.location is not None)
         bar.addAction(self.register_action)
         bar.addSeparator()
         bar.addWidget(QLabel("Operator: "))
@@ -208,12 +323,30 @@ class MachineWindow(QMainWindow):
         right.addWidget(self.banner)
         self.stack = QStackedWidget()
         right.addWidget(self.stack, 1)
+        #: in the place of the pages while the machine has no axis (one from the server to come)
+        self.no_axes_label = QLabel(self._no_axes_text())
+        self.no_axes_label.setObjectName("noAxes")
+        self.no_axes_label.setWordWrap(True)
+        self.no_axes_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        self.no_axes_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        right.addWidget(self.no_axes_label, 1)
         row.addLayout(right, 1)
         self.setCentralWidget(body)
         self._open_client = open_client
         for axis in self.project:
             self._add_axis_window(axis)
         self.axis_list.currentRowChanged.connect(self._axis_chosen)
+        self._show_pages_or_none()
+
+    def _show_pages_or_none(self) -> None:
+        """The pages of the axis on show, or the line in their place while there is no axis."""
+        has_axes = bool(self.axis_windows)
+        self.stack.setVisible(has_axes)
+        self.no_axes_label.setVisible(not has_axes)
+        self.banner.setVisible(has_axes)
+        self.report_action.setEnabled(has_axes)
+        if not has_axes:
+            self.setWindowTitle(f"FHA Studio — {self.project.name}")
 
     def _add_axis_window(self, axis: MachineAxis) -> MainWindow:
         """The pages of one axis: its own link (worker and thread), its own commissioning state."""
@@ -235,12 +368,14 @@ class MachineWindow(QMainWindow):
             signal.connect(lambda *_args, i=index: self._refresh_axis(i))
         link.sigStopped.connect(lambda _reply, i=index: self._refresh_axis(i))
         window.state.sigActuatorChanged.connect(lambda code, i=index: self._on_actuator(i, code))
-        if self.register is not None:
-            window.signing_register = self.register.location  # the sign step finds the keys there
+        if self.location is not None:
+            window.signing_register = self.location  # the sign step finds the keys there
             window.register_questions = self.questions  # and asks a server from another thread
+            writer = self.server_writer or self.register
+            assert writer is not None  # a location is a register file open here, or a server's
             self.recorders.append(
                 AxisRecorder(
-                    self.server_writer or self.register,
+                    writer,
                     f"{self.project.name}/{axis.name}",
                     window,
                     lambda: self.operator,
@@ -248,6 +383,9 @@ class MachineWindow(QMainWindow):
                 )
             )
         self._refresh_axis(index)
+        if index == 0:  # the first axis (after none, the pages take the place of the line)
+            self.axis_list.setCurrentRow(0)
+            self._show_pages_or_none()
         return window
 
     def add_axis(
@@ -503,13 +641,13 @@ class MachineWindow(QMainWindow):
             self._register_dialog = RegisterDialog(
                 self.questions,
                 self.project.name,
-                self.current_axis.name,
+                self.current_axis.name if self.axis_windows else None,
                 self,
                 writer=self.server_writer,  # a settlement on a server goes through this computer's queue
                 operator=lambda: self.operator,
             )
         else:
-            self._register_dialog.refresh(self.current_axis.name)
+            self._register_dialog.refresh(self.current_axis.name if self.axis_windows else None)
         self._register_dialog.show()
         self._register_dialog.raise_()
         return self._register_dialog
@@ -567,6 +705,7 @@ class MachineWindow(QMainWindow):
         if self._shut_down:
             return
         self._shut_down = True
+        self._axes_retry.stop()
         if self._register_dialog is not None:
             self._register_dialog.close()
         for window in self.axis_windows:
@@ -576,3 +715,8 @@ class MachineWindow(QMainWindow):
             self.questions.shutdown()  # a question the server did not answer yet is dropped
         if self.server_writer is not None:
             self.server_writer.shutdown()  # the facts handed over are in this computer's queue
+
+
+def _axes_text(count: int) -> str:
+    """``1 axis``, ``3 axes``."""
+    return f"{count} axis" if count == 1 else f"{count} axes"

@@ -29,6 +29,7 @@ import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
@@ -53,6 +54,9 @@ from fha_studio.logic.register.facts_from_session import (
 from fha_studio.logic.register.server import problem, shown_url
 from fha_studio.paths import user_data_dir
 
+if TYPE_CHECKING:
+    from fha_studio.logic.machine import MachineProject
+
 log = logging.getLogger(__name__)
 
 #: The folder of the user data directory that holds a register file per server.
@@ -75,6 +79,23 @@ def queue_path(url: str) -> Path:
     readable = re.sub(r"[^A-Za-z0-9._-]+", "-", shown.split("://", 1)[-1]).strip("-")[:60]
     digest = hashlib.sha256(shown.encode("utf-8")).hexdigest()[:12]
     return user_data_dir() / QUEUE_FOLDER / f"{readable}-{digest}.sqlite"
+
+
+def machine_known_here(url: str, name: str) -> MachineProject | None:
+    """The machine ``name`` as this computer's queue for the server at ``url`` holds it (what a
+    window here recorded of it before), None when the queue does not know it or cannot be read:
+    a window starts with it at once, never waiting for the server."""
+    from fha_studio.logic.machine import MachineError, MachineProject
+
+    path = queue_path(url)
+    if not path.exists():
+        return None
+    try:
+        with Register(path, read_only=True) as copy:
+            return MachineProject.from_register(copy, name)
+    except (RegisterError, MachineError, OSError, ValueError) as exc:
+        log.info("machine %s is not in this computer's queue %s: %s", name, path, exc)
+        return None
 
 
 @dataclass(frozen=True)
