@@ -39,6 +39,19 @@ def test_window_is_a_contiguous_view_without_copy():
     assert ring.window()[:, 0].tolist() == [8, 9, 10, 11, 12]
 
 
+def test_a_copied_window_of_the_whole_ring_stays_in_time_order_while_the_writer_goes_on():
+    """A view of the whole ring turns into newer rows at its start once the writer goes on (the
+    bench's Time plot drew a line from the newest row back to the oldest); the copy does not."""
+    ring = RingBuffer(1, 10)
+    ring.write(rows(0, 23, 1))
+    view, copied = ring.window(), ring.window(copy=True)
+    ring.write(rows(23, 3, 1))  # the stream's thread, while the GUI reads
+    assert copied[:, 0].tolist() == list(range(13, 23))
+    assert copied.flags.writeable and copied.base is None
+    assert view[:3, 0].tolist() == [23, 24, 25]  # what the view holds now: out of time order
+    assert ring.window(4, copy=True)[:, 0].tolist() == [22, 23, 24, 25]
+
+
 def test_wrong_channel_count_is_refused():
     ring = RingBuffer(3, 5)
     with pytest.raises(ValueError, match="2 channels, the buffer 3"):

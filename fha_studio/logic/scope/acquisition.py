@@ -466,7 +466,7 @@ class MoveTest:
             self._settled_since = None
         settled = self._settled_since is not None and now - self._settled_since >= self.settle_s
         if settled or now > self._deadline:
-            rows = poller.ring.window().copy()
+            rows = poller.ring.window(copy=True)
             t = rows[:, 0] - rows[0, 0]
             capture = TraceResult(tuple(poller.channels), t, rows[:, 1:], poller.rate_hz, 0,
                                   "polled around the MOV", clock.now_s(), "polling")

@@ -68,11 +68,19 @@ class RingBuffer:
             self._drained = self._written
             return self._tail(n).copy()
 
-    def window(self, n: int | None = None) -> np.ndarray:
-        """The newest ``n`` rows (all held rows when None) as a contiguous read-only view."""
+    def window(self, n: int | None = None, *, copy: bool = False) -> np.ndarray:
+        """The newest ``n`` rows (all held rows when None), oldest first: a contiguous read-only
+        view, or with ``copy`` a copy taken under the lock.
+
+        A view is no snapshot: the writer's next rows overwrite its oldest ones (a view of the
+        whole ring turns into newer rows at its start, out of time order, while it is read). A
+        view is for a few newest rows; a reader of more than the writer may write meanwhile (up
+        to the whole ring, from another thread) asks for the copy."""
         with self._lock:
             held = min(self._written, self.capacity)
             view = self._tail(held if n is None else min(n, held))
+            if copy:
+                return view.copy()
         view.flags.writeable = False
         return view
 

@@ -483,7 +483,7 @@ class BenchPanel(QWidget):
         if (last is None or last == self._move_seen_at or not len(new_rows)
                 or new_rows[-1, 0] - last < MOVE_SETTLED_S):
             return
-        rows = started.ring.window(len(started.ring))
+        rows = started.ring.window(copy=True)  # the whole ring: a view would be overwritten meanwhile
         if len(rows) < 3:
             return
         t = rows[:, 0]

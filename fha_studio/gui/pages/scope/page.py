@@ -109,7 +109,8 @@ class ScopePage(BasePage):
         if started is None or not plot.live:
             return
         span = self.view.toolbar.time_base_s()
-        rows = started.ring.window(int(span * started.row_rate_hz))
+        # a copy: the whole ring at the longest time base, which the stream's thread writes on
+        rows = started.ring.window(int(span * started.row_rate_hz), copy=True)
         plot.set_bench_curves(bench_traces(started, rows, self.bench.counts_per_output_turn,
                                            max(200, plot.plot.width())), COLORS)
 

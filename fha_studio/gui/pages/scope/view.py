@@ -471,10 +471,10 @@ class ScopeView(QWidget):
         live = self._live
         if live is None or len(live.ring) == 0:
             return None
-        data = live.ring.window()
+        data = live.ring.window(copy=True)
         x0, x1 = self.time_plot.x_range()
         i0, i1 = np.searchsorted(data[:, 0], [x0, x1])
-        return live.channels, np.array(data[max(0, i0 - 1): i1 + 1])
+        return live.channels, data[max(0, i0 - 1): i1 + 1]
 
     # ------------------------------------------------------------------------------------- files
     def file_actions(self) -> dict[FileAction, Callable[[str], object]]:
