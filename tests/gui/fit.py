@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
     QStyle,
     QStyleOptionGroupBox,
     QTabBar,
+    QTableView,
     QToolBar,
     QToolButton,
     QWidget,
@@ -161,3 +162,23 @@ def cut_texts(top: QWidget) -> list[str]:
             found.append(f"{_name(bar)}: {bar.text()!r} needs {need} px, has {room}")
     return found
 
+
+
+def elided_cells(table: QTableView, margin_px: int = 6) -> list[str]:
+    """Cells of ``table`` (its rows, scrolled or not) whose text is wider than their column: the
+    view draws them shortened with an ellipsis ("Speed loop integral compensa…")."""
+    model, header = table.model(), table.horizontalHeader()
+    metrics = QFontMetrics(table.font())
+    found = []
+    for column in range(model.columnCount()):
+        if header.isSectionHidden(column):
+            continue
+        room = header.sectionSize(column) - margin_px
+        for row in range(model.rowCount()):
+            text = model.data(model.index(row, column))
+            if text is None or not str(text):
+                continue
+            need = metrics.horizontalAdvance(str(text))
+            if need > room:
+                found.append(f"row {row}, column {column}: {str(text)[:60]!r} needs {need} px, has {room}")
+    return found

@@ -372,6 +372,27 @@ def test_walk_every_page_with_the_servo_off_and_on(window, qtbot):
     assert frames <= {b"DGR+00000\r", b"OWW+00000\r"}, frames
 
 
+def test_the_front_panel_worksheet_shows_every_cell_whole_on_a_small_screen(window, qtbot):
+    """At 1366 x 740 and 1280 x 720 the worksheet's names, values and states are whole (the
+    names were cut to "Speed loop integral compensa…" beside the long "not entered" states), and
+    who enters the values is asked beside the buttons, not inside the note's wrapped sentence."""
+    from tests.gui.fit import cut_texts, elided_cells
+
+    window.state.set_actuator("FHA-25C-50-S248", acknowledged=True)
+    page = window.show_page("parameters")
+    page.who_edit.setText("J. Field")
+    model = page.model
+    for key, text in (("position_loop_gain", "60"), ("rotary_direction", "0"), ("in_position_range", "20")):
+        assert model.setData(model.index(model.row_of(key), 3), text)  # "0: FWD turns CW (seen …)"
+    assert page.who_box.isVisible() and not page.panel_bar.isAncestorOf(page.who_edit)
+    assert "Nothing written yet" in page.log_view.placeholderText()
+    for size in ((1366, 740), (1280, 720)):
+        window.resize(*size)
+        qtbot.waitUntil(lambda size=size: window.size().toTuple() == size, timeout=10000)
+        qtbot.wait(20)  # let the table lay out its columns
+        assert not elided_cells(page.table) and not cut_texts(page), size
+
+
 def test_front_panel_worksheet_parameters_direction_file_and_report(window, qtbot, tmp_path):
     from fha_studio.logic.paramfile import FRONT_PANEL_SOURCE, read_parameter_file
     from fha_studio.logic.procedures.report import build_report
@@ -382,7 +403,7 @@ def test_front_panel_worksheet_parameters_direction_file_and_report(window, qtbo
     assert page.panel_bar.isVisible() and model.panel_mode
     assert model.headerData(3, Qt.Orientation.Horizontal) == "Value on the drive's panel"
     row = model.row_of("position_loop_gain")
-    assert "not entered" in model.state_text(row) and "item" in model.state_text(row)
+    assert model.state_text(row) == "not entered: tune 2 on the panel"
     refused = []
     model.sigRefused.connect(lambda why, _index: refused.append(why))
     assert not model.setData(model.index(row, 3), "60")  # nobody named: nothing recorded

@@ -108,8 +108,8 @@ class ParameterTableModel(QAbstractTableModel):
         panel = self.session.state.front_panel.get(key)
         if self.panel_mode and drive is None:
             words.append(f"from the panel: {panel.who}, {panel.time[11:16]}" if panel is not None
-                         else f"not entered: {MODE_WORDS.get(str(item.mode), str(item.mode))} mode, "
-                         f"item {item.number} on the panel")
+                         else f"not entered: {MODE_WORDS.get(str(item.mode), str(item.mode))} "
+                         f"{item.number} on the panel")  # short: the name keeps its room
         elif key in self.edits:
             words.append("edited, not written")
         elif drive is None:

@@ -35,6 +35,11 @@ from fha_studio.gui.pages.parameter_table import COLUMNS as COLUMNS  # the table
 from fha_studio.gui.parameter_text import MODE_WORDS, value_text
 from fha_studio.gui.session import Session
 
+#: The session log before its first write (on a drive of the manual's commands nothing is ever
+#: written over CN3: the values entered from its panel are in the table).
+LOG_EMPTY = ("Nothing written yet. Each write comes here with its read-back. On a drive without "
+             "parameter access over CN3 nothing is written: the values entered from its front panel "
+             "are in the table, with who entered them and when.")
 #: Why the write buttons are off while the servo is on (the driver's rule for parameter mode).
 SERVO_ON_WRITE_REASON = (
     "The servo is on: parameter-mode items can be written only with the servo off. "
@@ -81,6 +86,12 @@ class ParametersPage(BasePage):
         self._servo_was_on = False
         buttons.addWidget(self.servo_note, 1)
         buttons.addStretch(1)
+        # who enters the panel's values: beside the buttons (a field beside the wrapped note
+        # read as part of its sentence on a small screen)
+        self.who_box = QWidget()
+        wb = QHBoxLayout(self.who_box)
+        wb.setContentsMargins(0, 0, 0, 0)
+        buttons.addWidget(self.who_box)
         buttons.addWidget(self.save_button)
         buttons.addWidget(self.load_button)
         layout.addLayout(buttons)
@@ -92,8 +103,9 @@ class ParametersPage(BasePage):
         self.panel_note = QLabel(
             "This drive gives no parameter access over CN3. On its front panel, choose the mode and "
             "the item number shown in the table, read (or set) the value and type it into <b>Value on "
-            "the drive's panel</b>: it is recorded with who and when, compared with the default and a "
-            "parameter file, saved to files marked as entered from the panel, and goes into the report."
+            "the drive's panel</b>: it is recorded with who (<i>Entered by</i>) and when, compared with "
+            "the default and a parameter file, saved to files marked as entered from the panel, and goes "
+            "into the report."
         )
         self.panel_note.setWordWrap(True)
         self.who_edit = QLineEdit()
@@ -101,8 +113,10 @@ class ParametersPage(BasePage):
         self.who_edit.setPlaceholderText("your name")
         self.who_edit.textChanged.connect(self._who_changed)
         pb.addWidget(self.panel_note, 1)
-        pb.addWidget(QLabel("Entered by:"))
-        pb.addWidget(self.who_edit)
+        who_label = QLabel("Entered by:")
+        wb.addWidget(who_label)
+        wb.addWidget(self.who_edit)
+        self.who_box.setVisible(False)
         self.panel_bar.setStyleSheet("background: #e8f0fe; border-radius: 4px;")
         self.panel_bar.setVisible(False)
         layout.addWidget(self.panel_bar)
@@ -172,6 +186,7 @@ class ParametersPage(BasePage):
         self.log_view = QPlainTextEdit()
         self.log_view.setReadOnly(True)
         self.log_view.setObjectName("sessionLog")
+        self.log_view.setPlaceholderText(LOG_EMPTY)
         log_column.addWidget(self.log_view)
         lb.addLayout(log_column, 2)
         splitter.addWidget(log_box)
@@ -380,6 +395,7 @@ class ParametersPage(BasePage):
         self._update_buttons()
         self.model.set_panel_mode(not info.can_parameters)
         self.panel_bar.setVisible(not info.can_parameters)
+        self.who_box.setVisible(not info.can_parameters)
         if not info.can_parameters:
             self.message.setText(
                 "This drive does not give parameter access over CN3 (it answers only the commands of "
