@@ -318,6 +318,10 @@ def _page_facts(window, page_id: str, page, servo_on: bool) -> None:
     """What each page must show on a drive of the manual's commands (servo as given)."""
     if page_id == "connection":
         assert "only the commands of its manual" in window.caps_label.toolTip() or servo_on
+        # the order of the work as this drive allows it: the panel, the DGR checks, CN2
+        order = page.order_hint.text()
+        assert "read all" not in order and "Jog" not in order
+        assert "front panel" in order and "DGR checks" in order and "Bench" in order
     elif page_id == "parameters":
         assert "front panel" in page.message.text()
     elif page_id == "direction":

@@ -27,6 +27,27 @@ def _value_label() -> QLabel:
     return label
 
 
+#: The order of the work on a drive FHA Studio reads and writes over CN3.
+COMMISSIONING_ORDER = (
+    "<b>Commissioning order</b>: 1. connect · 2. check the actuator against the driver label · "
+    "3. <i>Parameters</i>: read all (a backup is saved before the first write) · "
+    "4. <i>Rotary direction</i>: set and check it · 5. <i>Jog &amp; test run</i> · "
+    "6. <i>Alarms</i>: clear what is left · 7. <i>Parameters</i>: save the parameter file."
+)
+#: The same on a drive of the manual's commands (no parameters, jog or alarms over CN3): the
+#: front panel, the controller and CN2 do what CN3 cannot.
+COMMISSIONING_ORDER_PANEL = (
+    "<b>Commissioning order</b> (this drive gives no parameter access and no jog over CN3): "
+    "1. connect · 2. check the actuator against the driver label · "
+    "3. <i>Parameters</i>: read each item on the drive's front panel and enter it · "
+    "4. <i>DGR checks</i> (absolute encoder): the encoder, the rotary direction with the "
+    "controller's FWD command, the sensor dogs, the absolute origin · "
+    "5. <i>Scope</i> → <i>Bench</i>: watch the controller's moves on CN2 · "
+    "6. <i>Alarms</i>: enter the front panel's code · "
+    "7. <i>Parameters</i>: save the parameter file."
+)
+
+
 class ConnectionPage(BasePage):
     """Drive identity, the actuator code and the pairing check."""
 
@@ -97,14 +118,10 @@ class ConnectionPage(BasePage):
         a_layout.addLayout(ack_row)
         layout.addWidget(actuator_box)
 
-        hint = QLabel(
-            "<b>Commissioning order</b>: 1. connect · 2. check the actuator against the driver label · "
-            "3. <i>Parameters</i>: read all (a backup is saved before the first write) · "
-            "4. <i>Rotary direction</i>: set and check it · 5. <i>Jog &amp; test run</i> · "
-            "6. <i>Alarms</i>: clear what is left · 7. <i>Parameters</i>: save the parameter file."
-        )
-        hint.setWordWrap(True)
-        layout.addWidget(hint)
+        self.order_hint = QLabel(COMMISSIONING_ORDER)
+        self.order_hint.setObjectName("commissioningOrder")
+        self.order_hint.setWordWrap(True)
+        layout.addWidget(self.order_hint)
         layout.addStretch(1)
 
         if main_window is not None:
@@ -134,6 +151,7 @@ class ConnectionPage(BasePage):
         self.adjusted_label.setText(info.adjusted_for or "not reported: read it from the driver's label")
         self.firmware_label.setText(info.firmware or "—")
         self.caps_label.setText(info.capabilities or "—")
+        self.order_hint.setText(COMMISSIONING_ORDER if info.can_parameters else COMMISSIONING_ORDER_PANEL)
         self.disconnect_button.setEnabled(True)
         if not self.actuator_combo.currentText().strip() and info.adjusted_for:
             self.actuator_combo.setCurrentText(info.adjusted_for)
