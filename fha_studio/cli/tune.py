@@ -14,7 +14,9 @@ mode (a CSV of time and volts, a WAV, or one normalised cycle), its bounds state
 ``analyse`` takes the capture (SPD-MON, and SPD-CMD or the excitation file) and gives the JSON of
 ``measure``. A drive that cannot be excited (a drive of the manual's commands, servo off, an
 alarm, parameter 0 not speed for SPD-CMD) gets one line saying what is needed and exit 4; nothing
-moves.
+moves. A drive that gives no parameter access over CN3 gets the same for ``propose`` (its tune
+items are read on its front panel: the Tuning page's worksheet, or ``analyse`` with the parameter
+file); a port that does not open or a drive that does not answer, one line and exit 3.
 
 Waiting is on what the drive reports (its trace's state and count: the drive's own time), never on
 the computer's clock; a stepped simulated drive (``sim://...&stepped=1``) is advanced between looks.
@@ -25,13 +27,21 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from fha_studio.cli import CliError
 from fha_studio.plausible import Range
 
 ORDER = 60
+EXIT_NO_ANSWER = 3
 EXIT_NOT_EXCITABLE = 4
+NO_PARAMETER_ACCESS = (
+    "the drive gives no parameter access over CN3 (a drive of the manual's commands): read its tune "
+    "items on the front panel and propose on the Tuning page (a front-panel worksheet), or from the "
+    "bench with 'tune analyse --parameters PARAMS.toml'"
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -62,6 +72,37 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     _add_bench(sub)
 
 
+class _TuneStop(Exception):
+    """Ends the command with ``code`` and one line."""
+
+    def __init__(self, code: int, message: str):
+        super().__init__(message)
+        self.code = code
+
+
+@contextmanager
+def _open(url: str) -> Iterator[Any]:
+    """The drive at ``url``; a port that does not open or a line that fails is one line and exit 3
+    (as ``fha-studio drive``), a drive's refusal one line and exit 4."""
+    from fha_studio.hardware.client import DriveClient
+    from fha_studio.hardware.errors import DriveRefused, LinkFailure
+
+    try:
+        client = DriveClient.open(url)
+    except ValueError as exc:
+        raise CliError(f"--url: {exc}") from None
+    except LinkFailure as exc:
+        raise _TuneStop(EXIT_NO_ANSWER, str(exc)) from None
+    try:
+        yield client
+    except LinkFailure as exc:
+        raise _TuneStop(EXIT_NO_ANSWER, f"the link to {url} failed: {exc}") from None
+    except DriveRefused as exc:
+        raise _TuneStop(EXIT_NOT_EXCITABLE, f"the drive refused: {exc}") from None
+    finally:
+        client.close()
+
+
 def _emit(args: argparse.Namespace, result: dict[str, Any], text: str) -> None:
     if args.json:
         data = json.dumps(result, indent=2)
@@ -85,7 +126,6 @@ def _model(args: argparse.Namespace) -> Any:
 
 
 def run_measure(args: argparse.Namespace) -> int:
-    from fha_studio.hardware.client import DriveClient
     from fha_studio.hardware.parameters import load_parameter_model
     from fha_studio.logic.tuning.measure import NotExcitable, check_excitable
     from fha_studio.logic.tuning.record import figure_words
@@ -93,18 +133,21 @@ def run_measure(args: argparse.Namespace) -> int:
 
     model = _model(args)
     parameters = load_parameter_model("HA-655")
-    with DriveClient.open(args.url) as client:
-        try:
+    try:
+        with _open(args.url) as client:
             check_excitable(client)
             tuner = tuner_for(client, parameters, model)
             pace, now = drive_clock(client)
             result = measure_report(client, tuner, pace, now, args.amplitude_rpm,
                                     announce=lambda s: print(s, file=sys.stderr))
-        except NotExcitable as exc:
-            print(f"fha-studio tune measure: {exc}", file=sys.stderr)
-            return EXIT_NOT_EXCITABLE
-        except ValueError as exc:
-            raise CliError(str(exc)) from None
+    except _TuneStop as stop:
+        print(f"fha-studio tune measure: {stop}", file=sys.stderr)
+        return stop.code
+    except NotExcitable as exc:
+        print(f"fha-studio tune measure: {exc}", file=sys.stderr)
+        return EXIT_NOT_EXCITABLE
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
 
     def f(key: str, unit: str) -> str:
         return figure_words(key, result[key], unit)
@@ -119,29 +162,33 @@ def run_measure(args: argparse.Namespace) -> int:
 
 
 def run_propose(args: argparse.Namespace) -> int:
-    from fha_studio.hardware.client import DriveClient
     from fha_studio.hardware.parameters import load_parameter_model
     from fha_studio.logic.tuning.measure import NotExcitable, check_excitable
     from fha_studio.logic.tuning.session import tuner_for
 
     model = _model(args)
     parameters = load_parameter_model("HA-655")
-    with DriveClient.open(args.url) as client:
-        if args.apply:
-            try:
+    try:
+        with _open(args.url) as client:
+            if args.apply:
                 check_excitable(client)
-            except NotExcitable as exc:
-                print(f"fha-studio tune propose: {exc}", file=sys.stderr)
-                return EXIT_NOT_EXCITABLE
-        tuner = tuner_for(client, parameters, model)
-        proposal = tuner.propose(args.aim)
-        result: dict[str, Any] = {"aim": proposal.aim, "used_aim": proposal.used_aim,
-                                  "warning": proposal.warning, "present": proposal.present.to_dict(),
-                                  "proposed": proposal.proposed.to_dict()}
-        if proposal.warning:
-            print(f"warning: {proposal.warning}", file=sys.stderr)
-        if args.apply:
-            result["measured"] = _apply(args, client, parameters, tuner, proposal)
+            if not client.capabilities.parameters:
+                raise _TuneStop(EXIT_NOT_EXCITABLE, NO_PARAMETER_ACCESS)
+            tuner = tuner_for(client, parameters, model)
+            proposal = tuner.propose(args.aim)
+            result: dict[str, Any] = {"aim": proposal.aim, "used_aim": proposal.used_aim,
+                                      "warning": proposal.warning, "present": proposal.present.to_dict(),
+                                      "proposed": proposal.proposed.to_dict()}
+            if proposal.warning:
+                print(f"warning: {proposal.warning}", file=sys.stderr)
+            if args.apply:
+                result["measured"] = _apply(args, client, parameters, tuner, proposal)
+    except _TuneStop as stop:
+        print(f"fha-studio tune propose: {stop}", file=sys.stderr)
+        return stop.code
+    except NotExcitable as exc:
+        print(f"fha-studio tune propose: {exc}", file=sys.stderr)
+        return EXIT_NOT_EXCITABLE
     from fha_studio.logic.tuning.record import figure_words
 
     items = ", ".join(f"{k} {v}" for k, v in proposal.proposed.items.items())

@@ -27,3 +27,18 @@ def test_cli_propose_prints_the_contract(tmp_path, capsys: pytest.CaptureFixture
                     "settling_ms"):
             assert key in result[side]
     assert "measured" not in result
+
+
+@pytest.mark.parametrize("action", ["propose", "measure"])
+def test_cli_a_drive_without_parameter_access_or_no_drive_is_one_line(
+        action: str, tmp_path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A drive of the manual's commands: exit 4, what is needed (its tune items are on its front
+    panel); a port that does not open: exit 3, as ``fha-studio drive`` says it. No traceback."""
+    code = "FHA-25C-50-US250"
+    for url, exit_code, said in ((f"sim://{code}?paced=0&profile=documented", 4, "manual's commands"),
+                                 (str(tmp_path / "no-such-port"), 3, "no-such-port")):
+        assert cli_main(["tune", action, "--url", url, "--actuator", code, "--load-inertia", "0.81"]) \
+            == exit_code, url
+        out, err = capsys.readouterr()
+        assert err.count("\n") == 1 and err.startswith(f"fha-studio tune {action}: ") and said in err, err
+        assert "Traceback" not in err and out == ""
