@@ -6,15 +6,9 @@ test is skipped, saying so."""
 
 from __future__ import annotations
 
-import contextlib
-import errno
-import os
-import pwd
 import secrets
 import shutil
-import subprocess
 import tempfile
-from collections.abc import Iterator
 from pathlib import Path
 from urllib.parse import urlsplit
 
@@ -23,48 +17,11 @@ import pytest
 
 from fha_studio.cli import main
 from fha_studio.logic.register import Register, RegisterError
+from tests.support.disk import fill, small_disk
 from tests.support.postgres import ROLE, SERVER_USER, SUPER_PASSWORD
 
 M = "Press 7"
 RAM = f"{M}/ram"
-TMPFS_BYTES = 4 * 1024 * 1024
-
-
-@contextlib.contextmanager
-def _small_disk(where: Path) -> Iterator[Path]:
-    """A tmpfs of TMPFS_BYTES mounted at ``where`` for the server's user; unmounted afterwards."""
-    if os.geteuid() != 0 or shutil.which("mount") is None:
-        pytest.skip("a full disk needs a tmpfs mounted, which needs root and mount(8)")
-    user = pwd.getpwnam(SERVER_USER)
-    where.mkdir()
-    done = subprocess.run(
-        ["mount", "-t", "tmpfs", "-o", f"size={TMPFS_BYTES},mode=0700,uid={user.pw_uid},gid={user.pw_gid}",
-         "fha-full-disk", str(where)], capture_output=True, text=True, timeout=30, check=False)
-    if done.returncode != 0:
-        pytest.skip(f"a full disk needs a tmpfs mounted; mount said: {done.stderr.strip()[:120]}")
-    try:
-        yield where
-    finally:
-        subprocess.run(["umount", "-l", str(where)], capture_output=True, timeout=30, check=False)
-
-
-def _fill(folder: Path) -> Path:
-    """Fills the file system of ``folder`` to its last byte; the file that fills it."""
-    junk = folder / "junk"
-    block = b"\0" * 65536
-    with junk.open("wb", buffering=0) as out:
-        while True:
-            try:
-                out.write(block)
-            except OSError as exc:
-                if exc.errno != errno.ENOSPC:
-                    raise
-                break
-        for size in (4096, 512, 1):  # the last bytes
-            with contextlib.suppress(OSError):
-                while True:
-                    out.write(block[:size])
-    return junk
 
 
 def test_a_full_disk_on_the_server_is_one_line_and_loses_nothing(postgres_cluster, capsys):
@@ -78,7 +35,7 @@ def test_a_full_disk_on_the_server_is_one_line_and_loses_nothing(postgres_cluste
     root = Path(tempfile.mkdtemp(prefix="fha-full-disk-", dir=postgres_cluster.root))
     root.chmod(0o755)
     superuser = postgres_cluster.url(database, "postgres", SUPER_PASSWORD)
-    with _small_disk(root / "disk") as disk, psycopg.connect(superuser, autocommit=True) as db:
+    with small_disk(root / "disk", SERVER_USER) as disk, psycopg.connect(superuser, autocommit=True) as db:
         tablespace = f"full_{database}"
         (disk / "pg").mkdir()
         shutil.chown(disk / "pg", SERVER_USER, SERVER_USER)
@@ -88,7 +45,7 @@ def test_a_full_disk_on_the_server_is_one_line_and_loses_nothing(postgres_cluste
             for kind in ("TABLE", "INDEX"):
                 db.execute(f"ALTER {kind} ALL IN TABLESPACE pg_default OWNED BY {ROLE}"
                            f" SET TABLESPACE {tablespace}")
-            junk = _fill(disk)
+            junk = fill(disk)
             with Register(url) as reg:
                 with pytest.raises(RegisterError) as full, reg.batch():  # a session's facts: all or none
                     reg.record_alarm(RAM, 11, "overload", who="ana")

@@ -148,7 +148,9 @@ def problem(path: Path, exc: sqlite3.Error, db: sqlite3.Connection | None = None
         return damaged(path, db)
     if primary == sqlite3.SQLITE_NOTADB or "not a database" in text:
         return RegisterError(f"{where} is not a register (not an SQLite database file): not changed")
-    if primary == sqlite3.SQLITE_FULL or "full" in text:
+    if primary == sqlite3.SQLITE_FULL or "full" in text or (
+        primary == sqlite3.SQLITE_IOERR and _no_room(path, code)
+    ):
         return RegisterError(f"the register {where}: no space left on the device: nothing was changed")
     if primary == sqlite3.SQLITE_CANTOPEN or "unable to open" in text:
         return RegisterError(f"the register {where} cannot be opened (its folder must be there and "
@@ -160,6 +162,23 @@ def problem(path: Path, exc: sqlite3.Error, db: sqlite3.Connection | None = None
     if opening:
         return RegisterError(f"register {where}: not a usable register file ({said})")
     return RegisterError(f"the register {where}: {said}")
+
+
+#: Free bytes below which a file system cannot take a page of the register and its journal.
+ROOM_NEEDED_BYTES = 65536
+
+
+def _no_room(path: Path, code: int | None) -> bool:
+    """Whether an input/output error is a full disk: SQLite could not make room for its shared
+    memory file (what a register opened on a full disk meets first; SQLite names that an I/O
+    error, not a full disk), or the register's file system has no room left."""
+    if code == sqlite3.SQLITE_IOERR_SHMSIZE:
+        return True
+    try:
+        disk = os.statvfs(os.path.dirname(os.path.abspath(path)))
+    except OSError:
+        return False
+    return disk.f_bavail * disk.f_frsize < ROOM_NEEDED_BYTES
 
 
 def damaged(path: Path, db: sqlite3.Connection | None) -> RegisterError:
