@@ -63,8 +63,7 @@ def main() -> int:
     window.sim_panel.command_spin.setValue(10.0)
     window.sim_panel.fwd_button.click()
     wait_until(lambda: bench.move_figures is not None, "the move's figures")
-    settle(0.6)
-    shot("bench-move")
+    shot("bench-move")  # at once: the tab shows the newest 2 s, the move among them
     wait_until(lambda: procedures.run is not None and procedures.run.completed, "the FWD step from the bench")
     scope.view.plots.setCurrentWidget(scope.view.time_plot)  # the same stream beside CN3's channels
     settle(1.0)

@@ -243,6 +243,7 @@ class BenchPanel(QWidget):
         self.command_edit.setText(command)
         self.in_position_edit.setText(in_position)
         self.channels_edit.setText(channels)
+        self.channels_edit.setCursorPosition(0)  # a long list shows its first channels, not its end
         self.rate_edit.setText(rate)
         self.start_button.setChecked(True)
         self._start_clicked(True)
@@ -336,6 +337,7 @@ class BenchPanel(QWidget):
         if fields is None or self.source.running:
             return
         self.channels_edit.setText(fields.get("channels", ""))
+        self.channels_edit.setCursorPosition(0)
         self.rate_edit.setText(fields.get("rate", ""))
         self.encoder_edit.setText(fields.get("encoder", ""))
         self.command_edit.setText(fields.get("command", ""))
