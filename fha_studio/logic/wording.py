@@ -6,6 +6,8 @@ file and a script read them); a page shows "N·m" and "kg·m²" as the manual do
 
 from __future__ import annotations
 
+import math
+
 #: ASCII unit -> the manual's spelling.
 UNIT_WORDS = {
     "N m": "N·m",
@@ -32,4 +34,18 @@ def with_unit(text: str, unit: str) -> str:
     return f"{text}{words}" if words == "°" else f"{text} {words}"
 
 
-__all__ = ["UNIT_WORDS", "unit_words", "with_unit"]
+def plain_number(value: float, significant: int = 4) -> str:
+    """``value`` with ``significant`` digits as a person reads it, never in exponent notation
+    ("7.933e-05" is "0.00007933", "1.2e+06" is "1200000"): a read-out, a cursor's value."""
+    text = f"{value:.{significant}g}"
+    if "e" not in text:
+        return text
+    if not math.isfinite(value):
+        return text
+    exponent = math.floor(math.log10(abs(value)))
+    if exponent >= 0:  # large: whole units
+        return f"{value:.0f}"
+    return f"{value:.{significant - 1 - exponent}f}".rstrip("0").rstrip(".")
+
+
+__all__ = ["UNIT_WORDS", "plain_number", "unit_words", "with_unit"]

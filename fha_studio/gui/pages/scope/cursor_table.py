@@ -9,6 +9,8 @@ from dataclasses import dataclass
 import pyqtgraph as pg
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableWidget, QTableWidgetItem
 
+from fha_studio.logic.wording import plain_number
+
 COLUMNS = ("Channel", "At A", "At B", "Δ (B − A)", "Slope")
 #: Rows on show before the table scrolls (the plots keep the rest of the height).
 MAX_VISIBLE_ROWS = 6
@@ -27,7 +29,7 @@ class CursorRow:
 
 
 def _number(value: float, unit: str) -> str:
-    return f"{value:.5g} {unit}".strip()
+    return f"{plain_number(value, 5)} {unit}".strip()  # "0.00007933 A", not "7.933e-05 A"
 
 
 class CursorTable(QTableWidget):

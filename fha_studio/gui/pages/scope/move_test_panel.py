@@ -15,6 +15,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.logic.scope.acquisition import MoveTestResult
+from fha_studio.logic.wording import plain_number
 
 RESULTS = (("overshoot", "Overshoot"), ("rise", "Rise time 10-90 %"), ("settling", "Settling time"),
            ("in_position", "In-position after command end"), ("final_error", "Final error"),
@@ -120,14 +121,15 @@ class MoveTestPanel(QWidget):
                 label.setText("—")
             self.test_message.setText(result.describe())
         else:
-            self.result_labels["overshoot"].setText(f"{m.overshoot_percent:.2f} % ({m.overshoot:.4g} deg)")
+            overshoot = f"{m.overshoot_percent:.2f} % ({plain_number(m.overshoot)} deg)"
+            self.result_labels["overshoot"].setText(overshoot)
             self.result_labels["rise"].setText(_ms(m.rise_time_s))
             band = f" (band ±{m.settling_band:.3g} deg)"
             self.result_labels["settling"].setText(_ms(m.settling_time_s) + band)
             window = result.in_position_range_deg
             inpos = "" if window is None else f" (±{window:.3g} deg)"
             self.result_labels["in_position"].setText(_ms(m.in_position_time_s) + inpos)
-            self.result_labels["final_error"].setText(f"{m.final_error:.4g} deg")
+            self.result_labels["final_error"].setText(f"{plain_number(m.final_error)} deg")
             self.test_message.setText(f"{result.kind} test of {result.angle_deg:g} deg at "
                                       f"{result.speed_rpm:g} r/min done.")
         c = result.capture

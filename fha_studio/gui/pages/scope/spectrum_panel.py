@@ -10,6 +10,11 @@ from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from fha_studio.logic.scope.channels import ScopeChannel
+from fha_studio.logic.wording import plain_number
+
+#: Arc-seconds per degree: a line of an angle's spectrum is read in arc-sec, as the manual gives
+#: the actuator's accuracy (a kinematic error of 40 arc-sec, not 0.011 deg or 7.41e-05 deg).
+ARCSEC_PER_DEG = 3600.0
 
 
 class SpectrumPanel(QWidget):
@@ -68,6 +73,16 @@ class SpectrumPanel(QWidget):
         if not len(f):
             self.message("Peaks: none")
             return
+        self.spectrum_plot.setLabel("left", f"amplitude ({unit})" if unit else "amplitude")
         peaks = spec.prominent_peaks(4, min_hz=f[0])
-        text = ", ".join(f"{hz:.2f} Hz ({amp:.3g} {unit})" for hz, amp in peaks) or "none stand out"
+        text = ", ".join(f"{hz:.2f} Hz ({peak_amplitude(amp, unit)})" for hz, amp in peaks)
+        text = text or "none stand out"
         self.message(f"Peaks: {text}. Resolution {f[0]:.3g} Hz.")
+
+
+def peak_amplitude(amplitude: float, unit: str) -> str:
+    """A peak's amplitude as a person reads it: an angle in arc-sec (``"39.6 arc-sec"``), any other
+    unit as it is, never in exponent notation."""
+    if unit == "deg":
+        return f"{plain_number(amplitude * ARCSEC_PER_DEG, 3)} arc-sec"
+    return f"{plain_number(amplitude, 3)} {unit}".strip()
