@@ -17,7 +17,8 @@ CODE = "FHA-25C-50-US250"
 RPM = 2 * math.pi / 60
 
 
-def test_a_bench_recording_opens_on_the_model_check_page_with_its_source(make_window, tmp_path):
+def bench_recording(tmp_path):
+    """A controller's move captured on the simulated drive's CN2 and imported: (capture, recording)."""
     axis = ServoAxis(AxisModel.from_actuator(get_actuator(CODE), load_inertia_kgm2=0.3))
     axis.servo_on()
     instrument = VirtualBenchInstrument(axis, 200e3, Cn2Settings(pulse_form=0))
@@ -32,7 +33,11 @@ def test_a_bench_recording_opens_on_the_model_check_page_with_its_source(make_wi
                           AxisFacts.for_actuator(CODE), DriveSettings(0, 4, 1, 1, 3000.0))
     path = tmp_path / "bench.csv"
     write_recording(path, result.recording)
+    return capture, path
 
+
+def test_a_bench_recording_opens_on_the_model_check_page_with_its_source(make_window, tmp_path):
+    capture, path = bench_recording(tmp_path)
     window = make_window()
     page = window.page(PageId.MODELCHECK)
     recording = page.load_recording(path)
@@ -41,3 +46,25 @@ def test_a_bench_recording_opens_on_the_model_check_page_with_its_source(make_wi
     assert "columns t, pos, cmd_pos, vel." in text and "current" not in text.split("columns")[1].split(".")[0]
     assert f"Position from {capture}#ENC_A and {capture}#ENC_B, x4" in text
     assert "No current column (no current probe on the bench)." in text
+
+
+def test_a_bench_recordings_check_says_where_its_torque_comes_from_and_why_no_effect_is_named(
+        make_window, qtbot, tmp_path):
+    """Without a current the torque plot says the torque is read through the speed loop (not
+    "measured (Kt x current)"), and an empty effects table says that no effect was named."""
+    from fha_studio.gui.pages.modelcheck.page import NO_CURRENT_TORQUE, NO_EFFECT, TORQUE_TITLE_NO_CURRENT
+
+    _capture, path = bench_recording(tmp_path)
+    window = make_window()
+    window.session.state.set_load_inertia(0.3)
+    page = window.page(PageId.MODELCHECK)
+    page.load_recording(path)
+    with qtbot.waitSignal(page.sigFinished, timeout=60000) as done:
+        page.run()
+    item = page.torque_plot.getPlotItem()
+    assert TORQUE_TITLE_NO_CURRENT in item.titleLabel.text
+    assert item.listDataItems()[0].name() == NO_CURRENT_TORQUE
+    table = page.effects_table
+    assert not done.args[0].effects  # a clean simulated axis, its inertia declared right
+    assert table.rowCount() == 1 and table.item(0, 0).text() == NO_EFFECT
+    assert table.columnSpan(0, 0) == table.columnCount()

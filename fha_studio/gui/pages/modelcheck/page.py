@@ -72,6 +72,18 @@ class _Worker(QObject):
         self.sigDone.emit(result, time.perf_counter() - started)
 
 
+#: The residual tab's torque plot: measured (a recording with the motor current) ...
+TORQUE_TITLE = "Motor torque (Kt x current) and what the nominal model needs"
+#: ... or read through the speed loop (a bench recording without current).
+TORQUE_TITLE_NO_CURRENT = ("Motor torque read through the speed loop (no current recorded) and what "
+                           "the nominal model needs")
+NO_CURRENT_TORQUE = "read through the speed loop (following error and speed)"
+#: The effects table when no effect was named.
+NO_EFFECT = ("No missing effect named: the nominal model explains this recording as far as it shows; "
+             "the lines below say what was tried, why nothing was named and what this recording "
+             "cannot show.")
+
+
 def _plot(title: str, left: str, bottom: str = "time (s)") -> pg.PlotWidget:
     widget = pg.PlotWidget(background="w")
     item = widget.getPlotItem()
@@ -103,6 +115,7 @@ class ModelCheckPage(BasePage):
         self._recording_label = ""
         self.result: ModelCheckResult | None = None
         self._running = False
+        self._ran_with_current = True  # what the last run had: a current column
         self._build()
         self._thread = QThread(self)
         self._thread.setObjectName("model check")
@@ -189,9 +202,7 @@ class ModelCheckPage(BasePage):
         layout.addWidget(split, 1)
 
     def _build_residual_tab(self) -> QWidget:
-        self.torque_plot = _plot(
-            "Motor torque (Kt x current) and what the nominal model needs", unit_words("N m")
-        )
+        self.torque_plot = _plot(TORQUE_TITLE, unit_words("N m"))
         self.residual_plot = _plot("Residual: measured - nominal", "")
         self.residual_plot.setXLink(self.torque_plot)
         return _stack(self.torque_plot, self.residual_plot)
@@ -372,6 +383,7 @@ class ModelCheckPage(BasePage):
         if self.recording is None or self._running:
             return
         recording = self.declared_recording()
+        self._ran_with_current = recording.has_current
         self._running = True
         self._update_buttons()
         self.summary.setPlainText("Running the model check…")
@@ -405,8 +417,12 @@ class ModelCheckPage(BasePage):
         res = r.residual
         t = res["t_s"]
         self.torque_plot.clear()
+        # without a current the motor's torque is read through the speed loop, not measured
+        measured = "measured (Kt x current)" if self._ran_with_current else NO_CURRENT_TORQUE
+        self.torque_plot.getPlotItem().setTitle(
+            TORQUE_TITLE if self._ran_with_current else TORQUE_TITLE_NO_CURRENT, color="#222", size="10pt")
         self.torque_plot.plot(t, res["torque_measured_nm"], pen=pg.mkPen(COLORS["measured"], width=1),
-                              name="measured (Kt x current)")
+                              name=measured)
         self.torque_plot.plot(t, res["torque_nominal_nm"], pen=pg.mkPen(COLORS["nominal"], width=1),
                               name="nominal model (J x acceleration)")
         self.residual_plot.clear()
@@ -485,6 +501,14 @@ class ModelCheckPage(BasePage):
                 item = QTableWidgetItem(text)
                 item.setToolTip(text)
                 table.setItem(row, col, item)
+        if not r.effects:  # an empty table would say nothing: the findings below say why
+            table.insertRow(0)
+            item = QTableWidgetItem(NO_EFFECT)
+            item.setToolTip(NO_EFFECT)
+            table.setItem(0, 0, item)
+            table.setSpan(0, 0, 1, table.columnCount())
+        else:
+            table.clearSpans()
         table.resizeRowsToContents()
         self.findings.setPlainText("\n".join(_findings_in_words(r)))
 
