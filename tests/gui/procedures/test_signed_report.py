@@ -4,6 +4,8 @@ the PDF is found in the register by its hash; both verify, and a changed byte fa
 from __future__ import annotations
 
 import json
+import shutil
+import subprocess
 
 from fha_studio.cli import main
 from fha_studio.logic.procedures import ProcedureRun, ProcedureSession, load_procedure
@@ -46,6 +48,10 @@ def test_the_page_signs_with_the_key_and_both_files_verify(make_window, tmp_path
     assert "with key" in page.message_label.text()
     html, pdf = page.write_report(tmp_path / "report.html", tmp_path / "report.pdf")
     assert "fha-studio register verify REPORT" in html.read_text()
+    if shutil.which("pdftotext") is not None:  # the PDF says it too (scripts/test installs it)
+        text = subprocess.run(["pdftotext", str(pdf), "-"], capture_output=True, text=True, check=True,
+                              timeout=60).stdout
+        assert "fha-studio register verify REPORT" in " ".join(text.split())
     for path in (html, pdf):
         code, verdict = _verify(path, capsys)
         assert code == 0 and verdict["signer"] == "A. Reviewer", verdict
