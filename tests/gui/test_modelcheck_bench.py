@@ -51,8 +51,15 @@ def test_a_bench_recording_opens_on_the_model_check_page_with_its_source(make_wi
 def test_a_bench_recordings_check_says_where_its_torque_comes_from_and_why_no_effect_is_named(
         make_window, qtbot, tmp_path):
     """Without a current the torque plot says the torque is read through the speed loop (not
-    "measured (Kt x current)"), and an empty effects table says that no effect was named."""
-    from fha_studio.gui.pages.modelcheck.page import NO_CURRENT_TORQUE, NO_EFFECT, TORQUE_TITLE_NO_CURRENT
+    "measured (Kt x current)"), so do the channel's name on the other tabs (not "Torque (motor
+    current)"), the re-simulation names its command in words (not "cmd_pos"), and an empty
+    effects table says that no effect was named."""
+    from fha_studio.gui.pages.modelcheck.page import (
+        NO_CURRENT_TORQUE,
+        NO_EFFECT,
+        TORQUE_THROUGH_LOOP,
+        TORQUE_TITLE_NO_CURRENT,
+    )
 
     _capture, path = bench_recording(tmp_path)
     window = make_window()
@@ -68,3 +75,9 @@ def test_a_bench_recordings_check_says_where_its_torque_comes_from_and_why_no_ef
     assert not done.args[0].effects  # a clean simulated axis, its inertia declared right
     assert table.rowCount() == 1 and table.item(0, 0).text() == NO_EFFECT
     assert table.columnSpan(0, 0) == table.columnCount()
+    findings = page.findings.toPlainText()
+    assert f"{TORQUE_THROUGH_LOOP}: checked." in findings and "Motor current: not checked" in findings
+    assert "motor current" not in " ".join(p.getPlotItem().titleLabel.text for p in page.gap_plots.values())
+    assert page.where_channel.itemText(0) == TORQUE_THROUGH_LOOP
+    resimulation = page.resim_torque_plot.getPlotItem().titleLabel.text
+    assert "recorded command position" in resimulation and "cmd_pos" not in resimulation

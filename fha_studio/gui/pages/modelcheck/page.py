@@ -444,7 +444,7 @@ class ModelCheckPage(BasePage):
         self.where_channel.blockSignals(True)
         self.where_channel.clear()
         for name in r.where:
-            self.where_channel.addItem(CHANNEL_WORDS.get(name, name), name)
+            self.where_channel.addItem(_channel_name(name, r), name)
         self.where_channel.blockSignals(False)
         self._fill_where_variables()
 
@@ -521,7 +521,7 @@ class ModelCheckPage(BasePage):
         self.gap_plots.clear()
         for name, gap in r.gap.items():
             unit = unit_words(gap.unit)
-            plot = _plot(f"{CHANNEL_WORDS.get(name, name)}: {_num(gap.rms_before)} → {_num(gap.rms_after)} "
+            plot = _plot(f"{_channel_name(name, r)}: {_num(gap.rms_before)} → {_num(gap.rms_after)} "
                          f"{unit} rms on held-out stretches (shaded): how much better the updated model "
                          "explains data it was not fitted on", unit)
             for start, stop in gap.blocks:
@@ -542,8 +542,10 @@ class ModelCheckPage(BasePage):
         if s is None:
             self.resim_torque_plot.getPlotItem().setTitle("No re-simulation for this recording")
             return
+        column, _, how = s.command.partition(" ")  # "cmd_pos through the loop identified ..."
+        command = " ".join([COMMAND_WORDS.get(column, column), *([how] if how else [])])
         self.resim_torque_plot.getPlotItem().setTitle(
-            f"Re-simulation of the recorded {s.command}: torque {_num(s.rms_nominal_nm)} → "
+            f"Re-simulation of the recorded {command}: torque {_num(s.rms_nominal_nm)} → "
             f"{_num(s.rms_updated_nm)} {unit_words('N m')} rms (nominal → updated)", color="#222", size="10pt"
         )
         for y, color, label in ((s.torque_measured_nm, COLORS["measured"], "measured"),
@@ -618,7 +620,21 @@ def _num(x: float) -> str:
 CHANNEL_WORDS = {
     "torque": "Torque (motor current)",
     "position": "Position (load encoder against motor encoder)",
+    "current": "Motor current",
 }
+#: The torque channel of a recording without current: read through the speed loop.
+TORQUE_THROUGH_LOOP = "Torque (read through the speed loop)"
+#: The column a re-simulation was driven by.
+COMMAND_WORDS = {"cmd_pos": "command position", "pos": "position"}
+
+
+def _channel_name(name: str, r: ModelCheckResult) -> str:
+    """A checked channel in words; the torque of a recording without current is not the motor
+    current's (it is read through the loop from the following error and the speed)."""
+    current = r.channel_status.get("current")
+    if name == "torque" and current is not None and not current.checked:
+        return TORQUE_THROUGH_LOOP
+    return CHANNEL_WORDS.get(name, name)
 GATE_WORDS = {
     "evidence": "the data do not show it clearly enough",
     "held_out": "it does not explain held-out data better",
@@ -641,7 +657,7 @@ def _findings_in_words(r: ModelCheckResult) -> list[str]:
     """The Effects tab's text: how each effect was tried, in the words a person uses."""
     out = [f"Analysis bandwidth {r.bandwidth_hz:.3g} Hz: {r.window_reason}.", ""]
     for ch, status in r.channel_status.items():
-        name = CHANNEL_WORDS.get(ch, ch)
+        name = _channel_name(ch, r)
         if not status.checked:
             out.append(f"{name}: not checked, it {status.reason}.")
             continue
