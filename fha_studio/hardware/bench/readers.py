@@ -6,7 +6,9 @@
   ``logic-1-1``, ``logic-1-2``... (``unitsize`` bytes per sample, little-endian) and each analog
   channel's float32 samples in ``analog-1-N-1``, ``analog-1-N-2``...
 - **VCD** (IEEE 1364 value change dump): ``$timescale``, ``$var wire 1 ID NAME $end`` per
-  channel, then ``#TIME`` and ``0ID`` / ``1ID`` changes (``x`` and ``z`` read as 0). The sample
+  channel, then ``#TIME`` and ``0ID`` / ``1ID`` changes (``x`` and ``z`` read as 0); an analog
+  channel as a ``$var real 64 ID NAME $end`` with ``rVALUE ID`` changes (held until the next;
+  its unit is not stated: V). The sample
   rate is the one sigrok states in its ``$comment`` ("at 1 MHz") or else the finest step between
   changes.
 - **sigrok-cli's CSV** (``-O csv``): ``;`` comment lines naming the channels and the sample rate,
@@ -198,7 +200,7 @@ _AT_RATE_RE = re.compile(r"\bat\s+([0-9.]+\s*[kKmMgG]?Hz)")
 
 
 def parse_vcd(data: bytes, name: str) -> Capture:
-    """A value change dump of 1-bit wires."""
+    """A value change dump of 1-bit wires and real variables."""
     end = data.find(b"$enddefinitions")
     if end < 0:
         raise CaptureError(f"{name}: line 1: no '$enddefinitions $end': not a VCD file")
@@ -209,6 +211,7 @@ def parse_vcd(data: bytes, name: str) -> Capture:
     timescale = 1e-6
     rate: float | None = None
     ids: dict[str, str] = {}
+    real_ids: dict[str, str] = {}
     for match in re.finditer(r"\$(\w+)(.*?)\$end", header, re.DOTALL):
         keyword, content = match.group(1), match.group(2)
         line = header.count("\n", 0, match.start()) + 1
@@ -227,13 +230,17 @@ def parse_vcd(data: bytes, name: str) -> Capture:
             if len(parts) < 4:
                 raise CaptureError(f"{name}: line {line}: $var '{content.strip()}', expected "
                                    "'$var wire 1 ID NAME $end'")
+            if parts[0] == "real":
+                real_ids.setdefault(parts[2], parts[3])
+                continue
             if parts[1] != "1":
                 raise CaptureError(f"{name}: line {line}: $var {parts[3]} is {parts[1]} bits wide; only "
-                                   "1-bit wires (logic channels) are read")
+                                   "1-bit wires (logic channels) and real variables (analog) are read")
             ids.setdefault(parts[2], parts[3])
-    if not ids:
+    if not ids and not real_ids:
         raise CaptureError(f"{name}: line {header_lines}: no $var: the file names no channels")
     names = list(dict.fromkeys(ids.values()))
+    analog_names = [n for n in dict.fromkeys(real_ids.values()) if n not in names]
     if len(names) > 64:
         raise CaptureError(f"{name}: {len(names)} channels; at most 64 are read")
     # libsigrok 0.5.2 prints a session's analog samples ('A0: 10.00 V DC' lines) into its VCD too
@@ -243,7 +250,14 @@ def parse_vcd(data: bytes, name: str) -> Capture:
     if tokens.size == 0:
         raise CaptureError(f"{name}: line {header_lines + 1}: no samples after $enddefinitions")
     first = np.array([t[:1] for t in tokens], dtype="S1")
-    is_time = first == b"#"
+    # a real's change is two tokens, 'rVALUE' and its id (which may begin with any character)
+    real_value = np.zeros(tokens.size, bool)
+    real_id = np.zeros(tokens.size, bool)
+    if real_ids:
+        for k in np.flatnonzero((first == b"r") | (first == b"R")).tolist():
+            if not real_id[k] and k + 1 < tokens.size:
+                real_value[k] = real_id[k + 1] = True
+    is_time = (first == b"#") & ~real_id
     if not is_time[0]:
         raise CaptureError(f"{name}: line {header_lines + 1}: '{_tok(tokens[0])}' before the first "
                            "'#time'")
@@ -256,8 +270,9 @@ def parse_vcd(data: bytes, name: str) -> Capture:
     if np.any(np.diff(times) < 0):
         i = int(np.flatnonzero(np.diff(times) < 0)[0]) + 1
         raise CaptureError(f"{name}: the time goes back at #{times[i]} (after #{times[i - 1]})")
-    changes = tokens[~is_time]
-    when = (np.cumsum(is_time) - 1)[~is_time]
+    is_change = ~is_time & ~real_value & ~real_id
+    changes = tokens[is_change]
+    when = (np.cumsum(is_time) - 1)[is_change]
     value = np.array([t[:1] for t in changes], dtype="S1")
     ident = np.array([t[1:].decode("ascii", "replace") for t in changes], dtype=object)
     bad_value = ~np.isin(value, [b"0", b"1", b"x", b"z", b"X", b"Z"])
@@ -288,23 +303,52 @@ def parse_vcd(data: bytes, name: str) -> Capture:
     bits = []
     for channel in names:
         own = np.isin(ident, [i for i, nm in ids.items() if nm == channel])
-        bits.append(_levels_from_changes(sample[own], high[own], n))
-    block = SampleBlock(rate, tuple(names), pack_logic(bits), {})
-    return Capture(name, block, {}, t0 * timescale, "VCD")
+        bits.append(_held(sample[own], high[own], n, bool))
+    analog = _reals(data, body_start, tokens, real_value, real_ids, analog_names,
+                    sample_of_time[(np.cumsum(is_time) - 1)[real_value]], n, name)
+    logic = pack_logic(bits) if bits else np.zeros(0, np.uint8)
+    block = SampleBlock(rate, tuple(names), logic, analog)
+    return Capture(name, block, {a: "V" for a in analog}, t0 * timescale, "VCD")
 
 
-def _levels_from_changes(at: np.ndarray, high: np.ndarray, n: int) -> np.ndarray:
-    """The level at each of ``n`` samples from (sample, level) changes in time order; 0 before
-    the first change; the last change at one sample wins."""
-    levels = np.zeros(n, bool)
+def _reals(data: bytes, body_start: int, tokens: np.ndarray, real_value: np.ndarray,
+           real_ids: dict[str, str], analog_names: list[str], sample: np.ndarray, n: int,
+           name: str) -> dict[str, np.ndarray]:
+    """Each real variable's samples, its value held from one change to the next."""
+    if not analog_names:
+        return {}
+    at = np.flatnonzero(real_value)
+    ident = np.array([t.decode("ascii", "replace") for t in tokens[at + 1]], dtype=object)
+    unknown = [i for i in set(ident.tolist()) if i not in real_ids]
+    if unknown:
+        raise CaptureError(f"{name}: a real change of '{unknown[0]}', which no '$var real' declares")
+    bad = next((t for t in tokens[at] if not _REAL_RE.fullmatch(t[1:])), None)
+    if bad is not None:
+        raise CaptureError(f"{name}: line {_line_of(data, body_start, bad)}: '{_tok(bad)}' is not a "
+                           "real value ('r' and a number)")
+    values = np.array([float(t[1:]) for t in tokens[at]], dtype=np.float64)
+    sample = np.minimum(sample, n - 1)
+    out = {}
+    for channel in analog_names:
+        own = np.isin(ident, [i for i, nm in real_ids.items() if nm == channel])
+        out[channel] = _held(sample[own], values[own], n)
+    return out
+
+
+_REAL_RE = re.compile(rb"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|[-+]?(inf|nan)", re.IGNORECASE)
+
+
+def _held(at: np.ndarray, value: np.ndarray, n: int, dtype: type = np.float32) -> np.ndarray:
+    """``n`` samples from (sample, value) changes in time order, each value held until the next;
+    0 before the first; the last change at one sample wins."""
+    out: np.ndarray = np.zeros(n, dtype)
     if at.size == 0:
-        return levels
+        return out
     last_at_sample = np.ones(at.size, bool)
     last_at_sample[:-1] = at[1:] != at[:-1]
-    at, high = at[last_at_sample], high[last_at_sample]
-    lengths = np.diff(np.append(at, n))
-    levels[at[0]:] = np.repeat(high, lengths)
-    return levels
+    at, value = at[last_at_sample], value[last_at_sample]
+    out[at[0]:] = np.repeat(value.astype(dtype), np.diff(np.append(at, n)))
+    return out
 
 
 def _tok(token: bytes) -> str:

@@ -68,42 +68,52 @@ def write_sr(path: str | os.PathLike[str], block: SampleBlock) -> Path:
 
 
 def vcd_bytes(block: SampleBlock) -> bytes:
-    """The logic channels as a VCD, as sigrok writes it (time in the unit of one sample where the
-    rate allows, a comment stating the rate)."""
-    if not block.logic_channels:
-        raise ValueError("a VCD holds logic channels; the block has none")
-    if len(block.logic_channels) > len(_VCD_IDS):
+    """The block as a VCD, as sigrok writes it (time in the unit of one sample where the rate
+    allows, a comment stating the rate): logic channels as 1-bit wires, analog channels as IEEE
+    1364 ``real`` variables (``r<value> ID``, written where the value changes; sigrok-cli's VCD
+    input skips them, a mixed-signal viewer such as GTKWave draws them)."""
+    analog = list(block.analog)
+    width = len(block.logic_channels)
+    if not width and not analog:
+        raise ValueError("a VCD holds channels; the block has none")
+    if width + len(analog) > len(_VCD_IDS):
         raise ValueError(f"at most {len(_VCD_IDS)} channels in one VCD")
     unit_s, unit = _vcd_timescale(block.sample_rate_hz)
     head = [
         "$version FHA Studio virtual bench instrument $end",
         "$comment",
-        f"  Acquisition with {len(block.logic_channels)}/{len(block.logic_channels)} channels at "
-        f"{rate_text(block.sample_rate_hz)}",
+        f"  Acquisition with {width}/{width} channels at {rate_text(block.sample_rate_hz)}",
         "$end",
         f"$timescale {unit} $end",
         "$scope module fha_studio $end",
     ]
     for i, name in enumerate(block.logic_channels):
         head.append(f"$var wire 1 {_VCD_IDS[i]} {name} $end")
+    for k, name in enumerate(analog):
+        head.append(f"$var real 64 {_VCD_IDS[width + k]} {name} $end")
     head += ["$upscope $end", "$enddefinitions $end"]
-    words = block.logic
-    n = words.shape[0]
-    change = np.flatnonzero(words[1:] != words[:-1]) + 1
-    at = np.concatenate(([0], change))
-    times = np.rint(at / block.sample_rate_hz / unit_s).astype(np.int64)
+    n = block.samples
+    words = block.logic if width else np.zeros(n, np.uint8)
+    values = [np.asarray(block.analog[name], np.float32) for name in analog]
+    changed_at = [words[1:] != words[:-1]] + [v[1:] != v[:-1] for v in values]
+    change = np.flatnonzero(np.logical_or.reduce(changed_at)) + 1 if n > 1 else np.zeros(0, np.int64)
+    at = np.concatenate(([0], change)) if n else np.zeros(0, np.int64)
+    times = np.rint(at / block.sample_rate_hz / unit_s).astype(np.int64).tolist()
+    words_at = words[at].tolist()
+    # 9 significant digits give a float32 back exactly
+    reals = [[f"r{x:.9g} {_VCD_IDS[width + k]}" for x in v[at].tolist()] for k, v in enumerate(values)]
     parts = ["\n".join(head), "\n"]
-    previous: int | None = None
-    values = words[at].tolist()
-    width = len(block.logic_channels)
-    for t, word in zip(times.tolist(), values, strict=True):
-        if previous is None:
-            changed = (1 << width) - 1
-        else:
-            changed = word ^ previous
+    previous_word: int | None = None
+    previous_real: list[str | None] = [None] * len(analog)
+    for j, (t, word) in enumerate(zip(times, words_at, strict=True)):
+        changed = (1 << width) - 1 if previous_word is None else word ^ previous_word
         items = [f"{(word >> i) & 1}{_VCD_IDS[i]}" for i in range(width) if (changed >> i) & 1]
+        for k, column in enumerate(reals):
+            if column[j] != previous_real[k]:
+                items.append(column[j])
+                previous_real[k] = column[j]
         parts.append(f"#{t} {' '.join(items)}\n")
-        previous = word
+        previous_word = word
     parts.append(f"#{round(n / block.sample_rate_hz / unit_s)}\n")
     return "".join(parts).encode("ascii")
 

@@ -456,14 +456,12 @@ class VirtualBenchInstrument:
         return join_blocks(self._blocks)
 
     def write(self, path: str | os.PathLike[str], form: str) -> Path:
-        """The capture so far in one of :data:`FORMS` (VCD: the logic channels only)."""
+        """The capture so far in one of :data:`FORMS` (VCD: SPD-MON as a real variable)."""
         block = self.capture()
         if form == "sr":
             return writers.write_sr(path, block)
         if form == "vcd":
-            return writers.write_vcd(
-                path, SampleBlock(block.sample_rate_hz, block.logic_channels, block.logic)
-            )
+            return writers.write_vcd(path, block)
         if form == "sigrok-csv":
             return writers.write_sigrok_csv(path, block)
         if form in ("csv", "csv-semicolon"):

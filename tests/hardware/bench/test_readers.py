@@ -69,11 +69,13 @@ def test_vcd_reads_back_and_sigrok_cli_reads_what_we_write(tmp_path):
     # 1 MHz: a VCD's time unit is one sample (sigrok reads a VCD at the rate of its time unit)
     block = _block(2000)
     block = SampleBlock(1e6, block.logic_channels, block.logic, block.analog)
-    logic = SampleBlock(block.sample_rate_hz, block.logic_channels, block.logic)
-    writers.write_vcd(tmp_path / "x.vcd", logic)
+    writers.write_vcd(tmp_path / "x.vcd", block)  # the analog channels as real variables
     back = read_capture(tmp_path / "x.vcd")
     assert back.samples == 2000 and back.sample_rate_hz == 1e6
-    assert np.array_equal(back.block.logic, logic.logic)
+    assert np.array_equal(back.block.logic, block.logic)
+    for name in ("SPD", "PROBE"):  # float32 written with 9 digits: the same numbers back
+        assert np.array_equal(back.analog(name), block.analog[name]), name
+    assert back.units == {"SPD": "V", "PROBE": "V"}
     writers.write_sr(tmp_path / "x.sr", block)
     if shutil.which("sigrok-cli") is None:
         pytest.skip("sigrok-cli is not installed (scripts/test installs it)")
@@ -91,6 +93,19 @@ def test_a_vcd_at_a_rate_that_is_not_a_whole_number_of_picoseconds():
     block = SampleBlock(24e6, ("A",), pack_logic([np.arange(500) % 3 == 0]))
     capture = _parse_vcd(writers.vcd_bytes(block))
     assert capture.sample_rate_hz == 24e6 and np.array_equal(capture.logic("A"), block.bit("A"))
+
+
+def test_a_vcds_real_variables_are_held_between_changes_and_a_bad_value_is_one_line():
+    # ids as IEEE 1364 allows them: '#' and 'r' are ids here, not a time or a real's value
+    head = ("$timescale 1 us $end\n$var wire 1 ! ENC_A $end\n$var real 64 # SPD_MON $end\n"
+            "$var real 64 r I $end\n$enddefinitions $end\n")
+    capture = _parse_vcd((head + "#0 0! r0.5 # r-1e-3 r\n#2 1! r1.25 #\n#3 0!\n#5\n").encode())
+    assert capture.samples == 5 and capture.channels == ("ENC_A", "SPD_MON", "I")
+    assert capture.analog("SPD_MON").tolist() == [0.5, 0.5, 1.25, 1.25, 1.25]
+    assert np.allclose(capture.analog("I"), -1e-3) and capture.logic("ENC_A").tolist() == [0, 0, 1, 0, 0]
+    with pytest.raises(CaptureError) as refused:
+        _parse_vcd((head + "#0 0! r0.5 #\n#1 rfast #\n").encode())
+    assert str(refused.value) == "x.vcd: line 7: 'rfast' is not a real value ('r' and a number)"
 
 
 def _parse_vcd(data: bytes):

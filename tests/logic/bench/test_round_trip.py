@@ -68,11 +68,8 @@ def test_each_file_form_gives_the_drives_positions_back(drive, form, tmp_path):
     axis, instrument = drive
     path = tmp_path / ("capture.sr" if form == "sr" else "capture.vcd" if form == "vcd" else "capture.csv")
     instrument.write(path, form)
-    signals = [
-        SignalSpec(role, str(path), channel)
-        for role, channel in CHANNELS.items()
-        if not (form == "vcd" and role == "speed_monitor")
-    ]  # a VCD holds logic only
+    # a VCD holds SPD-MON as a real variable
+    signals = [SignalSpec(role, str(path), channel) for role, channel in CHANNELS.items()]
     result = import_bench(signals, AxisFacts.for_actuator(CODE), _settings())
     truth = instrument.truth.arrays()
     decoded = result.decoded
@@ -89,9 +86,6 @@ def test_each_file_form_gives_the_drives_positions_back(drive, form, tmp_path):
     recording = result.recording
     assert recording.metadata.extra["source_pos"].startswith(f"{path}#ENC_A and {path}#ENC_B")
     assert not recording.has_current
-    if form == "vcd":
-        assert recording.vel_rpm is None and result.summary["speed_offset_v"] is None
-        return
     # speed: the drive's output r/min over each recording interval, within 1 % of the peak
     idx = np.rint(recording.t_s * instrument.sample_rate_hz).astype(int)
     drive_rpm = truth["motor_rpm"] / 50.0

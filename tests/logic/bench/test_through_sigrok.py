@@ -74,7 +74,7 @@ def test_each_file_form_through_sigrok_cli_gives_the_drives_positions_back(drive
     plan = sigrok_input.plan_input(path)
     # the file's own names and kinds, as sigrok-cli reads them
     assert {"ENC_A", "ENC_B", "CMD_A", "IN_POS"} <= set(plan.logic)
-    assert plan.analog == (() if form == "vcd" else ("SPD_MON",))
+    assert plan.analog == (() if form == "vcd" else ("SPD_MON",))  # sigrok-cli's VCD input skips reals
     assert not any(name.startswith("D") and name[1:].isdigit() for name in plan.channels)
     assert plan.sample_rate_hz == 200e3  # the VCD's 1 us timescale downsampled to its stated rate
 
