@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from PySide6.QtCore import QSettings, Slot
 from PySide6.QtWidgets import (
+    QCheckBox,
     QComboBox,
     QDialog,
     QDialogButtonBox,
@@ -39,11 +40,13 @@ def catalogue_codes() -> list[str]:
     return all_model_codes()
 
 
-def sim_url(actuator_code: str, load_inertia_kgm2: float = 0.0) -> str:
+def sim_url(actuator_code: str, load_inertia_kgm2: float = 0.0, documented: bool = False) -> str:
     """The embedded simulated drive for ``actuator_code`` with the declared load inertia [kg m^2]
-    on its output (none when 0)."""
+    on its output (none when 0); ``documented``: its profile of a real HA-655 (DGR and OWW only)."""
+    query = ([f"load_inertia={load_inertia_kgm2!r}"] if load_inertia_kgm2 > 0 else []) + (
+        ["profile=documented"] if documented else [])
     url = f"sim://{actuator_code.strip().upper()}"
-    return f"{url}?load_inertia={load_inertia_kgm2!r}" if load_inertia_kgm2 > 0 else url
+    return f"{url}?{'&'.join(query)}" if query else url
 
 
 class ConnectDialog(QDialog):
@@ -70,6 +73,7 @@ class ConnectDialog(QDialog):
         self.serial_radio = child(self.form, QRadioButton, "serialRadio")
         self.address_radio = child(self.form, QRadioButton, "addressRadio")
         self.sim_actuator = child(self.form, QComboBox, "simActuatorCombo")
+        self.sim_documented = child(self.form, QCheckBox, "simDocumentedCheck")
         self.port_combo = child(self.form, QComboBox, "portCombo")
         self.refresh_button = child(self.form, QPushButton, "refreshButton")
         self.address_edit = child(self.form, QLineEdit, "addressEdit")
@@ -85,6 +89,7 @@ class ConnectDialog(QDialog):
         self.port_combo.activated.connect(lambda: self.serial_radio.setChecked(True))
         self.address_edit.textEdited.connect(lambda: self.address_radio.setChecked(True))
         self.sim_actuator.activated.connect(lambda: self.sim_radio.setChecked(True))
+        self.sim_documented.toggled.connect(lambda: self.sim_radio.setChecked(True))
         self.refresh_ports(ports)
         self._restore()
         self.resize(max(self.width(), 600), self.sizeHint().height())
@@ -107,6 +112,7 @@ class ConnectDialog(QDialog):
         kind = str(settings.value("connect/kind", "sim"))
         actuator = settings.value("connect/actuator", DEFAULT_ACTUATOR)
         self.sim_actuator.setCurrentText(str(actuator))
+        self.sim_documented.setChecked(str(settings.value("connect/sim_documented", "false")) == "true")
         port = settings.value("connect/port", "")
         index = self.port_combo.findData(port)
         if index >= 0:
@@ -129,6 +135,7 @@ class ConnectDialog(QDialog):
         )
         settings.setValue("connect/kind", kind)
         settings.setValue("connect/actuator", self.sim_actuator.currentText().strip())
+        settings.setValue("connect/sim_documented", "true" if self.sim_documented.isChecked() else "false")
         if self.port_combo.currentData():
             settings.setValue("connect/port", self.port_combo.currentData())
         settings.setValue("connect/address", self.address_edit.text().strip())
@@ -149,7 +156,8 @@ class ConnectDialog(QDialog):
             return str(self.port_combo.currentData())
         if self.address_radio.isChecked():
             return self.address_edit.text().strip()
-        return sim_url(self.sim_actuator.currentText(), self.load_inertia_kgm2)
+        return sim_url(self.sim_actuator.currentText(), self.load_inertia_kgm2,
+                       documented=self.sim_documented.isChecked())
 
     def baud_rate(self) -> int:
         return int(self.baud_combo.currentData() or BAUDRATE)

@@ -51,6 +51,22 @@ def test_connect_dialog_defaults_to_the_simulated_drive_and_remembers(qtbot):
     assert again.address_radio.isChecked() and again.url() == "socket://127.0.0.1:5020"
 
 
+def test_connect_dialog_offers_the_simulated_drive_as_a_real_ha655_and_remembers_it(qtbot):
+    """A trainee picks the simulated drive of the manual's commands (DGR, OWW; CN3 silent while
+    the servo is on) in the dialog, not only with --url on the command line."""
+    dialog = ConnectDialog(ports=[], load_inertia_kgm2=0.5)
+    qtbot.addWidget(dialog)
+    assert not dialog.sim_documented.isChecked()
+    dialog.address_radio.setChecked(True)
+    dialog.sim_documented.setChecked(True)  # the simulated drive is meant
+    assert dialog.sim_radio.isChecked()
+    assert dialog.url() == "sim://FHA-25C-50-US250?load_inertia=0.5&profile=documented"
+    dialog._accept()
+    again = ConnectDialog(ports=[])
+    qtbot.addWidget(again)
+    assert again.sim_documented.isChecked() and again.url() == "sim://FHA-25C-50-US250?profile=documented"
+
+
 def test_window_layout_and_page_are_remembered(make_window):
     window = make_window()
     window.resize(1024, 600)  # narrower than its minimum width would be clamped
