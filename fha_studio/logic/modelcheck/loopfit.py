@@ -2,30 +2,37 @@
 
 A bench capture of an HA-655 gives the command and the encoder position, no current. The loop that
 ran (docs/physics.md, "Servo": speed command = Kp (cmd - pos) + FF cmd', current = Kv (e + integral
-(e) / Tv), e = speed command - speed) and the rigid plant J a = Kt i - d give, in Laplace terms,
+(e) / Tv), e = speed command - the speed the drive measures) and the rigid plant J a = Kt i - d
+give, in Laplace terms,
 
-    pos = Gc(s) cmd - H(s) d,   Gc = g (Tv s + 1)(FF s + Kp) / D(s),   H = Tv s / D(s),
-    D(s) = J Tv s^3 + g (Tv s + 1)(s + Kp),   g = Kt Kv (on the declared inertia J).
+    pos = Gc(s) cmd - H(s) d,   Gc = g (Tv s + 1)(lag s + 1)(FF s + Kp) / D(s),
+    H = Tv s (lag s + 1) / D(s),   D(s) = J Tv s^3 (lag s + 1) + g (Tv s + 1)(Kp (lag s + 1) + s),
+
+g = Kt Kv on the declared inertia J, ``lag`` the first-order lag of the drive's speed detection (a
+filter, a period's difference), and the command taken up to 2 ms early (``lead``: the drive samples
+the command and the encoder at its own instants, which the recording's common time stamps do not
+show; a lead reads as FF + Kp lead, so it is bounded to what a servo period can make).
 
 The loop is identified by *output error*: the position the model gives for the recorded command
-against the measured one (``RecordedLoop.fit``, least squares over Kp, FF, g and Tv, the disturbance
-columns and the start's free response solved linearly at every step). The tempting alternative,
-the loop's torque written from the measured signals (equation error), multiplies every timing
-detail of the drive (its servo period, its speed detection's lag, the integration rule) by the
-loop's gains: on the simulated drive's default loop (Kp 40 1/s, 60 Hz speed loop) a 0.1 ms
+against the measured one (``RecordedLoop.fit``, least squares over the loop's parameters, the
+disturbance columns and the start's free response solved linearly at every step). The tempting
+alternative, the loop's torque written from the measured signals (equation error), multiplies every
+timing detail of the drive (its servo period, its speed detection's lag, the integration rule) by
+the loop's gains: on the simulated drive's default loop (Kp 40 1/s, 60 Hz speed loop) a 0.1 ms
 difference already shows as 2 N m, and the fit then prefers a wrong loop that explains the
 acceleration as the following error's derivative. In the following error those details stay as
 small as they are.
 
 What the disturbance d does is H (a band-pass: the speed loop's integral holds whatever is constant,
 so H(0) = 0) applied to it. A candidate effect's columns are passed through H and scaled by
-1 / max |H|: the channel (``oe_channel``) stays in N m, a disturbance at the loop's most sensitive
-frequency keeping its size, every other one shown smaller; the effects' coefficients stay in N m.
+1 / max |H| (``through_loop``): the channel (``oe_channel``) stays in N m, a disturbance at the
+loop's most sensitive frequency keeping its size, every other one shown smaller; the effects'
+coefficients stay in N m. While the command pushes an axis that friction holds, the axis takes the
+torque the loop winds up (``RecordedLoop.stick_torque``), not a friction column's level.
 
-Not in the model, and why: the drive's speed detection lags (a filter, a period's difference),
-which reads as less inertia and negative viscous friction (g lag / Tv); viscous friction is
-therefore left out of the model: a column for it trades off against g and the lag (tried on the
-simulated drive: with a free viscous column g came out 1.8 x too large and every torque with it;
+Not in the model, and why: viscous friction. The speed detection's lag reads as less inertia and a
+negative viscous friction (g lag / Tv); a free viscous column trades off against g and the lag
+(tried on the simulated drive: with one, g came out 1.8 x too large and every torque with it;
 without it, within 1 %).
 """
 
