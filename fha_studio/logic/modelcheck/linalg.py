@@ -78,6 +78,41 @@ def ols(y: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, float]:
     return beta, float(r @ r)
 
 
+class Beside:
+    """Least squares of y on [x, c] for many c beside one x, by projection: x's normal equations
+    are solved once, and each c costs the products with it (x'c, c'c, c'y) and a solve as wide as
+    c, not the whole Gram matrix and its eigenvectors again. The coefficients of c and the residual
+    are those ``ols(y, [x, c])`` gives while [x, c] has full rank (a shape search or a frequency scan
+    tries a few dozen columns beside the same model)."""
+
+    def __init__(self, y: np.ndarray, x: np.ndarray, rcond: float = 1e-10):
+        self.y, self.x, self.rcond = y, x, rcond
+        if x.shape[1]:
+            gs, xtys, scale = _scaled(*gram(x, y))
+            w, v = np.linalg.eigh(gs)
+            magnitude = np.abs(w)
+            inv = np.divide(1.0, w, out=np.zeros_like(w), where=magnitude > rcond * magnitude.max())
+            # pinv(x'x) through the scaled columns: x pinv x' is the projection onto x's columns
+            self._pinv = (v * inv) @ v.T / np.outer(scale, scale)
+            self.beta_x = self._pinv @ (xtys * scale)
+            self.y_rest = y - x @ self.beta_x
+        else:
+            self._pinv = np.zeros((0, 0))
+            self.y_rest = y
+
+    def fit(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The coefficients of the columns c beside x, and the residual y - [x, c] beta."""
+        c_rest = c - self.x @ (self._pinv @ np.einsum("ij,ik->jk", self.x, c)) if self.x.shape[1] else c
+        beta = solve_normal_scaled(*gram(c_rest, self.y_rest), rcond=self.rcond)
+        return beta, self.y_rest - c_rest @ beta
+
+
+def solve_normal_scaled(g: np.ndarray, b: np.ndarray, rcond: float = 1e-10) -> np.ndarray:
+    """The normal equations g beta = b solved on unit-norm columns (pseudo-inverse), as ols does."""
+    gs, bs, scale = _scaled(g, b)
+    return solve_normal(gs, bs, rcond) / scale
+
+
 def bic(rss: float, n: int, k: int) -> float:
     """Bayesian information criterion of a Gaussian least-squares fit."""
     return n * math.log(max(rss / n, 1e-300)) + k * math.log(n)
@@ -93,15 +128,21 @@ def fold_betas(y: np.ndarray, x: np.ndarray, edges: list[tuple[int, int]]) -> li
     """Least-squares coefficients with each block [a, b) left out, in turn.
 
     The normal equations of a fold are the whole record's minus the left-out block's, so the
-    record is multiplied out once, not once per fold (the cost stays linear in its length).
+    record is multiplied out once, block by block, not once per fold (the cost stays linear in its
+    length).
     """
-    g_all, xty = gram(x, y)
+    blocks = [gram(x[a:b], y[a:b]) for a, b in edges]
+    if edges and edges[0][0] == 0 and edges[-1][1] == len(y) and all(
+        b == a2 for (_, b), (a2, _) in itertools.pairwise(edges)
+    ):  # the blocks cover the record: its products are theirs summed
+        g_all, xty = sum(g for g, _ in blocks), sum(v for _, v in blocks)
+    else:
+        g_all, xty = gram(x, y)
     scale = np.sqrt(np.diag(g_all))
     scale[scale == 0] = 1.0
     outer = np.outer(scale, scale)
     out = []
-    for a, b in edges:
-        g_block, xty_block = gram(x[a:b], y[a:b])
+    for g_block, xty_block in blocks:
         beta = solve_normal((g_all - g_block) / outer, (xty - xty_block) / scale)
         out.append(beta / scale)
     return out

@@ -46,7 +46,16 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from fha_studio.logic.modelcheck.candidates import Candidate, ChannelContext, Param
-from fha_studio.logic.modelcheck.linalg import bic, block_cv, block_edges, fit_ar, fold_betas, ols, whiten
+from fha_studio.logic.modelcheck.linalg import (
+    Beside,
+    bic,
+    block_cv,
+    block_edges,
+    fit_ar,
+    fold_betas,
+    ols,
+    whiten,
+)
 
 BIC_MIN = 10.0
 CV_MIN_GAIN = 0.005  # the held-out RMS must fall by at least 0.5 %
@@ -59,6 +68,10 @@ MIN_SIGMAS = 3.0  # a named effect's size must stand this many jackknife sigmas 
 MIN_OFF_SHAPE_RATIO = 6.0
 MASKED_CV_FACTOR = 3.0  # a look-alike the record cannot rule out fits within this factor of the chosen
 OFF_SHAPE_GAP = 0.45  # off-shape frequencies keep this far (cycles per turn) from the chosen one
+# a searched shape's refinement stops when a step moves it by less than this share: 4e-5 cycles per
+# turn at 4, a hundredth of what a record of a few hundred motor turns resolves (scipy's default,
+# 1e-8, took a third of the evaluations creeping on), and the final fit refines it again
+SHAPE_XTOL = 1e-5
 
 
 # Two scores this close (relative) are a tie, settled by the candidates' order: candidates that span
@@ -166,6 +179,10 @@ class ChannelSelector:
         # detection limits by (candidate, the terms beside it with their shapes): substitutes() and
         # the report ask for the same ones
         self._limit_cache: dict[tuple[object, ...], tuple[float, tuple[float, ...]]] = {}
+        # held-out RMS by the terms' columns: every candidate of a selection step is weighed against
+        # the same model, and the model a step chose is the next step's (the value keeps the columns,
+        # so their ids stay theirs while cached)
+        self._cv_cache: dict[tuple[int, ...], tuple[list[np.ndarray], float]] = {}
 
     # --- columns
     def cols(self, cand: Candidate, shape: tuple[float, ...]) -> np.ndarray:
@@ -182,6 +199,13 @@ class ChannelSelector:
         parts = [self.base] + [t.cols for t in terms]
         return np.column_stack(parts) if sum(p.shape[1] for p in parts) else np.empty((self.n, 0))
 
+    def cv_rms(self, terms: list[Term]) -> float:
+        """Held-out RMS (block_cv) of the model of ``terms``."""
+        key = tuple(id(t.cols) for t in terms)
+        if key not in self._cv_cache:
+            self._cv_cache[key] = ([t.cols for t in terms], block_cv(self.y, self.design(terms))[0])
+        return self._cv_cache[key][1]
+
     def residual(self, terms: list[Term]) -> np.ndarray:
         x = self.design(terms)
         beta, _ = ols(self.y, x)
@@ -190,8 +214,12 @@ class ChannelSelector:
     # --- scoring
     def _ar_for(self, x: np.ndarray) -> np.ndarray:
         """AR whitening estimated on the residual of the model with columns x (the alternative)."""
+        return self._fit_and_ar(x)[1]
+
+    def _fit_and_ar(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The least-squares coefficients of the columns x, and the AR whitening of their residual."""
         beta, _ = ols(self.y, x)
-        return fit_ar(self.y - x @ beta if x.shape[1] else self.y)
+        return beta, fit_ar(self.y - x @ beta if x.shape[1] else self.y)
 
     def _wrss(self, x: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, float, int]:
         """The criterion's fit: least squares on the whitened residual and columns (GLS); its RSS."""
@@ -226,14 +254,15 @@ class ChannelSelector:
         if not cand.shape_refine:
             return shape
 
+        beside = Beside(self.y, x0)
+
         def resid(s):
-            x1 = np.column_stack([x0, self.cols(cand, (float(s[0]),))])
-            beta, _ = ols(self.y, x1)
-            return self.y - x1 @ beta
+            return beside.fit(self.cols(cand, (float(s[0]),)))[1]
 
         try:
             sol = least_squares(
-                resid, [shape[0]], bounds=cand.shape_bounds(shape), diff_step=1e-4, max_nfev=30
+                resid, [shape[0]], bounds=cand.shape_bounds(shape), diff_step=1e-4, max_nfev=30,
+                xtol=SHAPE_XTOL,
             )
             return (float(sol.x[0]),)
         except (ValueError, np.linalg.LinAlgError):  # pragma: no cover - degenerate data
@@ -250,13 +279,12 @@ class ChannelSelector:
         term = Term(cand, shape, self.cols(cand, shape))
         x0 = self.design(terms)
         x1 = self.design([*kept, term])
-        phi = self._ar_for(x1)
+        beta1, phi = self._fit_and_ar(x1)  # size and sign from the plain least-squares estimate
         _, rss1, nw = self._wrss(x1, phi)
         _, rss0, _ = self._wrss(x0, phi)
-        beta1, _ = ols(self.y, x1)  # size and sign from the plain least-squares estimate
         bic0, bic1 = bic(rss0, nw, x0.shape[1]), bic(rss1, nw, x1.shape[1])
-        cv0, _ = block_cv(self.y, x0)
-        cv1, _ = block_cv(self.y, x1)
+        cv0 = self.cv_rms(terms)
+        cv1 = self.cv_rms([*kept, term])
         beta_c = beta1[-term.cols.shape[1] :]
         size = float(cand.size(beta_c, self.ctx))
         physical = self._physical(cand, beta_c)
@@ -320,11 +348,8 @@ class ChannelSelector:
         grid = [c for (c,) in cand.shape_grid]
         offs = np.arange(0.25, max(grid) + 0.76, 0.25)
         offs = offs[(np.abs(offs - shape[0]) >= OFF_SHAPE_GAP) & (np.abs(offs - np.round(offs)) > 0.1)]
-        sizes = []
-        for c in offs:
-            cols = self.cols(cand, (float(c),))
-            beta, _ = ols(self.y, np.column_stack([x1, cols]))
-            sizes.append(float(cand.size(beta[-cols.shape[1] :], self.ctx)))
+        beside = Beside(self.y, x1)
+        sizes = [float(cand.size(beside.fit(self.cols(cand, (float(c),)))[0], self.ctx)) for c in offs]
         return float(np.median(sizes)) if sizes else 0.0
 
     @staticmethod
@@ -381,12 +406,12 @@ class ChannelSelector:
             changed = False
             phi = self._ar_for(self.design(terms))
             full = self.score(terms, phi)
-            cv_full, _ = block_cv(self.y, self.design(terms))
+            cv_full = self.cv_rms(terms)
             trials: list[Trial] = []
             for term in terms:
                 rest = [t for t in terms if t is not term]
                 drop_bic = self.score(rest, phi)
-                cv_rest, _ = block_cv(self.y, self.design(rest))
+                cv_rest = self.cv_rms(rest)
                 keep = drop_bic - full >= BIC_MIN and cv_full < cv_rest * (1.0 - CV_MIN_GAIN)
                 trials.append(
                     Trial(
@@ -611,7 +636,7 @@ class ChannelSelector:
         out = []
         chosen = {t.id for t in terms}
         sizes = self._term_sizes(terms, beta)
-        cv_full, _ = block_cv(self.y, x_full)
+        cv_full = self.cv_rms(terms)
         hidden = {c.id: self.detection_limit(terms, c)[0] for c in self.candidates if c.id not in chosen}
         for term, size in zip(terms, sizes, strict=True):
             rest = [t for t in terms if t is not term]
