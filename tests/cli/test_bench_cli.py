@@ -194,3 +194,23 @@ def test_missing_parameters_are_named(bench, tmp_path, capsys):
     )
     err = capsys.readouterr().err
     assert "parameter 9 (speed conversion factor" in err and err.count("\n") == 1
+
+
+def test_a_capture_too_slow_for_the_encoder_is_one_line_and_exit_2(bench, tmp_path, capsys):
+    """The same move sampled at 25 kHz: the encoder's edges at the speed reached need more, and
+    the command line names both figures instead of counting wrong; nothing is written."""
+    from fha_studio.hardware.bench import writers
+    from fha_studio.hardware.bench.capture import SampleBlock
+
+    folder, _, instrument = bench
+    block, every = instrument.capture(), 8
+    writers.write_sr(tmp_path / "cn2.sr", SampleBlock(
+        block.sample_rate_hz / every, block.logic_channels, block.logic[::every].copy(),
+        {k: v[::every].copy() for k, v in block.analog.items()}))
+    args = ["bench", "import", "--actuator", CODE, "--parameters", str(folder / "params.toml"),
+            *_signals(tmp_path), "-o", str(tmp_path / "rec.csv"), "--json", str(tmp_path / "s.json")]
+    assert cli_main(args) == 2
+    out, err = capsys.readouterr()
+    assert err.count("\n") == 1 and out == "", err
+    assert "sample rate of 25 kHz cannot resolve the encoder" in err and "kHz of edges" in err
+    assert not (tmp_path / "rec.csv").exists() and not (tmp_path / "s.json").exists()
