@@ -81,3 +81,21 @@ def test_a_bench_recordings_check_says_where_its_torque_comes_from_and_why_no_ef
     assert page.where_channel.itemText(0) == TORQUE_THROUGH_LOOP
     resimulation = page.resim_torque_plot.getPlotItem().titleLabel.text
     assert "recorded command position" in resimulation and "cmd_pos" not in resimulation
+
+
+def test_a_model_check_plot_of_hundredths_of_a_newton_metre_reads_them_as_they_are(qtbot):
+    """A residual of a few hundredths of a N·m: its axis says "N·m" with ticks such as 0.2, not
+    "N·m (x0.001)" beside ticks of hundreds (pyqtgraph's own prefix for a unit it does not know)."""
+    import numpy as np
+
+    from fha_studio.gui.pages.modelcheck.page import _plot
+
+    plot = _plot("Torque: 0.0576 → 0.0576 N·m rms", "N·m")
+    qtbot.addWidget(plot)
+    plot.resize(600, 300)
+    plot.show()
+    t = np.linspace(0.0, 1.6, 400)
+    plot.plot(t, 0.3 * np.sin(8 * t))
+    qtbot.waitUntil(lambda: plot.getPlotItem().viewRange()[1][1] < 1.0, timeout=10000)
+    label = plot.getPlotItem().getAxis("left").labelString()
+    assert "N·m" in label and "(x" not in label

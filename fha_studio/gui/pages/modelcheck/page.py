@@ -90,6 +90,8 @@ def _plot(title: str, left: str, bottom: str = "time (s)") -> pg.PlotWidget:
     item.setTitle(title, color="#222", size="10pt")
     item.setLabel("left", left)
     item.setLabel("bottom", bottom)
+    for side in ("left", "bottom"):  # a residual of 0.3 N·m reads "0.3", not "300" and "(x0.001)"
+        item.getAxis(side).enableAutoSIPrefix(False)
     item.showGrid(x=True, y=True, alpha=0.25)
     item.addLegend(offset=(10, 5), labelTextColor="#222")
     item.setClipToView(True)
