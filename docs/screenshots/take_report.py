@@ -46,6 +46,7 @@ def main() -> int:
              who="T. Technician")
     procedures.capture_scope_plot("Jog FWD at 20 r/min: output speed and motor current")
     _html, pdf = procedures.write_report(Path(TMP) / "report.html", Path(TMP) / "report.pdf")
+    OUT.mkdir(parents=True, exist_ok=True)  # pdftoppm writes into it, it does not make it
     for old in OUT.glob("report-page-*.png"):
         old.unlink()
     subprocess.run(["pdftoppm", "-r", "70", "-png", str(pdf), str(OUT / "report-page")], check=True)
