@@ -71,22 +71,11 @@ def test_cli_exit_4_when_the_drive_cannot_be_excited(extra: str, capsys: pytest.
     assert ("servo is off" in err[0]) or ("front-panel" in err[0])
 
 
-def test_cli_measure_runs_to_completion_with_the_contract(tmp_path, monkeypatch,
+def test_cli_measure_runs_to_completion_with_the_contract(drives, tmp_path,
                                                           capsys: pytest.CaptureFixture[str]) -> None:
-    """``tune measure`` as a script runs it, to the end: the servo switched on by the controller (the
-    simulated drive's CN2 servo-ON input, as on a real axis: the command line never switches it
-    on), the excitation stated on stderr before it starts, bounded by --amplitude-rpm, waited for
-    on the stepped drive's own time; exit 0, one line of figures, the contract's JSON."""
-    opened = DriveClient.open.__func__
-    drives = []
-
-    def open_under_servo(cls, url, *args, **kwargs):
-        client = opened(cls, url, *args, **kwargs)
-        drives.append(_sim(client))
-        drives[-1].set_servo(True)
-        return client
-
-    monkeypatch.setattr(DriveClient, "open", classmethod(open_under_servo))
+    """``tune measure`` as a script runs it, to the end: the servo switched on by the controller
+    (``drives``), the excitation stated on stderr before it starts, bounded by --amplitude-rpm,
+    waited for on the stepped drive's own time; exit 0, one line of figures, the contract's JSON."""
     out = tmp_path / "measure.json"
     code = cli_main(["tune", "measure", "--url", _url(CODE, 0.81), "--actuator", CODE,
                      "--load-inertia", "0.81", "--amplitude-rpm", "0.3", "--json", str(out)])
