@@ -161,8 +161,26 @@ def test_triggered_move_is_captured_saved_and_loads_everywhere(qtbot, scope, sim
     readout = view.cursor_readout()
     assert readout["command_position"][0] == pytest.approx(0.5)
     assert view.export_png(tmp_path / "view.png").stat().st_size > 1000
+    _the_png_has_the_legend_above_the_plots(view, tmp_path / "view.png")
     csv = np.loadtxt(view.export_csv(tmp_path / "view.csv"), delimiter=",", skiprows=1)
     assert csv.shape == (1024, 5)
+
+
+def _the_png_has_the_legend_above_the_plots(view, png) -> None:
+    """The exported picture (the report's scope plot, the PNG… button) says which curve is which
+    channel: the legend's lines in the channels' colours above the plots."""
+    from pyqtgraph import exporters
+    from PySide6.QtGui import QColor, QImage
+
+    image = QImage(str(png))
+    plots = exporters.ImageExporter(view.time_plot.plot.ci)
+    plots.parameters()["width"] = image.width()
+    band = image.height() - plots.export(toBytes=True).height()
+    assert band > 10  # the legend's lines
+    color = view.time_plot._shown[3]  # the channels' colours, as set_curves was given them
+    wanted = {QColor(color(key)).rgb() & 0xFFFFFF for key in view.time_plot._curves}
+    seen = {image.pixel(x, y) & 0xFFFFFF for y in range(band) for x in range(0, image.width())}
+    assert wanted <= seen
 
 
 def test_move_and_step_tests_report_overshoot_settling_and_in_position(qtbot, scope, sim_client):

@@ -17,14 +17,17 @@ whole once, with pyqtgraph's peak downsampling and clip to view for zooming, on 
 from __future__ import annotations
 
 import html
+import math
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import pyqtgraph as pg
 from pyqtgraph import exporters
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import QBuffer, QIODevice, Qt, Signal
+from PySide6.QtGui import QColor, QImage, QImageWriter, QPainter, QTextDocument
 from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 
+from fha_studio import fileio
 from fha_studio.logic.scope.channels import ScopeChannel
 from fha_studio.logic.scope.levels import MinMaxLevels
 
@@ -34,6 +37,8 @@ from .cursor_table import CursorTable
 #: colours are the same on the plot, in the legend and in the channel table, all readable).
 BACKGROUND = "#ffffff"
 FOREGROUND = "#303030"
+#: Room around the legend above an exported plot [px].
+LEGEND_MARGIN_PX = 6
 
 
 class _UnitPlot:
@@ -440,6 +445,31 @@ class TimePlot(QWidget):
         return self._cursor_t[0] + self._x_offset, self._cursor_t[1] + self._x_offset
 
     def export_png(self, path) -> None:
+        """The plots as a PNG with the legend above them (which curve is which channel, in its
+        colour: a report's reader has no channel table beside the picture)."""
         exporter = exporters.ImageExporter(self.plot.ci)
         exporter.parameters()["width"] = max(800, self.plot.width())
-        exporter.export(str(path))
+        plots = exporter.export(toBytes=True)
+        entries = self._legend_entries + self._bench_entries
+        document = QTextDocument()
+        document.setDefaultFont(self.legend.font())
+        document.setHtml(" &nbsp; ".join(entries))
+        document.setTextWidth(plots.width() - 2 * LEGEND_MARGIN_PX)
+        legend_height = math.ceil(document.size().height()) + 2 * LEGEND_MARGIN_PX if entries else 0
+        image = QImage(plots.width(), plots.height() + legend_height, QImage.Format.Format_RGB32)
+        image.fill(QColor(BACKGROUND))
+        painter = QPainter(image)
+        try:
+            if entries:
+                painter.translate(LEGEND_MARGIN_PX, LEGEND_MARGIN_PX)
+                document.drawContents(painter)
+                painter.resetTransform()
+            painter.drawImage(0, legend_height, plots)
+        finally:
+            painter.end()
+        buffer = QBuffer()
+        buffer.open(QIODevice.OpenModeFlag.WriteOnly)
+        writer = QImageWriter(buffer, b"PNG")
+        if not writer.write(image):
+            raise OSError(f"{path}: the plot could not be turned into a PNG ({writer.errorString()})")
+        fileio.write_bytes(path, bytes(buffer.data().data()))  # whole or not at all
