@@ -52,6 +52,7 @@ from fha_studio.gui.link import LinkController, OpenClient
 from fha_studio.gui.main_window import MainWindow
 from fha_studio.gui.messages import Level
 from fha_studio.gui.pages.base import PageId
+from fha_studio.gui.register_connection import without_nothing_changed
 from fha_studio.gui.register_dialog import RegisterDialog
 from fha_studio.gui.register_questions import (
     LocalQuestions,
@@ -118,6 +119,9 @@ class MachineWindow(QMainWindow):
         self._shut_down = False
         self._closing_confirmed = False
         self._register_dialog: RegisterDialog | None = None
+        #: the last line about the register said while there was no axis (the first axis's message
+        #: line says it again)
+        self._line_without_axes: tuple[str, Level] | None = None
         #: the machine's axes are still to be had from the server (asked, or to be asked again)
         self.axes_wanted = ask_for_axes and self.questions is not None and self.questions.on_server
         self._asking_axes = False
@@ -204,9 +208,10 @@ class MachineWindow(QMainWindow):
                       Level.WARNING)
             self._axes_retry.start(int(AXES_RETRY_S * 1000))
             return
-        self.axes_wanted = False  # the server answered: it does not have the machine
+        # the server answered, and refused: it does not have the machine, or not this login
+        self.axes_wanted = False
         more = "" if len(self.project) else " Add axis… adds its first axis."
-        self._say(f"Register: {why}.{more}", Level.WARNING)
+        self._say(f"Register: {without_nothing_changed(why)}.{more}", Level.WARNING)
 
     def _server_answers(self) -> bool | None:
         """Whether the server answered the last question (None: none asked yet, or no server)."""
@@ -236,6 +241,7 @@ class MachineWindow(QMainWindow):
         if self.axis_windows:
             self.current_window.show_message(text, level)
         else:
+            self._line_without_axes = (text, level)
             self.no_axes_label.setText(f"{self._no_axes_text()}\n\n{text}")
             self.no_axes_label.setStyleSheet(
                 "color: #8a5a00; font-size: 11pt;" if level == Level.WARNING else "font-size: 11pt;"
@@ -386,6 +392,9 @@ class MachineWindow(QMainWindow):
         if index == 0:  # the first axis (after none, the pages take the place of the line)
             self.axis_list.setCurrentRow(0)
             self._show_pages_or_none()
+            if self._line_without_axes is not None:
+                window.show_message(*self._line_without_axes)
+                self._line_without_axes = None
         return window
 
     def add_axis(

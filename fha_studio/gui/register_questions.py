@@ -40,6 +40,7 @@ from fha_studio.gui.register_connection import (
     without_nothing_changed,
 )
 from fha_studio.logic.register import Register, RegisterError, guard
+from fha_studio.logic.register.guard import ServerAway
 from fha_studio.logic.register.server import problem, shown_url
 
 log = logging.getLogger(__name__)
@@ -168,11 +169,16 @@ class QuestionWorker(QObject):
                 self._server_socket = server_socket(self._server)
             value = question.ask(self._server)
         except Exception as exc:
-            gone = self._server is None or _broken(self._server)
+            # the server not reached, or its connection broken; a refusal is an answer (a wrong
+            # password, a machine it does not have)
+            gone = isinstance(exc, ServerAway | OSError) or (
+                _broken(self._server) if self._server is not None else not isinstance(exc, RegisterError)
+            )
             if isinstance(exc, RegisterError | ValueError | OSError):
                 said = str(exc)
             elif guard.is_db_error(exc):
-                said = str(problem(self.url, exc))
+                reason = problem(self.url, exc)
+                said, gone = str(reason), gone or isinstance(reason, ServerAway)
             else:
                 log.exception("register: %s asked of %s", question.what, shown_url(self.url))
                 said = f"the register {shown_url(self.url)}: {exc}"

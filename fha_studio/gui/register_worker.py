@@ -51,6 +51,7 @@ from fha_studio.logic.register.facts_from_session import (
     MachineLevelFact,
     record_machine_fact,
 )
+from fha_studio.logic.register.guard import ServerAway
 from fha_studio.logic.register.server import problem, shown_url
 from fha_studio.paths import user_data_dir
 
@@ -117,11 +118,13 @@ class MachineRequest:
 @dataclass(frozen=True)
 class ServerState:
     """What the last delivery found: the server answered (``reachable``) and took ``delivered``
-    facts, or it did not (``problem``, one line naming it by its URL without password)."""
+    facts, or it did not (``problem``, one line naming it by its URL without password): it could
+    not be reached, or it answered and ``refused`` them (a wrong password, a role's rule)."""
 
     reachable: bool
     problem: str = ""
     delivered: int = 0
+    refused: bool = False
 
 
 class QueueWorker(QObject):
@@ -281,11 +284,14 @@ class DeliveryWorker(QObject):
             delivered = self._deliver(*self._registers(), self._answered)
         except Closing:
             return ServerState(True)
-        except (RegisterError, OSError) as exc:
+        except (ServerAway, OSError) as exc:
             state = ServerState(False, str(exc))
+        except RegisterError as exc:  # the server answered: it refused them
+            state = ServerState(False, str(exc), refused=True)
         except Exception as exc:  # the server's or the queue's errors, never the thread's end
             if guard.is_db_error(exc):
-                state = ServerState(False, str(problem(self.url, exc)))
+                said = problem(self.url, exc)
+                state = ServerState(False, str(said), refused=not isinstance(said, ServerAway))
             else:
                 log.exception("register: delivery to %s", shown_url(self.url))
                 state = ServerState(False, f"the register {shown_url(self.url)}: {exc}")
@@ -364,6 +370,8 @@ class ServerWriter(RegisterWriter):
         #: whether the server took the last delivery (None: none tried yet), and how many facts
         #: went into the queue since it last did
         self.answers: bool | None = None
+        #: why the server refused the last delivery ("": it did not, or it was not reached)
+        self.refusal = ""
         self.waiting = 0
         self._said_slow = False
         self._shut_down = False
@@ -442,12 +450,20 @@ class ServerWriter(RegisterWriter):
                     Level.INFO,
                 )
             self.waiting = 0
-        elif self.answers is not False:
+        elif state.refused:
+            if state.problem != self.refusal:
+                self.sigSay.emit(
+                    f"Register: the server refused what this window records "
+                    f"({without_nothing_changed(state.problem)}); it waits on this computer and goes "
+                    "to the server once that is put right.", Level.WARNING
+                )
+        elif self.answers is not False or self.refusal:
             why = without_nothing_changed(state.problem)
             self.sigSay.emit(
                 "Register: the server does not answer; what this window records waits on this "
                 f"computer and goes to the server when it answers again ({why}).", Level.WARNING
             )
+        self.refusal = state.problem if state.refused else ""
         self.answers = state.reachable
         self.sigState.emit(state)
         self.sigChanged.emit()

@@ -238,7 +238,8 @@ class WindowRegister(QObject):
             width = max(160, min(LINE_WIDTH_MAX_PX, int(self.window.width() * LINE_WIDTH_SHARE)))
             server = self.server
             away = server is not None and server.answers is False
-            tail = f" · server away, {facts_text(server.waiting)} waiting" if server and away else ""
+            state_now = "server refuses them" if server and server.refusal else "server away"
+            tail = f" · {state_now}, {facts_text(server.waiting)} waiting" if server and away else ""
             self.button.setText(_line(self.button.fontMetrics(), axis, width - 16, tail))
             self.button.setStyleSheet("color: #8a5a00; font-weight: bold;" if away else "")
             how = "" if axis.named else (

@@ -175,3 +175,32 @@ def test_a_machine_the_server_does_not_have_is_said(started, qtbot, postgres_clu
     assert not window.axes_wanted
     with Register(url) as server:  # opening it by name did not make it
         assert [m.name for m in server.machines()] == ["Line 4"]
+
+
+def test_a_wrong_password_is_said_as_such_and_the_next_start_delivers(started, qtbot, postgres_cluster):
+    """A wrong password is no server away: the lines say the server refused the user name or
+    password; what the window records waits in this computer's queue (one per server and database,
+    whatever the password), and a start with the right password delivers it, each fact once."""
+    from tests.support.postgres import PASSWORD
+
+    url = postgres_cluster.new_database()
+    with Register(url) as server:
+        server.add_machine(MACHINE)
+        server.add_axis(MACHINE, "table", ACTUATOR, port_url="/dev/ttyUSB0")
+    wrong = url.replace(PASSWORD, "not-the-password")
+    window = started(wrong)
+    qtbot.waitUntil(lambda: "refused the user name or password" in window.no_axes_label.text(), timeout=30000)
+    said = window.no_axes_label.text().split("\n\n")[-1]
+    assert "not reachable" not in said and "does not answer" not in said
+    assert "not-the-password" not in said and "\n" not in said
+    window.add_axis("tilt", ACTUATOR, port_url="/dev/ttyUSB1")  # queued
+    qtbot.waitUntil(lambda: any("refused the user name or password" in text for text in _messages(window)),
+                    timeout=30000)
+    assert not any("does not answer" in text or "not reachable" in text for text in _messages(window))
+    qtbot.waitUntil(lambda: _queued_axes(wrong) == ["tilt"], timeout=30000)
+    window.shutdown()
+    right = started(url)  # the same queue: its facts go to the server now
+    qtbot.waitUntil(lambda: len(right.axis_windows) == 2, timeout=30000)
+    with Register(url) as server:
+        qtbot.waitUntil(lambda: [a.name for a in server.axes(MACHINE)] == ["table", "tilt"], timeout=30000)
+        assert len(server.history(f"{MACHINE}/tilt")) == 1

@@ -11,6 +11,7 @@ import pytest
 
 from fha_studio.cli import main
 from fha_studio.logic.register import SCHEMA_VERSION, Register, RegisterError, register_location
+from fha_studio.logic.register.guard import ServerAway
 from fha_studio.logic.register.identity import uid_hash
 from fha_studio.logic.register.schema import MIGRATIONS
 from fha_studio.logic.register.server import ServerDatabase, problem, shown_url
@@ -133,6 +134,11 @@ def test_a_full_disk_and_the_other_refusals_in_words(postgres_cluster):
     assert "fha may not do that: permission denied for table fact: nothing was changed" in str(denied)
     with pytest.raises(RegisterError, match="there is no register at postgresql://fha@/"):
         Register(url, create=False)
+    # a server not reached is away (a window tries again); one that refuses answered
+    timeout = problem(url, psycopg.errors.ConnectionTimeout("connection timeout expired"), opening=True)
+    assert isinstance(timeout, ServerAway) and "the server cannot be reached" in str(timeout)
+    password = problem(url, psycopg.OperationalError('FATAL:  password authentication failed for user "fha"'))
+    assert not isinstance(password, ServerAway) and "refused the user name or password" in str(password)
 
 
 def test_the_register_option_takes_a_url_and_the_old_name_too(postgres_cluster, capsys, monkeypatch):

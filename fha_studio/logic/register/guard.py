@@ -34,6 +34,11 @@ class RegisterError(ValueError):
     """The register cannot be used or a request does not fit it; the message says what and where."""
 
 
+class ServerAway(RegisterError):
+    """The register's server cannot be reached or went away (no answer: not a refusal). A window
+    that keeps its facts tries again later; a wrong password or a role's refusal is no such thing."""
+
+
 #: How the register's refusal to change or remove a fact begins (:mod:`.append_only`).
 APPEND_ONLY = "append-only:"
 

@@ -28,7 +28,7 @@ from typing import Any
 from urllib.parse import unquote, urlsplit, urlunsplit
 
 from fha_studio.logic.register import append_only
-from fha_studio.logic.register.guard import APPEND_ONLY, RegisterError, append_only_refusal
+from fha_studio.logic.register.guard import APPEND_ONLY, RegisterError, ServerAway, append_only_refusal
 from fha_studio.logic.register.roles import SQLSTATE as ROLES_SQLSTATE
 from fha_studio.logic.register.roles import refused_words, who_writes
 from fha_studio.logic.register.schema import MIGRATIONS
@@ -333,11 +333,14 @@ def problem(url: str, exc: BaseException, opening: bool = False) -> RegisterErro
                              "nothing was changed")
     if state == "42501" or "permission denied" in low or "must be owner" in low:
         return _not_allowed(url, where, first, opening)
-    if state in ("57P01", "57P02", "57P03") or state.startswith("08") or (type(exc).__name__ in (
-        "OperationalError", "InterfaceError"
-    ) and ("connect" in low or "closed" in low or "terminat" in low or "server" in low)):
+    # psycopg's connection errors (ConnectionTimeout among them) are OperationalErrors
+    kinds = {kind.__name__ for kind in type(exc).__mro__}
+    if state in ("57P01", "57P02", "57P03") or state.startswith("08") or (
+        kinds & {"OperationalError", "InterfaceError"}
+        and ("connect" in low or "closed" in low or "terminat" in low or "server" in low)
+    ):
         gone = "cannot be reached" if opening else "went away"
-        return RegisterError(f"the register {where}: the server {gone} "
+        return ServerAway(f"the register {where}: the server {gone} "
                              f"({quoted(first, limit=80, always=False)}): nothing was changed; "
                              "try again when it is back")
     said = quoted(first, limit=80, always=False)

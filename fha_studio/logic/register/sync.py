@@ -155,8 +155,8 @@ def sync_registers(
         try:
             return job.run()
         except RegisterError as exc:
-            if job.done:
-                raise RegisterError(
+            if job.done:  # a server away stays one (a window tries again later)
+                raise type(exc)(
                     f"{exc} (the sync had moved {job.done} of {job.total} facts: they are "
                     "kept; run it again to finish)"
                 ) from None
