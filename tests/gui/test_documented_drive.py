@@ -331,6 +331,7 @@ def _page_facts(window, page_id: str, page, servo_on: bool) -> None:
         assert "front panel" in page.drive_label.text()
     elif page_id == "jog":
         assert "CN2" in page.motion.message.text()
+        assert page.cn2_hint.isVisible() and "Bench" in page.cn2_hint.text()  # where the signals are
         assert not page.motion.servo_on_button.isEnabled()
     elif page_id == "absolute":
         if servo_on:

@@ -27,6 +27,11 @@ LIVE_SIGNALS = (
     (IoBit.ALARM, "Alarm output", RED),
 )
 
+#: Where the live signals are on a drive that gives none over CN3.
+CN2_HINT = ("This drive gives no live signals over CN3. While the controller moves it, watch its CN2 "
+            "outputs (the encoder's A/B, IN-POS, ALARM, SPD-MON) with an oscilloscope or a logic "
+            "analyzer on the <i>Scope</i> page's <i>Bench</i> tab.")
+
 
 class JogPage(BasePage):
     """Servo, jog, move-by and the live I/O of the drive."""
@@ -62,6 +67,11 @@ class JogPage(BasePage):
             self.signal_lamps[bit] = lamp
             l_layout.addRow(lamp)
         right.addWidget(live_box)
+        self.cn2_hint = QLabel(CN2_HINT)
+        self.cn2_hint.setObjectName("jogCn2Hint")
+        self.cn2_hint.setWordWrap(True)
+        self.cn2_hint.setVisible(False)
+        right.addWidget(self.cn2_hint)
         stop_hint = QLabel(
             "<b>STOP</b>: the red button in the toolbar, or the <b>Esc</b> key, on every page."
         )
@@ -107,6 +117,7 @@ class JogPage(BasePage):
 
     def link_connected(self, info: LinkInfo) -> None:
         self.motion.link_connected(info)
+        self.cn2_hint.setVisible(not info.can_monitor)  # the panel above stays empty: where to look
 
     @Slot(object)
     def _on_status(self, status: DriveStatus) -> None:
