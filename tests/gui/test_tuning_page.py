@@ -91,12 +91,19 @@ def test_hold_to_run_excites_only_while_held(make_window, qtbot, let_go):
 
 
 def test_documented_drive_gets_a_front_panel_worksheet(make_window, qtbot):
+    """... for a load of 10 x the actuator's own inertia, beyond the about 3 x of 2-1: the page
+    says so and tunes softer."""
+    from fha_studio.logic.tuning.session import declared_model
+
     window = make_window(connect=f"sim://{CODE}?paced=0&profile=documented")
     page = window.show_page(PageId.TUNING)
     assert "cannot be excited" in page.plan_label.text()
     page.actuator_edit.setText(CODE)  # the manual's commands do not say which actuator
+    page.load_spin.setValue(10.0 * declared_model(CODE, 0.0).actuator_inertia_kgm2)
     with qtbot.waitSignal(page.sigProposed, timeout=60000):
         page.propose_button.click()
     text = page.worksheet.toPlainText()
     assert "tune item 0" in text and "->" in text
     assert not page.apply_button.isEnabled()
+    warning = page.warning_label.text()
+    assert page.warning_label.isVisible() and "2-1" in warning and "softer" in warning, warning
