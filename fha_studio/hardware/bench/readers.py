@@ -335,7 +335,8 @@ def _reals(data: bytes, body_start: int, tokens: np.ndarray, real_value: np.ndar
     return out
 
 
-_REAL_RE = re.compile(rb"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|[-+]?(inf|nan)", re.IGNORECASE)
+#: A real's value: a finite number (an instrument never measured 'nan' or 'inf')
+_REAL_RE = re.compile(rb"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
 
 def _held(at: np.ndarray, value: np.ndarray, n: int, dtype: type = np.float32) -> np.ndarray:

@@ -103,9 +103,10 @@ def test_a_vcds_real_variables_are_held_between_changes_and_a_bad_value_is_one_l
     assert capture.samples == 5 and capture.channels == ("ENC_A", "SPD_MON", "I")
     assert capture.analog("SPD_MON").tolist() == [0.5, 0.5, 1.25, 1.25, 1.25]
     assert np.allclose(capture.analog("I"), -1e-3) and capture.logic("ENC_A").tolist() == [0, 0, 1, 0, 0]
-    with pytest.raises(CaptureError) as refused:
-        _parse_vcd((head + "#0 0! r0.5 #\n#1 rfast #\n").encode())
-    assert str(refused.value) == "x.vcd: line 7: 'rfast' is not a real value ('r' and a number)"
+    for bad in ("rfast", "rnan"):
+        with pytest.raises(CaptureError) as refused:
+            _parse_vcd((head + f"#0 0! r0.5 #\n#1 {bad} #\n").encode())
+        assert str(refused.value) == f"x.vcd: line 7: '{bad}' is not a real value ('r' and a number)"
 
 
 def _parse_vcd(data: bytes):
