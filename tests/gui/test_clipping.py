@@ -23,6 +23,7 @@ def write_rotary_direction_reversed(window, qtbot):
     row = model.row_of("rotary_direction")
     page.table.selectRow(row)
     model.setData(model.index(row, 3), "1")
+    assert page.message.text() == "1 item edited, not written yet."  # not "1 item(s)"
     with qtbot.waitSignal(window.session.sigWritesDone, timeout=10000):
         page.write_changed()
     qtbot.waitUntil(lambda: page.restart_banner.isVisible(), timeout=10000)

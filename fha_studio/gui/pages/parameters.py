@@ -47,6 +47,11 @@ SERVO_ON_WRITE_REASON = (
 )
 
 
+def items(n: int) -> str:
+    """``"1 item"``, ``"3 items"``: a count as a sentence says it."""
+    return f"{n} item" if n == 1 else f"{n} items"
+
+
 class ParametersPage(BasePage):
     """Read, edit, write (verified), save and load the driver's parameters."""
 
@@ -293,7 +298,7 @@ class ParametersPage(BasePage):
         if self._servo_blocks(m for m, _, _ in writes):
             self.message.setText(f"Nothing written. {SERVO_ON_WRITE_REASON}")
             return
-        self.message.setText(f"Writing {len(writes)} item(s) …")
+        self.message.setText(f"Writing {items(len(writes))} …")
         self.session.write(writes)
 
     @Slot(object)
@@ -367,7 +372,7 @@ class ParametersPage(BasePage):
         """A read of the session's (this page's, or after a power cycle, or before a backup)."""
         if result.ok:
             errors = result.answer.errors
-            text = f"Read {len(result.answer.values)} item(s) from the drive."
+            text = f"Read {items(len(result.answer.values))} from the drive."
             if errors:
                 text += " Not read: " + "; ".join(f"{m} {k}: {e}" for (m, k), e in errors.items())
             self.message.setText(text)
@@ -428,7 +433,7 @@ class ParametersPage(BasePage):
 
     def _edits_changed(self, n: int) -> None:
         if n:
-            self.message.setText(f"{n} item(s) edited, not written yet.")
+            self.message.setText(f"{items(n)} edited, not written yet.")
             self.message.setStyleSheet("")
         self._update_buttons()
 
@@ -514,7 +519,7 @@ class ParametersPage(BasePage):
             self.write_changed()
         elif self.model.edits:
             self.message.setText(
-                f"{len(self.model.edits)} item(s) taken from the file; connect and write them."
+                f"{items(len(self.model.edits))} taken from the file; connect and write them."
             )
         else:
             self.message.setText("The drive already holds the chosen values: nothing to write.")
