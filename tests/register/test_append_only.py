@@ -5,12 +5,14 @@ a mistake is corrected by a new fact that points at the one it corrects."""
 from __future__ import annotations
 
 import contextlib
+import datetime
 import json
 import sqlite3
 
 import psycopg
 import pytest
 
+from fha_studio import clock
 from fha_studio.logic.register import Register, RegisterError
 from fha_studio.logic.register.schema import ENTITY_TABLES, FACT_TABLES, REGISTER_TABLES
 from fha_studio.logic.register.server import is_server_url, problem
@@ -86,10 +88,11 @@ def test_the_refusal_is_one_line_naming_the_register(register_target):
 
 
 def test_a_correction_is_a_new_fact_pointing_at_the_one_it_corrects(line3):
+    # read from the panel an hour ago and corrected 5 min later; the notes below are stamped now
     wrong = line3.record_snapshot(TABLE, [("tune", 4, "in_position_range", 100)], "front_panel", who="ana",
-                                  at_utc="2026-11-30T08:00:00Z")
+                                  at_utc=_ago(minutes=60))
     right = line3.record_snapshot(TABLE, [("tune", 4, "in_position_range", 10)], "front_panel", who="ana",
-                                  note="read 100 for 10", corrects=wrong, at_utc="2026-11-30T08:05:00Z")
+                                  note="read 100 for 10", corrects=wrong, at_utc=_ago(minutes=55))
     lines = {e.ref: e for e in line3.history(TABLE) if e.kind == "snapshot"}
     assert lines[wrong].text.endswith(f"— corrected by snapshot {right}")
     assert lines[wrong].data["corrected_by"] == [right]
@@ -109,12 +112,19 @@ def test_a_correction_is_a_new_fact_pointing_at_the_one_it_corrects(line3):
         line3.record_checks(TABLE, [_Check(corrects="12")])
 
 
+def _ago(minutes: float) -> str:
+    """A moment before now by the one clock the register stamps with (never a calendar date: a
+    fixed date is in the future when the suite runs with the calendar moved back)."""
+    return (clock.now_utc() - datetime.timedelta(minutes=minutes)).isoformat()
+
+
 class _Check:
     procedure_id, step_id, kind, section, text = "wiring", "w1", "confirm", "1-14", "Motor wired"
-    value, expected, unit, passed, who, at_utc, detail = True, "", "", True, "ana", "2026-11-30T09:00:00Z", ""
+    value, expected, unit, passed, who, detail = True, "", "", True, "ana", ""
 
     def __init__(self, corrects=None):
         self.corrects = corrects
+        self.at_utc = _ago(minutes=30)  # checked before it is corrected
 
 
 def test_where_a_procedure_stands_is_a_row_each_time_it_moves_on(line3, register_target):
