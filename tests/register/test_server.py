@@ -74,6 +74,38 @@ def test_an_older_register_on_the_server_is_migrated_with_its_facts(postgres_clu
         assert reg.axis("Press 7/ram").serial_number == "S-1"  # the column of schema 2
 
 
+def test_a_failing_migration_leaves_the_server_at_its_version(postgres_cluster, monkeypatch):
+    """As for a file (test_durability.py): a migration that fails half-way is rolled back whole,
+    the register stays at its version with its facts, and a program whose migrations work brings
+    it up to date afterwards."""
+    from fha_studio.logic.register import store as register_store
+
+    url = postgres_cluster.new_database()
+    db = ServerDatabase(url)
+    assert db.prepare_register(create=True)
+    for statement in MIGRATIONS[0]:  # a register of schema 1
+        db.execute(statement)
+    db.execute("PRAGMA user_version = 1")
+    db.execute("INSERT INTO machine (name, created_utc) VALUES (?, ?)", ("Press 7", "2026-01-01T00:00:00Z"))
+    db.execute("INSERT INTO axis (machine_id, name, created_utc) VALUES (1, 'feed', '2026-01-01T00:00:00Z')")
+    db.close()
+    broken = (MIGRATIONS[0], (*MIGRATIONS[1][:1], "CREATE INDEX oops ON no_such_table (x)"))
+    monkeypatch.setattr(register_store, "MIGRATIONS", broken)
+    with pytest.raises(RegisterError) as failed:
+        Register(url)
+    assert "\n" not in str(failed.value) and PASSWORD not in str(failed.value)
+    with psycopg.connect(url) as check:
+        assert check.execute("SELECT version FROM register_schema").fetchone() == (1,)
+        columns = {r[0] for r in check.execute(
+            "SELECT column_name FROM information_schema.columns WHERE table_name = 'axis'")}
+        assert "serial_number" not in columns  # the first statement of schema 2 was rolled back too
+        assert check.execute("SELECT name FROM axis").fetchall() == [("feed",)]
+    monkeypatch.undo()
+    with Register(url) as reg:
+        assert reg.version == SCHEMA_VERSION
+        assert [a.name for a in reg.axes("Press 7")] == ["feed"]
+
+
 def test_a_register_from_a_newer_program_is_refused_unchanged(postgres_cluster):
     url = postgres_cluster.new_database()
     Register(url).close()
