@@ -127,7 +127,8 @@ def _model(args: argparse.Namespace) -> Any:
 
 def run_measure(args: argparse.Namespace) -> int:
     from fha_studio.hardware.parameters import load_parameter_model
-    from fha_studio.logic.tuning.measure import NotExcitable, check_excitable
+    from fha_studio.logic.tuning.excitation import NotExcitable
+    from fha_studio.logic.tuning.measure import check_excitable
     from fha_studio.logic.tuning.record import figure_words
     from fha_studio.logic.tuning.session import drive_clock, measure_report, tuner_for
 
@@ -163,7 +164,8 @@ def run_measure(args: argparse.Namespace) -> int:
 
 def run_propose(args: argparse.Namespace) -> int:
     from fha_studio.hardware.parameters import load_parameter_model
-    from fha_studio.logic.tuning.measure import NotExcitable, check_excitable
+    from fha_studio.logic.tuning.excitation import NotExcitable
+    from fha_studio.logic.tuning.measure import check_excitable
     from fha_studio.logic.tuning.session import tuner_for
 
     model = _model(args)
@@ -179,6 +181,8 @@ def run_propose(args: argparse.Namespace) -> int:
             result: dict[str, Any] = {"aim": proposal.aim, "used_aim": proposal.used_aim,
                                       "warning": proposal.warning, "present": proposal.present.to_dict(),
                                       "proposed": proposal.proposed.to_dict()}
+            if proposal.reference is not None:  # beyond 2-1: what the standard aim would have proposed
+                result["reference"] = proposal.reference.to_dict()
             if proposal.warning:
                 print(f"warning: {proposal.warning}", file=sys.stderr)
             if args.apply:

@@ -4,7 +4,9 @@
 - `Effects` and one dataclass per effect, with the model check's ids and parameter names.
 - `GearStiffness`: the wind-up curve of manual 1-9-2.
 - `ServoSettings`, `ServoAxis`: the HA-655-like cascade (P position, PI speed, current limit,
-  feed-forward, electronic gear, rotary direction, in-position) at >= 5 kHz over the plant.
+  feed-forward, electronic gear, rotary direction, in-position) at >= 5 kHz over the plant;
+  `PanelGains`: the front panel's tune items 0-3 in SI (the one reading of them), and
+  `servo_settings()`: the drive's items as `ServoSettings`.
 - `MotionGenerator`: jog and trapezoidal move profiles.
 - `simulate()`: a whole recorded command through the closed loop; `MonitorOptions` for the
   monitors' quantisation and noise.
@@ -31,7 +33,14 @@ from fha_studio.physics.effects import (
 )
 from fha_studio.physics.model import MODEL_FORMAT, AxisModel, catalogue_effects
 from fha_studio.physics.motion import MotionGenerator
-from fha_studio.physics.servo import RAD_S_PER_RPM, TRACE_CHANNELS, ServoAxis, ServoSettings
+from fha_studio.physics.servo import (
+    RAD_S_PER_RPM,
+    TRACE_CHANNELS,
+    PanelGains,
+    ServoAxis,
+    ServoSettings,
+    servo_settings,
+)
 from fha_studio.physics.simulate import SIMULATION_UNITS, MonitorOptions, apply_monitor, simulate
 from fha_studio.physics.stiffness import ARCMIN_PER_RAD, ARCSEC_PER_RAD, GearStiffness
 
@@ -56,6 +65,7 @@ __all__ = [
     "LostMotion",
     "MonitorOptions",
     "MotionGenerator",
+    "PanelGains",
     "ServoAxis",
     "ServoSettings",
     "StribeckFriction",
@@ -65,5 +75,6 @@ __all__ = [
     "ViscousFriction",
     "apply_monitor",
     "catalogue_effects",
+    "servo_settings",
     "simulate",
 ]

@@ -22,6 +22,7 @@ Electronic gear: command input pulses x numerator / denominator = output encoder
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -126,6 +127,90 @@ class ServoSettings:
         """+1 when a FWD command turns the flange CW (the 1-10 table's row for
         ``rotary_direction``), -1 when it turns it CCW."""
         return 1.0 if rotary_direction_setting(self.rotary_direction).fwd_turns_cw else -1.0
+
+
+@dataclass(frozen=True)
+class PanelGains:
+    """The HA-655's tune items 0-3 as the front panel shows them, and what they mean in SI.
+
+    The one reading of them (resources/drive/ha655-parameters.toml states it, in the notes on tune
+    items 0-3; docs/physics.md repeats it): the speed loop gain (tune 0, Hz) is the speed loop's
+    crossover frequency with the actuator's own inertia J_A alone, Kv = 2 pi f J_A / Kt. The drive
+    does not know the load, so a load J_L lowers the crossover in proportion, to about
+    f J_A / (J_A + J_L). Tv (tune 1) in ms; Kp (tune 2) is output speed (rad/s) per rad of position
+    error; feed-forward (tune 3) in % of the command speed.
+
+    Used wherever panel values and physical gains meet: the simulated drive's loops
+    (``hardware.sim.axis.servo_settings``), tuning's loops and proposals, the bench move fit, and
+    the model check's comparison of an identified loop with the panel's values.
+    """
+
+    speed_loop_gain_hz: float
+    speed_loop_integral_compensation_ms: float
+    position_loop_gain_per_s: float
+    feed_forward_gain_pct: float
+
+    @classmethod
+    def from_items(cls, values: Mapping[str, int]) -> PanelGains:
+        """Tune items 0-3 from the drive's items (wire values by key)."""
+        return cls(
+            speed_loop_gain_hz=values["speed_loop_gain"],
+            speed_loop_integral_compensation_ms=values["speed_loop_integral_compensation"],
+            position_loop_gain_per_s=values["position_loop_gain"],
+            feed_forward_gain_pct=values["feed_forward_gain"],
+        )
+
+    @staticmethod
+    def speed_gain_per_hz(model: AxisModel) -> float:
+        """Kv (A s/rad) per Hz of tune 0: 2 pi J_A / Kt, the actuator's own inertia only."""
+        return 2.0 * math.pi * model.actuator_inertia_kgm2 / model.torque_constant_nm_per_a
+
+    def servo_fields(self, model: AxisModel) -> dict[str, float]:
+        """The ``ServoSettings`` fields these items set, in SI."""
+        return dict(
+            position_loop_gain_per_s=float(self.position_loop_gain_per_s),
+            speed_loop_gain_a_s_per_rad=self.speed_loop_gain_hz * self.speed_gain_per_hz(model),
+            speed_loop_integral_time_s=self.speed_loop_integral_compensation_ms / 1000.0,
+            feed_forward_gain=self.feed_forward_gain_pct / 100.0,
+        )
+
+    @classmethod
+    def of_settings(cls, model: AxisModel, settings: ServoSettings) -> PanelGains:
+        """The panel values (not rounded) that would give ``settings``' gains on ``model``."""
+        return cls(
+            speed_loop_gain_hz=settings.speed_loop_gain_a_s_per_rad / cls.speed_gain_per_hz(model),
+            speed_loop_integral_compensation_ms=1000.0 * settings.speed_loop_integral_time_s,
+            position_loop_gain_per_s=settings.position_loop_gain_per_s,
+            feed_forward_gain_pct=100.0 * settings.feed_forward_gain,
+        )
+
+    @staticmethod
+    def crossover_hz(model: AxisModel, speed_loop_gain_hz: float) -> float:
+        """Where a speed loop gain of ``speed_loop_gain_hz`` crosses over on the whole rigid body
+        of ``model`` (actuator and load): f J_A / (J_A + J_L), the proportional part alone."""
+        return speed_loop_gain_hz * model.actuator_inertia_kgm2 / model.total_inertia_kgm2
+
+
+def servo_settings(model: AxisModel, values: Mapping[str, int], servo_rate_hz: float,
+                   quantised_feedback: bool = True) -> ServoSettings:
+    """The HA-655's items (wire values by key) as ServoSettings for ``model``: the one mapping the
+    simulated drive, tuning and the bench move fit share.
+
+    Tune items 0-3 as :class:`PanelGains` reads them (the speed loop gain on the actuator's own
+    inertia, whatever the load: a drive does not know it); control mode (system 0): 0 position,
+    1 speed; the electronic gear, rotary direction and in-position range as the items say. With
+    ``quantised_feedback`` the loops see whole encoder pulses, as a real drive does.
+    """
+    return ServoSettings(
+        **PanelGains.from_items(values).servo_fields(model),
+        electronic_gear_numerator=int(values["electronic_gear_numerator"]),
+        electronic_gear_denominator=int(values["electronic_gear_denominator"]),
+        rotary_direction=int(values["rotary_direction"]),
+        in_position_range_pulses=int(values["in_position_range"]),
+        servo_rate_hz=servo_rate_hz,
+        control_mode="speed" if values["control_mode"] == 1 else "position",
+        quantised_feedback=quantised_feedback,
+    )
 
 
 def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelParams:

@@ -3,34 +3,31 @@ pulses, the encoder outputs, SPD-MON) gives the load inertia within 10 %, says w
 without current cannot tell, and refuses a move the loop model does not follow; a verification
 capture after the worksheet's items compared with their prediction.
 
-The drive's gains here are the ones its items give for the axis it was set up for (declared
-without a load) while the axis carries 1 x or 3 x the actuator's own inertia, as on a real drive
-whose gains do not know the load. The simulated drive (``SimDrive``) scales its speed loop gain
-with the load it was built with (``hardware.sim.axis.servo_settings``), so its loop looks the
-same whatever the load; the servo axis of the one physics model is therefore built directly and
-recorded by the virtual bench instrument, as in the bench round-trip test."""
+The captures are the real path's: a stepped simulated drive (``SimDrive``, the manual's commands
+only) carrying 1 x or 3 x the actuator's own inertia, moved by the controller's command pulses and
+recorded on CN2 by the virtual bench instrument, imported as ``bench import`` does. The drive's
+gains do not know the load (tune 0 is read on the actuator's own inertia, ``physics.PanelGains``),
+so the fit, declared without the load, finds it in how the loop follows."""
 
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import pytest
 
 from fha_studio.hardware.parameters import Mode, load_parameter_model
-from fha_studio.hardware.sim.cn2 import Cn2Settings, VirtualBenchInstrument
+from fha_studio.hardware.sim.cn2 import VirtualBenchInstrument
+from fha_studio.hardware.sim.drive import SimDrive
 from fha_studio.logic.paramfile import dump_parameter_file
 from fha_studio.logic.tuning.bench_move import verify_move
 from fha_studio.logic.tuning.bench_session import RoleSignal, bench_move_report, bench_tuner, move_samples
 from fha_studio.logic.tuning.session import declared_model
 from fha_studio.main import main as cli_main
-from fha_studio.physics import ServoAxis
 
 PARAMETERS = load_parameter_model("HA-655")
 CODE = "FHA-25C-50-US250"
 OWN = declared_model(CODE, 0.0).actuator_inertia_kgm2
-RPM = 2 * math.pi / 60
 #: the encoder's edges at 10 r/min (output) of a 500000-count output turn: 83 kHz
 RATE_HZ = 250e3
 CHANNELS = {"encoder_a": "ENC_A", "encoder_b": "ENC_B", "command_a": "CMD_A", "command_b": "CMD_B",
@@ -47,17 +44,24 @@ def _values(**items: int) -> dict[tuple[str, int], int]:
 
 
 def _capture(folder: Path, load: float, values: dict[tuple[str, int], int]) -> Path:
-    """A move of +10 deg and back at 10 r/min, 200 r/min/s (the controller's profile), recorded
-    on CN2 as a sigrok session."""
-    tuner = bench_tuner(CODE, 0.0, PARAMETERS, values)
-    axis = ServoAxis(declared_model(CODE, load), tuner.loop({}).settings)
-    axis.servo_on()
-    instrument = VirtualBenchInstrument(axis, RATE_HZ, Cn2Settings())
-    instrument.record(0.05)
-    for angle in (10.0, -10.0):
-        axis.move_by(math.radians(angle), speed_rad_s=10 * RPM, accel_rad_s2=200 * RPM)
-        instrument.record(0.7)
-    return instrument.write(folder / "move.sr", "sr")
+    """A move of +10 deg and back at 10 r/min, 200 r/min/s (the JOG acceleration, test item 1: the
+    controller's profile), the drive set up with ``values``, recorded on CN2 as a sigrok session."""
+    preset = tuple((mode, number, value) for (mode, number), value in values.items()
+                   if PARAMETERS.item(Mode(mode), number).default != value)
+    drive = SimDrive(CODE, profile="documented", stepped=True, eeprom=str(folder / "eeprom.json"),
+                     load_inertia_kgm2=load, effects={"torsional_compliance": {}}, preset=preset)
+    try:
+        instrument = VirtualBenchInstrument.on_drive(drive, RATE_HZ)
+        drive.set_servo(True)
+        instrument.record(0.05)
+        drive.set_move_speed(10.0)
+        for angle in (10.0, -10.0):
+            drive.controller_command(angle)
+            instrument.record(0.7)
+        assert drive.alarm == 0
+        return instrument.write(folder / "move.sr", "sr")
+    finally:
+        drive.close()
 
 
 def _signals(path: Path) -> list[RoleSignal]:

@@ -12,8 +12,8 @@ import pytest
 from fha_studio.cli import main as cli_main
 from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import load_parameter_model
-from fha_studio.logic.tuning.excitation import plan_excitation
-from fha_studio.logic.tuning.measure import NotExcitable, measure
+from fha_studio.logic.tuning.excitation import NotExcitable, plan_excitation
+from fha_studio.logic.tuning.measure import measure
 from fha_studio.logic.tuning.session import declared_model, tuner_for
 
 PARAMETERS = load_parameter_model("HA-655")

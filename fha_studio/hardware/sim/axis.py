@@ -2,13 +2,12 @@
 
 The plant and its loops are :class:`fha_studio.physics.ServoAxis`; this module only resolves
 what to build (options B and L from the code or the sim options, the driver from the combination
-table of FHA-C manual 1-3, the effects) and maps the HA-655's tune / parameter items onto the
-physics' :class:`ServoSettings`.
+table of FHA-C manual 1-3, the effects). The HA-655's tune / parameter items become the physics'
+:class:`ServoSettings` through ``physics.servo_settings``, the mapping tuning uses too.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -89,31 +88,6 @@ def build_model(resolved: ResolvedActuator, config: SimConfig) -> AxisModel:
                                        effects=effects)
     except (TypeError, ValueError) as exc:
         raise SimConfigError(f"simulated drive: {exc}") from None
-
-
-def servo_settings(model: AxisModel, values: dict[str, int], servo_rate_hz: float,
-                   quantised_feedback: bool = True) -> ServoSettings:
-    """The HA-655 items (wire values by key) as physics ServoSettings.
-
-    Control mode (system 0): 0 position, 1 speed (JOG is then the speed command). With
-    ``quantised_feedback`` the loops see whole encoder pulses, as a real drive does.
-    The speed loop gain is a bandwidth in Hz (tune 0): Kv = 2 pi f J / Kt on the rigid-body
-    inertia of the axis (actuator + load), as the physics' own ``tuned_for`` does.
-    """
-    bandwidth = 2.0 * math.pi * values["speed_loop_gain"]
-    return ServoSettings(
-        position_loop_gain_per_s=float(values["position_loop_gain"]),
-        speed_loop_gain_a_s_per_rad=bandwidth * model.total_inertia_kgm2 / model.torque_constant_nm_per_a,
-        speed_loop_integral_time_s=values["speed_loop_integral_compensation"] / 1000.0,
-        feed_forward_gain=values["feed_forward_gain"] / 100.0,
-        electronic_gear_numerator=int(values["electronic_gear_numerator"]),
-        electronic_gear_denominator=int(values["electronic_gear_denominator"]),
-        rotary_direction=int(values["rotary_direction"]),
-        in_position_range_pulses=int(values["in_position_range"]),
-        servo_rate_hz=servo_rate_hz,
-        control_mode="speed" if values["control_mode"] == 1 else "position",
-        quantised_feedback=quantised_feedback,
-    )
 
 
 def build_axis(model: AxisModel, settings: ServoSettings, initial_pos_rad: float) -> ServoAxis:

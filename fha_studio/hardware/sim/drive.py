@@ -41,7 +41,6 @@ from fha_studio.hardware.sim.axis import (
     build_axis,
     build_model,
     resolve_actuator,
-    servo_settings,
 )
 from fha_studio.hardware.sim.constants import SimConstants, load_sim_constants
 from fha_studio.hardware.sim.eeprom import EepromFile, eeprom_path
@@ -63,7 +62,7 @@ from fha_studio.hardware.sim.supervision import (
     WiringFaultTrip,
 )
 from fha_studio.hardware.sim.trace import SimTrace
-from fha_studio.physics import ServoAxis, ServoSettings
+from fha_studio.physics import ServoAxis, ServoSettings, servo_settings
 
 TWO_PI = 2.0 * math.pi
 

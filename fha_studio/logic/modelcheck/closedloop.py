@@ -5,7 +5,9 @@ current. The disturbance then shows in the following error, through the loop tha
 loop is identified from the recording (loopfit.py: the following error its linear model leaves,
 Kp, FF, g = Kt Kv and Tv fitted), and the candidate effects are seen through it. The tune items'
 units are not documented on the HA-655, so the loop comes from the recording and is compared with
-the panel's values when the caller knows them, not taken from them.
+the panel's values when the caller knows them, not taken from them; the loop found is also given as
+the panel would show it (``physics.PanelGains``: the speed loop gain read on the actuator's own
+inertia, as the simulated drive and tuning read it).
 
 What cannot be identified this way, said in the report: a constant load torque and the part of
 friction that differs by direction are held by the speed loop's integral (they leave no trace in
@@ -30,7 +32,7 @@ from fha_studio.logic.modelcheck.axis import DeclaredAxis, ModelCheckError
 from fha_studio.logic.modelcheck.candidates import TORQUE, TORQUE_CANDIDATES, ChannelContext
 from fha_studio.logic.modelcheck.loopfit import LoopFit, LoopParams
 from fha_studio.logic.modelcheck.signals import ARCSEC_PER_RAD, Signals, build_signals, window_for_bandwidth
-from fha_studio.physics import ServoSettings
+from fha_studio.physics import AxisModel, PanelGains, ServoSettings
 from fha_studio.recording import Recording
 
 #: without a current the torque is only as good as the acceleration: a fixed analysis bandwidth,
@@ -61,6 +63,7 @@ class Loop:
     explains: bool = True  # the loop model explains the following error (loopfit.LoopFit.explains)
     speed_lag_s: float = 0.0  # the lag of the speed the loop sees (the drive's speed detection)
     command_lead_s: float = 0.0  # the drive acts on the command this much earlier than recorded
+    model: AxisModel | None = None  # the declared axis, to say the loop in the panel's units
 
     def servo(self, servo_rate_hz: float = 5000.0) -> ServoSettings:
         """The identified loop as servo settings, for the re-simulation: whole encoder pulses, their
@@ -105,9 +108,21 @@ class Loop:
             f"Tv {1000.0 * self.integral_time_s:.3g} ms, "
             f"feed-forward {self.feed_forward:.2f}, the speed it sees {1000.0 * self.speed_lag_s:.2g} ms late"
         )
+        if self.model is not None:
+            found = PanelGains.of_settings(self.model, self.servo())
+            text += (
+                "; as the front panel would show it (tune 0 read on the actuator's own inertia): speed loop "
+                f"gain {found.speed_loop_gain_hz:.3g} Hz, integral compensation "
+                f"{found.speed_loop_integral_compensation_ms:.3g} ms, position loop gain "
+                f"{found.position_loop_gain_per_s:.3g} 1/s, feed-forward {found.feed_forward_gain_pct:.0f} %"
+            )
         if self.panel is None:
             return [text + " (no panel values given to compare)."]
         p = self.panel
+        on_panel = "."
+        if self.model is not None:
+            panel_hz = PanelGains.of_settings(self.model, p).speed_loop_gain_hz
+            on_panel = f" (speed loop gain {panel_hz:.4g} Hz on the panel)."
 
         def pct(found: float, panel: float) -> str:
             return f"{100.0 * (found / panel - 1.0):+.0f} %" if panel and math.isfinite(panel) else "n/a"
@@ -121,7 +136,7 @@ class Loop:
             f"({pct(self.speed_gain_a_s_per_rad, p.speed_loop_gain_a_s_per_rad)}), "
             f"Tv {1000.0 * p.speed_loop_integral_time_s:.3g} ms "
             f"({pct(self.integral_time_s, p.speed_loop_integral_time_s)}), "
-            f"feed-forward {p.feed_forward_gain:.2f}.",
+            f"feed-forward {p.feed_forward_gain:.2f}{on_panel}",
         ]
 
 
@@ -181,20 +196,21 @@ SEPARATING_WITHOUT_CURRENT: dict[frozenset[str], str] = {
 }
 
 
-def loop_of(fit: LoopFit, kt_nm_per_a: float, panel: ServoSettings | None, inertia_kgm2: float) -> Loop:
-    """The loop to report from its fit."""
+def loop_of(fit: LoopFit, model: AxisModel, panel: ServoSettings | None, inertia_kgm2: float) -> Loop:
+    """The loop to report from its fit, on the declared axis ``model``."""
     p = fit.params
     return Loop(
         position_gain_per_s=p.kp,
         feed_forward=p.ff,
         integral_time_s=p.tv,
         torque_per_speed_error_nm_s_per_rad=p.g,
-        speed_gain_a_s_per_rad=p.g / kt_nm_per_a,
+        speed_gain_a_s_per_rad=p.g / model.torque_constant_nm_per_a,
         panel=panel,
         inertia_kgm2=inertia_kgm2,
         explains=fit.explains,
         speed_lag_s=p.lag,
         command_lead_s=p.lead,
+        model=model,
     )
 
 

@@ -187,7 +187,7 @@ def run_without_current(
         updated_model, updated_fit = _with_effects(loop_model, fit, named, raw, ctx)
     if not named:
         updated_model, updated_fit = loop_model, nominal_fit
-    loop = loop_of(updated_fit, axis.kt_nm_per_a, servo, j_loop)
+    loop = loop_of(updated_fit, axis.model, servo, j_loop)
     resim = _resimulation(sig, loop_model, nominal_fit, updated_model, updated_fit, residual, effects_nm)
     fe_nominal = resim.following_error_rms_nominal_arcsec or 0.0
     fe_updated = resim.following_error_rms_updated_arcsec or 0.0

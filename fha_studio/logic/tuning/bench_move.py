@@ -3,10 +3,13 @@ real HA-655 in position mode moved by its controller's command pulses, recorded 
 command pulses, the encoder outputs, SPD-MON) and imported (``bench import``: a recording with
 ``t``, ``cmd_pos``, ``pos``, ``vel``).
 
-The drive's own parts are its items (Kp, Kv, Tv, feed-forward, taken in SI as for the declared
-axis: ``Tuner.loop``); the axis's inertia is what is fitted. The linearised position loop of the
-one physics model (``LoopModel.position_closed_loop``, the gear's spring at the catalogue's K1)
-is driven by the captured command, and the load inertia is the one whose predicted encoder
+The drive's own parts are its items (Kp, Kv, Tv, feed-forward, in SI as ``physics.PanelGains``
+reads them: the speed loop gain on the actuator's own inertia, so the gains do not depend on the
+load, as on a real drive); the axis's inertia is what is fitted: a heavier load slows the loop the
+same gains close around it. The linearised position loop of the one physics model (the gear's
+spring at the catalogue's K1; ``LoopModel.polynomials``, its numpy form, evaluated for every
+inertia the fit tries) is driven by the captured command, and the load inertia is the one whose
+predicted encoder
 position and speed match the captured ones best (scipy.optimize.least_squares on its logarithm,
 each signal weighted by its own residual; the model's delay against the capture searched in whole
 servo periods first). Its uncertainty is the least-squares one from the residuals, with the
@@ -32,13 +35,11 @@ from typing import Any
 import numpy as np
 from scipy import optimize
 
-from fha_studio.hardware.sim.axis import servo_settings
 from fha_studio.logic.bench.move import BenchMoveFigures, bench_move_figures
-from fha_studio.logic.tuning.bench_excitation import discrete_filter
 from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
 from fha_studio.logic.tuning.propose import TUNE_KEYS, Tuner, step_figures
 from fha_studio.logic.tuning.response import loop_figures
-from fha_studio.physics import AxisModel
+from fha_studio.physics import AxisModel, servo_settings
 from fha_studio.recording import Recording
 
 TWO_PI = 2.0 * math.pi
@@ -57,8 +58,9 @@ SHIFTS = range(-3, 4)
 CANNOT_TELL = (
     "a constant load torque and the direction-dependent part of friction: the speed loop's integral "
     "holds them, so neither position nor speed shows them (a current probe or the CN3 trace does)",
-    "the inertia apart from the speed loop gain's scale: the fit takes the gains in SI as the tune "
-    "items give them for the declared load (the HA-655 manual gives no unit for the speed loop gain)",
+    "the inertia apart from the speed loop gain's scale: the fit takes the speed loop gain (tune 0) as "
+    "the speed loop's crossover with the actuator's own inertia alone; the HA-655 manual gives it no "
+    "unit, and a drive that means another scale by it moves the estimate in proportion",
     "the current and how close the move came to the current limit: a fit of a move that reached it "
     "is not linear",
     "the gear's resonance, unless the move excites it: the resonance given is the catalogue "
@@ -108,9 +110,9 @@ def _model_with_load(declared: AxisModel, load_kgm2: float) -> AxisModel:
 
 def predict(lm: LoopModel, samples: MoveSamples, shift: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Encoder position (rad) and mean speed (rad/s) the loop predicts for the captured command,
-    ``shift`` servo periods later."""
-    c0 = samples.command_rad[0]
-    pos = discrete_filter(lm.position_closed_loop(), samples.command_rad - c0) + samples.position_rad[0]
+    ``shift`` servo periods later (the loop's numpy form, ``LoopModel.polynomials``: the fit
+    evaluates it for every inertia it tries)."""
+    pos = lm.polynomials().move(samples.command_rad)[0] - samples.command_rad[0] + samples.position_rad[0]
     if shift > 0:
         pos = np.concatenate([np.full(shift, pos[0]), pos[:-shift]])
     elif shift < 0:

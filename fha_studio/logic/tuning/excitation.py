@@ -10,6 +10,11 @@ L1 norm from the added speed command to the position (the position loop closed: 
 axis). The drive stops the excitation if the output ever travels farther than that bound (with
 a margin) from where it started.
 
+Only a stable loop is excited: with the present tune items and the declared load the linearised
+loops must be stable (:func:`check_stable`), or the drive is not excitable (the speed loop gain is
+set on the actuator's own inertia, ``physics.PanelGains``: a heavy load lowers the speed loop's
+crossover under the position loop's, and the axis oscillates as soon as anything moves it).
+
 Before each record the loop settles: the excitation runs until what its start set going has
 died away, i.e. until the impulse responses' tails beyond that time hold at most
 ``SETTLE_TAIL`` of their L1 norms (a slow pole that its zero nearly cancels does not count).
@@ -24,6 +29,7 @@ import numpy as np
 
 from fha_studio.hardware.protocol import excitation_period_periods
 from fha_studio.logic.tuning.linear import LoopModel, LoopPolynomials, two_mass_prediction
+from fha_studio.physics import PanelGains
 
 RPM = 2.0 * math.pi / 60.0
 #: the excitation's current stays below this share of the maximum current (linear bound)
@@ -40,6 +46,29 @@ RECORDS = 5
 SETTLE_TAIL = 0.005
 #: the impulse responses are followed this long at most (s)
 HORIZON_S = 30.0
+
+
+class NotExcitable(Exception):
+    """The drive cannot be excited: the message says what is needed (the CLI's exit 4)."""
+
+
+def check_stable(lm: LoopModel) -> None:
+    """Raise NotExcitable unless ``lm``'s speed and position loops are stable: the message names
+    the load, where the speed loop gain puts the crossover with it, and what to do."""
+    poly = lm.polynomials()
+    if poly.stable():
+        return
+    model = lm.model
+    panel = PanelGains.of_settings(model, lm.settings)
+    ratio = model.load_inertia_kgm2 / model.actuator_inertia_kgm2
+    crossover = PanelGains.crossover_hz(model, panel.speed_loop_gain_hz)
+    which = "speed loop" if not poly.speed_stable() else "position loop"
+    raise NotExcitable(
+        f"the present tune items make the {which} unstable with the declared load ({ratio:.3g} x the "
+        f"actuator's own inertia: the speed loop gain of {panel.speed_loop_gain_hz:.4g} Hz crosses over "
+        f"at about {crossover:.3g} Hz with it, position loop gain {panel.position_loop_gain_per_s:.4g} "
+        "1/s): the axis would oscillate; propose gains and apply them (or lower the position loop "
+        "gain) before measuring")
 
 
 @dataclass(frozen=True)
@@ -96,7 +125,8 @@ def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> Excita
     """The excitation for ``lm``'s axis: bits held so that the PRBS covers ~5 x the predicted
     resonance (or 2 x the speed loop's reach), the largest amplitude within the current and speed
     shares and the gear's torque on its first slope (or ``requested_rpm`` when lower; a higher
-    request raises ValueError)."""
+    request raises ValueError; an unstable loop NotExcitable)."""
+    check_stable(lm)
     model = lm.model
     rate = lm.settings.servo_rate_hz
     dt = 1.0 / rate

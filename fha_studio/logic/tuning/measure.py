@@ -30,7 +30,7 @@ import numpy as np
 
 from fha_studio.hardware.parameters import MonitorItem
 from fha_studio.hardware.protocol import JOG_HOLD_S, Command
-from fha_studio.logic.tuning.excitation import RPM, ExcitationPlan
+from fha_studio.logic.tuning.excitation import RPM, ExcitationPlan, NotExcitable
 from fha_studio.logic.tuning.move import until_trace_done, wait_drive_time
 
 #: the channels of each capture
@@ -40,10 +40,6 @@ NEEDED = frozenset({Command.EXA, Command.EXL, Command.EXG, Command.TCH, Command.
                     Command.TRB, Command.IOS, Command.ALM, Command.MON})
 #: the drive's excitation watchdog (as JOG's, protocol.JOG_HOLD_S)
 WATCHDOG_S = JOG_HOLD_S
-
-
-class NotExcitable(Exception):
-    """The drive cannot be excited: the message says what is needed (the CLI's exit 4)."""
 
 
 class Stopped(Exception):
