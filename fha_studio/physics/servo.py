@@ -133,16 +133,16 @@ class ServoSettings:
 class PanelGains:
     """The HA-655's tune items 0-3 as the front panel shows them, and what they mean in SI.
 
-    The one reading of them (resources/drive/ha655-parameters.toml states it, in the notes on tune
-    items 0-3; docs/physics.md repeats it): the speed loop gain (tune 0, Hz) is the speed loop's
+    The one reading of them (resources/drive/ha655-parameters.toml states it in the notes on tune
+    items 0-2; docs/physics.md repeats it): the speed loop gain (tune 0, Hz) is the speed loop's
     crossover frequency with the actuator's own inertia J_A alone, Kv = 2 pi f J_A / Kt. The drive
     does not know the load, so a load J_L lowers the crossover in proportion, to about
     f J_A / (J_A + J_L). Tv (tune 1) in ms; Kp (tune 2) is output speed (rad/s) per rad of position
     error; feed-forward (tune 3) in % of the command speed.
 
-    Used wherever panel values and physical gains meet: the simulated drive's loops
-    (``hardware.sim.axis.servo_settings``), tuning's loops and proposals, the bench move fit, and
-    the model check's comparison of an identified loop with the panel's values.
+    Used wherever panel values and physical gains meet, through :func:`servo_settings`: the
+    simulated drive's loops, tuning's loops and proposals, the bench move fit; and the model
+    check, which gives the loop it identifies in panel units.
     """
 
     speed_loop_gain_hz: float
@@ -189,6 +189,12 @@ class PanelGains:
         """Where a speed loop gain of ``speed_loop_gain_hz`` crosses over on the whole rigid body
         of ``model`` (actuator and load): f J_A / (J_A + J_L), the proportional part alone."""
         return speed_loop_gain_hz * model.actuator_inertia_kgm2 / model.total_inertia_kgm2
+
+    @staticmethod
+    def speed_loop_gain_for(model: AxisModel, crossover_hz: float) -> float:
+        """The speed loop gain (Hz, not rounded) that crosses over at ``crossover_hz`` on
+        ``model``'s rigid body: the inverse of :meth:`crossover_hz`."""
+        return crossover_hz * model.total_inertia_kgm2 / model.actuator_inertia_kgm2
 
 
 def servo_settings(model: AxisModel, values: Mapping[str, int], servo_rate_hz: float,

@@ -21,19 +21,32 @@ from bench_capture_gen import LOAD_COUNTS_PER_TURN, LOAD_ROLES, ROLES, BenchAxis
 
 from fha_studio.logic.modelcheck import run_modelcheck
 from fha_studio.main import main as cli_main
-from fha_studio.physics import AxisModel
+from fha_studio.physics import AxisModel, PanelGains
 
 TOL = 0.35
 PHASE_TOL_DEG = 20.0
 
-# the tune items as a technician leaves them: the drive's defaults where the load allows, softer
-# speed loops (tune 0, Hz) below 1.5 x the load's anti-resonance on the gear's spring
+
+def _speed_loop_gain(code: str, load_kgm2: float, crossover_hz: float) -> int:
+    """Tune 0 (read on the actuator's own inertia, ``PanelGains``) for a speed loop crossing over
+    at ``crossover_hz`` with the load."""
+    return round(PanelGains.speed_loop_gain_for(AxisModel.from_code(code, load_inertia_kgm2=load_kgm2),
+                                                crossover_hz))
+
+
+def _axis(code: str, load_kgm2: float, crossover_hz: float, rest: str = "") -> BenchAxis:
+    preset = f"tune.0={_speed_loop_gain(code, load_kgm2, crossover_hz)}" + (f",{rest}" if rest else "")
+    return BenchAxis(code, load_kgm2, preset=preset)
+
+
+# the tune items as a technician leaves them: the drive's defaults where the load allows, speed
+# loops crossing over (Hz, with the load) below 1.5 x the load's anti-resonance on the gear's spring
 LIGHT_17C = BenchAxis("FHA-17C-50-US250", 0.1)
-MEDIUM_17C = BenchAxis("FHA-17C-50-US250", 0.5, preset="tune.0=30")
-HEAVY_17C = BenchAxis("FHA-17C-50-US250", 1.5, preset="tune.0=20,tune.1=40")
-LIGHT_40C = BenchAxis("FHA-40C-50-S248", 2.0, preset="tune.0=40,tune.1=30,tune.2=30,tune.3=50")
-MEDIUM_40C = BenchAxis("FHA-40C-50-S248", 8.0, preset="tune.0=30,tune.1=40,tune.2=30,tune.3=50")
-HEAVY_40C = BenchAxis("FHA-40C-50-S248", 25.0, preset="tune.0=20,tune.1=50,tune.2=20,tune.3=50")
+MEDIUM_17C = _axis("FHA-17C-50-US250", 0.5, 30.0)
+HEAVY_17C = _axis("FHA-17C-50-US250", 1.5, 20.0, "tune.1=40")
+LIGHT_40C = _axis("FHA-40C-50-S248", 2.0, 40.0, "tune.1=30,tune.2=30,tune.3=50")
+MEDIUM_40C = _axis("FHA-40C-50-S248", 8.0, 30.0, "tune.1=40,tune.2=30,tune.3=50")
+HEAVY_40C = _axis("FHA-40C-50-S248", 25.0, 20.0, "tune.1=50,tune.2=20,tune.3=50")
 AXES = (LIGHT_17C, MEDIUM_17C, HEAVY_17C, LIGHT_40C, MEDIUM_40C, HEAVY_40C)
 
 

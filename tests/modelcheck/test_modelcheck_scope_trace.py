@@ -19,17 +19,25 @@ from fha_studio.logic.modelcheck import run_modelcheck
 from fha_studio.logic.scope.acquisition import convert_rows
 from fha_studio.logic.scope.channels import scope_channels
 from fha_studio.logic.scope.recorder import ScopeRecorder
+from fha_studio.physics import AxisModel, PanelGains
 from fha_studio.recording import RecordingMetadata, read_recording
 
 FRICTION_NM = 12.0
 KEYS = ("feedback_position", "command_position", "output_speed", "motor_current")
 MOVING_BIT = 15  # I/O bit "moving" of monitor 106 (docs/protocol.md)
+#: the speed loop's crossover (Hz, with the load) the trace is taken with. Tune 0 is read on the
+#: actuator's own inertia (``PanelGains``): the factory's 60 Hz crosses over at 37 Hz with 0.5 kg m^2,
+#: and there the check names the feedback's quantisation pattern in the current (1.4 N m at 8 cycles
+#: per motor turn; gone with ideal feedback) as torque ripple, which it does not yet tell apart
+TRACE_CROSSOVER_HZ = 60.0
 
 
 def scope_trace_recording(path, effects: str = "", load_kgm2: float = 0.5):
     """Trace a +90/-90 deg move at 20 r/min on the stepped simulated drive, as the Scope page
     does (trigger: "moving" rises, 2 pre-trigger samples), and save it as the page saves it."""
-    url = f"sim://FHA-25C-50-US250?paced=0&load_inertia={load_kgm2}"
+    model = AxisModel.from_code("FHA-25C-50-US250", load_inertia_kgm2=load_kgm2)
+    speed_loop_gain = round(PanelGains.speed_loop_gain_for(model, TRACE_CROSSOVER_HZ))
+    url = f"sim://FHA-25C-50-US250?paced=0&load_inertia={load_kgm2}&preset=tune.0={speed_loop_gain}"
     url += f"&effects={effects}" if effects else ""
     with SimDrive.from_url(url) as drive:
         family = "HA-675" if drive.driver.startswith("HA-675") else "HA-655"

@@ -12,9 +12,11 @@ from fha_studio.physics import (
     AxisModel,
     Effects,
     MonitorOptions,
+    PanelGains,
     ServoAxis,
     ServoSettings,
     catalogue_effects,
+    servo_settings,
     simulate,
 )
 
@@ -427,3 +429,30 @@ def test_the_kernels_accounting_does_not_change_the_motion(make_model):
     assert (with_.xm, with_.vm, with_.integ, with_.current) == (without.xm, without.vm, without.integ,
                                                                  without.current)
     assert with_.i2_integral > 0 and without.i2_integral == 0.0
+
+
+@pytest.mark.parametrize("load_ratio", [0.0, 1.0, 3.0, 10.0])
+def test_the_panels_speed_loop_gain_is_read_on_the_actuators_own_inertia(load_ratio):
+    """Tune 0 (Hz) sets Kv = 2 pi f J_A / Kt whatever the load (resources' note on tune 0: a drive
+    does not know its load), so a load J_L lowers the crossover to f J_A / (J_A + J_L); the
+    simulated drive's loops are that mapping's."""
+    from fha_studio.hardware.parameters import Mode, load_parameter_model
+    from fha_studio.hardware.sim.drive import SimDrive
+
+    parameters = load_parameter_model("HA-655")
+    items = {it.key: it.default for it in parameters if it.mode in (Mode.TUNE, Mode.SYSTEM)
+             and it.default is not None}
+    code = "FHA-25C-50-US250"
+    own = AxisModel.from_code(code).actuator_inertia_kgm2
+    model = AxisModel.from_code(code, load_inertia_kgm2=load_ratio * own)
+    settings = servo_settings(model, items, 5000.0)
+    kv = 2.0 * math.pi * items["speed_loop_gain"] * own / model.torque_constant_nm_per_a
+    assert settings.speed_loop_gain_a_s_per_rad == pytest.approx(kv, rel=1e-12)
+    assert PanelGains.of_settings(model, settings) == PanelGains.from_items(items)
+    # the rigid body's proportional loop Kt Kv / (J s) crosses 1 where PanelGains says
+    crossover = PanelGains.crossover_hz(model, items["speed_loop_gain"])
+    w = 2.0 * math.pi * crossover
+    assert model.torque_constant_nm_per_a * kv / (model.total_inertia_kgm2 * w) == pytest.approx(1.0)
+    assert crossover == pytest.approx(items["speed_loop_gain"] / (1.0 + load_ratio))
+    with SimDrive(code, stepped=True, load_inertia_kgm2=load_ratio * own) as drive:
+        assert drive.axis.settings.speed_loop_gain_a_s_per_rad == pytest.approx(kv, rel=1e-12)

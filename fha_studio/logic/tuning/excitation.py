@@ -12,8 +12,9 @@ a margin) from where it started.
 
 Only a stable loop is excited: with the present tune items and the declared load the linearised
 loops must be stable (:func:`check_stable`), or the drive is not excitable (the speed loop gain is
-set on the actuator's own inertia, ``physics.PanelGains``: a heavy load lowers the speed loop's
-crossover under the position loop's, and the axis oscillates as soon as anything moves it).
+set on the actuator's own inertia, ``physics.PanelGains``: a heavy load can lower the speed
+loop's crossover under the position loop's, and the axis then oscillates as soon as anything
+moves it).
 
 Before each record the loop settles: the excitation runs until what its start set going has
 died away, i.e. until the impulse responses' tails beyond that time hold at most
