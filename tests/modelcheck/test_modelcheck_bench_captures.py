@@ -157,10 +157,16 @@ def _assert_named_within(case: BenchCase, result) -> None:
                 assert abs((got - value + 180.0) % 360.0 - 180.0) < PHASE_TOL_DEG, (name, got, text)
             else:
                 assert got == pytest.approx(value, rel=TOL), (name, got, text)
-    # what a recording without a torque measurement cannot show is said, whatever was hidden
-    not_seen = "\n".join(result.not_seen)
-    assert "a constant load torque" in not_seen and "an inertia error" in not_seen, not_seen
-    assert "viscous friction" in not_seen, not_seen
+    # what a recording without a torque measurement cannot show is said, whatever was hidden: one
+    # line says why a constant load torque, an inertia error and viscous friction cannot be seen
+    # without it, and one that every torque rests on the declared inertia
+    why = next((line for line in result.not_seen if line.startswith("Without a torque measurement")), "")
+    assert "cannot be seen: a constant load torque" in why, result.not_seen
+    assert "an inertia error trades off against the loop's gain scale" in why, why
+    assert "viscous friction" in why and "Record the current (or an output torque sensor)" in why, why
+    on_inertia = "Every torque above, in N m, rests on the declared inertia"
+    assert any(line.startswith(on_inertia) for line in result.not_seen), result.not_seen
+    assert why in text  # in the report the user reads, not only in the result
     assert result.channel_status["current"].status == "absent"
     assert result.channel_status["position"].status != "absent" or not case.load_encoder
     assert result.loop is not None and result.loop.plausible, text
