@@ -245,6 +245,9 @@ def test_alarms_are_typed_from_the_front_panel(window, qtbot):
     assert page.enter_from_panel()
     assert page.code_label.text().startswith("Alarm 60")
     assert "Cause:" in page.cause_label.text() and "Remedy:" in page.cause_label.text()
+    # the source says what a technician can find: the manual's page, its web copy by its address
+    assert "Source: HA-655 manual p.10 (1-9-1); causes and recovery: the manual's web copy at relianca.com" \
+        in page.cause_label.text().replace("&#x27;", "'").replace("&#39;", "'")
     assert "recorded" in page.panel_result.text()
     page.panel_code_edit.setText("20")  # the lamps still say 0010: they do not match 20 (0001)
     assert page.enter_from_panel()
