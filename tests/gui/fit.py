@@ -13,6 +13,7 @@ from PySide6.QtWidgets import (
     QCheckBox,
     QGroupBox,
     QLabel,
+    QLineEdit,
     QProgressBar,
     QPushButton,
     QRadioButton,
@@ -181,4 +182,19 @@ def elided_cells(table: QTableView, margin_px: int = 6) -> list[str]:
             need = metrics.horizontalAdvance(str(text))
             if need > room:
                 found.append(f"row {row}, column {column}: {str(text)[:60]!r} needs {need} px, has {room}")
+    return found
+
+
+def cut_hints(top: QWidget) -> list[str]:
+    """Empty fields whose hint (placeholder) is wider than the field: "your name (goes …" no
+    longer says why the name is asked."""
+    found = []
+    for edit in top.findChildren(QLineEdit):  # an empty field's hint: "your name (goes …"
+        hint = edit.placeholderText()
+        if not _shown(edit, top) or edit.text() or not hint or not edit.isEnabled():
+            continue
+        need = QFontMetrics(edit.font()).horizontalAdvance(hint)
+        room = edit.contentsRect().width() - 8  # the frame's and the text's own margins
+        if need > room:
+            found.append(f"{_name(edit)}: its hint {hint!r} needs {need} px, has {room}")
     return found

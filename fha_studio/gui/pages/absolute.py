@@ -111,6 +111,9 @@ class AbsolutePage(BasePage):
         self.read_button.clicked.connect(lambda: self._read(self._show_position))
         self.who_edit = QLineEdit()
         self.who_edit.setPlaceholderText("your name (goes into every record)")
+        # the hint whole: a field cut to "your name (goes …" no longer says why it is asked
+        self.who_edit.setMinimumWidth(
+            self.who_edit.fontMetrics().horizontalAdvance(self.who_edit.placeholderText()) + 16)
         top.addWidget(self.position_label, 1)
         top.addWidget(self.read_button)
         top.addWidget(QLabel("Technician:"))

@@ -92,7 +92,7 @@ class BenchTuningPanel(QGroupBox):
         self.capture_path: str | None = None
         self.capture_edit = QLineEdit()
         self.capture_edit.setReadOnly(True)
-        self.capture_edit.setPlaceholderText("the capture of CN2 (sigrok session, VCD, CSV)")
+        self.capture_edit.setPlaceholderText("the CN2 capture (.sr, VCD, CSV)")
         choose = QPushButton("Capture…")
         choose.setToolTip("Choose the capture of CN2")
         choose.clicked.connect(self._choose_capture)
