@@ -75,6 +75,8 @@ AXIS_LIST_WIDTH_PX = 230
 #: The machine's axes are asked of a server that did not answer again after this long [s] (at
 #: once when a delivery finds it answering).
 AXES_RETRY_S = 30.0
+#: Lines about the register shown in the pages' place while the machine has no axis.
+LINES_WITHOUT_AXES = 3
 
 
 class MachineWindow(QMainWindow):
@@ -119,9 +121,9 @@ class MachineWindow(QMainWindow):
         self._shut_down = False
         self._closing_confirmed = False
         self._register_dialog: RegisterDialog | None = None
-        #: the last line about the register said while there was no axis (the first axis's message
-        #: line says it again)
-        self._line_without_axes: tuple[str, Level] | None = None
+        #: the last lines about the register said while there was no axis, shown in the pages'
+        #: place (the first axis's message line says them again)
+        self._lines_without_axes: list[tuple[str, Level]] = []
         #: the machine's axes are still to be had from the server (asked, or to be asked again)
         self.axes_wanted = ask_for_axes and self.questions is not None and self.questions.on_server
         self._asking_axes = False
@@ -241,8 +243,10 @@ class MachineWindow(QMainWindow):
         if self.axis_windows:
             self.current_window.show_message(text, level)
         else:
-            self._line_without_axes = (text, level)
-            self.no_axes_label.setText(f"{self._no_axes_text()}\n\n{text}")
+            # the last few (the questions' and the deliveries' lines come in any order)
+            self._lines_without_axes = [*self._lines_without_axes, (text, level)][-LINES_WITHOUT_AXES:]
+            lines = "\n\n".join(line for line, _level in self._lines_without_axes)
+            self.no_axes_label.setText(f"{self._no_axes_text()}\n\n{lines}")
             self.no_axes_label.setStyleSheet(
                 "color: #8a5a00; font-size: 11pt;" if level == Level.WARNING else "font-size: 11pt;"
             )
@@ -392,9 +396,9 @@ class MachineWindow(QMainWindow):
         if index == 0:  # the first axis (after none, the pages take the place of the line)
             self.axis_list.setCurrentRow(0)
             self._show_pages_or_none()
-            if self._line_without_axes is not None:
-                window.show_message(*self._line_without_axes)
-                self._line_without_axes = None
+            for line in self._lines_without_axes:
+                window.show_message(*line)
+            self._lines_without_axes = []
         return window
 
     def add_axis(

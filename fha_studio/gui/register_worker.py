@@ -132,6 +132,7 @@ class QueueWorker(QObject):
 
     sigNotRecorded = Signal(str, str, str)  # axis, what, why
     sigQueued = Signal(int)  # how many facts were written into the file
+    sigReady = Signal()  # the file is open (or said not to be): a delivery may read it
 
     def __init__(self, path: Path):
         super().__init__()
@@ -146,6 +147,7 @@ class QueueWorker(QObject):
         except (RegisterError, OSError) as exc:
             self._problem = f"this computer's queue for the server cannot be opened: {exc}"
             log.warning("register queue %s: %s", self.path, exc)
+        self.sigReady.emit()
 
     @Slot(object)
     def record(self, request: RecordRequest) -> None:
@@ -258,9 +260,8 @@ class DeliveryWorker(QObject):
     @Slot()
     def deliver(self) -> None:
         self.wanted.clear()  # a fact queued from now on asks for one more delivery
-        if self._stopping.is_set() or not self.path.exists():
-            return
-        assert self._timer is not None
+        if self._stopping.is_set() or self._timer is None or not self.path.exists():
+            return  # (not started yet: its start delivers)
         self._timer.stop()
         self.sigBusy.emit(True)
         # a connection kept from before may have been cut meanwhile (the server restarted): once
@@ -383,7 +384,8 @@ class ServerWriter(RegisterWriter):
         self._delivery = DeliveryWorker(self.queue, url, deliver)
         self._delivery.moveToThread(self._delivery_thread)
         self._queue_thread.started.connect(self._queue_worker.start)
-        self._delivery_thread.started.connect(self._delivery.start)
+        # the first delivery once the queue's file is made (half made, it is no register to read)
+        self._queue_worker.sigReady.connect(self._delivery.start)
         self._sigRecord.connect(self._queue_worker.record)
         self._sigRecordMachine.connect(self._queue_worker.record_machine)
         self._sigStop.connect(self._queue_worker.stop)

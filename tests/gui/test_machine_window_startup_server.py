@@ -5,10 +5,11 @@ opened here); the machine's axes are asked of the server from the questions' thr
 message line says that the plant's register is not reachable and that what the window records is
 queued on this computer. Three servers: a closed port (refused at once), a listening socket that
 never answers (a network that swallows the connection: the connection waits for its timeout), and
-a real PostgreSQL server that has an axis this computer did not know.
+a real PostgreSQL server that has an axis this computer did not know; a wrong password.
 
 The window's start is proved not to wait without a clock: it is built, shown and says it asks
-while the question's connection still waits, unanswered, in the silent server's backlog."""
+while the question's connection still waits, unanswered, in the silent server's backlog (with a
+connection timeout no test reaches: a start that waited for it would hang the test)."""
 
 from __future__ import annotations
 
@@ -22,6 +23,7 @@ from fha_studio.gui import register_questions, register_worker
 from fha_studio.gui.app import _machine_window, parse_arguments
 from fha_studio.logic.machine import MachineProject
 from fha_studio.logic.register import Register
+from fha_studio.logic.register.facts_from_session import alarm_facts, axis_fact
 from fha_studio.logic.register.sync import sync_registers
 from tests.support.windows import torn_down
 
@@ -29,6 +31,9 @@ MACHINE = "Line 3"
 ACTUATOR = "FHA-25C-50-US250"
 #: the shortest connection timeout libpq keeps [s] (it takes a smaller one as 2)
 SHORT_CONNECT_TIMEOUT_S = 2.0
+#: a connection timeout no test reaches [s]: a connection to the silent server waits until the
+#: test closes it (a start that waited for it would hang the test)
+NEVER_S = 600.0
 
 
 @pytest.fixture
@@ -70,6 +75,11 @@ def _queued_axes(url: str) -> list[str]:
 
 def _messages(window) -> list[str]:
     return [m.text for w in window.axis_windows for m in w.message_area.messages]
+
+
+def _in_the_pages_place(window, words: str) -> str:
+    """The line holding ``words`` among those said in the pages' place (no axis yet)."""
+    return next(line for line in window.no_axes_label.text().split("\n\n") if words in line)
 
 
 def _free_port() -> int:
@@ -116,7 +126,9 @@ def test_a_closed_port_the_window_shows_the_axes_known_here_and_queues(started, 
     assert window.server_writer.answers is False
 
 
-def test_a_server_that_never_answers_the_window_is_there_before_its_timeout(started, qtbot):
+def test_a_server_that_never_answers_the_window_is_there_before_its_timeout(started, qtbot, monkeypatch):
+    monkeypatch.setattr(register_questions, "CONNECT_TIMEOUT_S", NEVER_S)
+    monkeypatch.setattr(register_worker, "CONNECT_TIMEOUT_S", NEVER_S)
     with _silent_server() as listener:
         url = f"postgresql://fha:secret-word@127.0.0.1:{listener.getsockname()[1]}/plant"
         window = started(url)  # this machine was never opened here: no axis yet
@@ -129,9 +141,11 @@ def test_a_server_that_never_answers_the_window_is_there_before_its_timeout(star
         # is up: its start did not wait for the server
         qtbot.waitUntil(lambda: _waiting_in(listener), timeout=30000)
         assert window.questions.answers is None and window.axes_wanted
-        # once the connection's timeout has passed: one line says it
+        # the network gives up on it (its own timeout is psycopg's: test_server.py says it is a
+        # server away too): one line says it
+        listener.close()
         qtbot.waitUntil(lambda: "not reachable" in window.no_axes_label.text(), timeout=30000)
-        said = window.no_axes_label.text().split("\n\n")[-1]
+        said = _in_the_pages_place(window, "not reachable")
         assert said.startswith("Register: the plant's register is not reachable (")
         assert "the machine's axes come when it answers" in said and "queued on this computer" in said
         assert "secret-word" not in said
@@ -169,7 +183,7 @@ def test_a_machine_the_server_does_not_have_is_said(started, qtbot, postgres_clu
         server.add_machine("Line 4")
     window = started(url)
     qtbot.waitUntil(lambda: "no machine called" in window.no_axes_label.text(), timeout=30000)
-    said = window.no_axes_label.text().split("\n\n")[-1]
+    said = _in_the_pages_place(window, "no machine called")
     assert said == ("Register: no machine called 'Line 3' in the register (machines: Line 4). "
                     "Add axis… adds its first axis.")
     assert not window.axes_wanted
@@ -190,7 +204,9 @@ def test_a_wrong_password_is_said_as_such_and_the_next_start_delivers(started, q
     wrong = url.replace(PASSWORD, "not-the-password")
     window = started(wrong)
     qtbot.waitUntil(lambda: "refused the user name or password" in window.no_axes_label.text(), timeout=30000)
-    said = window.no_axes_label.text().split("\n\n")[-1]
+    said = _in_the_pages_place(window, "refused the user name or password")
+    assert "not reachable" not in window.no_axes_label.text()
+    assert "does not answer" not in window.no_axes_label.text()
     assert "not reachable" not in said and "does not answer" not in said
     assert "not-the-password" not in said and "\n" not in said
     window.add_axis("tilt", ACTUATOR, port_url="/dev/ttyUSB1")  # queued
@@ -202,5 +218,40 @@ def test_a_wrong_password_is_said_as_such_and_the_next_start_delivers(started, q
     right = started(url)  # the same queue: its facts go to the server now
     qtbot.waitUntil(lambda: len(right.axis_windows) == 2, timeout=30000)
     with Register(url) as server:
-        qtbot.waitUntil(lambda: [a.name for a in server.axes(MACHINE)] == ["table", "tilt"], timeout=30000)
+        # the axis and its entry (the delivery's batches come one after another), each once
+        qtbot.waitUntil(lambda: [a.name for a in server.axes(MACHINE)] == ["table", "tilt"]
+                        and len(server.history(f"{MACHINE}/tilt")) == 1, timeout=30000)
+        right.shutdown()  # every delivery ended: nothing more comes
         assert len(server.history(f"{MACHINE}/tilt")) == 1
+
+
+def test_the_single_axis_window_on_a_server_that_never_answers_is_there_at_once(qtbot, monkeypatch):
+    """``fha-studio gui --register URL`` (the single-axis window) neither: shown while the
+    delivery's connection waits unanswered; then the line says the server does not answer, and
+    the register line in the toolbar that the facts wait on this computer."""
+    from fha_studio.gui.app import single_axis_window
+
+    monkeypatch.setattr(register_worker, "CONNECT_TIMEOUT_S", NEVER_S)
+    monkeypatch.setattr(register_questions, "CONNECT_TIMEOUT_S", NEVER_S)
+    monkeypatch.setattr(register_worker, "RETRY_MIN_S", 0.5)
+    # the listener closed before the window (the threads end at once)
+    with torn_down(lambda window: [window.link]) as windows, _silent_server() as listener:
+        url = f"postgresql://fha:secret-word@127.0.0.1:{listener.getsockname()[1]}/plant"
+        window = single_axis_window(parse_arguments(["--register", url, "--machine", MACHINE,
+                                                     "--axis", "table", "--no-connect"]))
+        windows.append(window)
+        window.show()
+        server = window.window_register.server
+        assert window.isVisible() and server is not None and server.answers is None
+        # an alarm recorded: its delivery's connection waits, unanswered, while the window is up
+        server.record(f"{MACHINE}/table", [axis_fact({"actuator_code": ACTUATOR}, "ana"),
+                                            *alarm_facts(20, "HA-655", "ana")])
+        qtbot.waitUntil(lambda: _waiting_in(listener), timeout=30000)
+        assert server.answers is None
+        listener.close()  # the network gives up on it
+        qtbot.waitUntil(lambda: server.answers is False, timeout=30000)
+        said = [m.text for m in window.message_area.messages if "does not answer" in m.text]
+        assert said and said[0].startswith("Register: the server does not answer; what this window "
+                                           "records waits on this computer")
+        assert "server away, 1 fact waiting" in window.window_register.button.text()
+        qtbot.waitUntil(lambda: _queued_axes(url) == ["table"], timeout=30000)
