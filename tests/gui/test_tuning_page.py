@@ -32,7 +32,9 @@ def test_measure_propose_apply_end_to_end(make_window, qtbot, tmp_path):
     with qtbot.waitSignal(window.link.sigResult, timeout=20000):
         page.plan_button.click()
     qtbot.waitUntil(page.start_button.isEnabled, timeout=10000)
-    assert "r/min" in page.plan_label.text() and "deg" in page.plan_label.text()
+    # the manual's symbols on a page, not the terminal's ASCII
+    assert "r/min" in page.plan_label.text() and "°" in page.plan_label.text()
+    assert "+/-" not in page.plan_label.text() and " deg" not in page.plan_label.text()
     drive = window.link._worker._client.transaction.transport.inner.sim_drive
     before = drive.axis.output_pos_rad
     page.start_countdown()
@@ -50,6 +52,11 @@ def test_measure_propose_apply_end_to_end(make_window, qtbot, tmp_path):
     with qtbot.waitSignal(page.sigProposed, timeout=120000):
         page.propose_button.click()
     assert page.table.item(0, 1) is not None
+    # the text and the table say the same gain margin: the table's present one is the model's
+    present_gm = page.table.item(len(page.proposal.proposed.items), 0).text()
+    assert "(model)" in page.table.horizontalHeaderItem(0).text()
+    if result["gain_margin_db"] is None and page.proposal.present.gain_margin_db is not None:
+        assert f"gain margin {float(present_gm):.3g} dB by the model" in page.result_label.text()
     assert page.apply_button.isEnabled()
     with qtbot.waitSignal(page.sigApplied, timeout=180000) as applied:
         page.apply_button.click()

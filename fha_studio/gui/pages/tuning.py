@@ -52,7 +52,7 @@ from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
 from fha_studio.logic.tuning.excitation import plan_excitation
 from fha_studio.logic.tuning.measure import NEEDED
 from fha_studio.logic.tuning.propose import AIMS, TUNE_KEYS, Proposal, Tuner
-from fha_studio.logic.tuning.record import TuningRecord, figure_words, tuning_notes
+from fha_studio.logic.tuning.record import TuningRecord, result_figure_words, tuning_notes
 from fha_studio.logic.tuning.response import COHERENCE_TRUSTED
 from fha_studio.logic.tuning.session import declared_model, drive_clock, measure_report, tuner_for
 
@@ -61,15 +61,17 @@ HOLD_TIP = ("Hold (mouse or Space key) to run the excitation until the measureme
             "leaving the page or the window ends it")
 FIGURE_ROWS = ("gain_margin_db", "phase_margin_deg", "overshoot_pct", "settling_ms")
 #: the table's words for the figures beside the tune items
-FIGURE_WORDS = {"gain_margin_db": "Gain margin [dB]", "phase_margin_deg": "Phase margin [deg]",
+FIGURE_WORDS = {"gain_margin_db": "Gain margin [dB]", "phase_margin_deg": "Phase margin [°]",
                 "overshoot_pct": "Overshoot of a move [%]", "settling_ms": "Settling time of a move [ms]"}
 
 
-def _cell(key: str, value: Any) -> str:
-    """A figure in the table: a gain margin without a phase crossing, and a move in position as
-    its command arrives, in words."""
+def _cell(key: str, value: Any, measured_to_hz: float | None = None) -> str:
+    """A figure in the table: a gain margin without a phase crossing (a measured one: none within
+    the measured band, ``measured_to_hz``), and a move in position as its command arrives, in words."""
     if value is None:
-        return "none: phase never −180°" if key == "gain_margin_db" else "—"
+        if key != "gain_margin_db":
+            return "—"
+        return f"none to {measured_to_hz:.0f} Hz" if measured_to_hz else "none: phase never −180°"
     if key == "settling_ms" and value == 0:
         return "0 (at arrival)"
     return f"{value:g}"
@@ -87,7 +89,7 @@ def _dashed(colour: str) -> Any:
 def tuning_plot_title(n: int, record: TuningRecord, who: str) -> str:
     """The report's words over a tuning's plot: when, who, the aim and the figures before / after."""
     def fig(result: Any, key: str, unit: str) -> str:
-        return figure_words(key, (result or {}).get(key), unit)
+        return result_figure_words(result or {}, key, unit, manual_units=True)
 
     words = f"Tuning {n} ({record.at}, {record.who or who or 'operator not named'}): "
     b, a = record.before, record.after
@@ -129,7 +131,7 @@ def export_response_png(record: TuningRecord, title: str, path: Path) -> Path:
     legend = pg.LegendItem(colCount=2, labelTextColor="k")
     view.addItem(legend, row=1, col=0)
     mag = view.addPlot(row=2, col=0, title="Magnitude [dB]", axisItems={"bottom": FrequencyAxis("bottom")})
-    phase = view.addPlot(row=3, col=0, title="Phase [deg]", axisItems={"bottom": FrequencyAxis("bottom")})
+    phase = view.addPlot(row=3, col=0, title="Phase [°]", axisItems={"bottom": FrequencyAxis("bottom")})
     phase.setLabel("bottom", "frequency (bins of coherence at least 0.9)", units="Hz")
     for plot in (mag, phase):
         plot.setLogMode(x=True, y=False)
@@ -260,11 +262,15 @@ class TuningPage(BasePage):
 
         self.plots = pg.GraphicsLayoutWidget()
         self.plots.setBackground("w")
-        self.mag_plot = self.plots.addPlot(row=0, col=0, title="Magnitude [dB]",
+        # the legend in a row of its own above the plots (as the scope's): inside the magnitude
+        # plot it covered the resonance markers' labels
+        self.legend = pg.LegendItem(colCount=3, labelTextColor="#303030")
+        self.plots.addItem(self.legend, row=0, col=0)
+        self.mag_plot = self.plots.addPlot(row=1, col=0, title="Magnitude [dB]",
                                            axisItems={"bottom": FrequencyAxis("bottom")})
-        self.phase_plot = self.plots.addPlot(row=1, col=0, title="Phase [deg]",
+        self.phase_plot = self.plots.addPlot(row=2, col=0, title="Phase [°]",
                                              axisItems={"bottom": FrequencyAxis("bottom")})
-        self.coh_plot = self.plots.addPlot(row=2, col=0, title="Coherence",
+        self.coh_plot = self.plots.addPlot(row=3, col=0, title="Coherence",
                                            axisItems={"bottom": FrequencyAxis("bottom")})
         for plot in (self.mag_plot, self.phase_plot, self.coh_plot):
             plot.setLogMode(x=True, y=False)
@@ -273,24 +279,28 @@ class TuningPage(BasePage):
         self.coh_plot.setXLink(self.mag_plot)
         self.coh_plot.setLabel("bottom", "frequency", units="Hz")
         self.coh_plot.setYRange(0.0, 1.05)
-        self.mag_plot.addLegend(offset=(-10, 10))
         self.curves = {
-            "closed": (self.mag_plot.plot(pen=pg.mkPen("#1f4e9c", width=2), name="speed loop (closed)"),
+            "closed": (self.mag_plot.plot(pen=pg.mkPen("#1f4e9c", width=2)),
                        self.phase_plot.plot(pen=pg.mkPen("#1f4e9c", width=2)),
                        self.coh_plot.plot(pen=pg.mkPen("#1f4e9c", width=2))),
-            "plant": (self.mag_plot.plot(pen=pg.mkPen("#c05000", width=2), name="plant (speed per torque)"),
+            "plant": (self.mag_plot.plot(pen=pg.mkPen("#c05000", width=2)),
                       self.phase_plot.plot(pen=pg.mkPen("#c05000", width=2)),
                       self.coh_plot.plot(pen=pg.mkPen("#c05000", width=2))),
             # what the linearised loop predicts, beside a bench measurement
             "predicted": (self.mag_plot.plot(pen=_dashed("#1f4e9c")),
                           self.phase_plot.plot(pen=_dashed("#1f4e9c")), self.coh_plot.plot()),
         }
+        self.legend.addItem(self.curves["closed"][0], "speed loop (closed)")
+        self.legend.addItem(self.curves["plant"][0], "plant (speed per torque)")
         self.markers: list[Any] = []
 
         self.table = QTableWidget(len(TUNE_KEYS) + len(FIGURE_ROWS), 3)
-        self.table.setHorizontalHeaderLabels(["present", "proposed", "measured\nafter"])
-        self.table.setToolTip("Tune mode items of the front panel, and the figures they give; a move that "
-                              "settles in 0 ms is within the in-position range as its command arrives")
+        # the present and proposed figures are the model's (the proposal is computed on it), the
+        # measured ones are beside the plots and in the last column
+        self.table.setHorizontalHeaderLabels(["present\n(model)", "proposed\n(model)", "measured\nafter"])
+        self.table.setToolTip("Tune mode items of the front panel, and the figures the model gives with "
+                              "them; a move that settles in 0 ms is within the in-position range as its "
+                              "command arrives")
         model = session.parameter_model
         self.table.setVerticalHeaderLabels(
             [*(_item_words(model.by_key(k)) for k in TUNE_KEYS), *(FIGURE_WORDS[k] for k in FIGURE_ROWS)])
@@ -389,8 +399,8 @@ class TuningPage(BasePage):
                                     "worksheet.")
             return
         self.plan = reply.value
-        self.plan_label.setText(reply.value.describe() + ". Servo on, the axis free to move that far; "
-                                "STOP ends it at once.")
+        self.plan_label.setText(reply.value.describe(manual_units=True) + ". Servo on, the axis free to move "
+                                "that far; STOP ends it at once.")
         self.start_button.setEnabled(True)
         self.hold_button.setEnabled(True)
 
@@ -490,7 +500,7 @@ class TuningPage(BasePage):
             coherence = np.asarray(data.get("coherence", []), float)
             coh.setData(f if len(coherence) == len(f) else [], coherence if len(coherence) == len(f) else [])
         # the prediction is in the legend while it is on the plot
-        legend, predicted = self.mag_plot.legend, self.curves["predicted"][0]
+        legend, predicted = self.legend, self.curves["predicted"][0]
         legend.removeItem(predicted)
         if result.get("predicted_response"):
             legend.addItem(predicted, "speed loop (predicted)")
@@ -514,7 +524,7 @@ class TuningPage(BasePage):
                 self.markers.append(line)
 
         def fmt(key: str, unit: str) -> str:
-            return figure_words(key, result.get(key), unit)
+            return result_figure_words(result, key, unit, manual_units=True)
 
         self.status_label.setText("Measured.")
         uncertainty = result.get("load_inertia_uncertainty_kgm2")  # a bench measurement says it
@@ -644,5 +654,5 @@ class TuningPage(BasePage):
                                        after=result)
         for row, key in enumerate((*TUNE_KEYS, *FIGURE_ROWS)):
             value = self.proposal.proposed.items.get(key) if key in TUNE_KEYS else result.get(key)
-            self.table.setItem(row, 2, QTableWidgetItem(_cell(key, value)))
+            self.table.setItem(row, 2, QTableWidgetItem(_cell(key, value, result.get("measured_to_hz"))))
         self.sigApplied.emit(result)

@@ -42,6 +42,7 @@ from fha_studio.logic.tuning.bench_session import (
     is_move,
     move_samples,
 )
+from fha_studio.logic.wording import with_unit
 
 #: the roles the panel maps, with their words on CN2
 ROLE_WORDS = (("speed_monitor", "SPD-MON"), ("speed_command", "SPD-CMD"), ("encoder_a", "Encoder A"),
@@ -193,8 +194,8 @@ class BenchTuningPanel(QGroupBox):
     def plan_excitation(self) -> Any:
         """The excitation for the page's axis and the drive's items, its bounds shown."""
         excitation = design_excitation(self._tuner(), amplitude_rpm=self.page._amplitude())
-        self.status.setText(excitation.describe() + ". Speed mode, the servo on from the controller, the "
-                            "axis free to move that far; the file ends at 0 V.")
+        self.status.setText(excitation.describe(manual_units=True) + ". Speed mode, the servo on from the "
+                            "controller, the axis free to move that far; the file ends at 0 V.")
         return excitation
 
     def write_excitation(self, path: str, excitation: Any | None = None) -> Path:
@@ -202,8 +203,9 @@ class BenchTuningPanel(QGroupBox):
         written = write_waveform(path, excitation.waveform, form_of(path))
         self.excitation_path = str(written)
         self.excitation_edit.setText(str(written))
-        self.status.setText(f"{excitation.describe()}. Written to {written}: play it into SPD-CMD (CN2-31, "
-                            "common CN2-32) and record SPD-MON (CN2-23), with SPD-CMD beside it if you can.")
+        self.status.setText(f"{excitation.describe(manual_units=True)}. Written to {written}: play it into "
+                            "SPD-CMD (CN2-31, common CN2-32) and record SPD-MON (CN2-23), with SPD-CMD "
+                            "beside it if you can.")
         return written
 
     def _choose_excitation(self) -> None:
@@ -311,7 +313,7 @@ class BenchTuningPanel(QGroupBox):
 
 
 def _n(value: float | None, unit: str, digits: str = ".3g") -> str:
-    return "—" if value is None else f"{value:{digits}} {unit}"
+    return "—" if value is None else with_unit(f"{value:{digits}}", unit)
 
 
 def analysis_words(result: dict[str, Any]) -> str:
@@ -327,7 +329,7 @@ def analysis_words(result: dict[str, Any]) -> str:
     if dev["magnitude_db"] is None:
         return f"Analysed from the bench: no frequency bin was trusted (coherence below 0.9); {inertia}."
     return (f"Analysed from the bench: {dev['trusted_bins']} trusted bins, within {dev['magnitude_db']:.2g} "
-            f"dB and {dev['phase_deg']:.2g} deg of the linearised loop (dashed); {inertia}.")
+            f"dB and {dev['phase_deg']:.2g}° of the linearised loop (dashed); {inertia}.")
 
 
 def verification_words(result: dict[str, Any]) -> str:
@@ -348,7 +350,7 @@ def verification_words(result: dict[str, Any]) -> str:
     if dev["magnitude_db"] is None:
         return "Verified from the bench: no frequency bin was trusted (coherence below 0.9)."
     return (f"Verified from the bench (the response with the proposed items): within "
-            f"{dev['magnitude_db']:.2g} dB and {dev['phase_deg']:.2g} deg of the prediction over "
+            f"{dev['magnitude_db']:.2g} dB and {dev['phase_deg']:.2g}° of the prediction over "
             f"{dev['trusted_bins']} trusted bins; phase margin {_n(result['phase_margin_deg'], 'deg')} "
             f"(predicted {_n(predicted['phase_margin_deg'], 'deg')}), crossover "
             f"{_n(result['crossover_hz'], 'Hz')} (predicted {_n(predicted['crossover_hz'], 'Hz')}).")

@@ -83,13 +83,16 @@ class BenchExcitation:
     def period_s(self) -> float:
         return self.waveform.period_samples / self.waveform.rate_hz
 
-    def describe(self) -> str:
+    def describe(self, manual_units: bool = False) -> str:
+        """The excitation in a line; ``manual_units``: "°" as the manual prints it (a page), else
+        "deg" (a terminal)."""
         w = self.waveform
+        travel = f"{self.travel_bound_deg:.3g}" + ("°" if manual_units else " deg")
         periods = (len(w.volts) - 2 * w.start_sample) // max(1, w.period_samples)
         return (f"excitation on SPD-CMD: {self.form} of ±{self.amplitude_rpm:.3g} r/min at the output "
                 f"(peak {self.peak_v:.3g} V), {self.f_lo_hz:.3g} ... {self.f_hi_hz:.3g} Hz, "
                 f"{periods} periods of {self.period_s:.3g} s at {w.rate_hz:g} samples/s "
-                f"({w.duration_s:.1f} s); the output travels at most ±{self.travel_bound_deg:.3g} deg, "
+                f"({w.duration_s:.1f} s); the output travels at most ±{travel}, "
                 f"current at most {self.peak_current_a:.3g} A of {self.max_current_a:g} A, speed at most "
                 f"{self.peak_speed_rpm:.3g} r/min; 1 mV of offset on SPD-CMD turns the output at "
                 f"{self.drift_rpm_per_mv:.2g} r/min (tune item 5 cancels it)")

@@ -30,6 +30,7 @@ import numpy as np
 
 from fha_studio.hardware.protocol import excitation_period_periods
 from fha_studio.logic.tuning.linear import LoopModel, LoopPolynomials, two_mass_prediction
+from fha_studio.logic.wording import with_unit
 from fha_studio.physics import PanelGains
 
 RPM = 2.0 * math.pi / 60.0
@@ -85,11 +86,19 @@ class ExcitationPlan:
     settle_s: float  # before each record: the slowest closed-loop mode decays (6 time constants)
     duration_s: float
 
-    def describe(self) -> str:
-        return (f"excitation: PRBS of +/-{self.amplitude_rpm:.3g} r/min on the speed command, bits of "
-                f"{self.hold_periods} servo period(s), {self.records} records of {self.period_samples} "
+    def describe(self, manual_units: bool = False) -> str:
+        """The excitation in a line. ``manual_units``: "±" and "°" as the FHA-C manual prints them
+        (what a person reads on a page); else plain ASCII ("+/-", "deg") for a terminal or a log."""
+        pm = "±" if manual_units else "+/-"
+
+        def deg(value: float) -> str:
+            return with_unit(f"{value:.3g}", "deg") if manual_units else f"{value:.3g} deg"
+
+        periods = f"{self.hold_periods} servo period" + ("" if self.hold_periods == 1 else "s")
+        return (f"excitation: PRBS of {pm}{self.amplitude_rpm:.3g} r/min on the speed command, bits of "
+                f"{periods}, {self.records} records of {self.period_samples} "
                 f"samples ({self.duration_s:.1f} s); the output travels at most "
-                f"+/-{self.travel_bound_deg:.3g} deg (the drive stops at {self.travel_limit_deg:.3g} deg), "
+                f"{pm}{deg(self.travel_bound_deg)} (the drive stops at {deg(self.travel_limit_deg)}), "
                 f"current at most {self.peak_current_a:.3g} A")
 
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from fha_studio.hardware.parameters import ParameterModel, load_parameter_model
+from fha_studio.logic.wording import with_unit
 
 FIGURES = (("resonance_hz", "resonance", "Hz"), ("antiresonance_hz", "anti-resonance", "Hz"),
            ("load_inertia_estimate_kgm2", "load inertia estimate", "kg·m²"),
@@ -32,15 +33,31 @@ class TuningRecord:
 NO_PHASE_CROSSING = "none (the phase never reaches -180 deg)"
 
 
-def figure_words(key: str, value: float | None, unit: str) -> str:
-    """A figure in words: the value and unit, or why there is none."""
+def figure_words(key: str, value: float | None, unit: str, manual_units: bool = False) -> str:
+    """A figure in words: the value and unit, or why there is none. ``manual_units``: units as
+    the FHA-C manual prints them ("°", not "deg"), for what a person reads."""
     if value is None:
-        return NO_PHASE_CROSSING if key == "gain_margin_db" else "none found"
-    return f"{value:.3g} {unit}"
+        if key != "gain_margin_db":
+            return "none found"
+        return NO_PHASE_CROSSING.replace("-180 deg", "−180°") if manual_units else NO_PHASE_CROSSING
+    return with_unit(f"{value:.3g}", unit) if manual_units else f"{value:.3g} {unit}"
+
+
+def result_figure_words(result: Mapping[str, Any], key: str, unit: str, manual_units: bool = False) -> str:
+    """A measurement's figure in words. A measured gain margin is taken over the measured band
+    alone: where the phase stays above -180 deg there, the crossing (if any) lies beyond it and
+    the margin is the model's, said as such (not "none", beside the model's figure in dB)."""
+    value, top_hz = result.get(key), result.get("measured_to_hz")
+    if key != "gain_margin_db" or value is not None or not top_hz:
+        return figure_words(key, value, unit, manual_units)
+    predicted = (result.get("predicted") or {}).get("gain_margin_db")
+    minus_180 = "−180°" if manual_units else "-180 deg"
+    model = f"{predicted:.3g} dB by the model" if predicted is not None else "none by the model either"
+    return f"{model} (the measured phase stays above {minus_180} up to {top_hz:.0f} Hz)"
 
 
 def _figures(result: Mapping[str, Any]) -> str:
-    return ", ".join(f"{words} {figure_words(key, result.get(key), unit)}" for key, words, unit in FIGURES)
+    return ", ".join(f"{words} {result_figure_words(result, key, unit)}" for key, words, unit in FIGURES)
 
 
 def items_words(items: Mapping[str, int], parameters: ParameterModel) -> str:

@@ -100,6 +100,7 @@ def response_figures(tuner: Tuner, lm: LoopModel, closed: FrequencyResponse, pla
     measured = measured_loop_figures(lm.speed_open_loop(), lm.plant(), plant)
     predicted = two_mass_prediction(tuner.model)
     own = tuner.model.actuator_inertia_kgm2
+    trusted = plant.freq_hz[plant.trusted()]
     return {
         "resonance_hz": fit.resonance_hz if fit else None,
         "antiresonance_hz": fit.antiresonance_hz if fit else None,
@@ -109,6 +110,8 @@ def response_figures(tuner: Tuner, lm: LoopModel, closed: FrequencyResponse, pla
         "gain_margin_db": measured.gain_margin_db,
         "phase_margin_deg": measured.phase_margin_deg,
         "crossover_hz": measured.crossover_hz,
+        # the band the measured margins cover: a phase crossing above it is the model's alone
+        "measured_to_hz": float(trusted.max()) if len(trusted) else None,
         "predicted": {"gain_margin_db": figures.gain_margin_db, "phase_margin_deg": figures.phase_margin_deg,
                       "crossover_hz": figures.crossover_hz, "bandwidth_hz": figures.bandwidth_hz},
         "bandwidth_hz": bandwidth_hz(closed),
