@@ -98,13 +98,13 @@ def choose_bandwidth(
         # convolution with the reversed kernel, its samples where the kernel lies within the record
         length = len(f.smooth)
         cols = irfft(raw_f * rfft(f.smooth[::-1], size)[:, None], size, axis=0)[length - 1 : m]
-        torque = kt_nm_per_a * cols[:, 0]
         accel = cols[:, 1] / dt_s**2
-        y = torque - inertia_kgm2 * accel
-        jerk = np.gradient(accel, dt_s)
-        x = np.column_stack([accel, jerk, cols[:, 2:]])
-        step = max(1, min(len(y) // 2500, (w - 2) // 2))
-        rms = _heldout_rms(y[::step], x[::step], gap=w // (2 * step) + 1)
+        jerk = np.gradient(accel, dt_s)  # at the full rate, then taken at the fitted rows
+        step = max(1, min(len(accel) // 2500, (w - 2) // 2))
+        rows = cols[::step]
+        y = kt_nm_per_a * rows[:, 0] - inertia_kgm2 * accel[::step]
+        x = np.column_stack([accel[::step], jerk[::step], rows[:, 2:]])
+        rms = _heldout_rms(y, x, gap=w // (2 * step) + 1)
         acc_noise = inertia_kgm2 * pos_noise_rad * math.sqrt(float(np.sum(f.d2**2))) / dt_s**2
         noise = math.hypot(kt_nm_per_a * current_noise_a * f.noise_gain, acc_noise)
         unexplained = math.sqrt(max(rms**2 - noise**2, 0.0))
