@@ -6,8 +6,16 @@ import math
 from collections.abc import Iterable
 
 from PySide6.QtCore import QEvent, QObject, QPointF, QRectF, QSize, Qt, Signal
-from PySide6.QtGui import QBrush, QColor, QFont, QPainter, QPainterPath, QPen, QPolygonF
-from PySide6.QtWidgets import QAbstractButton, QLabel, QPushButton, QScrollArea, QSizePolicy, QWidget
+from PySide6.QtGui import QBrush, QColor, QFont, QFontMetrics, QPainter, QPainterPath, QPen, QPolygonF
+from PySide6.QtWidgets import (
+    QAbstractButton,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QScrollArea,
+    QSizePolicy,
+    QWidget,
+)
 
 GREEN = QColor("#2e9d3a")
 RED = QColor("#d12c2c")
@@ -295,3 +303,10 @@ def scrolling(panel: QWidget, minimum_width_px: int = 240) -> QScrollArea:
     area.setWidget(panel)
     area.setMinimumWidth(minimum_width_px)
     return area
+
+
+def hint_whole(edit: QLineEdit) -> QLineEdit:
+    """``edit`` never narrower than its hint (placeholder): an empty field that says only "cha…"
+    no longer says what it wants. The frame's and the text's own margins are added."""
+    edit.setMinimumWidth(QFontMetrics(edit.font()).horizontalAdvance(edit.placeholderText()) + 14)
+    return edit

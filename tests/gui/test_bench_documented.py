@@ -73,9 +73,11 @@ def test_a_controller_move_is_shown_live_from_cn2_with_the_move_tests_figures(wi
     assert figures.following_error_peak_counts > 10  # the error counter fills while the axis runs
     assert abs(figures.following_error_end_counts) <= 10  # within the in-position range (tune 4)
     text = bench.move_label.text()
-    for words in ("Move from the bench: +10.000 deg", "overshoot", "settling time", "in-position (IN-POS)",
-                  "following error (command − encoder)", "counts at the end"):
+    for words in ("Move from the bench: +10.000°", "overshoot", "settling time", "in-position (IN-POS)",
+                  "following error (command − encoder)", "at the end"):
         assert words in text, text
+    # counted as a sentence counts: "1 count", "11 channels", never "1 counts" or "channel(s)"
+    assert " 1 counts" not in text and "(s)" not in bench.status_label.text()
     x, y = bench._curves[0].getData()
     assert x is not None and len(x) > 1000 and set(np.unique(np.round(y % 1.2, 3))) <= {0.0, 0.8}
     # the logic lanes named at the right beside each, the analog channel in the legend

@@ -30,6 +30,7 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
 )
 
+from fha_studio.gui.widgets import hint_whole
 from fha_studio.hardware.bench.readers import read_capture
 from fha_studio.hardware.bench.waveform import form_of, write_waveform
 from fha_studio.logic.tuning.bench_excitation import design_excitation
@@ -94,12 +95,14 @@ class BenchTuningPanel(QGroupBox):
         self.capture_edit = QLineEdit()
         self.capture_edit.setReadOnly(True)
         self.capture_edit.setPlaceholderText("the CN2 capture (.sr, VCD, CSV)")
+        hint_whole(self.capture_edit)
         choose = QPushButton("Capture…")
         choose.setToolTip("Choose the capture of CN2")
         choose.clicked.connect(self._choose_capture)
         self.excitation_edit = QLineEdit()
         self.excitation_edit.setReadOnly(True)
         self.excitation_edit.setPlaceholderText("the excitation file played")
+        hint_whole(self.excitation_edit)
         self.excitation_edit.setToolTip("The input when SPD-CMD was not recorded beside SPD-MON")
         choose_exc = QPushButton("Excitation…")
         choose_exc.setToolTip("Choose the excitation file that was played")

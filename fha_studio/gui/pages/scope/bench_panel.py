@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio.gui.widgets import hint_whole
 from fha_studio.hardware.bench import sigrok
 from fha_studio.hardware.parameters import load_cn2
 from fha_studio.logic.bench import alarm_code
@@ -58,6 +59,23 @@ MIN_COUNTS_PAD = 5.0
 #: The width a trace's name takes in the legend [px] ("bench sim-cn2:ENC_A" and its line).
 LEGEND_NAME_PX = 190
 _COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#e07000", "#9467bd", "#8c564b", "#e377c2", "#008b8b")
+
+
+def _legend_above(item: pg.PlotItem, columns: int = 1) -> None:
+    """The plot's legend in its title row, above the traces (inside the view it sat on a trace, as
+    the scope's legend is above its plots); curves named when plotted go into it as into a plot's
+    own legend."""
+    item.legend = pg.LegendItem(colCount=columns, labelTextColor="#303030")
+    item.layout.removeItem(item.titleLabel)  # no title: its row (fixed at 0 height) takes the legend
+    item.titleLabel.setVisible(False)
+    item.layout.setRowMaximumHeight(0, 1000)
+    item.layout.addItem(item.legend, 0, 1)
+
+
+def _counted(n: float, noun: str) -> str:
+    """``"1 count"``, ``"11 channels"``: a whole number of things as a sentence says it."""
+    whole = round(n)
+    return f"{whole} {noun}" if abs(whole) == 1 else f"{whole} {noun}s"
 
 
 def _flange(check: BenchCheck) -> str:
@@ -129,19 +147,21 @@ class BenchPanel(QWidget):
         roles = QHBoxLayout()
         roles.addWidget(QLabel("Encoder"))
         self.encoder_edit = QLineEdit("")
-        self.encoder_edit.setPlaceholderText("A,B e.g. D0,D1")
-        self.encoder_edit.setToolTip("encoder A and B among the channels: counted x4 as they come")
+        # the hints are examples, short enough to be whole on a 1024 px screen (the tooltips say more)
+        self.encoder_edit.setPlaceholderText("D0,D1")
+        self.encoder_edit.setToolTip("encoder A and B among the channels, e.g. D0,D1: counted x4 as they "
+                                     "come")
         roles.addWidget(self.encoder_edit, 1)
         roles.addWidget(QLabel("Command"))
         self.command_edit = QLineEdit("")
-        self.command_edit.setPlaceholderText("A,B e.g. D2,D3")
-        self.command_edit.setToolTip("the command pulse lines into CN2 among the channels (A, and B for "
-                                     "two-pulse, the sign or two-phase), decoded by parameters 1, 2, 3 "
-                                     "and 4")
+        self.command_edit.setPlaceholderText("D2,D3")
+        self.command_edit.setToolTip("the command pulse lines into CN2 among the channels, e.g. D2,D3 (A, "
+                                     "and B for two-pulse, the sign or two-phase), decoded by parameters "
+                                     "1, 2, 3 and 4")
         roles.addWidget(self.command_edit, 1)
         roles.addWidget(QLabel("IN-POS"))
         self.in_position_edit = QLineEdit("")
-        self.in_position_edit.setPlaceholderText("e.g. D5 (CN2-33)")
+        self.in_position_edit.setPlaceholderText("D4")
         self.in_position_edit.setToolTip(f"the drive's in-position output ({cn2.pins_text('in_position')}) "
                                          "among the channels: the move's in-position time is taken from it")
         roles.addWidget(self.in_position_edit, 1)
@@ -149,26 +169,30 @@ class BenchPanel(QWidget):
         alarms = QHBoxLayout()
         alarms.addWidget(QLabel("ALARM"))
         self.alarm_edit = QLineEdit("")
-        self.alarm_edit.setPlaceholderText("e.g. D6")
+        self.alarm_edit.setPlaceholderText("D5")
         self.alarm_edit.setToolTip(f"the drive's ALARM output ({cn2.pins_text('alarm')}) among the channels: "
                                    "the checks of a move say whether it came on")
         alarms.addWidget(self.alarm_edit, 1)
         self.alm_edits: list[QLineEdit] = []
-        for role, line in zip(("alm_a", "alm_b", "alm_c", "alm_d"), alarm_code.LINES, strict=True):
+        roles_lines = zip(("alm_a", "alm_b", "alm_c", "alm_d"), alarm_code.LINES, strict=True)
+        for n, (role, line) in enumerate(roles_lines):
             alarms.addWidget(QLabel(line))
             edit = QLineEdit("")
             edit.setObjectName(f"scopeBench_{role}")
-            edit.setPlaceholderText("channel")
+            edit.setPlaceholderText(f"D{6 + n}")
             edit.setToolTip(f"the alarm code line {line} ({cn2.pins_text(role)}) among the channels: the "
                             "code (ALM-D C B A, ON = 1) is shown as the alarms it can be")
             alarms.addWidget(edit, 1)
             self.alm_edits.append(edit)
+        for edit in (self.encoder_edit, self.command_edit, self.in_position_edit, self.alarm_edit,
+                     *self.alm_edits):
+            hint_whole(edit)
         grid.addLayout(alarms, 3, 0, 1, 4)
         grid.setColumnStretch(1, 1)
         layout.addLayout(grid)
         self.plot = pg.PlotWidget(background="w")
         self.plot.setLabel("bottom", "time", units="s")
-        self.plot.addLegend(offset=(5, 5), colCount=3)  # in rows above the lanes
+        _legend_above(self.plot.plotItem, columns=3)
         layout.addWidget(self.plot, 2)
         # the lanes' names at the right, a little smaller than the plot's numbers (many lanes)
         lane_font = QFont(self.font())
@@ -181,7 +205,7 @@ class BenchPanel(QWidget):
         for plot in (self.plot, self.counts_plot):  # equal left axes: the two time axes line up
             plot.getAxis("left").setWidth(LEFT_AXIS_PX)
         self.counts_plot.setVisible(False)
-        self.counts_plot.addLegend(offset=(5, 5))
+        _legend_above(self.counts_plot.plotItem)
         self._counts_curve = self.counts_plot.plot([], [], pen=pg.mkPen("#333333", width=1))
         self._counts_curve.setSkipFiniteCheck(True)
         self.counts_plot.enableAutoRange(enable=False)  # ranges set per frame, not from the data's bounds
@@ -377,6 +401,7 @@ class BenchPanel(QWidget):
         self._named = len(self._curves) - len(lanes)  # in the legend
         self._legend_columns = max(1, min(self._named, self.plot.width() // LEGEND_NAME_PX))
         self.plot.plotItem.legend.setColumnCount(self._legend_columns)
+        self.plot.plotItem.layout.setRowMaximumHeight(0, 1000 if self._named else 0)
         self.plot.enableAutoRange(axis="x", enable=False)
         self._y_range = self._counts_range = self._x_range = None
         self.plot.enableAutoRange(axis="y", enable=False)  # set per frame: lanes, analog, the legend
@@ -394,8 +419,9 @@ class BenchPanel(QWidget):
         # one line: every trace is named on the plot, and all of them in the tooltip
         decoded = len(started.labels) - len(started.channels)
         self.status_label.setText(f"LIVE from the bench: {started.device} at "
-                                  f"{sigrok.rate_text(started.sample_rate_hz)}, {len(started.channels)} "
-                                  f"channel(s)" + (f" and {decoded} decoded" if decoded else ""))
+                                  f"{sigrok.rate_text(started.sample_rate_hz)}, "
+                                  f"{_counted(len(started.channels), 'channel')}"
+                                  + (f" and {decoded} decoded" if decoded else ""))
         self.status_label.setToolTip(", ".join(started.labels))
 
     def _on_rows(self, _rows: np.ndarray) -> None:
@@ -422,10 +448,9 @@ class BenchPanel(QWidget):
                 values = values * 0.8 + lane
             curve.setData(rows[:, 0], values)
             low, high = min(low, float(values.min())), max(high, float(values.max()))
-        # room above the traces for the legend's rows, so it covers none
-        legend_rows = math.ceil(self._named / self._legend_columns)
+        # the lowest lane's name is centred 0.4 above its floor: room below for its lower half
         span = high - low
-        y_range = (low - 0.05 * span, high + span * (0.28 * legend_rows + 0.02))
+        y_range = (low - 0.08 * span, high + 0.03 * span)
         if y_range != self._y_range:  # set only when it changes: a new range lays the axis out again
             self._y_range = y_range
             self.plot.setYRange(*y_range, padding=0)
@@ -532,11 +557,12 @@ class BenchPanel(QWidget):
 
         inpos = ms(figures.in_position_time_s) if in_pos is not None else "no IN-POS channel"
         self.move_label.setText(
-            f"Move from the bench: {m.target - m.start:+.3f} deg; overshoot {m.overshoot_percent:.2f} % "
-            f"({m.overshoot:.4f} deg); settling time {ms(m.settling_time_s)} "
-            f"(band ±{m.settling_band:.3g} deg); in-position (IN-POS) {inpos} after the command ended; "
-            f"following error (command − encoder) at most {figures.following_error_peak_counts:.0f} "
-            f"counts, {figures.following_error_end_counts:.0f} counts at the end\n"
+            f"Move from the bench: {m.target - m.start:+.3f}°; overshoot {m.overshoot_percent:.2f} % "
+            f"({m.overshoot:.4f}°); settling time {ms(m.settling_time_s)} "
+            f"(band ±{m.settling_band:.3g}°); in-position (IN-POS) {inpos} after the command ended; "
+            f"following error (command − encoder) at most "
+            f"{_counted(figures.following_error_peak_counts, 'count')}, "
+            f"{_counted(figures.following_error_end_counts, 'count')} at the end\n"
             + "; ".join(f"{CHECK_WORDS[c.check]}: {VERDICT[c.passed]}{_flange(c)}" for c in self.checks))
         self.sigChecks.emit(list(self.checks))
 
