@@ -61,7 +61,7 @@ from fha_studio.gui.register_questions import (
     shown_location,
 )
 from fha_studio.gui.register_worker import ServerWriter
-from fha_studio.gui.widgets import StopButton
+from fha_studio.gui.widgets import StopButton, hint_whole
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures import ProcedureSession
 from fha_studio.logic.register import Register, RegisterError
@@ -291,11 +291,15 @@ class MachineWindow(QMainWindow):
         self.operator_edit = QLineEdit(str(QSettings().value(OPERATOR_KEY, "")))
         self.operator_edit.setObjectName("operator")
         login = login_name()
-        self.operator_edit.setPlaceholderText(
-            f"your name (the register records it; else the login name {login})" if login
-            else "your name (the register records it)"
+        # the hint short enough to be whole in the toolbar; the tooltip says why the name is asked
+        self.operator_edit.setPlaceholderText(f"your name, else {login}" if login else "your name")
+        self.operator_edit.setToolTip(
+            "Your name: the register records it with what you do"
+            + (f"; left empty, the login name {login}" if login else "")
         )
         self.operator_edit.setMaximumWidth(200)
+        hint_whole(self.operator_edit)
+        self.operator_edit.setMaximumWidth(max(200, self.operator_edit.minimumWidth()))
         self.operator_edit.editingFinished.connect(
             lambda: QSettings().setValue(OPERATOR_KEY, self.operator_edit.text().strip())
         )

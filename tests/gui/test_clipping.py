@@ -164,7 +164,7 @@ def test_the_machine_window_fits_with_every_axis_and_says_it_whole(qtbot, tmp_pa
     the status bar are whole."""
     from fha_studio.gui.machine_window import MachineWindow
     from fha_studio.logic.machine import MachineProject
-    from tests.gui.fit import cut_texts, hidden_actions
+    from tests.gui.fit import cut_hints, cut_texts, hidden_actions
     from tests.support.windows import torn_down
 
     project = MachineProject("Line 3 positioner", site="Plant A, hall 2")
@@ -189,6 +189,7 @@ def test_the_machine_window_fits_with_every_axis_and_says_it_whole(qtbot, tmp_pa
                 if hint.width() > size[0] or hint.height() > size[1]:
                     problems.append(f"{name}: the window needs {hint.width()} x {hint.height()}")
                     continue
-                found = hidden_actions(window) + cut_texts(window)
+                # the operator's hint too: it was cut at both sizes
+                found = hidden_actions(window) + cut_texts(window) + cut_hints(window)
                 problems += [f"{name}, {size[0]} x {size[1]}: {p}" for p in found]
         assert not problems, "\n".join(problems)
