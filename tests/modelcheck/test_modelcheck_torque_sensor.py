@@ -64,3 +64,38 @@ def test_without_the_current_the_load_is_judged_on_the_sensor_alone(with_sensor)
     assert found["coulomb_friction"][1]["torque_nm"] == pytest.approx(5.0, rel=0.35)  # through the loop
     text = "\n".join(result.summary_lines())
     assert "the load on the torque sensor" in text and "the load's are measured" in text
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("current", [True, False], ids=["with-current", "without-current"])
+def test_a_compliant_gear_keeps_its_friction_and_wind_up_apart_from_the_load(current):
+    """The gear winds up (the catalogue's curve), with Coulomb friction 5 N m in it, and a 20 N m
+    unbalance at the load; an encoder on the load, and the sensor on the flange reads what the
+    gear passes on: the load's inertia times the load's own acceleration plus the unbalance. The
+    friction is named in the gear, the unbalance at the load, the wind-up between the encoders."""
+    model = AxisModel.from_code(CODE, load_inertia_kgm2=1.5)
+    t, cmd = trapezoid_moves(moves_for(model), 1000.0)
+    effects = Effects().with_effect("coulomb_friction", torque_nm=5.0)
+    effects = effects.with_effect("gravity_load", amplitude_nm=20.0, phase_deg=30.0)
+    effects = effects.with_effect("torsional_compliance")
+    gen = record(model, effects, t, cmd, actuator_code=CODE, with_load_pos=True)
+    channels = dict(gen.recording.channels)
+    q_load = np.radians(channels["load_pos"])
+    acc = np.zeros_like(q_load)
+    acc[1:-1] = (q_load[2:] - 2.0 * q_load[1:-1] + q_load[:-2]) / 1e-6
+    noise = np.random.default_rng(2).normal(0.0, 0.05, len(q_load))
+    channels["torque"] = model.load_inertia_kgm2 * acc + 20.0 * np.sin(q_load + math.radians(30.0)) + noise
+    if not current:
+        del channels["current"]
+    result = run_modelcheck(Recording(gen.recording.metadata, channels, "sensor"), resimulate=False)
+    found = _found(result)
+    assert set(found) == {"coulomb_friction", "gravity_load", "torsional_compliance"}, result.summary_lines()
+    assert found["coulomb_friction"][0].endswith("in the gear")
+    assert found["gravity_load"][0].endswith("at the load")
+    assert found["gravity_load"][1]["amplitude_nm"] == pytest.approx(20.0, rel=0.05)  # measured
+    # through the loop without the current: the issue's tolerance for what the loop shows
+    tol = 0.05 if current else 0.35
+    assert found["coulomb_friction"][1]["torque_nm"] == pytest.approx(5.0, rel=tol)
+    stiffness = found["torsional_compliance"][1]["stiffness_nm_per_rad"]
+    assert model.stiffness is not None
+    assert stiffness == pytest.approx(model.stiffness.k1_nm_per_rad, rel=0.1 if current else 0.35)
