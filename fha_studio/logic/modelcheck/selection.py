@@ -69,8 +69,8 @@ MIN_OFF_SHAPE_RATIO = 6.0
 MASKED_CV_FACTOR = 3.0  # a look-alike the record cannot rule out fits within this factor of the chosen
 OFF_SHAPE_GAP = 0.45  # off-shape frequencies keep this far (cycles per turn) from the chosen one
 # a searched shape's refinement stops when a step moves it by less than this share: 4e-5 cycles per
-# turn at 4, a hundredth of what a record of a few hundred motor turns resolves (scipy's default,
-# 1e-8, took a third of the evaluations creeping on), and the final fit refines it again
+# turn at 4, a fiftieth of what a record of 500 motor turns resolves (with scipy's default, 1e-8, a
+# sixth of the evaluations crept on below it), and the final fit refines it again
 SHAPE_XTOL = 1e-5
 
 
