@@ -31,9 +31,18 @@ import numpy as np
 from fha_studio.logic.modelcheck.shapes import cycles_within, stribeck_within
 from fha_studio.logic.modelcheck.signals import ARCSEC_PER_RAD, Signals
 from fha_studio.logic.wording import with_unit
+from fha_studio.physics.servo import MIN_SERVO_RATE_HZ
 
 TORQUE = "torque"
 POSITION = "position"
+# A drive reads its speed as the encoder pulses counted per servo period. While the motor turns a
+# few pulses per period or fewer (the creep into a target), that count is a train of 0s and 1s and
+# the speed loop answers it with a current pattern of its own: on the simulated drive with friction
+# a bump of some 5 % of the friction torque over the creep, gone with ideal feedback. Over the
+# fraction of a motor turn a creep covers, a sinusoid of any order fits it, so a torque ripple must
+# also stand where the motor turns faster (or stands still). The servo rate is not in the HA-655's
+# manual: the slowest loop the physics models gives the lowest, most permissive speed.
+QUANTISED_PULSES_PER_PERIOD = 4.0
 # the torque channel split by an output torque sensor: the gear's part and the load's (workflow.py)
 CHANNEL_UNITS = {TORQUE: "N m", POSITION: "arcsec", "gear torque": "N m", "load torque": "N m"}
 
@@ -52,11 +61,19 @@ class ChannelContext:
     cache: dict[tuple[object, ...], np.ndarray] = field(default_factory=dict)
     # > 1: a candidate that `decimates` builds only every rows_step-th sample of the valid part
     rows_step: int = 1
+    # the declared encoder's pulse (rad at the output; 0: not known): the drive's loops see whole pulses
+    pulse_rad: float = 0.0
 
     def smooth(self, full_rate_column: np.ndarray) -> np.ndarray:
         """A column computed on the whole record, smoothed onto the valid part (every rows_step-th
         sample of it)."""
         return self.sig.filt.apply_every(full_rate_column, self.rows_step)
+
+    @property
+    def quantised_below_rad_s(self) -> float:
+        """The output speed below which the drive's speed feedback is ruled by the encoder's
+        quantum (QUANTISED_PULSES_PER_PERIOD pulses per servo period; 0 when the pulse is unknown)."""
+        return QUANTISED_PULSES_PER_PERIOD * self.pulse_rad * MIN_SERVO_RATE_HZ
 
     def full_sign_speed(self, memory: bool = False) -> np.ndarray:
         """Direction of motion on the whole record: 0 while standing, or (memory) the last direction."""
@@ -145,6 +162,9 @@ class Candidate:
     # why a fitted shape lies outside what the recording spans ("" when it does not): checked in
     # every re-fit, since the joint refinement of all parameters is not bounded
     shape_check: Callable[[tuple[float, ...], ChannelContext], str] | None = None
+    # the columns without the creep into a target (where the encoder's quantum rules the speed
+    # feedback): when given, the effect must also stand on them, or the creep alone shows it
+    beyond_creep: Callable[[ChannelContext, tuple[float, ...]], np.ndarray] | None = None
     # build honours ChannelContext.rows_step (smooths with ctx.smooth only): a searched shape's
     # columns are rebuilt at every trial, and the selection then computes only the rows it fits
     decimates: bool = False
@@ -201,6 +221,15 @@ def _periodic_motor_cols(ctx, shape):
     (cycles,) = shape
     angle = cycles * ctx.sig.ratio * ctx.sig.raw_pos_rad
     return np.column_stack([ctx.smooth(np.sin(angle)), ctx.smooth(np.cos(angle))])
+
+
+def _periodic_beyond_creep_cols(ctx, shape):
+    # the same sinusoid, zero while the motor creeps (moving below ctx.quantised_below_rad_s)
+    (cycles,) = shape
+    angle = cycles * ctx.sig.ratio * ctx.sig.raw_pos_rad
+    creeping = (ctx.full_sign_speed() != 0.0) & (np.abs(ctx.sig.full_speed_rad_s) < ctx.quantised_below_rad_s)
+    read = (~creeping).astype(float)
+    return np.column_stack([ctx.smooth(np.sin(angle) * read), ctx.smooth(np.cos(angle) * read)])
 
 
 def _one(name: str, unit: str, scale: float = 1.0):
@@ -400,6 +429,7 @@ TORQUE_CANDIDATES: tuple[Candidate, ...] = (
         primary="amplitude_nm",
         needs_ratio=True,
         motor_side=True,
+        beyond_creep=_periodic_beyond_creep_cols,
         advice=lambda p: (
             f"add {_nm(p['amplitude_nm'])} ripple at {p['cycles_per_motor_rev']:.3g} cycles per motor turn "
             "to the model; if it is large, have the motor and its encoder alignment checked"

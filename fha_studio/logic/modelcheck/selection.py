@@ -45,7 +45,12 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from fha_studio.logic.modelcheck.candidates import Candidate, ChannelContext, Param
+from fha_studio.logic.modelcheck.candidates import (
+    QUANTISED_PULSES_PER_PERIOD,
+    Candidate,
+    ChannelContext,
+    Param,
+)
 from fha_studio.logic.modelcheck.linalg import (
     Beside,
     bic,
@@ -117,7 +122,7 @@ class Trial:
     accepted: bool
     reason: str
     noise_peak: bool = False  # a searched shape that does not stand above its neighbours (look-elsewhere)
-    # gates failed: "evidence", "held_out", "floor", "precision", "noise_peak", "sign"
+    # gates failed: "evidence", "held_out", "floor", "precision", "creep", "noise_peak", "sign"
     failed: tuple[str, ...] = ()
 
 
@@ -303,6 +308,11 @@ class ChannelSelector:
         if size < MIN_SIGMAS * sigma:
             reasons.append(f"size {size:.3g} {self.unit} within {MIN_SIGMAS:g} sigma ({sigma:.3g}) of zero")
             failed.append("precision")
+        if cand.beyond_creep is not None and size >= self.floor and not failed:
+            creep_only = self._creep_only(cand, kept, shape)
+            if creep_only:
+                reasons.append(creep_only)
+                failed.append("creep")
         noise_peak = False
         if cand.look_elsewhere and size >= self.floor:
             off = self.off_shape_size(cand, x1, shape)
@@ -329,6 +339,26 @@ class ChannelSelector:
             tuple(failed + (["noise_peak"] if noise_peak else [])),
         )
         return trial, term
+
+    def _creep_only(self, cand: Candidate, kept: list[Term], shape: tuple[float, ...]) -> str:
+        """Why cand at shape is seen only while the motor creeps ("" when it stands beyond that):
+        its size without the creep must pass the floor and stand MIN_SIGMAS jackknife sigmas."""
+        assert cand.beyond_creep is not None
+        if cand.decimates and self._decimated is not None:
+            cols = np.asarray(cand.beyond_creep(self._decimated, shape), dtype=float)
+        else:
+            cols = np.asarray(cand.beyond_creep(self.ctx, shape), dtype=float)[self.index]
+        x = np.column_stack([self.design(kept), cols])
+        beta, _ = ols(self.y, x)
+        k = cols.shape[1]
+        size = float(cand.size(beta[-k:], self.ctx))
+        sigma = self.size_sigma(cand, x, k)
+        if size >= self.floor and size >= MIN_SIGMAS * sigma:
+            return ""
+        return (
+            f"without the creep into a target (under {QUANTISED_PULSES_PER_PERIOD:g} encoder pulses per "
+            f"servo period) its size is {size:.3g} ± {sigma:.3g} {self.unit}: the creep alone shows it"
+        )
 
     def size_sigma(self, cand: Candidate, x: np.ndarray, k: int) -> float:
         """Delete-one-block jackknife sigma of cand's size (its last k columns of x, shape held)."""

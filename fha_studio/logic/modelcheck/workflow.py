@@ -25,6 +25,7 @@ from fha_studio.logic.modelcheck.candidates import (
     CHANNEL_UNITS,
     POSITION,
     POSITION_CANDIDATES,
+    QUANTISED_PULSES_PER_PERIOD,
     TORQUE,
     TORQUE_CANDIDATES,
     Candidate,
@@ -197,6 +198,7 @@ def run_modelcheck(
     found = Findings()
     for s in chosen:
         _name(s, sig, index, step, found)
+    notes.extend(_creep_notes(chosen, found))
 
     # ---- add: the updated model, named only when it is consistent with the recording
     updated = _updated_model(model, found.effects)
@@ -283,7 +285,9 @@ def _torque_step(
     jerk_col = (axis.nominal_inertia_kgm2 * sig.jerk_rad_s3)[index][:, None]
     return ChannelStep(
         TORQUE,
-        ChannelContext(sig, TORQUE, nominal_inertia_kgm2=axis.nominal_inertia_kgm2),
+        ChannelContext(
+            sig, TORQUE, nominal_inertia_kgm2=axis.nominal_inertia_kgm2, pulse_rad=axis.model.output_pulse_rad
+        ),
         y_nm,
         tuple(c for c in TORQUE_CANDIDATES if c.id not in excitation.excluded()),
         floor_nm,
@@ -456,6 +460,30 @@ def _name(s: Selected, sig: Signals, index: np.ndarray, step: int, found: Findin
         {k: binned(v, after, k, var_units[k]) for k, v in variables.items()},
     )
     found.gaps[ch] = _gap(sel, terms, ch, unit, sig.t_s[index])
+
+
+def _creep_notes(chosen: list[Selected], found: Findings) -> list[str]:
+    """One line for each effect left unnamed only because the creep into a target alone shows it
+    (its last trial failed that gate): the drive's speed from whole encoder pulses, not the axis."""
+    named = {e.id for e in found.effects}
+    lines = []
+    for s in chosen:
+        last = {t.id: t for st in s.report.steps for t in st.trials}
+        labels = {c.id: c for c in s.step.candidates}
+        for trial in last.values():
+            if "creep" not in trial.failed or trial.id in named:
+                continue
+            cand = labels[trial.id]
+            searched = "cycles_per_motor_rev" in cand.shape_names
+            at = f" at {trial.shape[0]:.2f} cycles per motor turn" if searched else ""
+            speed_rpm = s.step.ctx.quantised_below_rad_s * 60.0 / (2.0 * np.pi)
+            lines.append(
+                f"Note: {cand.label.lower()} ({trial.size:.3g} {s.report.unit}{at}) is not named: only "
+                "the creep into a target shows it, where the drive counts fewer than "
+                f"{QUANTISED_PULSES_PER_PERIOD:g} encoder pulses per servo period (below {speed_rpm:.2g} "
+                "r/min at the output) and its speed loop makes a current pattern of its own."
+            )
+    return lines
 
 
 def _signals(rec: Recording, axis: DeclaredAxis, window: int | None) -> Signals:

@@ -642,6 +642,7 @@ GATE_WORDS = {
     "held_out": "it does not explain held-out data better",
     "floor": "too small to matter",
     "precision": "the recording does not pin its size down",
+    "creep": "only the creep into a target shows it (the encoder's pulses rule the drive's speed there)",
     "noise_peak": "no larger than what noise gives at other frequencies",
     "sign": "its sign is not physical (friction cannot push)",
 }
