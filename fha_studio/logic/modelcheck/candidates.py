@@ -36,12 +36,12 @@ from fha_studio.physics.servo import MIN_SERVO_RATE_HZ
 TORQUE = "torque"
 POSITION = "position"
 # A drive reads its speed as the encoder pulses counted per servo period. While the motor turns a
-# few pulses per period or fewer (the creep into a target), that count is a train of 0s and 1s and
-# the speed loop answers it with a current pattern of its own: on the simulated drive with friction
-# a bump of some 5 % of the friction torque over the creep, gone with ideal feedback. Over the
-# fraction of a motor turn a creep covers, a sinusoid of any order fits it, so a torque ripple must
-# also stand where the motor turns faster (or stands still). The servo rate is not in the HA-655's
-# manual: the slowest loop the physics models gives the lowest, most permissive speed.
+# few pulses per period or fewer (the creep into a target), that count is coarse (0s and 1s at the
+# slowest) and the speed loop answers it with a current pattern of its own: on the simulated drive
+# with friction a bump of some 5 % of the friction torque over the creep, gone with ideal feedback.
+# Over the fraction of a motor turn a creep covers, a sinusoid of any order fits it, so a torque
+# ripple must also stand where the motor turns faster (or stands still). The servo rate is not in
+# the HA-655's manual: the slowest loop the physics models gives the lowest, most permissive speed.
 QUANTISED_PULSES_PER_PERIOD = 4.0
 # the torque channel split by an output torque sensor: the gear's part and the load's (workflow.py)
 CHANNEL_UNITS = {TORQUE: "N m", POSITION: "arcsec", "gear torque": "N m", "load torque": "N m"}

@@ -471,7 +471,7 @@ def _creep_notes(chosen: list[Selected], found: Findings) -> list[str]:
         last = {t.id: t for st in s.report.steps for t in st.trials}
         labels = {c.id: c for c in s.step.candidates}
         for trial in last.values():
-            if "creep" not in trial.failed or trial.id in named:
+            if trial.failed != ("creep",) or trial.id in named:
                 continue
             cand = labels[trial.id]
             searched = "cycles_per_motor_rev" in cand.shape_names
