@@ -559,9 +559,7 @@ class RegisterDialog(QDialog):
         self._conflicts = self._every if self.show_settled.isChecked() else open_now
         rows = []
         for c in self._conflicts:
-            what = ", ".join(c.item_name(k) for k in c.items())
-            rows.append([c.axis.name, when_text(c.at_utc), c.who, f"{SUBJECTS[c.subject]}: {what}",
-                         self._state_words(c)])
+            rows.append([c.axis.name, when_text(c.at_utc), c.who, c.differs_words(), self._state_words(c)])
         self.conflicts_table.blockSignals(True)
         _fill(self.conflicts_table, rows)
         self.conflicts_table.blockSignals(False)

@@ -23,7 +23,7 @@ MACHINE = "Line 3 positioner"
 TABLE = "FHA-25C-50-US250"
 TILT = "FHA-32C-100-S248-B"
 #: The rotary direction's write, as the register's history says it.
-WRITTEN = "parameter 8 Rotary direction: 0 → 1: reversed: FWD turns CCW, verified"
+WRITTEN = "parameter 8 Rotary direction: 0 → 1: FWD turns CCW (reversed), verified"
 
 
 @pytest.fixture

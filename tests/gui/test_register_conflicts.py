@@ -72,7 +72,9 @@ def test_a_reviewer_settles_a_conflict_side_by_side(qtbot, synced, fixed_clock):
     )
     # the history says where a conflict is settled in this window, not the command line
     history = _column(dialog.history_table, 3)
-    assert sum(t.endswith("): open — settle it on the Conflicts tab") for t in history) == 2
+    assert sum(t.endswith(": open — settle it on the Conflicts tab") for t in history) == 2
+    # the origin is named once: "the origin differs between …: open", not "… (origin): open"
+    assert not any("(origin)" in t for t in history)
     assert not any("fha-studio register resolve" in t for t in history)
     # the open items lead there
     row = _column(dialog.open_table, 1).index("conflict")
@@ -80,7 +82,7 @@ def test_a_reviewer_settles_a_conflict_side_by_side(qtbot, synced, fixed_clock):
     assert dialog.tabs.currentIndex() == dialog.conflicts_index
     assert sorted(_column(dialog.conflicts_table, 3)) == [
         "parameters differ: tune 4 In-position range, parameter 8 Rotary direction",
-        "the origin differs: origin",
+        "the origin differs",  # not "the origin differs: origin"
     ]
     assert _column(dialog.conflicts_table, 4) == ["open", "open"]
     parameters = next(c for c in reg.conflicts() if c.subject == "parameters")
@@ -101,7 +103,7 @@ def test_a_reviewer_settles_a_conflict_side_by_side(qtbot, synced, fixed_clock):
     assert [r[0] for r in rows] == ["tune 4 In-position range (pulse)", "parameter 8 Rotary direction"]
     in_position, direction = rows
     assert direction[ana_n].splitlines() == [
-        "1: reversed: FWD turns CCW",
+        "1: FWD turns CCW (reversed)",
         "parameters read — ana, 2026-11-30 07:01:00 UTC",
         f"recorded in {headers[ana_n].split(': ', 1)[1]}",
     ]

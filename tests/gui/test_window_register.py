@@ -15,7 +15,7 @@ from tests.support.windows import torn_down
 FULL = "sim://FHA-25C-50-US250?paced=0"
 #: As a real HA-655: DGR and OWW only; the drive names no actuator.
 DOCUMENTED = "sim://FHA-32C-100-S248?profile=documented&paced=0"
-ROTARY_DIRECTION_WRITTEN = "parameter 8 Rotary direction: 0 → 1: reversed: FWD turns CCW, verified"
+ROTARY_DIRECTION_WRITTEN = "parameter 8 Rotary direction: 0 → 1: FWD turns CCW (reversed), verified"
 
 
 @pytest.fixture

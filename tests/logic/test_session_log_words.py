@@ -29,5 +29,5 @@ def test_a_failed_write_says_so():
     )
     assert record.line(item).endswith(
         "parameter 8, rotary direction: 0: FWD turns CW (seen from the flange) → "
-        "1: reversed: FWD turns CCW, NOT verified (the servo is on)"
+        "1: FWD turns CCW (reversed), NOT verified (the servo is on)"
     )

@@ -67,12 +67,12 @@ def test_machines_and_axes(capsys, db):
 def test_history_diff_find_in_words_and_json(capsys, db):
     code, out, _ = run(capsys, db, "history", "Line 3/table")
     assert code == 0
-    written = "parameter 8 Rotary direction: 0 → 1: reversed: FWD turns CCW, verified"
+    written = "parameter 8 Rotary direction: 0 → 1: FWD turns CCW (reversed), verified"
     assert f"2026-11-30 08:10:00  write       {written} [ana]" in out
     assert "parameters  parameters read over the link: 2 values, snapshot 1 [ana]" in out
     code, out, _ = run(capsys, db, "diff", "Line 3/table", "Line 3/table twin")
     assert code == 0
-    assert "parameter 8 Rotary direction" in out and "1: reversed: FWD turns CCW" in out
+    assert "parameter 8 Rotary direction" in out and "1: FWD turns CCW (reversed)" in out
     assert "In-position" not in out and "in_position" not in out  # the same on both
     code, out, _ = run(capsys, db, "diff", "1", "2", "--json")
     assert json.loads(out)["differences"] == []  # both snapshots read the delivery values

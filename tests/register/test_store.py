@@ -107,7 +107,7 @@ def test_history_of_an_axis_in_time_order(line3):
     events = [e for e in history if e.kind != "axis"]  # the axis events are stamped now
     assert [e.kind for e in events] == ["snapshot", "write", "alarm"]  # 09:01+01:00 is 08:01 UTC
     assert events[0].ref == first and "3 values" in events[0].text and events[0].who == "ana"
-    assert events[1].text == "parameter 8 Rotary direction: 0 → 1: reversed: FWD turns CCW, verified"
+    assert events[1].text == "parameter 8 Rotary direction: 0 → 1: FWD turns CCW (reversed), verified"
     assert events[1].at_utc == "2026-11-30T08:01:00.000000+00:00"
     axis_events = [e for e in history if e.kind == "axis"]
     assert axis_events[0].text.startswith("axis added: FHA-25C-50-US250") and axis_events[0].who == "ana"

@@ -104,7 +104,7 @@ class Resolution:
 class HeldWords:
     """What one side of a conflict held for one item, for people."""
 
-    value: str  # in the item's words: "1: reversed: FWD turns CCW", "25 pulse"
+    value: str  # in the item's words: "1: FWD turns CCW (reversed)", "25 pulse"
     source: str  # the fact that says it: "parameters read", "verified write", "axis entry"
     who: str
     when: str  # UTC, "2026-12-05 08:12:40"
@@ -171,6 +171,14 @@ class Conflict:
                 out.append(f"    {n}. {held.value}{from_what}{f' ({by})' if by else ''}, in {held.where}")
         return out
 
+    def differs_words(self) -> str:
+        """What differs, in words: "parameters differ: parameter 8 Rotary direction"; the origin is
+        one item, which its subject names ("the origin differs", not "the origin differs: origin")."""
+        subject = SUBJECTS.get(self.subject, self.subject)
+        if self.subject == "origin":
+            return subject
+        return f"{subject}: {', '.join(self.item_name(k) for k in self.items())}"
+
     def summary(self) -> str:
         """One line: what differs, and where it stands."""
         what = ", ".join(item_name(self.subject, k, self.sides, self.axis.driver_model) for k in self.items())
@@ -178,7 +186,8 @@ class Conflict:
         state = "open" if self.open else f"settled: kept {self.resolutions[-1].kept}"
         if self.open and len(self.resolutions) > 1:
             state = "open: settled twice differently"
-        return f"{SUBJECTS.get(self.subject, self.subject)} between {where} ({what}): {state}"
+        items = "" if self.subject == "origin" else f" ({what})"  # the subject names the origin
+        return f"{SUBJECTS.get(self.subject, self.subject)} between {where}{items}: {state}"
 
     def as_dict(self) -> dict[str, Any]:
         return {

@@ -68,7 +68,7 @@ def parameter_name(key: str, driver_model: str = "", where: tuple[str, int] | No
 
 
 def change_text(key: str, old: int | None, new: int, driver_model: str = "") -> str:
-    """``"10 → 25 pulse"``, ``"0 → 1: reversed: FWD turns CCW"``: a
+    """``"10 → 25 pulse"``, ``"0 → 1: FWD turns CCW (reversed)"``: a
     change of a parameter's value in the item's words ("unknown" for a value nobody read)."""
     item = parameter_item(key, driver_model)
     after = value_text(key, new, driver_model)
@@ -99,7 +99,7 @@ def readings_text(values: dict[str, Any]) -> str:
 
 
 def value_text(key: str, value: int | None, driver_model: str = "") -> str:
-    """A wire value in the item's words (``"1: reversed: FWD command turns CCW"``, ``"20 pulse"``)."""
+    """A wire value in the item's words (``"1: FWD turns CCW (reversed)"``, ``"20 pulse"``)."""
     if value is None:
         return "(not in it)"
     item = parameter_item(key, driver_model)
