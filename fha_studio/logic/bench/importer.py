@@ -8,12 +8,12 @@ them at :data:`OUTPUT_RATE_HZ` (or the capture's rate if lower):
   an encoder, SPD-MON integrated (the metadata says so);
 - ``cmd_pos`` [deg]: the command pulses through parameters 1, 2, 3, 4, in the same counts;
 - ``vel`` [r/min, output]: SPD-MON by parameter 9, less its offset at standstill, / ratio, the
-  mean over each output interval;
+  mean over one output interval centred on the sample's instant (the instant ``pos`` is taken);
 - ``alm_code``: the alarm code lines ALM-A ... ALM-D (roles ``alm_a`` ... ``alm_d``) as the 4-bit
   code (D C B A, ON = 1; 13 = 1101, the encoder alarms), the summary naming each code that came,
   when, and the alarms of the HA-655's table it can be;
 - ``in_pos`` (1 = on), ``alarm`` (1 = on) and ``current`` [A] = probe volts x A per V, the mean
-  over each interval, only where a probe measured it;
+  over the same centred interval, only where a probe measured it;
 - ``load_pos`` [deg, output]: an external encoder on the output flange (roles ``load_encoder_a``,
   ``load_encoder_b``; not a CN2 signal: the bench's own), counted x4 at the counts per output turn
   the technician states: the load after the gear's wind-up, kinematic error and lost motion.
@@ -348,11 +348,16 @@ def _peak_mean(values: np.ndarray, window: int) -> float:
     return float(np.max(np.abs(means)))
 
 
-def _window_means(values: np.ndarray, idx: np.ndarray, n: int) -> np.ndarray:
-    """Mean of ``values`` over [idx[k], idx[k+1]) (the last window runs to the end)."""
+def _centred_means(values: np.ndarray, idx: np.ndarray, n: int, step: float) -> np.ndarray:
+    """Mean of ``values`` over a window of one output interval centred on each ``idx[k]`` (cut at
+    the capture's ends): an analog channel decimated without aliasing and without a lag against
+    the positions, which are taken at the instant ``idx[k]`` (a window starting there made the
+    speed lead the position by half an interval, 0.5 ms at 1 kHz)."""
+    window = max(1, round(step))
     csum = np.concatenate(([0.0], np.cumsum(values, dtype=np.float64)))
-    ends = np.append(idx[1:], n)
-    means: np.ndarray = (csum[ends] - csum[idx]) / np.maximum(ends - idx, 1)
+    starts = np.clip(idx - window // 2, 0, n - 1)
+    ends = np.clip(idx - window // 2 + window, starts + 1, n)
+    means: np.ndarray = (csum[ends] - csum[starts]) / (ends - starts)
     return means
 
 
@@ -408,7 +413,7 @@ def _make(
             + f", electronic gear {settings.gear_numerator}/{settings.gear_denominator}"
         )
     if decoded.speed is not None:
-        columns["vel"] = _window_means(decoded.speed.motor_rpm, idx, n) / axis.ratio
+        columns["vel"] = _centred_means(decoded.speed.motor_rpm, idx, n, step) / axis.ratio
         sources["vel"] = (
             f"{src('speed_monitor')}, +10 V = {settings.speed_conversion_rpm:g} r/min motor "
             f"(parameter 9) / {axis.ratio}, offset {decoded.speed.offset_v * 1000:.1f} mV"
@@ -423,7 +428,7 @@ def _make(
     if any(role in logic for role in ALM_ROLES):
         columns["alm_code"], sources["alm_code"], alarm_codes = _alarm_code(logic, idx, columns["t"], src)
     if "current_probe" in analog and current_scale is not None:
-        columns["current"] = _window_means(analog["current_probe"], idx, n) * current_scale
+        columns["current"] = _centred_means(analog["current_probe"], idx, n, step) * current_scale
         sources["current"] = f"{src('current_probe')}, {current_scale:g} A/V"
     extra = {f"source_{name}": text for name, text in sources.items()}
     extra["recorded_by"] = "fha-studio bench import"
