@@ -7,7 +7,8 @@ HA-655), its CN2 streamed as the ``sim-cn2`` instrument (a logic analyzer on the
 outputs, the command pulse inputs, IN-POS, ALARM and ALM-A ... D, an oscilloscope channel on
 SPD-MON), parameter 8 entered from the drive's panel, the Procedures page on the rotary
 direction's FWD step, the controller played by the drive's panel: servo-ON and a 10 deg FWD
-command, which answers that step; then an alarm (60) on the code lines. Then sigrok-cli's
+command, which answers that step (the tab holds the move its figures describe while the
+stream goes on); then, back to live, an alarm (60) on the code lines. Then sigrok-cli's
 ``demo`` driver, as any of its instruments shows on the tab. Settings and data go to a
 temporary directory, never the user's.
 """
@@ -63,7 +64,8 @@ def main() -> int:
     window.sim_panel.command_spin.setValue(10.0)
     window.sim_panel.fwd_button.click()
     wait_until(lambda: bench.move_figures is not None, "the move's figures")
-    shot("bench-move")  # at once: the tab shows the newest 2 s, the move among them
+    settle(2.5)  # the stream goes on past the live window: the tab holds the move its figures describe
+    shot("bench-move")
     wait_until(lambda: procedures.run is not None and procedures.run.completed, "the FWD step from the bench")
     scope.view.plots.setCurrentWidget(scope.view.time_plot)  # the same stream beside CN3's channels
     settle(1.0)
@@ -73,6 +75,7 @@ def main() -> int:
     shot("procedures-bench")
     window.show_page("scope")
     scope.view.plots.setCurrentWidget(bench)
+    bench.back_button.click()  # the newest seconds again, to watch the alarm come
     # an alarm: the code on ALM-D C B A in the manual's words (60: the error counter overflowed)
     window.link._worker._client.transaction.transport.inner.sim_drive.raise_alarm(60)
     wait_until(lambda: "60 Error counter overflow" in bench.alarm_label.text(), "the alarm code")

@@ -88,6 +88,45 @@ def test_a_controller_move_is_shown_live_from_cn2_with_the_move_tests_figures(wi
         bench.start_button.click()
 
 
+def test_the_analysed_move_stays_on_the_plots_while_the_stream_goes_on(window, qtbot):
+    """The figures describe a move the technician can see: the plots hold it (the live window
+    shows only the newest 2 s) until Back to live, and the stream is received meanwhile."""
+    from fha_studio.gui.pages.scope.bench_panel import STEP_S, WINDOW_S
+
+    bench = window.show_page("scope").bench
+    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
+        bench.scan()
+    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
+        bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS", "250k",
+                    "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS")
+    assert bench.hold_bar.isHidden()
+    _panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
+    qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
+    window.sim_panel.command_spin.setValue(10.0)
+    _panel_done(window, qtbot, window.sim_panel.fwd_button.click)
+    qtbot.waitUntil(lambda: bench.move_figures is not None, timeout=30000)
+    assert "Showing the move at " in bench.showing_label.text() and not bench.hold_bar.isHidden()
+    ring = bench.source.started.ring
+    shown_until = float(bench._counts_curve.getData()[0][-1])
+    # the stream goes on past the live window: a live view would show none of the move now
+    qtbot.waitUntil(lambda: float(ring.window(1)[0, 0]) > shown_until + WINDOW_S + STEP_S, timeout=20000)
+    t, counts = bench._counts_curve.getData()
+    step_counts = round(10.0 / 360.0 * COUNTS_PER_OUTPUT_TURN)
+    # from standing before the command to standing in position after it: within the in-position
+    # range (tune 4: 10 counts) of the move's counts
+    assert abs((counts[-1] - counts[0]) - step_counts) <= 10
+    assert float(t[-1]) == shown_until  # still the move, not the newest rows
+    low, high = bench.plot.getViewBox().viewRange()[0]
+    assert low <= float(t[0]) and float(t[-1]) <= high
+    # back to the newest seconds: the rows received while the move was on show are there
+    bench.back_button.click()
+    assert bench.hold_bar.isHidden()
+    qtbot.waitUntil(lambda: float(bench._counts_curve.getData()[0][-1]) > shown_until + WINDOW_S,
+                    timeout=10000)
+    with qtbot.waitSignal(bench.source.sigStopped, timeout=10000):
+        bench.start_button.click()
+
+
 def test_the_instrument_goes_when_its_drive_does(make_window, qtbot):
     window = make_window(connect=URL)
     assert [d.spec for d in cn2_live.devices()] == ["sim-cn2"]

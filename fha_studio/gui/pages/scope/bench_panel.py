@@ -5,13 +5,16 @@ encoder A/B/Z, IN-POS, ALARM) still show on a logic analyzer or an oscilloscope.
 the instruments sigrok-cli finds, streams the channels asked for (``BenchSource``) and plots the
 newest seconds, every trace named with its source (``bench demo:D0``) so nobody takes it for a
 CN3 channel; ALARM and the alarm code on ALM-A ... D are shown in the manual's words as they
-come. Where sigrok-cli is missing the tab says how to install it.
+come. Once a move's figures come, the plots hold that move (from a little before its command
+until a little after IN-POS came on) while the stream goes on, until the next move or "Back to
+live". Where sigrok-cli is missing the tab says how to install it.
 """
 
 from __future__ import annotations
 
 import math
 import shutil
+import time
 
 import numpy as np
 import pyqtgraph as pg
@@ -48,6 +51,10 @@ STEP_S = 0.5
 MOVE_SETTLED_S = 0.5
 #: A command standing still this long before a change marks where a move began [s].
 MOVE_GAP_S = 0.2
+#: The move on hold is shown from this long before its command began [s].
+MOVE_BEFORE_S = 0.2
+#: ... until this long after IN-POS came on [s] (without IN-POS: until its figures were taken).
+MOVE_AFTER_S = 0.2
 #: The checks as the move's line names them.
 CHECK_WORDS = {"bench_encoder": "encoder outputs follow the command", "bench_direction": "direction",
                "bench_in_position": "IN-POS", "bench_alarm": "ALARM"}
@@ -190,6 +197,22 @@ class BenchPanel(QWidget):
         grid.addLayout(alarms, 3, 0, 1, 4)
         grid.setColumnStretch(1, 1)
         layout.addLayout(grid)
+        # while a move is on hold: which, and the way back to the newest seconds (hidden while
+        # live: the plots keep their height on a small screen)
+        self.hold_bar = QWidget()
+        showing = QHBoxLayout(self.hold_bar)
+        showing.setContentsMargins(0, 0, 0, 0)
+        self.showing_label = QLabel("")
+        self.showing_label.setObjectName("scopeBenchShowing")
+        showing.addWidget(self.showing_label, 1)
+        self.back_button = QPushButton("Back to live")
+        self.back_button.setObjectName("scopeBenchBack")
+        self.back_button.setToolTip("Leave the move on show and return to the newest seconds of the stream")
+        self.back_button.clicked.connect(self.back_to_live)
+        showing.addWidget(self.back_button)
+        self.hold_bar.setVisible(False)
+        layout.addWidget(self.hold_bar)
+        self._held: np.ndarray | None = None  # the move's rows on show (a copy), else None: live
         self.plot = pg.PlotWidget(background="w")
         self.plot.setLabel("bottom", "time", units="s")
         _legend_above(self.plot.plotItem, columns=3)
@@ -275,6 +298,25 @@ class BenchPanel(QWidget):
     def stop(self) -> None:
         self.source.stop()
 
+    def back_to_live(self) -> None:
+        """The newest seconds again (the stream went on meanwhile: nothing of it is lost)."""
+        if self._held is None:
+            return
+        self._held = None
+        self.hold_bar.setVisible(False)
+        self._x_range = self._y_range = self._counts_range = None
+        self._draw_live()
+
+    def _hold(self, started: BenchStarted, rows: np.ndarray) -> None:
+        """The move's rows on the plots until the next move or Back to live."""
+        self._held = rows
+        wall = time.time() - (time.monotonic() - started.t0 - float(rows[0, 0]))
+        self.showing_label.setText(f"Showing the move at {time.strftime('%H:%M:%S', time.localtime(wall))}"
+                                   f" ({float(rows[-1, 0] - rows[0, 0]):.2f} s) while the stream goes on.")
+        self.hold_bar.setVisible(True)
+        self._x_range = self._y_range = self._counts_range = None
+        self._draw(started, rows, (float(rows[0, 0]), float(rows[-1, 0])))
+
     def shutdown(self) -> None:
         self.source.shutdown()
 
@@ -320,6 +362,8 @@ class BenchPanel(QWidget):
         self._move_seen_at = None
         self._last_command_change = None
         self.move_label.setText("")
+        self._held = None
+        self.hold_bar.setVisible(False)
         self.status_label.setText(f"Starting {device} …")
         self.source.start(BenchSettings(device, names, rate, encoder, command, self.drive))
 
@@ -428,16 +472,30 @@ class BenchPanel(QWidget):
         started = self._started
         if started is None:
             return
+        newest = self._draw_live() if self._held is None else started.ring.window(1)
+        if not len(newest):
+            return
+        self._show_alarm(started, newest[-1])
+        self._measure_move(started, _rows)
+
+    def _draw_live(self) -> np.ndarray:
+        """The newest WINDOW_S of the stream on the plots; the rows drawn (none: nothing yet)."""
+        started = self._started
+        if started is None:
+            return np.empty((0, 1))
         rows = started.ring.window(int((WINDOW_S + STEP_S) * started.row_rate_hz))
         if not len(rows):
-            return
-        # drawn as the plot's pixels show it (each pixel's least and largest value), over a fixed
-        # window: a redraw neither walks every row nor looks for the data's bounds
-        rows = peak_rows(rows, max(200, self.plot.width()))
+            return rows
         # the time axis steps on every STEP_S instead of scrolling each frame (a new range lays
         # its ticks out again, which costs more than the traces): the newest WINDOW_S always shows
         right = (math.floor(float(rows[-1, 0]) / STEP_S) + 1) * STEP_S
-        x_range = (max(0.0, right - WINDOW_S - STEP_S), max(right, WINDOW_S + STEP_S))
+        return self._draw(started, rows, (max(0.0, right - WINDOW_S - STEP_S), max(right, WINDOW_S + STEP_S)))
+
+    def _draw(self, started: BenchStarted, rows: np.ndarray, x_range: tuple[float, float]) -> np.ndarray:
+        """``rows`` on the plots over ``x_range`` [s]; the rows as drawn."""
+        # drawn as the plot's pixels show it (each pixel's least and largest value), over a fixed
+        # window: a redraw neither walks every row nor looks for the data's bounds
+        rows = peak_rows(rows, max(200, self.plot.width()))
         if x_range != self._x_range:
             self._x_range = x_range
             self.plot.setXRange(*x_range, padding=0)
@@ -464,8 +522,7 @@ class BenchPanel(QWidget):
                 pad = max(0.1 * (hi - lo), MIN_COUNTS_PAD)  # a count's dither at standstill is no band
                 self._counts_range = (lo - pad, hi + pad)
                 self.counts_plot.setYRange(*self._counts_range, padding=0)
-        self._show_alarm(started, rows[-1])
-        self._measure_move(started, _rows)
+        return rows
 
     def _alarm_columns(self, started: BenchStarted) -> tuple[int | None, list[int | None]]:
         """The row columns of ALARM and of ALM-A ... D (None: not mapped)."""
@@ -533,6 +590,13 @@ class BenchPanel(QWidget):
         except ValueError:
             return
         self.move_figures = figures
+        # the move on show: from a little before its command began until a little after IN-POS
+        # came on (without IN-POS: all the rows its figures were taken from)
+        end = t[-1]
+        if figures.in_position_time_s is not None:
+            end = min(end, t[changes[-1] + 1] + figures.in_position_time_s + MOVE_AFTER_S)
+        first_shown = int(np.searchsorted(t, t[begun] - MOVE_BEFORE_S))
+        self._hold(started, rows[first_shown: int(np.searchsorted(t, end, side="right"))].copy())
         alarm_name = self.alarm_edit.text().strip()
         alarm_column, alm_columns = self._alarm_columns(started)
         alarm = rows[start:, alarm_column] if alarm_column is not None else None

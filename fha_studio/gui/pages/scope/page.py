@@ -54,6 +54,7 @@ class ScopePage(BasePage):
         self.view.plots.addTab(self.bench, "Bench")
         self._host = main_window
         self.bench.sigChecks.connect(self._bench_checks)
+        self.view.toolbar.sigBackToLive.connect(self.bench.back_to_live)  # the bench's move too
         # its stream on the Time plot too, beside the CN3 channels
         self.bench.source.sigRows.connect(self._bench_on_time_plot)
         self.bench.source.sigStarted.connect(lambda _s: self.view.time_plot.set_bench_curves({}))
