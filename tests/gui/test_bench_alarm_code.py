@@ -13,7 +13,9 @@ URL = f"sim://{CODE}?paced=0&profile=documented"
 def test_the_alarm_code_lines_are_shown_in_the_manuals_words(make_window, qtbot):
     window = make_window(connect=URL)
     drive = window.link._worker._client.transaction.transport.inner.sim_drive
-    bench = window.show_page("scope").bench
+    scope = window.show_page("scope")
+    bench = scope.bench
+    scope.view.plots.setCurrentWidget(bench)
     with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
         bench.start("sim-cn2", "ENC_A,ENC_B,ALARM,ALM_A,ALM_B,ALM_C,ALM_D", "50k",
                     "ENC_A,ENC_B", alarm="ALARM", alm=("ALM_A", "ALM_B", "ALM_C", "ALM_D"))
@@ -25,6 +27,12 @@ def test_the_alarm_code_lines_are_shown_in_the_manuals_words(make_window, qtbot)
     assert bench.alarm_label.text() == ("Alarm from the bench: ALARM ON; ALM-D C B A 0010: 60 Error "
                                         "counter overflow; the front panel's 2-digit code and the Alarms "
                                         "page say more")
+    # the code lines in one lane, as a logic analyzer shows a bus: the code written in it
+    lanes = [name for _, name in bench.plot.getAxis("right")._tickLevels[0]]
+    assert lanes == ["bench sim-cn2:ENC_A", "bench sim-cn2:ENC_B", "bench sim-cn2:ALARM",
+                     "bench sim-cn2:ALM-D C B A"]
+    qtbot.waitUntil(lambda: "0010" in [t.toPlainText() for t in bench._code_texts if t.isVisible()],
+                    timeout=10000)
     with qtbot.waitSignal(bench.source.sigStopped, timeout=10000):
         bench.start_button.click()
     saved = bench_mappings.saved("sim-cn2")

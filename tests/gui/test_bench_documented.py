@@ -80,10 +80,11 @@ def test_a_controller_move_is_shown_live_from_cn2_with_the_move_tests_figures(wi
     assert " 1 counts" not in text and "(s)" not in bench.status_label.text()
     x, y = bench._curves[0].getData()
     assert x is not None and len(x) > 1000 and set(np.unique(np.round(y % 1.2, 3))) <= {0.0, 0.8}
-    # the logic lanes named at the right beside each, the analog channel in the legend
+    # the logic lanes named at the right beside each, the analog channel at its own plot's right
     lanes = [name for _, name in bench.plot.getAxis("right")._tickLevels[0]]
     assert lanes[0] == "bench sim-cn2:ENC_A" and lanes[-1] == "bench sim-cn2:IN_POS" and len(lanes) == 5
-    assert [item.text for _, item in bench.plot.plotItem.legend.items] == ["bench sim-cn2:SPD_MON"]
+    analog = [name for _, name in bench.analog_plot.getAxis("right")._tickLevels[0]]
+    assert analog == ["bench sim-cn2:SPD_MON"]
     with qtbot.waitSignal(bench.source.sigStopped, timeout=10000):
         bench.start_button.click()
 

@@ -3,11 +3,13 @@
 A real HA-655 answers CN3 with ``s`` while its servo is on; its CN2 monitor outputs (SPD-MON,
 encoder A/B/Z, IN-POS, ALARM) still show on a logic analyzer or an oscilloscope. This tab lists
 the instruments sigrok-cli finds, streams the channels asked for (``BenchSource``) and plots the
-newest seconds, every trace named with its source (``bench demo:D0``) so nobody takes it for a
-CN3 channel; ALARM and the alarm code on ALM-A ... D are shown in the manual's words as they
-come. Once a move's figures come, the plots hold that move (from a little before its command
-until a little after IN-POS came on) while the stream goes on, until the next move or "Back to
-live". Where sigrok-cli is missing the tab says how to install it.
+newest seconds as a logic analyzer does (each logic channel a lane of a fixed height, ALM-A ... D
+one lane showing the code, the analog channels and the encoder's counts in plots of their own, all
+scrolling where the screen is too low), every trace named with its source (``bench demo:D0``) so
+nobody takes it for a CN3 channel; ALARM and the alarm code on ALM-A ... D are shown in the
+manual's words as they come. Once a move's figures come, the plots hold that move (from a little
+before its command until a little after IN-POS came on) while the stream goes on, until the next
+move or "Back to live". Where sigrok-cli is missing the tab says how to install it.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QLineEdit,
     QPushButton,
+    QScrollArea,
     QVBoxLayout,
     QWidget,
 )
@@ -63,20 +66,27 @@ VERDICT = {True: "pass", False: "FAIL", None: "recorded"}
 LEFT_AXIS_PX = 62
 #: The counts' plot shows at least this many counts above and below what it draws.
 MIN_COUNTS_PAD = 5.0
-#: The width a trace's name takes in the legend [px] ("bench sim-cn2:ENC_A" and its line).
-LEGEND_NAME_PX = 190
+#: The analog plot shows at least this much above and below what it draws [V] (noise is no band).
+MIN_ANALOG_PAD_V = 0.1
+#: A logic lane's height [px], as a logic analyzer's: its name (the lane font) whole beside it.
+LANE_PX = 16
+#: A lane's height in the lanes' plot [its units]; the trace takes LANE_HIGH of it.
+LANE_STEP = 1.2
+LANE_HIGH = 0.8
+#: The analog channels' plot and the counts' plot draw their traces at least this high [px] (room
+#: to read a trace's shape and three of its axis's numbers); the time axis comes on top.
+TRACE_VIEW_MIN_PX = 50
+#: A plot's height besides its view [px] (the scene's margins); the time axis below adds its own.
+PLOT_MARGINS_PX = 6
 _COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#e07000", "#9467bd", "#8c564b", "#e377c2", "#008b8b")
 
 
-def _legend_above(item: pg.PlotItem, columns: int = 1) -> None:
-    """The plot's legend in its title row, above the traces (inside the view it sat on a trace, as
-    the scope's legend is above its plots); curves named when plotted go into it as into a plot's
-    own legend."""
-    item.legend = pg.LegendItem(colCount=columns, labelTextColor="#303030")
-    item.layout.removeItem(item.titleLabel)  # no title: its row (fixed at 0 height) takes the legend
-    item.titleLabel.setVisible(False)
-    item.layout.setRowMaximumHeight(0, 1000)
-    item.layout.addItem(item.legend, 0, 1)
+def _names_at_right(plot: pg.PlotWidget, names: list[str], y_range: tuple[float, float]) -> None:
+    """The traces of ``plot`` named at its right, as the lanes are (a legend row above it would
+    take the height its traces need on a small screen)."""
+    low, high = y_range
+    ticks = [(low + (high - low) * (len(names) - n - 0.5) / len(names), name) for n, name in enumerate(names)]
+    plot.getAxis("right").setTicks([ticks, []])
 
 
 def _counted(n: float, noun: str) -> str:
@@ -120,8 +130,14 @@ class BenchPanel(QWidget):
         self.source.sigStopped.connect(self._on_stopped)
         self._curves: list[pg.PlotDataItem] = []
         self._lanes: list[float | None] = []  # each curve's lane offset (a logic channel), else None
-        self._named = 0  # curves named in the legend (the analog ones)
-        self._legend_columns = 1
+        self._named = 0  # analog channels, in their own plot
+        self.analog_names: list[str] = []  # as named at the analog plot's right
+        self.counts_name = ""  # as named at the counts' plot's right
+        # ALM-A ... D in one lane, "ALM-D C B A", showing the code (as the front panel's LEDs would)
+        self._code_bits: list[tuple[int, int]] = []  # (bit, the channel's index) of the mapped lines
+        self._code_lane: float | None = None
+        self._code_edges = [pg.PlotDataItem(pen=pg.mkPen("#7f3f00", width=1)) for _ in range(2)]
+        self._code_texts: list[pg.TextItem] = []
         self._started: BenchStarted | None = None
 
         layout = QVBoxLayout(self)
@@ -213,29 +229,50 @@ class BenchPanel(QWidget):
         self.hold_bar.setVisible(False)
         layout.addWidget(self.hold_bar)
         self._held: np.ndarray | None = None  # the move's rows on show (a copy), else None: live
-        self.plot = pg.PlotWidget(background="w")
-        self.plot.setLabel("bottom", "time", units="s")
-        _legend_above(self.plot.plotItem, columns=3)
-        layout.addWidget(self.plot, 2)
-        # the lanes' names at the right, a little smaller than the plot's numbers (many lanes)
+        # the plots as a logic analyzer lays them out: each logic lane a fixed height with its name
+        # beside it, the analog channels (SPD-MON) and the encoder's counts below in plots of their
+        # own that keep a readable height; where the screen is too low for all of them they scroll
+        self.plots = QWidget()
+        self.plots.setObjectName("scopeBenchPlots")
+        plots = QVBoxLayout(self.plots)
+        plots.setContentsMargins(0, 0, 0, 0)
+        plots.setSpacing(0)
+        self.plots_scroll = QScrollArea()
+        self.plots_scroll.setObjectName("scopeBenchPlotsScroll")
+        self.plots_scroll.setWidgetResizable(True)
+        self.plots_scroll.setFrameShape(QScrollArea.Shape.NoFrame)
+        self.plots_scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.plots_scroll.setWidget(self.plots)
+        layout.addWidget(self.plots_scroll, 1)
+        self.plot = pg.PlotWidget(background="w")  # the logic lanes
+        self.plot.setMouseEnabled(x=True, y=False)
+        self.plot.getAxis("left").setTicks([[], []])  # the lanes' names are at the right
+        plots.addWidget(self.plot)
+        # the traces' names at the right, a little smaller than the plots' numbers (many lanes)
         lane_font = QFont(self.font())
         lane_font.setPointSizeF(max(6.0, lane_font.pointSizeF() * 0.8))
-        self.plot.getAxis("right").setTickFont(lane_font)
-        self._lane_metrics = QFontMetrics(lane_font)
+        self._lane_font = lane_font
+        self.lane_metrics = QFontMetrics(lane_font)
+        self.lane_px = max(LANE_PX, self.lane_metrics.height())
+        self.analog_plot = pg.PlotWidget(background="w")
+        self.analog_plot.setLabel("left", units="V")
+        plots.addWidget(self.analog_plot, 1)
         self.counts_plot = pg.PlotWidget(background="w")
         self.counts_plot.setLabel("left", "counts")
-        self.counts_plot.setXLink(self.plot)
-        for plot in (self.plot, self.counts_plot):  # equal left axes: the two time axes line up
+        for plot in (self.analog_plot, self.counts_plot):
+            plot.setXLink(self.plot)
+        for plot in (self.plot, self.analog_plot, self.counts_plot):  # equal left axes: times line up
             plot.getAxis("left").setWidth(LEFT_AXIS_PX)
+            plot.getAxis("right").setTickFont(lane_font)  # every trace's name at the right
+            plot.setLabel("bottom", "time", units="s")
         self.counts_plot.setVisible(False)
-        _legend_above(self.counts_plot.plotItem)
         self._counts_curve = self.counts_plot.plot([], [], pen=pg.mkPen("#333333", width=1))
         self._counts_curve.setSkipFiniteCheck(True)
         self.counts_plot.enableAutoRange(enable=False)  # ranges set per frame, not from the data's bounds
         self._y_range: tuple[float, float] | None = None
         self._x_range: tuple[float, float] | None = None
         self._counts_range: tuple[float, float] | None = None
-        layout.addWidget(self.counts_plot, 1)
+        plots.addWidget(self.counts_plot, 1)
         self.alarm_label = QLabel("")
         self.alarm_label.setObjectName("scopeBenchAlarm")
         self.alarm_label.setWordWrap(True)
@@ -419,47 +456,77 @@ class BenchPanel(QWidget):
         bench_mappings.save(started.device, self._fields())
         self._started = started
         self.plot.clear()
+        self.analog_plot.clear()
         self._curves = []
-        # a logic analyzer's look: one lane per logic channel, named at the right beside it; the
-        # analog ones in volts on the left axis, named in the legend
-        logic = [name for name in started.channels if name in started.logic]
-        self._lanes = [1.2 * (len(logic) - 1 - logic.index(name)) if name in logic else None
-                       for name in started.channels]
-        for i, label in enumerate(started.labels[: len(started.channels)]):
+        # a logic analyzer's look: one lane per logic channel (the first at the top), named at the
+        # right beside it, the code lines ALM-A ... D in one lane where the first of them would be;
+        # the analog ones in volts in their own plot, named at its right too
+        self._code_bits = [(bit, started.channels.index(name)) for bit, name in enumerate(self._alm_names())
+                           if name in started.channels and name in started.logic]
+        code_first = min((i for _, i in self._code_bits), default=None)
+        in_code = {i for _, i in self._code_bits}
+        rows = [i for i, name in enumerate(started.channels)
+                if name in started.logic and (i not in in_code or i == code_first)]
+        offsets = {i: LANE_STEP * (len(rows) - 1 - n) for n, i in enumerate(rows)}
+        self._lanes = [offsets[i] if i in offsets and i not in in_code else None
+                       for i in range(len(started.channels))]
+        self._code_lane = offsets.get(code_first) if code_first is not None else None
+        for i in range(len(started.channels)):
             pen = pg.mkPen(_COLORS[i % len(_COLORS)], width=1)
-            lane = self._lanes[i] is not None
-            curve = self.plot.plot([], [], pen=pen, name=None if lane else f"bench {label}")
+            if i in in_code:  # drawn in the code's lane
+                curve = pg.PlotDataItem()
+            else:
+                lane = self._lanes[i] is not None
+                plot = self.plot if lane else self.analog_plot
+                curve = plot.plot([], [], pen=pen)
             curve.setSkipFiniteCheck(True)  # display rows are finite, and already one or two a pixel
             self._curves.append(curve)
-        lanes = [(offset + 0.4, f"bench {label}")
-                 for offset, label in zip(self._lanes, started.labels, strict=False) if offset is not None]
-        self.plot.showAxis("right", bool(lanes))
-        self.plot.getAxis("right").setTicks([lanes, []] if lanes else None)
-        # the counts' plot as wide as the lanes' (its right axis as wide and empty), so times align
-        self.counts_plot.showAxis("right", bool(lanes))
-        if lanes:
-            width = max(self._lane_metrics.horizontalAdvance(name) for _, name in lanes) + 12
-            self.plot.getAxis("right").setWidth(width)
-            self.counts_plot.getAxis("right").setStyle(showValues=False)
-            self.counts_plot.getAxis("right").setWidth(width)
-        self._named = len(self._curves) - len(lanes)  # in the legend
-        self._legend_columns = max(1, min(self._named, self.plot.width() // LEGEND_NAME_PX))
-        self.plot.plotItem.legend.setColumnCount(self._legend_columns)
-        self.plot.plotItem.layout.setRowMaximumHeight(0, 1000 if self._named else 0)
-        self.plot.enableAutoRange(axis="x", enable=False)
-        self._y_range = self._counts_range = self._x_range = None
-        self.plot.enableAutoRange(axis="y", enable=False)  # set per frame: lanes, analog, the legend
+        lanes = [(offsets[i] + LANE_HIGH / 2, f"bench {started.labels[i]}") for i in rows if i not in in_code]
+        if self._code_lane is not None:
+            lanes.append((self._code_lane + LANE_HIGH / 2, f"bench {started.device}:"
+                          + " ".join(["ALM-D", "C", "B", "A"])))
+            for edge in self._code_edges:
+                self.plot.addItem(edge)
+        self._code_texts = []
+        self.analog_names = [f"bench {started.labels[i]}" for i, name in enumerate(started.channels)
+                             if name not in started.logic]
+        self._named = len(self.analog_names)
+        self.counts_name = (f"bench {started.labels[len(started.channels) + started.extra.index('counts')]}"
+                            if "counts" in started.extra else "")
         counting = "counts" in started.extra
+        self.plot.setVisible(bool(lanes))
+        self.analog_plot.setVisible(bool(self._named))
         self.counts_plot.setVisible(counting)
+        shown = [p for p in (self.plot, self.analog_plot, self.counts_plot) if not p.isHidden()]
+        for plot in (self.plot, self.analog_plot, self.counts_plot):  # one time axis: the lowest plot's
+            plot.showAxis("bottom", bool(shown) and plot is shown[-1])
+        self.plot.getAxis("right").setTicks([lanes, []] if lanes else None)
+        # every plot's right axis as wide as the longest name, so times align
+        names = [name for _, name in lanes] + self.analog_names + [self.counts_name]
+        width = max(self.lane_metrics.horizontalAdvance(name) for name in names) + 12
+        for plot in (self.plot, self.analog_plot, self.counts_plot):
+            plot.showAxis("right", True)
+            plot.getAxis("right").setWidth(width)
+        # the lanes at a fixed height each: their plot is as high as they need, the others stretch
+        # from a readable least height
+        def time_axis_px(plot: pg.PlotWidget) -> int:
+            return int(plot.getAxis("bottom").height()) if plot is shown[-1] else 0
+
+        for plot in (self.analog_plot, self.counts_plot):
+            plot.setMinimumHeight(TRACE_VIEW_MIN_PX + PLOT_MARGINS_PX + time_axis_px(plot))
+        if lanes:
+            self.plot.setFixedHeight(len(lanes) * self.lane_px + PLOT_MARGINS_PX + time_axis_px(self.plot))
+            gap = (LANE_STEP - LANE_HIGH) / 2  # half a lane's gap above the top one and below the lowest
+            self.plot.setYRange(-gap, len(lanes) * LANE_STEP - gap, padding=0)
+        for plot in (self.plot, self.analog_plot, self.counts_plot):
+            plot.enableAutoRange(enable=False)  # set per frame: lanes, analog, counts
+        self._y_range = self._counts_range = self._x_range = None
         self._counts_curve.setData([], [])
         if counting:
             label = started.labels[len(started.channels) + started.extra.index("counts")]
-            # named in the legend (a vertical axis label of this length is cut at this height)
+            # named at the right (a vertical axis label of this length is cut at this height)
             self.counts_plot.setLabel("left", f"bench {label}")
             self.counts_plot.getAxis("left").showLabel(False)
-            legend = self.counts_plot.plotItem.legend
-            legend.clear()
-            legend.addItem(self._counts_curve, f"bench {label}")
         # one line: every trace is named on the plot, and all of them in the tooltip
         decoded = len(started.labels) - len(started.channels)
         self.status_label.setText(f"LIVE from the bench: {started.device} at "
@@ -495,23 +562,33 @@ class BenchPanel(QWidget):
         """``rows`` on the plots over ``x_range`` [s]; the rows as drawn."""
         # drawn as the plot's pixels show it (each pixel's least and largest value), over a fixed
         # window: a redraw neither walks every row nor looks for the data's bounds
-        rows = peak_rows(rows, max(200, self.plot.width()))
+        rows = peak_rows(rows, max(200, self.plots.width() - LEFT_AXIS_PX))
         if x_range != self._x_range:
             self._x_range = x_range
-            self.plot.setXRange(*x_range, padding=0)
-        low, high = 0.0, 1.0
+            for plot in (self.plot, self.analog_plot, self.counts_plot):  # linked, also where hidden
+                plot.setXRange(*x_range, padding=0)
+        low, high = math.inf, -math.inf
+        in_code = {i for _, i in self._code_bits}
         for i, (curve, lane) in enumerate(zip(self._curves, self._lanes, strict=True)):
             values = rows[:, 1 + i]
             if lane is not None:
-                values = values * 0.8 + lane
-            curve.setData(rows[:, 0], values)
-            low, high = min(low, float(values.min())), max(high, float(values.max()))
-        # the lowest lane's name is centred 0.4 above its floor: room below for its lower half
-        span = high - low
-        y_range = (low - 0.08 * span, high + 0.03 * span)
-        if y_range != self._y_range:  # set only when it changes: a new range lays the axis out again
-            self._y_range = y_range
-            self.plot.setYRange(*y_range, padding=0)
+                values = values * LANE_HIGH + lane
+            else:
+                low, high = min(low, float(values.min())), max(high, float(values.max()))
+            if i not in in_code:
+                curve.setData(rows[:, 0], values)
+        if self._code_lane is not None:
+            self._draw_code(rows, x_range)
+        if self._named:
+            # the analog range moves only when a trace leaves it or fills less than half of it (a
+            # new range lays the axis out again, which costs more than the traces)
+            shown = self._y_range
+            if (shown is None or low < shown[0] or high > shown[1]
+                    or (high - low) < 0.5 * (shown[1] - shown[0])):
+                pad = max(0.1 * (high - low), MIN_ANALOG_PAD_V)
+                self._y_range = (low - pad, high + pad)
+                self.analog_plot.setYRange(*self._y_range, padding=0)
+                _names_at_right(self.analog_plot, self.analog_names, self._y_range)
         if "counts" in started.extra:
             counts = rows[:, 1 + len(started.channels)]
             self._counts_curve.setData(rows[:, 0], counts)
@@ -522,7 +599,51 @@ class BenchPanel(QWidget):
                 pad = max(0.1 * (hi - lo), MIN_COUNTS_PAD)  # a count's dither at standstill is no band
                 self._counts_range = (lo - pad, hi + pad)
                 self.counts_plot.setYRange(*self._counts_range, padding=0)
+                _names_at_right(self.counts_plot, [self.counts_name], self._counts_range)
         return rows
+
+    def _draw_code(self, rows: np.ndarray, x_range: tuple[float, float]) -> None:
+        """The alarm code's lane as a logic analyzer draws a bus: a band that crosses where the
+        code changes, the code (ALM-D C B A, "?" for a line not mapped) written in each stretch
+        wide enough for it."""
+        assert self._code_lane is not None
+        t = rows[:, 0]
+        code = np.zeros(len(rows), dtype=int)
+        for bit, i in self._code_bits:
+            code |= (rows[:, 1 + i] > 0.5).astype(int) << bit
+        changes = np.flatnonzero(np.diff(code) != 0) + 1
+        low, high = self._code_lane, self._code_lane + LANE_HIGH
+        middle = (low + high) / 2
+        px = max(1, self.plot.getViewBox().width())
+        half = 3.0 * (x_range[1] - x_range[0]) / px  # the crossing's half width: 3 px
+        at = t[changes]
+        xs = np.concatenate([[t[0]], np.column_stack([at - half, at, at + half]).ravel(), [t[-1]]])
+        for edge, side in zip(self._code_edges, (high, low), strict=True):
+            ys = np.concatenate([[side], np.tile([side, middle, side], len(at)), [side]])
+            edge.setData(xs, ys)
+        mapped = {bit for bit, _ in self._code_bits}
+        starts = np.concatenate([[0], changes])
+        ends = np.concatenate([changes, [len(t) - 1]])
+        shown = 0
+        for start, end in zip(starts, ends, strict=True):
+            digits = "".join(str(code[start] >> bit & 1) if bit in mapped else "?" for bit in (3, 2, 1, 0))
+            width_px = (t[end] - t[start]) * px / (x_range[1] - x_range[0])
+            if width_px < self.lane_metrics.horizontalAdvance(digits) + 10:
+                continue
+            if shown == len(self._code_texts):
+                if shown >= 16:  # a code that flickers: its crossings say so
+                    break
+                text = pg.TextItem(color="#7f3f00", anchor=(0.5, 0.5))
+                text.setFont(self._lane_font)
+                self.plot.addItem(text)
+                self._code_texts.append(text)
+            text = self._code_texts[shown]
+            text.setText(digits)
+            text.setPos((max(t[start], x_range[0]) + min(t[end], x_range[1])) / 2, middle)
+            text.setVisible(True)
+            shown += 1
+        for text in self._code_texts[shown:]:
+            text.setVisible(False)
 
     def _alarm_columns(self, started: BenchStarted) -> tuple[int | None, list[int | None]]:
         """The row columns of ALARM and of ALM-A ... D (None: not mapped)."""
