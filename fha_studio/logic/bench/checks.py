@@ -104,7 +104,8 @@ def bench_checks(t_s: ArrayLike, command_counts: ArrayLike, encoder_counts: Arra
 def _alarm_check(t: np.ndarray, alarm: ArrayLike | None, alarm_code: ArrayLike | None,
                  unmapped: Sequence[str], where: str, values: dict[str, Any]) -> BenchCheck:
     """``bench_alarm``: ALARM (or a code on ALM-A ... D) off all through the capture."""
-    on = np.zeros(t.size, bool) if alarm is None else np.asarray(alarm, dtype=float) > 0.5
+    # a live stream's row is 0.5 where ALARM came on within its window: that is on
+    on = np.zeros(t.size, bool) if alarm is None else np.asarray(alarm, dtype=float) >= 0.5
     codes = None if alarm_code is None else np.asarray(alarm_code, dtype=float).astype(np.int64)
     if codes is not None:
         on = on | (codes != 0)

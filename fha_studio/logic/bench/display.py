@@ -3,8 +3,11 @@ about :data:`DISPLAY_RATE_HZ`, for the scope's ring buffer. No Qt.
 
 A logic analyzer at 24 MS/s is far more than a plot draws (a few thousand points across), and far
 more than a float64 ring holds. Each window of ``factor`` samples becomes one row: a logic
-channel is high if it was high anywhere in the window (a pulse shorter than a window still
-shows), an analog channel is the window's mean (noise averaged, not aliased). Windows run on
+channel is 1 where it was high all through the window, 0 where it was low all through, and
+:data:`CHANGED` (0.5) where it was both (a pulse shorter than a window still shows, and an
+encoder line toggling far faster than the rows is a busy line, not a steady level: taken as
+high-anywhere it read as stuck high all through a move); an analog channel is the window's mean
+(noise averaged, not aliased). Windows run on
 across blocks, so the rows of a stream are the same however sigrok-cli cut it.
 
 The encoder's counts and the commanded counts of a row are those at its window's last sample.
@@ -28,6 +31,9 @@ from fha_studio.logic.bench.edges import Lines, Steps
 
 #: Rows per second that go to the scope (each channel).
 DISPLAY_RATE_HZ = 10_000.0
+#: A logic channel's row value where it was high and low within the window (high anywhere is
+#: ``>= CHANGED``, high throughout is ``> CHANGED``).
+CHANGED = 0.5
 
 
 def display_factor(sample_rate_hz: float, display_rate_hz: float = DISPLAY_RATE_HZ) -> int:
@@ -73,14 +79,15 @@ class Decimator:
         logic = block.logic
         if m and self._carry_logic is not None:
             logic = np.concatenate([self._carry_logic, logic])
-        windows = None
+        anywhere = throughout = None
         for i, name in enumerate(self.channels):
             if name in block.logic_channels:
-                if windows is None:
-                    windows = np.bitwise_or.reduce(logic[:whole].reshape(count, k), axis=1) if count \
-                        else logic[:0]
+                if anywhere is None or throughout is None:
+                    shaped = logic[:whole].reshape(count, k)
+                    anywhere = np.bitwise_or.reduce(shaped, axis=1) if count else logic[:0]
+                    throughout = np.bitwise_and.reduce(shaped, axis=1) if count else logic[:0]
                 bit = logic.dtype.type(block.logic_channels.index(name))
-                rows[:, 1 + i] = (windows >> bit) & 1
+                rows[:, 1 + i] = (((anywhere >> bit) & 1) + ((throughout >> bit) & 1)) * CHANGED
             else:
                 values = block.analog[name]
                 if m:

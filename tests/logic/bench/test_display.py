@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from fha_studio.hardware.bench.capture import SampleBlock, pack_logic
-from fha_studio.logic.bench.display import Decimator, display_factor
+from fha_studio.logic.bench.display import CHANGED, Decimator, display_factor
 
 
 def _stream(n: int = 10_007) -> SampleBlock:
@@ -42,8 +42,17 @@ def test_a_pulse_shorter_than_a_window_shows_and_levels_stay_levels():
     block = _stream()
     rows = Decimator(1e6, ("D0", "D1"), 100).feed(block)
     pulses = block.bit("D0")[:10_000].reshape(100, 100).any(axis=1)
-    assert np.array_equal(rows[:, 1] == 1.0, pulses) and pulses.sum() > 30
+    assert np.array_equal(rows[:, 1] == CHANGED, pulses) and pulses.sum() > 30  # high and low in it
     assert np.array_equal(rows[:, 2], np.repeat([0.0, 1.0], 50))
+
+
+def test_a_line_toggling_faster_than_the_rows_is_busy_not_stuck_high():
+    n = 10_000
+    a = (np.arange(n) // 7) % 2 == 1  # an encoder line at 71 kHz, the rows at 10 kHz
+    rows = Decimator(1e6, ("A", "HIGH"), 100).feed(SampleBlock(1e6, ("A", "HIGH"),
+                                                               pack_logic([a, np.ones(n, bool)]), {}))
+    assert np.all(rows[:, 1] == CHANGED)  # taken as high anywhere it read as a steady high
+    assert np.all(rows[:, 2] == 1.0)
 
 
 def test_analog_windows_are_averaged_and_slow_instruments_are_not_decimated():

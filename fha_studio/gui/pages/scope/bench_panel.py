@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 import shutil
 import time
+from collections.abc import Sequence
 
 import numpy as np
 import pyqtgraph as pg
@@ -39,7 +40,7 @@ from fha_studio.hardware.bench import sigrok
 from fha_studio.hardware.parameters import load_cn2
 from fha_studio.logic.bench import alarm_code
 from fha_studio.logic.bench.checks import BenchCheck, bench_checks
-from fha_studio.logic.bench.display import peak_rows
+from fha_studio.logic.bench.display import CHANGED, peak_rows
 from fha_studio.logic.bench.importer import DriveSettings
 from fha_studio.logic.bench.move import BenchMoveFigures, bench_move_figures
 
@@ -99,6 +100,21 @@ def _flange(check: BenchCheck) -> str:
     """`` (FWD rotation, CW viewing the output flange)`` for a direction check that knows it."""
     flange = check.values.get("flange") if check.check == "bench_direction" else None
     return f" ({check.values['rotation']}, {flange} viewing the output flange)" if flange else ""
+
+
+def _busy_as_band(rows: np.ndarray, lanes: Sequence[float | None]) -> np.ndarray:
+    """``rows`` with each lane's windows where the line changed (:data:`CHANGED`) drawn low and
+    high in turn, so that a line toggling faster than the rows fills its lane as a logic analyzer
+    shows it (a busy band), instead of a line at half height."""
+    busy = [1 + i for i, lane in enumerate(lanes) if lane is not None and np.any(rows[:, 1 + i] == CHANGED)]
+    if not busy:
+        return rows
+    rows = rows.copy()  # the ring's rows stay as they were
+    turn = (np.arange(len(rows)) & 1).astype(float)
+    for column in busy:
+        changed = rows[:, column] == CHANGED
+        rows[changed, column] = turn[changed]
+    return rows
 
 
 def _rate(text: str) -> float | None:
@@ -562,7 +578,7 @@ class BenchPanel(QWidget):
         """``rows`` on the plots over ``x_range`` [s]; the rows as drawn."""
         # drawn as the plot's pixels show it (each pixel's least and largest value), over a fixed
         # window: a redraw neither walks every row nor looks for the data's bounds
-        rows = peak_rows(rows, max(200, self.plots.width() - LEFT_AXIS_PX))
+        rows = peak_rows(_busy_as_band(rows, self._lanes), max(200, self.plots.width() - LEFT_AXIS_PX))
         if x_range != self._x_range:
             self._x_range = x_range
             for plot in (self.plot, self.analog_plot, self.counts_plot):  # linked, also where hidden
@@ -610,7 +626,7 @@ class BenchPanel(QWidget):
         t = rows[:, 0]
         code = np.zeros(len(rows), dtype=int)
         for bit, i in self._code_bits:
-            code |= (rows[:, 1 + i] > 0.5).astype(int) << bit
+            code |= (rows[:, 1 + i] >= CHANGED).astype(int) << bit
         changes = np.flatnonzero(np.diff(code) != 0) + 1
         low, high = self._code_lane, self._code_lane + LANE_HIGH
         middle = (low + high) / 2
@@ -657,10 +673,10 @@ class BenchPanel(QWidget):
         alarm_column, alm_columns = self._alarm_columns(started)
         if alarm_column is None and all(c is None for c in alm_columns):
             return
-        on = None if alarm_column is None else bool(row[alarm_column] > 0.5)
+        on = None if alarm_column is None else bool(row[alarm_column] >= CHANGED)
         code = None
         if any(c is not None for c in alm_columns):
-            code = sum(1 << bit for bit, c in enumerate(alm_columns) if c is not None and row[c] > 0.5)
+            code = sum(1 << bit for bit, c in enumerate(alm_columns) if c is not None and row[c] >= CHANGED)
         if (on, code) == self._alarm_shown:
             return
         self._alarm_shown = (on, code)
@@ -723,7 +739,7 @@ class BenchPanel(QWidget):
         alarm = rows[start:, alarm_column] if alarm_column is not None else None
         code = None
         if any(c is not None for c in alm_columns):
-            code = sum((rows[start:, c] > 0.5).astype(int) << bit for bit, c in enumerate(alm_columns)
+            code = sum((rows[start:, c] >= CHANGED).astype(int) << bit for bit, c in enumerate(alm_columns)
                        if c is not None)
         unmapped = [line for line, c in zip(alarm_code.LINES, alm_columns, strict=True) if c is None]
         wired = [f"encoder {self.encoder_edit.text().strip()}", f"command {self.command_edit.text().strip()}"]
