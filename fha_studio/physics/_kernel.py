@@ -63,6 +63,8 @@ class KernelParams:
     stribeck_v: float = 1.0  # its characteristic speed (rad/s)
     pulse_rad: float = 0.0  # > 0: feedback quantised to encoder pulses of this size
     speed_filter_alpha: float = 1.0  # first-order filter of the pulse-difference speed (1 = none)
+    # the load beyond the flange's torque sensor: jl without the actuator's output flange (kg m^2)
+    j_sensed: float = 0.0
 
 
 @dataclass
@@ -88,6 +90,7 @@ class KernelState:
     rec_count: int = 0  # periods since the last recorded sample
     fb_prev: float | None = None  # quantised feedback of the previous period (rad, physical)
     v_filt: float = 0.0  # filtered pulse-difference speed (rad/s, physical)
+    flange_torque: float = 0.0  # N m, what a torque sensor on the output flange reads (see run())
 
 
 def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_on: bool,
@@ -98,11 +101,19 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     speed_injection: n speeds (rad/s, command frame) added to the speed command (an excitation
     at the speed loop's summing point), or None.
 
-    rec: lists (t, cmd_phys, xm, xl, vm, current, vref) appended every rec_every periods, or only
-    at the periods record_at names (increasing, 0 = the first of these n; rec_every is then unused):
-    simulate() keeps only the periods its samples fall between.
+    rec: lists (t, cmd_phys, xm, xl, vm, current, vref, flange_torque) appended every rec_every
+    periods, or only at the periods record_at names (increasing, 0 = the first of these n; rec_every
+    is then unused): simulate() keeps only the periods its samples fall between.
     accounting: False skips the cumulative figures (I^2 t, work, regeneration, peaks) that only the
     simulated drive reads; the motion is the same.
+
+    The flange torque (N m, physical frame) is what a strain-gauge sensor between the actuator's
+    output flange and the load reads: the torque the flange exerts on the load, + = driving it CW;
+    J_sensed x a_load = flange torque - T_load, where J_sensed (p.j_sensed) is the load beyond the
+    sensor (jl less the actuator's flange) and T_load the load's own torques (gravity, load offset).
+    With a compliant gear: the gear's twist torque (wind-up and damping, the last substep's) less what
+    accelerates the flange; on a rigid axis, where the load moves with the motor side, J_sensed x the
+    period's acceleration + T_load.
     """
     dt = p.dt
     rate = 1.0 / dt
@@ -153,12 +164,17 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     exp = math.exp
     h_jl = h / jl
     if rec is not None:
-        r_t, r_c, r_xm, r_xl, r_vm, r_i, r_vr = rec
+        r_t, r_c, r_xm, r_xl, r_vm, r_i, r_vr, r_tf = rec
     rec_count = s.rec_count
     # the next period to record when record_at is given (-1: none left)
     at = iter(record_at) if record_at is not None else None
     next_at = next(at, -1) if at is not None else -1
     k0 = s.step_index + 1
+    # flange torque: compliant, tg - flange_share x tl (the twist torque less the flange's share of
+    # the load side's acceleration); rigid, j_sensed x (vm - v0) x rate + tload
+    tg = tl = v0 = tload = 0.0
+    j_sensed = p.j_sensed
+    flange_share = 1.0 - j_sensed / jl
 
     for k in range(n):
         # ---------------- servo (command frame) ----------------
@@ -258,9 +274,11 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
                 xl += h * vl
         else:
             # one rigid mass: no spring to resolve, one step per period (nsub is 1)
-            tm = motor_torque - off
+            tload = off
             if sin_ga:
-                tm -= ga * sin(xm + gph)
+                tload += ga * sin(xm + gph)
+            tm = motor_torque - tload
+            v0 = vm
             if sin_ra:
                 tm -= ra * sin(rw * xm + rph)
             v = vm + h_jm * tm
@@ -318,6 +336,7 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
                 r_vm.append(vm)
                 r_i.append(cur)
                 r_vr.append(vref)
+                r_tf.append(tg - flange_share * tl if compliant else j_sensed * (vm - v0) * rate + tload)
         elif rec is not None:
             rec_count += 1
             if rec_count >= rec_every:
@@ -329,6 +348,7 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
                 r_vm.append(vm)
                 r_i.append(cur)
                 r_vr.append(vref)
+                r_tf.append(tg - flange_share * tl if compliant else j_sensed * (vm - v0) * rate + tload)
 
     s.xm, s.vm, s.xl, s.vl = xm, vm, xl, vl
     s.integ, s.cprev, s.current, s.vref = integ, cprev, cur, vref
@@ -339,6 +359,8 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     s.step_index += n
     s.fb_prev, s.v_filt = fb_prev, v_filt
     s.rec_count = rec_count
+    if n > 0:
+        s.flange_torque = tg - flange_share * tl if compliant else j_sensed * (vm - v0) * rate + tload
 
 
 def substeps_for(jm: float, jl: float, k_max: float, dt: float) -> int:

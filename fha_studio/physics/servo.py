@@ -270,11 +270,13 @@ def kernel_params(model: AxisModel, settings: ServoSettings) -> _kernel.KernelPa
         pulse_rad=model.output_pulse_rad if settings.quantised_feedback else 0.0,
         speed_filter_alpha=(1.0 - math.exp(-2.0 * math.pi * settings.speed_filter_hz * dt)
                             if settings.speed_filter_hz > 0 else 1.0),
+        j_sensed=jl - (model.flange_inertia_kgm2 or 0.0),
     )
 
 
 SMALL_STEP_COUNT = 16
-TRACE_CHANNELS = ("t", "cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd", "controller_pos")
+TRACE_CHANNELS = ("t", "cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd", "flange_torque",
+                  "controller_pos")
 #: the channels the kernel records; ``controller_pos`` is the axis's own (see ``controller_pos_rad``)
 _KERNEL_CHANNELS = len(TRACE_CHANNELS) - 1
 
@@ -552,6 +554,16 @@ class ServoAxis:
         return self._model.torque_constant_nm_per_a * self._state.current
 
     @property
+    def flange_torque_nm(self) -> float:
+        """What a torque sensor between the output flange and the load reads (N m): the torque the
+        flange exerts on the load, + = driving it CW. The load (its inertia beyond the sensor, the
+        actuator's flange not included) x its acceleration + its own torques (gravity, load offset):
+        with a compliant gear the gear's twist torque less what accelerates the flange, on a rigid
+        axis from the last servo period's acceleration. Kt x current minus it is what the actuator
+        takes (friction, its own inertia). 0 until the axis has been stepped."""
+        return self._state.flange_torque
+
+    @property
     def command_pos_rad(self) -> float:
         """The position command in the physical frame (rad)."""
         return self._settings.direction_sign * self._state.cprev
@@ -639,6 +651,7 @@ class ServoAxis:
             "motor_speed_rpm": self.motor_speed_rpm,
             "current_a": self.current_a,
             "torque_nm": self.torque_nm,
+            "flange_torque_nm": self.flange_torque_nm,
             "command_pos_rad": self.command_pos_rad,
             "command_pulses": self.command_pulses,
             "feedback_pulses": self.feedback_pulses,
@@ -670,8 +683,8 @@ class ServoAxis:
 
     def read_trace(self, clear: bool = True) -> dict[str, np.ndarray]:
         """The recorded samples (t s, cmd_pos rad, pos rad, load_pos rad, vel rad/s, current A,
-        speed_cmd rad/s command frame, controller_pos rad command frame); clear=True empties the
-        buffer, recording continues."""
+        speed_cmd rad/s command frame, flange_torque N m (see :attr:`flange_torque_nm`),
+        controller_pos rad command frame); clear=True empties the buffer, recording continues."""
         if self._trace is None:
             return {name: np.empty(0) for name in TRACE_CHANNELS}
         out = {name: np.array(ch) for name, ch in zip(TRACE_CHANNELS, self._trace, strict=True)}

@@ -25,6 +25,9 @@ SIMULATION_UNITS: dict[str, str] = {
     "current": "A",  # motor current; torque = Kt x current
     "torque": "N m",  # Kt x current
     "speed_cmd": "rad/s",  # speed-loop reference (command frame)
+    # what a torque sensor on the output flange reads: the torque the flange exerts on the load,
+    # + = driving it CW (a recording's ``torque`` column); ServoAxis.flange_torque_nm says how
+    "flange_torque": "N m",
 }
 
 
@@ -40,6 +43,7 @@ class MonitorOptions:
     load_encoder_ppr: pulses per turn of an external load encoder (None = not quantised).
     current_resolution_a: step of the current monitor (0 = none); current_noise_a: its noise (std, A).
     speed_noise_rad_s: noise (std) on vel. seed: of the noise generator.
+    flange_torque_noise_nm: noise (std, N m) of the output torque sensor on flange_torque.
     """
 
     quantise_position: bool = True
@@ -48,6 +52,7 @@ class MonitorOptions:
     current_noise_a: float = 0.0
     speed_noise_rad_s: float = 0.0
     seed: int | None = 0
+    flange_torque_noise_nm: float = 0.0
 
     @classmethod
     def typical(cls, model: AxisModel, seed: int | None = 0) -> MonitorOptions:
@@ -77,6 +82,9 @@ def apply_monitor(result: dict[str, np.ndarray], model: AxisModel,
     out["torque"] = cur * model.torque_constant_nm_per_a
     if monitor.speed_noise_rad_s > 0:
         out["vel"] = result["vel"] + rng.normal(0.0, monitor.speed_noise_rad_s, result["vel"].shape)
+    if monitor.flange_torque_noise_nm > 0 and "flange_torque" in result:  # drawn last: the others stay
+        flange = result["flange_torque"]
+        out["flange_torque"] = flange + rng.normal(0.0, monitor.flange_torque_noise_nm, flange.shape)
     return out
 
 
@@ -91,9 +99,9 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
     command, at rest, holding its static load (gravity, offset) as a servo that has been on.
     Returns {key: array} with the keys and units of SIMULATION_UNITS, sampled at t_s (the servo
     period ending at or just after each sample time, interpolated). monitor: quantisation/noise.
-    current_average: current and torque as their mean over each sample interval (t[k-1], t[k]]
-    (a sampled monitor with an anti-alias filter) instead of the instantaneous value; the first
-    sample stays instantaneous.
+    current_average: current, torque and flange_torque as their mean over each sample interval
+    (t[k-1], t[k]] (a sampled monitor or sensor with an anti-alias filter) instead of the
+    instantaneous value; the first sample stays instantaneous.
     """
     t = np.asarray(t_s, dtype=float)
     cmd = np.asarray(command_pos_rad, dtype=float)
@@ -116,14 +124,17 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
 
     state = _kernel.KernelState(step_index=0)
     _initialise_at_rest(state, p, float(cmd[0]), start_at_rest)
-    keys = ("cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd")
+    keys = ("cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd", "flange_torque")
     out: dict[str, np.ndarray] = {"t": t.copy()}
     for key in keys:
         out[key] = np.empty(len(t))
-    charge_at = np.empty(len(t))  # integral of the current over time at each sample (current_average)
+    # integrals over time of the current and the flange torque at each sample (current_average)
+    charge_at = np.empty(len(t))
+    impulse_at = np.empty(len(t))
     # the servo periods run in chunks: memory stays bounded by the chunk, whatever the duration
-    last_t, last = 0.0, [d * state.cprev, state.xm, state.xl, state.vm, state.current, state.vref]
-    last_charge = 0.0
+    last_t = 0.0
+    last = [d * state.cprev, state.xm, state.xl, state.vm, state.current, state.vref, state.flange_torque]
+    last_charge = last_impulse = 0.0
     done = 0  # samples filled
     for k0 in range(0, n, SIMULATION_CHUNK):
         m = min(SIMULATION_CHUNK, n - k0)
@@ -140,7 +151,7 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
             j = np.searchsorted(ts, rel, side="right") - 1
             keep = np.unique(np.concatenate(([0, m], np.clip(j, 0, m), np.clip(j + 1, 0, m))))
             record_at = (keep[1:] - 1).tolist()
-        rec: tuple[list, ...] = ([], [], [], [], [], [], [])
+        rec: tuple[list, ...] = ([], [], [], [], [], [], [], [])
         _kernel.run(p, state, cmd_servo, m, True, rec, 1, record_at=record_at, accounting=False)
         ts = ts[keep]
         # the lists to arrays with their dtype stated: numpy then skips its type discovery per item
@@ -151,12 +162,16 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
             charge = last_charge + np.concatenate(([0.0], np.cumsum(recorded[4]) * dt))
             charge_at[done:stop] = np.interp(rel, ts, charge)
             last_charge = float(charge[-1])
+            impulse = last_impulse + np.concatenate(([0.0], np.cumsum(recorded[6]) * dt))
+            impulse_at[done:stop] = np.interp(rel, ts, impulse)
+            last_impulse = float(impulse[-1])
         done = stop
         last_t = float(ts[-1])
         last = [float(rec[j_key + 1][-1]) for j_key in range(len(keys))]
     if current_average:
         # the current recorded at the end of a servo period was applied during all of it
         out["current"][1:] = np.diff(charge_at) / np.diff(t)
+        out["flange_torque"][1:] = np.diff(impulse_at) / np.diff(t)
     out["torque"] = out["current"] * model.torque_constant_nm_per_a
     if monitor is not None:
         out = apply_monitor(out, model, monitor)
@@ -182,7 +197,11 @@ def _initialise_at_rest(s: _kernel.KernelState, p: _kernel.KernelParams, x0: flo
     s.cprev = p.direction * x0
     s.xl = _rest_load(p, x0)
     if not hold_load:
+        # no current and no wind-up: a compliant flange passes nothing yet; a rigid axis starts to
+        # fall under its load, the sensed load's share of that acceleration taken off its torque
+        s.flange_torque = 0.0 if p.compliant else _static_load_nm(p, x0) * (1.0 - p.j_sensed / p.j_total)
         return
+    s.flange_torque = _static_load_nm(p, x0)  # the flange holds the static load
     i_hold = _hold_current(p, x0)
     s.current = i_hold
     # integ holds the current in the command frame: ic = kv * integ at zero error

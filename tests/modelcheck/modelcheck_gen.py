@@ -88,12 +88,18 @@ def record(
     declared_load: float | None = None,
     servo: ServoSettings | None = None,
     metadata_overrides: dict | None = None,
+    torque_sensor_noise_nm: float | None = None,
 ) -> Generated:
-    """Simulate the closed loop with the hidden effects and write what a drive would record."""
+    """Simulate the closed loop with the hidden effects and write what a drive would record.
+
+    torque_sensor_noise_nm: with a number, the recording has the ``torque`` column of a torque
+    sensor on the output flange (the simulation's flange_torque, averaged over each interval as the
+    current is, with this noise std in N m)."""
     truth_model = model.with_effects(effects)
     step = 2.0 * model.max_current_a / 1024.0
     monitor = MonitorOptions(
-        True, model.output_resolution_ppr if with_load_pos else None, step, noise_steps * step, 0.0, seed
+        True, model.output_resolution_ppr if with_load_pos else None, step, noise_steps * step, 0.0, seed,
+        torque_sensor_noise_nm or 0.0,
     )
     # the loops see whole encoder pulses, so the current carries a real drive's quantisation noise
     settings = servo or ServoSettings.tuned_for(
@@ -109,6 +115,8 @@ def record(
     out = {k: v[::sub] for k, v in fine.items()}
     cur = fine["current"]
     out["current"] = np.concatenate([[cur[0]], cur[1:].reshape(-1, sub).mean(axis=1)])
+    flange = fine["flange_torque"]  # a strain-gauge amplifier's anti-alias filter, as the current's
+    out["flange_torque"] = np.concatenate([[flange[0]], flange[1:].reshape(-1, sub).mean(axis=1)])
     out = apply_monitor(out, truth_model, monitor)
     meta = dict(
         actuator=actuator_code,
@@ -125,6 +133,8 @@ def record(
     channels = dict(t=out["t"], pos=np.degrees(out["pos"]), current=out["current"], cmd_pos=np.degrees(cmd))
     if with_load_pos:
         channels["load_pos"] = np.degrees(out["load_pos"])
+    if torque_sensor_noise_nm is not None:
+        channels["torque"] = out["flange_torque"]
     rec = make_recording(RecordingMetadata(**meta), **channels)
     return Generated(rec, effects, truth_model)
 

@@ -381,12 +381,13 @@ def _every_period_interpolated(model, servo, t, cmd):
     n = math.ceil((t[-1] - t[0]) / p.dt - 1e-9) + 1
     state = _kernel.KernelState()
     simulate_module._initialise_at_rest(state, p, float(cmd[0]), True)
-    first = [p.direction * state.cprev, state.xm, state.xl, state.vm, state.current, state.vref]
+    first = [p.direction * state.cprev, state.xm, state.xl, state.vm, state.current, state.vref,
+             state.flange_torque]
     t_servo = p.dt * np.arange(1, n + 1)
-    rec: tuple[list, ...] = ([], [], [], [], [], [], [])
+    rec: tuple[list, ...] = ([], [], [], [], [], [], [], [])
     _kernel.run(p, state, (p.direction * np.interp(t[0] + t_servo, t, cmd)).tolist(), n, True, rec, 1)
     ts = np.concatenate(([0.0], t_servo))
-    keys = ("cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd")
+    keys = ("cmd_pos", "pos", "load_pos", "vel", "current", "speed_cmd", "flange_torque")
     return {k: np.interp(t - t[0], ts, np.concatenate(([first[j]], rec[j + 1]))) for j, k in enumerate(keys)}
 
 
