@@ -72,6 +72,9 @@ def register(subparsers: Any) -> None:
                    "sim stops)")
     p.add_argument("--record-rate", type=in_range(plausible.SIM_RECORD_RATE_HZ), default=1000.0, metavar="HZ",
                    help="recording sample rate (default %(default)s Hz)")
+    p.add_argument("--record-torque", action="store_true",
+                   help="the recording also has the column torque: what a torque sensor between the output "
+                   "flange and the load reads (N m, positive = the flange driving the load CW)")
     p.set_defaults(func=run)
 
 
@@ -120,7 +123,7 @@ def run(args: Any) -> int:
     try:
         if args.record:
             try:
-                drive.start_recording(args.record, args.record_rate)
+                drive.start_recording(args.record, args.record_rate, torque_sensor=args.record_torque)
             except (OSError, ValueError) as exc:
                 raise CliError(f"--record: {exc}") from None
         drive.start()

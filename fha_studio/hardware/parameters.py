@@ -145,6 +145,7 @@ class MonitorItem(IntEnum):
     OUTPUT_TORQUE = 108  # 0.01 N m
     SPEED_COMMAND = 109  # 0.0001 r/min, the speed loop's reference
     OUTPUT_SPEED_FINE = 110  # 0.0001 r/min
+    FLANGE_TORQUE = 111  # 0.01 N m, a torque sensor between the output flange and the load
 
 
 class ParameterModel:

@@ -18,6 +18,7 @@ def test_channels_cover_positions_speed_current_and_io_bits(channels):
     assert by_key["feedback_position"].convert(500_000) == pytest.approx(360.0)
     assert by_key["output_speed"].convert(6000) == pytest.approx(60.0)  # 0.01 r/min on the wire
     assert by_key["motor_current"].convert(1500) == pytest.approx(1.5)  # mA on the wire
+    assert by_key["flange_torque"].convert(-2050) == pytest.approx(-20.5)  # 0.01 N m on the wire
     assert by_key["in_position"].convert(0b1000) == 1.0
     assert by_key["origin_sensor"].convert(0b1000) == 0.0
     assert items_to_poll([by_key["in_position"], by_key["alarm"], by_key["feedback_position"]]) == [100, 106]
@@ -25,7 +26,7 @@ def test_channels_cover_positions_speed_current_and_io_bits(channels):
 
 def test_recorder_writes_a_recording_the_model_check_reads(tmp_path, channels):
     chosen = [c for c in channels if c.key in ("feedback_position", "command_position", "motor_current",
-                                               "output_speed", "error_pulses", "in_position")]
+                                               "output_speed", "error_pulses", "in_position", "flange_torque")]
     meta = RecordingMetadata(actuator="FHA-25C-50-US250", load_inertia_kgm2=1.5, sample_rate_hz=100)
     path = tmp_path / "rec.csv"
     rec = ScopeRecorder(path, meta, chosen)
@@ -41,6 +42,8 @@ def test_recorder_writes_a_recording_the_model_check_reads(tmp_path, channels):
     assert recording.current_a[0] == keys.index("motor_current")
     assert recording.cmd_pos_deg[0] == keys.index("command_position")
     assert recording.vel_rpm[0] == keys.index("output_speed")
+    # the simulated drive's torque sensor on the flange (monitor 111) is the recording's torque column
+    assert recording.channels["torque"][0] == keys.index("flange_torque")
     assert set(recording.extra_channels) == {"error_pulses", "in_position"}
     # plain numpy reads it too
     plain = np.genfromtxt(path, delimiter=",", comments="#")[1:]

@@ -357,6 +357,12 @@ class SimDrive:
         return self._direction * self.axis.torque_nm
 
     @property
+    def flange_torque_nm(self) -> float:
+        """Monitor 111: a torque sensor between the output flange and the load, N m, physical sense
+        (+ = the flange driving the load CW): an instrument on the load, as the load encoder."""
+        return self.axis.flange_torque_nm
+
+    @property
     def absolute_counts(self) -> int:
         """Multi-turn x 8192 + single-turn of the absolute motor encoder (DGR), physical sense."""
         angle = self._encoder_sign * (self.axis.output_pos_rad - self._absolute_zero_rad)
@@ -664,9 +670,12 @@ class SimDrive:
         self.close()
 
     # ------------------------------------------------------------------ recording
-    def start_recording(self, path: str | Path, sample_rate_hz: float = 1000.0) -> None:
+    def start_recording(self, path: str | Path, sample_rate_hz: float = 1000.0, *,
+                        torque_sensor: bool = False) -> None:
         """Write what the axis does to an ``fha-recording/1`` CSV (t, pos, current, cmd_pos,
-        load_pos, vel; physical frame, CW positive) until :meth:`stop_recording` or :meth:`close`."""
+        load_pos, vel; physical frame, CW positive) until :meth:`stop_recording` or :meth:`close`.
+        ``torque_sensor``: also ``torque``, a torque sensor between the output flange and the load
+        (monitor 111)."""
         with self.lock:
             self.stop_recording()
             self._recorder = SimRecorder(
@@ -676,6 +685,7 @@ class SimDrive:
                 load_inertia_kgm2=self.config.load_inertia_kgm2,
                 supply_voltage=self.actuator.supply_voltage,
                 recorded_by=f"FHA Studio simulated drive {_version} ({self.driver})",
+                torque_sensor=torque_sensor,
             )
 
     def stop_recording(self) -> None:

@@ -34,6 +34,8 @@ class MonitorSource(Protocol):
     @property
     def output_torque_nm(self) -> float: ...
     @property
+    def flange_torque_nm(self) -> float: ...
+    @property
     def overload_rate(self) -> float: ...
     def io_bits(self) -> int: ...
 
@@ -63,6 +65,8 @@ def monitor_wire(drive: MonitorSource, item: int) -> int:
         return round(axis.speed_command_rad_s / RAD_S_PER_RPM * 10000) if axis.servo_is_on else 0
     if item == MonitorItem.OUTPUT_SPEED_FINE:
         return round(drive.output_speed_rpm * 10000)
+    if item == MonitorItem.FLANGE_TORQUE:
+        return round(drive.flange_torque_nm * 100)
     if item == 0:  # motor speed, r/min
         return round(drive.output_speed_rpm * drive.ratio)
     if item == 1:  # current, % of the maximum

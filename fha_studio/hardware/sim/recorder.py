@@ -12,12 +12,14 @@ from fha_studio.recording import RecordingMetadata, RecordingWriter
 
 class SimRecorder:
     """Rows taken at the supervision ticks (t, pos, current, cmd_pos, load_pos, vel; physical frame,
-    CW positive), written in blocks of 200."""
+    CW positive), written in blocks of 200. With ``torque_sensor`` also ``torque``: what a torque
+    sensor between the output flange and the load reads (ServoAxis.flange_torque_nm), an instrument
+    few axes have, so a recording carries it only when asked."""
 
     COLUMNS = ("t", "pos", "current", "cmd_pos", "load_pos", "vel")
 
     def __init__(self, path: Path, sample_rate_hz: float, *, actuator_code: str, load_inertia_kgm2: float,
-                 supply_voltage: int, recorded_by: str):
+                 supply_voltage: int, recorded_by: str, torque_sensor: bool = False):
         if not 0 < sample_rate_hz <= 1.0 / SUPERVISION_PERIOD_S:
             raise ValueError(f"recording rate {sample_rate_hz:g} Hz: 0 ... {1 / SUPERVISION_PERIOD_S:g}")
         self.every = max(1, round(1.0 / (sample_rate_hz * SUPERVISION_PERIOD_S)))
@@ -28,7 +30,8 @@ class SimRecorder:
             sample_rate_hz=1.0 / (self.every * SUPERVISION_PERIOD_S),
             extra={"recorded_by": recorded_by},
         )
-        self.writer = RecordingWriter(path, metadata, self.COLUMNS)
+        self.torque_sensor = torque_sensor
+        self.writer = RecordingWriter(path, metadata, self.COLUMNS + (("torque",) if torque_sensor else ()))
         self.rows: list[tuple[float, ...]] = []
         self.count = 0
 
@@ -38,10 +41,11 @@ class SimRecorder:
         if self.count < self.every:
             return
         self.count = 0
-        self.rows.append((
+        row = (
             clock_s, math.degrees(axis.output_pos_rad), axis.current_a,
             math.degrees(axis.command_pos_rad), math.degrees(axis.load_pos_rad), axis.output_speed_rpm,
-        ))
+        )
+        self.rows.append((*row, axis.flange_torque_nm) if self.torque_sensor else row)
         if len(self.rows) >= 200:
             self.flush()
 

@@ -2,8 +2,9 @@
 
 The contract columns come from the channels the model check needs: ``pos`` = feedback position
 [deg], ``current`` = motor current [A], and when present ``cmd_pos`` [deg], ``load_pos`` [deg],
-``vel`` [r/min]; every other channel is written as an extra column under its key. The writer
-flushes at least once per second, so a crash loses at most a second of data.
+``vel`` [r/min], ``torque`` [N m, the flange's torque sensor]; every other channel is written as an
+extra column under its key. The writer flushes at least once per second, so a crash loses at most a
+second of data.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ CONTRACT_SOURCES = {
     "cmd_pos": "command_position",
     "load_pos": "load_position",
     "vel": "output_speed",
+    "torque": "flange_torque",  # the simulated drive's torque sensor on the flange (monitor 111)
 }
 
 
