@@ -25,8 +25,9 @@ def test_channels_cover_positions_speed_current_and_io_bits(channels):
 
 
 def test_recorder_writes_a_recording_the_model_check_reads(tmp_path, channels):
-    chosen = [c for c in channels if c.key in ("feedback_position", "command_position", "motor_current",
-                                               "output_speed", "error_pulses", "in_position", "flange_torque")]
+    keys_chosen = ("feedback_position", "command_position", "motor_current", "output_speed", "error_pulses",
+                   "in_position", "flange_torque")
+    chosen = [c for c in channels if c.key in keys_chosen]
     meta = RecordingMetadata(actuator="FHA-25C-50-US250", load_inertia_kgm2=1.5, sample_rate_hz=100)
     path = tmp_path / "rec.csv"
     rec = ScopeRecorder(path, meta, chosen)
