@@ -146,6 +146,7 @@ class MonitorItem(IntEnum):
     SPEED_COMMAND = 109  # 0.0001 r/min, the speed loop's reference
     OUTPUT_SPEED_FINE = 110  # 0.0001 r/min
     FLANGE_TORQUE = 111  # 0.01 N m, a torque sensor between the output flange and the load
+    MOTOR_CURRENT_MEAN = 112  # 0.001 A, item 104's mean over the last 10 ms
 
 
 class ParameterModel:

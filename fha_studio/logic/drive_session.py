@@ -65,8 +65,10 @@ PROBE_INTERVAL_MS = 700
 SERVO_ON_PROBE_MS = 1000
 #: What the technician is told while a drive answers s (the words of the DGR checks and the CLI).
 SERVO_ON_NOTE = SERVO_ON_TEXT
-#: The monitor items of the status poll: output position, output speed, motor current.
-STATUS_MONITORS = (MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.MOTOR_CURRENT)
+#: The monitor items of the status poll: output position, output speed, motor current (its mean
+#: over 10 ms: one instantaneous sample per poll shows the quantised encoder's dither, tenths of an
+#: ampere, as if it were a standing current).
+STATUS_MONITORS = (MonitorItem.FEEDBACK_POSITION, MonitorItem.OUTPUT_SPEED, MonitorItem.MOTOR_CURRENT_MEAN)
 
 #: One parameter item: its front-panel mode and number.
 ParameterKey = tuple[Mode, int]
@@ -202,8 +204,8 @@ class StatusPoller:
         return max(self.interval_ms, PROBE_INTERVAL_MS)
 
     def _poll_monitors(self, got: _Fields) -> None:
-        """Output position (pulse), output speed (r/min) and motor current (A), scaled by the
-        parameter model's monitor items."""
+        """Output position (pulse), output speed (r/min) and motor current (A, the 10 ms mean),
+        scaled by the parameter model's monitor items."""
         try:
             values = self.drive.read_monitors(STATUS_MONITORS)
         except (CommandNotSupported, CommandRejected) as exc:
@@ -217,7 +219,7 @@ class StatusPoller:
 
         got.position_pulse = values.get(MonitorItem.FEEDBACK_POSITION)
         got.speed_rpm = scaled(MonitorItem.OUTPUT_SPEED)
-        got.current_a = scaled(MonitorItem.MOTOR_CURRENT)
+        got.current_a = scaled(MonitorItem.MOTOR_CURRENT_MEAN)
 
 
 @dataclass(frozen=True)

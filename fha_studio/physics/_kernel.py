@@ -81,6 +81,7 @@ class KernelState:
     vref: float = 0.0  # speed command (rad/s, command frame)
     # accumulators (cumulative)
     i2_integral: float = 0.0  # A^2 s
+    i_integral: float = 0.0  # A s (a mean current over any window is its difference / the window)
     work_j: float = 0.0  # motor work on the axis (Kt i w), J
     regen_j: float = 0.0  # energy returned to the DC bus, J
     peak_speed: float = 0.0  # |motor-side speed| max, rad/s
@@ -104,8 +105,8 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     rec: lists (t, cmd_phys, xm, xl, vm, current, vref, flange_torque) appended every rec_every
     periods, or only at the periods record_at names (increasing, 0 = the first of these n; rec_every
     is then unused): simulate() keeps only the periods its samples fall between.
-    accounting: False skips the cumulative figures (I^2 t, work, regeneration, peaks) that only the
-    simulated drive reads; the motion is the same.
+    accounting: False skips the cumulative figures (integrals of I and I^2, work, regeneration,
+    peaks) that only the simulated drive reads; the motion is the same.
 
     The flange torque (N m, physical frame) is what a strain-gauge sensor between the actuator's
     output flange and the load reads: the torque the flange exerts on the load, + = driving it CW;
@@ -145,7 +146,7 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
 
     xm, vm, xl, vl = s.xm, s.vm, s.xl, s.vl
     integ, cprev, cur, vref = s.integ, s.cprev, s.current, s.vref
-    i2, work, regen, pk_v, pk_e = 0.0, 0.0, 0.0, s.peak_speed, s.peak_error
+    i1, i2, work, regen, pk_v, pk_e = 0.0, 0.0, 0.0, 0.0, s.peak_speed, s.peak_error
     sin_ga = ga != 0.0
     sin_ra = ra != 0.0
     sin_ke = kea != 0.0
@@ -317,6 +318,7 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
 
         # ---------------- accounting ----------------
         if accounting:
+            i1 += cur
             i2 += cur * cur
             pm = motor_torque * vm
             work += pm
@@ -352,6 +354,7 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
 
     s.xm, s.vm, s.xl, s.vl = xm, vm, xl, vl
     s.integ, s.cprev, s.current, s.vref = integ, cprev, cur, vref
+    s.i_integral += i1 * dt
     s.i2_integral += i2 * dt
     s.work_j += work * dt
     s.regen_j += regen * dt

@@ -612,6 +612,12 @@ class ServoAxis:
 
     # ----- accumulators for the drive's alarms ---------------------------------------------
     @property
+    def current_integral_a_s(self) -> float:
+        """Cumulative integral of current dt (A s, + = CW); difference it for a mean current (the
+        instantaneous current carries the quantised feedback's noise)."""
+        return self._state.i_integral
+
+    @property
     def current_squared_integral_a2s(self) -> float:
         """Cumulative integral of current^2 dt (A^2 s); difference it for an I^2 t model."""
         return self._state.i2_integral

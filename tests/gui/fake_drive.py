@@ -240,7 +240,7 @@ class FakeDriveClient:
             return int(position)
         if item == MonitorItem.OUTPUT_SPEED:
             return round(speed_rpm / self.model.item(Mode.MONITOR, item).scale)
-        if item == MonitorItem.MOTOR_CURRENT:
+        if item in (MonitorItem.MOTOR_CURRENT, MonitorItem.MOTOR_CURRENT_MEAN):
             return round((0.5 if speed_rpm else 0.0) / self.model.item(Mode.MONITOR, item).scale)
         if item == MonitorItem.IO_STATE:
             return self._io_bits(moving=bool(speed_rpm))

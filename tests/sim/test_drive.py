@@ -375,6 +375,46 @@ def test_quantised_feedback_gives_a_real_drives_current_noise_while_moving(make_
     assert abs(sum(currents) / len(currents)) < 500  # ... around zero without friction
 
 
+@pytest.mark.parametrize("load_inertia_kgm2", [0.0, 1.5])
+def test_the_status_current_is_the_mean_not_one_sample_of_the_quantisation_dither(make_drive,
+                                                                                 load_inertia_kgm2):
+    # A frictionless, gravity-free axis needs no current at a steady 8 r/min or at rest; one sample
+    # of monitor 104 per status poll read -0.19 A and -0.3 A there (the pulse-difference speed's
+    # dither). Monitor 112, the mean over 10 ms, is what the read-outs show.
+    drive = make_drive(load_inertia_kgm2=load_inertia_kgm2)
+    drive.set_servo(True)
+
+    def polls(hold_rpm: float | None) -> tuple[list[int], list[int]]:
+        instantaneous, mean = [], []
+        for k in range(25):  # polls at phases that do not repeat the dither's period
+            if hold_rpm is not None:
+                drive.jog(hold_rpm)
+            drive.advance(0.0503 + 0.0007 * k)
+            instantaneous.append(drive.monitor(104))
+            mean.append(drive.monitor(112))
+        return instantaneous, mean
+
+    for rpm in (8.0, -8.0):
+        jog_for(drive, rpm, 1.5)
+        instantaneous, mean = polls(rpm)
+        assert max(instantaneous) - min(instantaneous) > 200  # mA: the dither is there ...
+        assert max(abs(m) for m in mean) < 30  # ... and the mean is zero within its residue (mA)
+        drive.stop()
+        drive.advance(1.0)
+    drive.move_by(90.0)
+    drive.advance(4.0)
+    assert drive.axis.motion_done and drive.axis.in_position
+    _, mean = polls(None)  # at rest the axis hunts between pulses now and then (or sits still)
+    assert max(abs(m) for m in mean) < 30
+    # the mean is item 104's over the last 10 ms, servo period by servo period (5 kHz)
+    drive.move_by(-30.0)
+    samples = []
+    for _ in range(100):
+        drive.advance(0.0002)
+        samples.append(drive.monitor(104))
+    assert drive.monitor(112) == pytest.approx(sum(samples[-50:]) / 50, abs=1.0)
+
+
 def test_driver_from_the_combination_table_and_supply_voltage(make_drive):
     assert make_drive("FHA-25C-50-US250-A").driver == "HA-655-4-100"  # 100 V (option A), 1-3
     assert make_drive("FHA-32C-100-S248").driver == "HA-655-4A-200"

@@ -61,6 +61,10 @@ class JogPage(BasePage):
         l_layout.addRow("Output position:", self.position_label)
         l_layout.addRow("Output speed:", self.speed_label)
         l_layout.addRow("Motor current:", self.current_label)
+        self.current_label.setToolTip(
+            "The motor current's mean over the last 10 ms. The current itself ripples by tenths of an "
+            "ampere around it (the encoder's pulses); the scope shows that ripple."
+        )
         self.signal_lamps: dict[IoBit, Lamp] = {}
         for bit, caption, colour in LIVE_SIGNALS:
             lamp = Lamp(caption, colour)

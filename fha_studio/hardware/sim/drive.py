@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 import tempfile
 import threading
+from collections import deque
 from pathlib import Path
 from typing import Any
 
@@ -65,6 +66,12 @@ from fha_studio.hardware.sim.trace import SimTrace
 from fha_studio.physics import ServoAxis, ServoSettings, servo_settings
 
 TWO_PI = 2.0 * math.pi
+#: Monitor 112 and the status read-outs give the motor current as its mean over this window: with
+#: quantised feedback the instantaneous current (monitor 104) dithers by tenths of an ampere around
+#: its mean (the pulse-difference speed steps by one pulse per servo period), so one sample per
+#: status poll reads as a standing current that is not there. 10 ms spans many dither periods and
+#: is still short against a move.
+CURRENT_MEAN_WINDOW_S = 0.01
 
 
 class SimDrive:
@@ -221,6 +228,8 @@ class SimDrive:
         self._oww_done_at: float | None = None
         self._step_debt = 0.0
         self._steps_to_supervision = 0
+        # (time_s, cumulative current integral A s, physical sense) after each step of _advance
+        self._current_history: deque[tuple[float, float]] = deque([(0.0, axis.current_integral_a_s)])
         self.trace = SimTrace()
         self.excitation = SimExcitation()  # EXA / EXL / EXG: stopped by STP, servo off, an alarm
         axis.servo_off()
@@ -350,6 +359,22 @@ class SimDrive:
     def motor_current_a(self) -> float:
         """Motor current, A, command sense."""
         return self._direction * self.axis.current_a
+
+    @property
+    def motor_current_mean_a(self) -> float:
+        """Monitor 112: the motor current's mean over the last CURRENT_MEAN_WINDOW_S, A, command
+        sense (the instantaneous current just after power-on, before any time has passed)."""
+        t0, q0 = self._current_history[0]
+        if self.time_s <= t0:
+            return self.motor_current_a
+        return self._direction * (self.axis.current_integral_a_s - q0) / (self.time_s - t0)
+
+    def _note_current(self) -> None:
+        """Keep the newest point at least CURRENT_MEAN_WINDOW_S old, and those after it."""
+        history = self._current_history
+        history.append((self.time_s, self.axis.current_integral_a_s))
+        while len(history) > 1 and self.time_s - history[1][0] >= CURRENT_MEAN_WINDOW_S - 1e-12:
+            history.popleft()
 
     @property
     def output_torque_nm(self) -> float:
@@ -591,6 +616,7 @@ class SimDrive:
             self._steps_to_supervision -= chunk
             self.time_s += chunk * dt
             self.clock_s += chunk * dt
+            self._note_current()
             if tracing and self.trace.after_steps(chunk):
                 self.trace.sample(self._trace_value, self.alarm)
 

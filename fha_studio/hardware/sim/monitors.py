@@ -32,6 +32,8 @@ class MonitorSource(Protocol):
     @property
     def motor_current_a(self) -> float: ...
     @property
+    def motor_current_mean_a(self) -> float: ...
+    @property
     def output_torque_nm(self) -> float: ...
     @property
     def flange_torque_nm(self) -> float: ...
@@ -52,6 +54,8 @@ def monitor_wire(drive: MonitorSource, item: int) -> int:
         return round(drive.output_speed_rpm * 100)
     if item == MonitorItem.MOTOR_CURRENT:
         return round(drive.motor_current_a * 1000)
+    if item == MonitorItem.MOTOR_CURRENT_MEAN:
+        return round(drive.motor_current_mean_a * 1000)
     if item == MonitorItem.OVERLOAD_RATE:
         return round(drive.overload_rate * 1000)
     if item == MonitorItem.IO_STATE:

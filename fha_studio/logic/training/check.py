@@ -103,7 +103,8 @@ def _jogs(client: DriveClient, out: dict[str, Observed]) -> None:
     client.servo(True)
     try:
         time.sleep(0.2)
-        holding = client.read_monitor(MonitorItem.MOTOR_CURRENT) * AMPS_PER_MA
+        # the 10 ms mean: one instantaneous sample carries the quantised encoder's dither
+        holding = client.read_monitor(MonitorItem.MOTOR_CURRENT_MEAN) * AMPS_PER_MA
         out["Current holding still (A)"] = Observed(f"{holding:.2f}", holding, 0.25)
         for name, sign in (("FWD", 1.0), ("REV", -1.0)):
             start = client.read_monitor(MonitorItem.LOAD_POSITION)
@@ -114,10 +115,10 @@ def _jogs(client: DriveClient, out: dict[str, Observed]) -> None:
                     client.jog(sign * JOG_SPEED_RPM)
                 except LinkError:
                     break
-                amps = abs(client.read_monitor(MonitorItem.MOTOR_CURRENT)) * AMPS_PER_MA
-                peak = max(peak, amps)
+                both = client.read_monitors((MonitorItem.MOTOR_CURRENT, MonitorItem.MOTOR_CURRENT_MEAN))
+                peak = max(peak, abs(both[MonitorItem.MOTOR_CURRENT]) * AMPS_PER_MA)
                 if elapsed > JOG_S / 2:
-                    steady = amps
+                    steady = abs(both[MonitorItem.MOTOR_CURRENT_MEAN]) * AMPS_PER_MA
                 time.sleep(KEEPALIVE_S)
             client.stop()
             time.sleep(0.25)
