@@ -14,6 +14,7 @@ move or "Back to live". Where sigrok-cli is missing the tab says how to install 
 
 from __future__ import annotations
 
+import datetime
 import math
 import shutil
 import time
@@ -35,6 +36,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio import clock
 from fha_studio.gui.widgets import hint_whole
 from fha_studio.hardware.bench import sigrok
 from fha_studio.hardware.parameters import load_cn2
@@ -363,8 +365,10 @@ class BenchPanel(QWidget):
     def _hold(self, started: BenchStarted, rows: np.ndarray) -> None:
         """The move's rows on the plots until the next move or Back to live."""
         self._held = rows
-        wall = time.time() - (time.monotonic() - started.t0 - float(rows[0, 0]))
-        self.showing_label.setText(f"Showing the move at {time.strftime('%H:%M:%S', time.localtime(wall))}"
+        # the move's start by the one clock every stamp reads (its time since, by the stream's own)
+        ago_s = time.monotonic() - started.t0 - float(rows[0, 0])
+        at = (clock.now_utc() - datetime.timedelta(seconds=ago_s)).astimezone()
+        self.showing_label.setText(f"Showing the move at {at:%H:%M:%S}"
                                    f" ({float(rows[-1, 0] - rows[0, 0]):.2f} s) while the stream goes on.")
         self.hold_bar.setVisible(True)
         self._x_range = self._y_range = self._counts_range = None
