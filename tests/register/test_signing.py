@@ -180,6 +180,32 @@ def test_bad_keys_and_passphrases_are_one_line_and_write_nothing(
     assert [k["person"] for k in keys] == ["A. Reviewer"]
 
 
+def test_every_wrong_passphrase_is_said_as_one(tmp_path):
+    """A wrong passphrase decrypts to garbage, and now and then the garbage has valid padding so
+    the parser calls the key damaged instead: that passphrase must still be said to be wrong."""
+    from cryptography.hazmat.primitives import serialization
+
+    from fha_studio.logic.register.signing import SigningError, load_private_key, new_key
+
+    key_file = tmp_path / "mine.pem"
+    key_file.write_bytes(new_key().private_bytes(
+        serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8,
+        serialization.BestAvailableEncryption(b"right")))
+    data = key_file.read_bytes()
+    for attempt in range(20_000):  # about one in 256 fails as damaged data
+        guess = f"wrong {attempt}"
+        try:
+            serialization.load_pem_private_key(data, password=guess.encode())
+        except ValueError as exc:
+            if "password" not in str(exc).lower():
+                break
+    else:
+        pytest.fail("no passphrase that decrypts to damaged data")
+    with pytest.raises(SigningError, match="wrong passphrase"):
+        load_private_key(key_file, guess)
+    assert load_private_key(key_file, "right") is not None
+
+
 def test_a_key_is_never_replaced_and_a_revocation_is_a_fact_of_its_own(register_target):
     from fha_studio.logic.register.signing import key_id_of, new_key, public_raw
 

@@ -126,11 +126,11 @@ def load_private_key(path: Path, passphrase: str = "") -> Ed25519PrivateKey:
     try:
         key = serialization.load_pem_private_key(
             data, password=passphrase.encode("utf-8") if encrypted else None)
-    except (ValueError, TypeError) as exc:
-        if encrypted and ("decrypt" in str(exc).lower() or "password" in str(exc).lower()):
-            raise SigningError(f"key file {path}: wrong passphrase") from None
-        raise SigningError(f"key file {path}: not a private key (damaged, or not a PEM key file)") from None
-    except Exception:  # cryptography's Rust parser raises its own errors for damaged input
+    except Exception:  # ValueError/TypeError, or the Rust parser's own errors for damaged input
+        if encrypted:
+            # A wrong passphrase decrypts to garbage; about one time in 256 the garbage has valid
+            # padding and fails as a damaged key instead of a bad password, so both say the same.
+            raise SigningError(f"key file {path}: wrong passphrase (or the key file is damaged)") from None
         raise SigningError(f"key file {path}: not a private key (damaged, or not a PEM key file)") from None
     if not isinstance(key, Ed25519PrivateKey):
         raise SigningError(f"key file {path}: not an Ed25519 key")
