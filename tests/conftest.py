@@ -21,6 +21,14 @@ from tests.support.clock import FakeClock
 #: (postgres_cluster, started once per session by the first test that asks).
 pytest_plugins = ["tests.support.links", "tests.support.processes", "tests.support.postgres"]
 
+# Property tests are the same on every run and every machine: a loaded CI machine is no reason
+# to fail (no deadline), and an example that fails here fails again there (derandomize).
+from hypothesis import settings as _hypothesis_settings  # noqa: E402
+
+_hypothesis_settings.register_profile("fha", deadline=None, derandomize=True, database=None,
+                                      print_blob=True)
+_hypothesis_settings.load_profile("fha")
+
 # GUI tests run headless; the environment can override (e.g. xcb under xvfb-run).
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
