@@ -39,6 +39,7 @@ from fha_studio.gui.register_connection import (
     shut_socket,
     without_nothing_changed,
 )
+from fha_studio.gui.register_writer import HeldRegisterFile
 from fha_studio.logic.register import Register, RegisterError, guard
 from fha_studio.logic.register.guard import ServerAway
 from fha_studio.logic.register.server import problem, shown_url
@@ -106,18 +107,13 @@ class RegisterQuestions(QObject):
     def shutdown(self) -> None:
         """Answers nothing more (idempotent); the answers still owed are dropped."""
 
+    def _say_refused(self, why: str) -> None:
+        """A question the register refused, with no ``failed`` of its own: the message line."""
+        self.sigSay.emit(f"Register: {why}", Level.WARNING)
 
-class LocalQuestions(RegisterQuestions):
+
+class LocalQuestions(HeldRegisterFile, RegisterQuestions):
     """A register file: each question answered at once, on this thread."""
-
-    def __init__(self, register: Register, parent: QObject | None = None):
-        super().__init__(parent)
-        self.register: Register | None = register
-        self._location = register.location
-
-    @property
-    def location(self) -> Path | str:
-        return self._location
 
     def ask(self, what: str, question: Callable[[Register], Any], answered: Answered,
             failed: Failed | None = None) -> None:
@@ -126,15 +122,10 @@ class LocalQuestions(RegisterQuestions):
         try:
             value = question(self.register)
         except (RegisterError, ValueError, OSError) as exc:
-            (failed or self._say)(str(exc))
+            (failed or self._say_refused)(str(exc))
             return
         answered(value)
 
-    def _say(self, why: str) -> None:
-        self.sigSay.emit(f"Register: {why}", Level.WARNING)
-
-    def shutdown(self) -> None:
-        self.register = None
 
 
 class QuestionWorker(QObject):
@@ -314,9 +305,6 @@ class ServerQuestions(RegisterQuestions):
                 f"Register: the server does not answer: no answer about {what} ({why}).", Level.WARNING
             )
         self.answers, self._said_slow = False, False
-
-    def _say_refused(self, why: str) -> None:
-        self.sigSay.emit(f"Register: {why}", Level.WARNING)
 
     @Slot()
     def _on_slow(self) -> None:

@@ -42,17 +42,25 @@ class RegisterWriter(QObject):
         """Records nothing more (idempotent)."""
 
 
-class DirectWriter(RegisterWriter):
-    """Writes into an open register on the GUI thread (a file)."""
+class HeldRegisterFile:
+    """An open register file used on the GUI thread until ``shutdown`` lets it go (the window
+    closes it): what a local writer and a local asker share. Put before the QObject base."""
 
     def __init__(self, register: Register, parent: QObject | None = None):
-        super().__init__(parent)
+        super().__init__(parent)  # type: ignore[call-arg]  # the QObject base after this one
         self.register: Register | None = register
         self._location = register.location
 
     @property
     def location(self) -> Path | str:
         return self._location
+
+    def shutdown(self) -> None:
+        self.register = None
+
+
+class DirectWriter(HeldRegisterFile, RegisterWriter):
+    """Writes into an open register on the GUI thread (a file)."""
 
     def record(self, axis: str, facts: Sequence[Fact]) -> None:
         for fact in facts:
@@ -63,9 +71,6 @@ class DirectWriter(RegisterWriter):
                 self.sigNotRecorded.emit(axis, fact.what, problem)
                 if isinstance(fact, AxisFact):
                     return
-
-    def shutdown(self) -> None:
-        self.register = None
 
 
 def write_fact(register: Register, axis: str, fact: Fact) -> str:
