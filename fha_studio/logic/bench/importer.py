@@ -87,19 +87,21 @@ class SignalSpec:
         return f"{self.path}#{self.channel}" if self.channel else self.path
 
 
-def parse_signal(text: str) -> SignalSpec:
-    """``ROLE=FILE[#CHANNEL]`` -> SignalSpec; BenchImportError naming what is wrong."""
+def parse_signal(text: str, roles: Sequence[str] = ROLES,
+                 error: type[ValueError] = BenchImportError) -> SignalSpec:
+    """``ROLE=FILE[#CHANNEL]`` with ROLE one of ``roles`` -> SignalSpec; ``error`` (BenchImportError)
+    naming what is wrong. ``bench import`` and ``tune analyse`` take their signals so."""
     role, sep, rest = text.partition("=")
     role = role.strip()
     if not sep or not rest:
-        raise BenchImportError(f"--signal '{text}': expected ROLE=FILE or ROLE=FILE#CHANNEL")
-    if role not in ROLES:
-        raise BenchImportError(f"--signal '{text}': unknown role '{role}' (roles: {', '.join(ROLES)})")
+        raise error(f"--signal '{text}': expected ROLE=FILE or ROLE=FILE#CHANNEL")
+    if role not in roles:
+        raise error(f"--signal '{text}': unknown role '{role}' (roles: {', '.join(roles)})")
     path, hash_, channel = rest.rpartition("#") if "#" in rest else (rest, "", "")
     if hash_ and not channel:
-        raise BenchImportError(f"--signal '{text}': no channel after '#'")
+        raise error(f"--signal '{text}': no channel after '#'")
     if not path:
-        raise BenchImportError(f"--signal '{text}': no file before '#'")
+        raise error(f"--signal '{text}': no file before '#'")
     return SignalSpec(role, path, channel or None)
 
 

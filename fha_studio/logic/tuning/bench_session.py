@@ -13,7 +13,6 @@ and the Tuning page share (no Qt).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -23,6 +22,7 @@ from fha_studio.hardware.bench.readers import read_capture
 from fha_studio.hardware.bench.waveform import Waveform, read_waveform
 from fha_studio.hardware.parameters import Mode, ParameterModel
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
+from fha_studio.logic.bench.importer import SignalSpec, parse_signal
 from fha_studio.logic.tuning import bench_names
 from fha_studio.logic.tuning.bench_move import MoveFitError, MoveSamples, move_fit_report
 from fha_studio.logic.tuning.bench_response import BenchCapture, BenchResponseError, analyse_bench_response
@@ -33,33 +33,13 @@ RESPONSE_ROLES = bench_names.RESPONSE_ROLES
 MOVE_ROLES = bench_names.MOVE_ROLES
 
 
-@dataclass(frozen=True)
-class RoleSignal:
-    """``ROLE=FILE[#CHANNEL]``."""
-
-    role: str
-    path: str
-    channel: str | None = None
-
-    @property
-    def text(self) -> str:
-        return f"{self.path}#{self.channel}" if self.channel else self.path
+#: ``ROLE=FILE[#CHANNEL]``: a signal as ``bench import`` takes it.
+RoleSignal = SignalSpec
 
 
 def parse_role(text: str, roles: Sequence[str]) -> RoleSignal:
     """``ROLE=FILE[#CHANNEL]`` with ROLE one of ``roles``; BenchResponseError naming what is wrong."""
-    role, sep, rest = text.partition("=")
-    role = role.strip()
-    if not sep or not rest:
-        raise BenchResponseError(f"--signal '{text}': expected ROLE=FILE or ROLE=FILE#CHANNEL")
-    if role not in roles:
-        raise BenchResponseError(f"--signal '{text}': unknown role '{role}' (roles: {', '.join(roles)})")
-    path, hash_, channel = rest.rpartition("#") if "#" in rest else (rest, "", "")
-    if hash_ and not channel:
-        raise BenchResponseError(f"--signal '{text}': no channel after '#'")
-    if not path:
-        raise BenchResponseError(f"--signal '{text}': no file before '#'")
-    return RoleSignal(role, path, channel or None)
+    return parse_signal(text, roles, BenchResponseError)
 
 
 def bench_items(parameters: ParameterModel,
@@ -163,7 +143,6 @@ def move_samples(tuner: Tuner, signals: Sequence[RoleSignal],
         AxisFacts,
         BenchImportError,
         DriveSettings,
-        SignalSpec,
         import_bench,
     )
 
@@ -174,10 +153,9 @@ def move_samples(tuner: Tuner, signals: Sequence[RoleSignal],
     if missing:
         raise BenchResponseError(f"a move needs {', '.join(missing)} too: the encoder outputs and the "
                                  "command pulses, captured together")
-    specs = [SignalSpec(s.role, s.path, s.channel) for s in signals]
     try:
         settings = DriveSettings.from_values({(str(m), n): v for (m, n), v in values.items()})
-        result = import_bench(specs, AxisFacts.for_actuator(tuner.model.actuator_code), settings,
+        result = import_bench(signals, AxisFacts.for_actuator(tuner.model.actuator_code), settings,
                               output_rate_hz=tuner.servo_rate_hz)
     except BenchImportError as exc:
         raise BenchResponseError(str(exc)) from None
