@@ -48,123 +48,64 @@ class History(Conflicts):
         """Everything recorded for the axis, oldest first."""
         current = self.axis(axis)
         a = current.id
-        db = self._db
-        events: list[Event] = []
-        for r in db.execute("SELECT * FROM axis_event WHERE axis_id = ?", (a,)):
-            events.append(Event(r["at_utc"], EventKind.AXIS, r["who"], r["text"], r["id"], _corrects(r),
-                                r["uid"]))
+
+        def rows(kind: EventKind) -> Any:
+            return self._db.execute(f"SELECT * FROM {KIND_TABLES[kind]} WHERE axis_id = ?", (a,))
+
+        events = [_event(r, EventKind.AXIS, r["text"]) for r in rows(EventKind.AXIS)]
         for r in self.snapshots(current):
             where = f" ({r['file']})" if r["file"] else ""
-            events.append(
-                Event(
-                    r["at_utc"],
-                    EventKind.SNAPSHOT,
-                    r["who"],
-                    f"parameters {SNAPSHOT_SOURCE_WORDS[r['source']]}: {r['count']} values,"
-                    f" snapshot {r['id']}{where}",
-                    r["id"],
-                    {"source": r["source"], "file": r["file"], "count": r["count"], **_corrects(r)},
-                    uid=r["uid"],
-                )
-            )
-        for r in db.execute("SELECT * FROM parameter_write WHERE axis_id = ?", (a,)):
+            events.append(_event(
+                r, EventKind.SNAPSHOT,
+                f"parameters {SNAPSHOT_SOURCE_WORDS[r['source']]}: {r['count']} values,"
+                f" snapshot {r['id']}{where}",
+                {"source": r["source"], "file": r["file"], "count": r["count"]},
+            ))
+        for r in rows(EventKind.WRITE):
             outcome = "verified" if r["verified"] else f"NOT verified ({r['error'] or 'read-back differs'})"
             name = words.parameter_name(r["key"], current.driver_model, (r["mode"], r["number"]))
             change = words.change_text(r["key"], r["old"], r["new"], current.driver_model)
-            events.append(
-                Event(
-                    r["at_utc"],
-                    EventKind.WRITE,
-                    r["who"],
-                    f"{name}: {change}, {outcome}",
-                    r["id"],
-                    {
-                        **{
-                            k: r[k]
-                            for k in ("mode", "number", "key", "old", "new", "read_back", "verified", "error")
-                        },
-                        **_corrects(r),
-                    },
-                    uid=r["uid"],
-                )
-            )
+            events.append(_event(
+                r, EventKind.WRITE, f"{name}: {change}, {outcome}",
+                {k: r[k] for k in ("mode", "number", "key", "old", "new", "read_back", "verified", "error")},
+            ))
         titles = self._procedure_titles(a)
-        for r in db.execute("SELECT * FROM check_result WHERE axis_id = ?", (a,)):
+        for r in rows(EventKind.CHECK):
             value = json.loads(r["value_json"])
             shown = ("yes" if value else "no") if r["kind"] == "confirm" else f"{value} {r['unit']}".strip()
             verdict = "pass" if r["passed"] else "FAIL"
             if isinstance(value, dict):  # a check with several readings: its own sentence says them
                 shown = r["detail"] or words.readings_text(value)
-            events.append(
-                Event(
-                    r["at_utc"],
-                    EventKind.CHECK,
-                    r["who"],
-                    f"{check_name(r, titles)}: {shown} — {verdict}",
-                    r["id"],
-                    {
-                        "procedure_id": r["procedure_id"],
-                        "step_id": r["step_id"],
-                        "value": value,
-                        "passed": bool(r["passed"]),
-                        "expected": r["expected"],
-                        "detail": r["detail"],
-                        **_corrects(r),
-                    },
-                    uid=r["uid"],
-                )
-            )
-        for r in db.execute("SELECT * FROM alarm WHERE axis_id = ?", (a,)):
+            events.append(_event(
+                r, EventKind.CHECK, f"{check_name(r, titles)}: {shown} — {verdict}",
+                {
+                    "procedure_id": r["procedure_id"],
+                    "step_id": r["step_id"],
+                    "value": value,
+                    "passed": bool(r["passed"]),
+                    "expected": r["expected"],
+                    "detail": r["detail"],
+                },
+            ))
+        for r in rows(EventKind.ALARM):
             note = f" ({r['note']})" if r["note"] else ""
-            events.append(
-                Event(
-                    r["at_utc"],
-                    EventKind.ALARM,
-                    r["who"],
-                    f"alarm {r['code']}: {r['name']}{note}",
-                    r["id"],
-                    {"code": r["code"], **_corrects(r)},
-                    uid=r["uid"],
-                )
-            )
-        for r in db.execute("SELECT * FROM report WHERE axis_id = ?", (a,)):
+            events.append(_event(r, EventKind.ALARM, f"alarm {r['code']}: {r['name']}{note}",
+                                 {"code": r["code"]}))
+        for r in rows(EventKind.REPORT):
             signed = f"signed by {r['signed_by']}" if r["signed_by"] else "not signed"
-            events.append(
-                Event(
-                    r["at_utc"],
-                    EventKind.REPORT,
-                    r["who"],
-                    f"report {r['file']} ({signed}, {r['open_warnings']} open warnings)",
-                    r["id"],
-                    {"file": r["file"], "sha256": r["sha256"], "signed_by": r["signed_by"], **_corrects(r)},
-                    uid=r["uid"],
-                )
-            )
-        for r in db.execute("SELECT * FROM recording WHERE axis_id = ?", (a,)):
+            events.append(_event(
+                r, EventKind.REPORT, f"report {r['file']} ({signed}, {r['open_warnings']} open warnings)",
+                {"file": r["file"], "sha256": r["sha256"], "signed_by": r["signed_by"]},
+            ))
+        for r in rows(EventKind.RECORDING):
             summary = f": {r['summary']}" if r["summary"] else ""
-            events.append(
-                Event(
-                    r["at_utc"],
-                    EventKind.RECORDING,
-                    r["who"],
-                    f"recording {r['file']}{summary}",
-                    r["id"],
-                    {"file": r["file"], **_corrects(r)},
-                    uid=r["uid"],
-                )
-            )
-        for r in db.execute("SELECT * FROM model_check WHERE axis_id = ?", (a,)):
-            events.append(
-                Event(
-                    r["at_utc"],
-                    EventKind.MODEL_CHECK,
-                    r["who"],
-                    f"model check: {r['summary']}",
-                    r["id"],
-                    {"file": r["file"], "recording_file": r["recording_file"], **_corrects(r)},
-                    uid=r["uid"],
-                )
-            )
+            events.append(_event(r, EventKind.RECORDING, f"recording {r['file']}{summary}",
+                                 {"file": r["file"]}))
+        for r in rows(EventKind.MODEL_CHECK):
+            events.append(_event(
+                r, EventKind.MODEL_CHECK, f"model check: {r['summary']}",
+                {"file": r["file"], "recording_file": r["recording_file"]},
+            ))
         events += _conflict_events(self.conflicts(current, open_only=False))
         events = self._with_receipts(_with_corrections(events), a)
         if since is not None:
@@ -224,6 +165,14 @@ def _conflict_events(conflicts: list[Conflict]) -> list[Event]:
                              f"conflict {c.short} settled: kept {r.kept}, {side_name(side) if side else ''}: "
                              f"{kept}{note}", r.id, {"conflict": c.short, "kept": r.kept}, r.uid))
     return out
+
+
+def _event(row: Mapping[str, Any], kind: EventKind, text: str,
+           data: Mapping[str, Any] | None = None) -> Event:
+    """A fact's row as a history line: its time, who, row id and stable id as every fact table
+    holds them, ``data`` with the fact it corrects."""
+    return Event(row["at_utc"], kind, row["who"], text, row["id"], {**(data or {}), **_corrects(row)},
+                 uid=row["uid"])
 
 
 def _corrects(row: Mapping[str, Any]) -> dict[str, int]:
