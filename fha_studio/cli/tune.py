@@ -83,9 +83,11 @@ class _TuneStop(Exception):
 @contextmanager
 def _open(url: str) -> Iterator[Any]:
     """The drive at ``url``; a port that does not open or a line that fails is one line and exit 3
-    (as ``fha-studio drive``), a drive's refusal one line and exit 4."""
+    (as ``fha-studio drive``), a drive's refusal or one that cannot be excited one line and exit 4
+    (``_TuneStop``: :func:`_stopped` says it)."""
     from fha_studio.hardware.client import DriveClient
     from fha_studio.hardware.errors import DriveRefused, LinkFailure
+    from fha_studio.logic.tuning.excitation import NotExcitable
 
     try:
         client = DriveClient.open(url)
@@ -99,8 +101,16 @@ def _open(url: str) -> Iterator[Any]:
         raise _TuneStop(EXIT_NO_ANSWER, f"the link to {url} failed: {exc}") from None
     except DriveRefused as exc:
         raise _TuneStop(EXIT_NOT_EXCITABLE, f"the drive refused: {exc}") from None
+    except NotExcitable as exc:
+        raise _TuneStop(EXIT_NOT_EXCITABLE, str(exc)) from None
     finally:
         client.close()
+
+
+def _stopped(command: str, why: Exception, code: int) -> int:
+    """A ``tune`` command ended by ``why``: one line, and its exit status ``code``."""
+    print(f"fha-studio tune {command}: {why}", file=sys.stderr)
+    return code
 
 
 def _emit(args: argparse.Namespace, result: dict[str, Any], text: str) -> None:
@@ -127,7 +137,6 @@ def _model(args: argparse.Namespace) -> Any:
 
 def run_measure(args: argparse.Namespace) -> int:
     from fha_studio.hardware.parameters import load_parameter_model
-    from fha_studio.logic.tuning.excitation import NotExcitable
     from fha_studio.logic.tuning.measure import check_excitable
     from fha_studio.logic.tuning.record import figure_words
     from fha_studio.logic.tuning.session import drive_clock, measure_report, tuner_for
@@ -142,11 +151,7 @@ def run_measure(args: argparse.Namespace) -> int:
             result = measure_report(client, tuner, pace, now, args.amplitude_rpm,
                                     announce=lambda s: print(s, file=sys.stderr))
     except _TuneStop as stop:
-        print(f"fha-studio tune measure: {stop}", file=sys.stderr)
-        return stop.code
-    except NotExcitable as exc:
-        print(f"fha-studio tune measure: {exc}", file=sys.stderr)
-        return EXIT_NOT_EXCITABLE
+        return _stopped("measure", stop, stop.code)
     except ValueError as exc:
         raise CliError(str(exc)) from None
 
@@ -164,7 +169,6 @@ def run_measure(args: argparse.Namespace) -> int:
 
 def run_propose(args: argparse.Namespace) -> int:
     from fha_studio.hardware.parameters import load_parameter_model
-    from fha_studio.logic.tuning.excitation import NotExcitable
     from fha_studio.logic.tuning.measure import check_excitable
     from fha_studio.logic.tuning.session import tuner_for
 
@@ -188,11 +192,7 @@ def run_propose(args: argparse.Namespace) -> int:
             if args.apply:
                 result["measured"] = _apply(args, client, parameters, tuner, proposal)
     except _TuneStop as stop:
-        print(f"fha-studio tune propose: {stop}", file=sys.stderr)
-        return stop.code
-    except NotExcitable as exc:
-        print(f"fha-studio tune propose: {exc}", file=sys.stderr)
-        return EXIT_NOT_EXCITABLE
+        return _stopped("propose", stop, stop.code)
     from fha_studio.logic.tuning.record import figure_words
 
     items = ", ".join(f"{k} {v}" for k, v in proposal.proposed.items.items())
@@ -325,8 +325,7 @@ def run_excitation(args: argparse.Namespace) -> int:
     try:
         excitation = design_excitation(tuner, args.form, args.amplitude_rpm, args.rate, args.periods)
     except NotInSpeedMode as exc:
-        print(f"fha-studio tune excitation: {exc}", file=sys.stderr)
-        return EXIT_NOT_EXCITABLE
+        return _stopped("excitation", exc, EXIT_NOT_EXCITABLE)
     except ValueError as exc:
         raise CliError(str(exc)) from None
     form = form_of(args.output)
@@ -361,8 +360,7 @@ def run_analyse(args: argparse.Namespace) -> int:
         else:
             result = bench_response_report(tuner, signals, args.excitation, args.monitor_bandwidth_hz)
     except NotInSpeedMode as exc:
-        print(f"fha-studio tune analyse: {exc}", file=sys.stderr)
-        return EXIT_NOT_EXCITABLE
+        return _stopped("analyse", exc, EXIT_NOT_EXCITABLE)
     except (BenchResponseError, ValueError) as exc:
         raise CliError(str(exc)) from None
     _emit(args, _finite(result), _summary(result))
