@@ -33,7 +33,10 @@ torque the loop winds up (``RecordedLoop.stick_torque``), not a friction column'
 Not in the model, and why: viscous friction. The speed detection's lag reads as less inertia and a
 negative viscous friction (g lag / Tv); a free viscous column trades off against g and the lag
 (tried on the simulated drive: with one, g came out 1.8 x too large and every torque with it;
-without it, within 1 %).
+without it, within 1 %). Nor with the lag held at the simulated drive's detection (0.33 ms): each
+0.1 ms off moves the drag by g x 0.1 ms / Tv, the lag at which nothing hidden reads as no drag
+ranges over 0.27-0.41 ms from axis to axis, and with 50 % feed-forward the drag trades off against
+Kp, FF and g (docs/physics.md).
 """
 
 from __future__ import annotations
