@@ -162,7 +162,6 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     has_st = p.stribeck_a > 0.0
     st_dv = h * p.stribeck_a / j_motor
     st_iv = 1.0 / p.stribeck_v
-    exp = math.exp
     h_jl = h / jl
     if rec is not None:
         r_t, r_c, r_xm, r_xl, r_vm, r_i, r_vr, r_tf = rec
@@ -249,24 +248,8 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
                         tg = 0.0
                 else:
                     tg = 0.0
-                tm = motor_torque - tg
-                if sin_ra:
-                    tm -= ra * sin(rw * xm + rph)
-                v = vm + h_jm * tm
-                if has_visc:
-                    v *= visc_den
-                up, dn = fcp_dv, fcn_dv
-                if has_st:
-                    q = vm * st_iv
-                    e = st_dv * exp(-q * q)
-                    up += e
-                    dn += e
-                if v > up:
-                    vm = v - up
-                elif v < -dn:
-                    vm = v + dn
-                else:
-                    vm = 0.0
+                vm = _motor_speed(vm, xm, motor_torque - tg, h_jm, sin_ra, ra, rw, rph, has_visc, visc_den,
+                                  fcp_dv, fcn_dv, has_st, st_iv, st_dv)
                 tl = tg - off
                 if sin_ga:
                     tl -= ga * sin(xl + gph)
@@ -278,25 +261,9 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
             tload = off
             if sin_ga:
                 tload += ga * sin(xm + gph)
-            tm = motor_torque - tload
             v0 = vm
-            if sin_ra:
-                tm -= ra * sin(rw * xm + rph)
-            v = vm + h_jm * tm
-            if has_visc:
-                v *= visc_den
-            up, dn = fcp_dv, fcn_dv
-            if has_st:
-                q = vm * st_iv
-                e = st_dv * exp(-q * q)
-                up += e
-                dn += e
-            if v > up:
-                vm = v - up
-            elif v < -dn:
-                vm = v + dn
-            else:
-                vm = 0.0
+            vm = _motor_speed(vm, xm, motor_torque - tload, h_jm, sin_ra, ra, rw, rph, has_visc, visc_den,
+                              fcp_dv, fcn_dv, has_st, st_iv, st_dv)
             xm += h * vm
             vl = vm
             # load = motor side + kinematic error, through the lost-motion play operator
@@ -364,6 +331,31 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
     s.rec_count = rec_count
     if n > 0:
         s.flange_torque = tg - flange_share * tl if compliant else j_sensed * (vm - v0) * rate + tload
+
+
+def _motor_speed(vm: float, xm: float, tm: float, h_jm: float, sin_ra: bool, ra: float, rw: float,
+                 rph: float, has_visc: bool, visc_den: float, fcp_dv: float, fcn_dv: float,
+                 has_st: bool, st_iv: float, st_dv: float) -> float:
+    """The motor side's speed after one step of ``h`` (``h_jm`` = h / jm) under the torque ``tm``
+    on it (besides the ripple and the friction): the torque ripple, viscous friction implicitly,
+    then Coulomb and Stribeck friction by the stick/slip clamp. The rigid and the compliant plant
+    step the motor side by this one rule."""
+    if sin_ra:
+        tm -= ra * math.sin(rw * xm + rph)
+    v = vm + h_jm * tm
+    if has_visc:
+        v *= visc_den
+    up, dn = fcp_dv, fcn_dv
+    if has_st:
+        q = vm * st_iv
+        e = st_dv * math.exp(-q * q)
+        up += e
+        dn += e
+    if v > up:
+        return v - up
+    if v < -dn:
+        return v + dn
+    return 0.0
 
 
 def substeps_for(jm: float, jl: float, k_max: float, dt: float) -> int:
