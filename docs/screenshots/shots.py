@@ -46,6 +46,12 @@ OWNER_NOTE = "owner.json"
 #: A folder without an owner's note (left by a script before the note existed) is removed once
 #: nobody has touched it for this long.
 UNOWNED_STALE_S = 3600.0
+#: Where the pictures show the run's files: a technician's home, not the temporary folder the
+#: script really uses (a reader would take ``/tmp/fha-shots-x1y2/...`` for where FHA Studio puts
+#: them). Only the picture changes: the widgets get their own text back after the grab.
+SHOWN_HOME = "/home/technician"
+#: The run's temporary folder (private_folder's), once made.
+_folder = ""
 
 
 def private_folder() -> str:
@@ -56,7 +62,8 @@ def private_folder() -> str:
     from fha_studio.temporaries import started_ticks
 
     sweep_left_folders()
-    folder = tempfile.mkdtemp(prefix=FOLDER_PREFIX)
+    global _folder
+    folder = _folder = tempfile.mkdtemp(prefix=FOLDER_PREFIX)
     pid = os.getpid()
     Path(folder, OWNER_NOTE).write_text(json.dumps({"pid": pid, "pid_started_ticks": started_ticks(pid)}))
     atexit.register(shutil.rmtree, folder, True)
@@ -98,6 +105,68 @@ def sweep_left_folders(base: str | None = None) -> list[Path]:
         except OSError:
             continue
     return removed
+
+
+def shown_paths(text: str, folder: str | None = None) -> str:
+    """``text`` with the run's temporary ``folder`` (private_folder's) as :data:`SHOWN_HOME`'s
+    folders: its data and settings where the user's are, the rest in ``commissioning``."""
+    folder = _folder if folder is None else folder
+    if not folder or folder not in text:
+        return text
+    home = SHOWN_HOME
+    qt_data = f"{folder}/data/FHA Studio Screenshots/fha-studio-screenshots"  # Qt's, by the run's name
+    for real, shown in (
+        (qt_data, f"{home}/.local/share/FHA Studio/fha-studio"),
+        (f"{folder}/data", f"{home}/.local/share"),
+        (f"{folder}/config", f"{home}/.config"),
+        (folder, f"{home}/commissioning"),
+    ):
+        text = text.replace(real, shown)
+    return text
+
+
+def _paths_shown_plausibly(widget: Any) -> Callable[[], None]:
+    """Shows the run's folder as :func:`shown_paths` does in the texts of ``widget`` and its
+    children (labels, fields, buttons, text views) without a signal; returns what
+    puts the texts back."""
+    from PySide6.QtWidgets import (
+        QAbstractButton,
+        QLabel,
+        QLineEdit,
+        QPlainTextEdit,
+        QTextEdit,
+        QWidget,
+    )
+
+    undo: list[Callable[[], None]] = []
+
+    def change(obj: Any, get: Callable[[], str], put: Callable[[str], None]) -> None:
+        text = get()
+        shown = shown_paths(text)
+        if shown != text:
+            blocked = obj.blockSignals(True)
+            put(shown)
+            obj.blockSignals(blocked)
+
+            def back(obj: Any = obj, put: Callable[[str], None] = put, text: str = text) -> None:
+                blocked = obj.blockSignals(True)
+                put(text)
+                obj.blockSignals(blocked)
+
+            undo.append(back)
+
+    for w in [widget, *widget.findChildren(QWidget)]:
+        if isinstance(w, QLabel | QLineEdit | QAbstractButton):
+            change(w, w.text, w.setText)
+        elif isinstance(w, QPlainTextEdit):
+            change(w, w.toPlainText, w.setPlainText)
+        elif isinstance(w, QTextEdit):
+            change(w, w.toHtml, w.setHtml)
+    def put_back() -> None:
+        for back in reversed(undo):
+            back()
+
+    return put_back
 
 
 def window_size(default: tuple[int, int]) -> tuple[int, int]:
@@ -158,7 +227,13 @@ class ScreenshotRun:
         self.settle(self.settle_before_shot_s)
         OUT.mkdir(parents=True, exist_ok=True)
         path = OUT / f"{name}.png"
-        (widget or self.window).grab().save(str(path))
+        widget = widget or self.window
+        put_back = _paths_shown_plausibly(widget)
+        try:
+            self.app.processEvents()
+            widget.grab().save(str(path))
+        finally:
+            put_back()
         print("saved", path)
         return path
 

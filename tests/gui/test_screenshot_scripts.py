@@ -175,3 +175,43 @@ def test_the_model_check_screenshots_give_up_on_a_move_that_does_not_end(monkeyp
     assert script.MOVE_DEADLINE_S >= 10.0
     with pytest.raises(TimeoutError, match=r"the move by 90° had not ended after 0 s .*no screenshots taken"):
         script.back_and_forth(_StuckDrive(), deadline_s=0.0)
+
+
+def test_the_pictures_show_a_technicians_folders_not_the_temporary_one(qtbot, monkeypatch):
+    """A path into the run's temporary folder is shown as a technician's (the register in the
+    user's data, a session in their commissioning folder) in every text of the grabbed widget,
+    without a signal to the page behind it; the widgets get their own text back."""
+    from PySide6.QtWidgets import QLabel, QLineEdit, QPlainTextEdit, QVBoxLayout, QWidget
+
+    monkeypatch.syspath_prepend(str(SHOTS))
+    import shots
+
+    folder = "/tmp/fha-shots-x1y2"
+    monkeypatch.setattr(shots, "_folder", folder)
+    data = f"{folder}/data/FHA Studio Screenshots/fha-studio-screenshots"
+    assert shots.shown_paths(f"Register file: {data}/register.sqlite") == (
+        "Register file: /home/technician/.local/share/FHA Studio/fha-studio/register.sqlite")
+    assert shots.shown_paths(f"Session {folder}/axis1.json — FHA-25C-50-US250") == (
+        "Session /home/technician/commissioning/axis1.json — FHA-25C-50-US250")
+    assert shots.shown_paths("/tmp/fha-shots-other/axis1.json") == "/tmp/fha-shots-other/axis1.json"
+
+    page = QWidget()
+    qtbot.addWidget(page)
+    label = QLabel(f"Session {folder}/axis1.json")
+    field = QLineEdit(f"{folder}/capture.sr")
+    log = QPlainTextEdit(f"Backup saved: {folder}/config/backup.toml")
+    plain = QLabel("no path here")
+    layout = QVBoxLayout(page)
+    for w in (label, field, log, plain):
+        layout.addWidget(w)
+    edits: list[str] = []
+    field.textChanged.connect(edits.append)
+    put_back = shots._paths_shown_plausibly(page)
+    assert label.text() == "Session /home/technician/commissioning/axis1.json"
+    assert field.text() == "/home/technician/commissioning/capture.sr"
+    assert log.toPlainText() == "Backup saved: /home/technician/.config/backup.toml"
+    assert plain.text() == "no path here"
+    put_back()
+    assert (label.text(), field.text(), log.toPlainText()) == (
+        f"Session {folder}/axis1.json", f"{folder}/capture.sr", f"Backup saved: {folder}/config/backup.toml")
+    assert edits == []  # the page behind a field never saw the picture's text
