@@ -432,13 +432,17 @@ class MainWindow(QMainWindow, PageLookup):
     @Slot(object)
     def _on_connected(self, info: LinkInfo) -> None:
         self.link_lamp.set_state(True, GREEN)
-        where = "embedded simulated drive" if info.is_simulated else info.url
+        # the embedded drive in words, also as a drive of the manual's commands: its address
+        # carries its options (a file of the run among them), which say nothing in the status bar
+        simulated = info.is_simulated or info.embedded_sim
+        where = "embedded simulated drive" if simulated else info.url
         model = info.driver_model or "driver model unknown"
         self.link_lamp.setToolTip(f"Link: connected to {where} ({model})")
         summary = info.capabilities_summary or "what it supports is unknown"
         # a drive that does not say its model (a real HA-655) is named by where it is
         self._set_caps(" · ".join(([info.driver_model] if info.driver_model else []) + [where, summary]))
-        self.caps_label.setToolTip(f"{model} · {where}\n{info.capabilities}")
+        address = f" ({info.url})" if simulated else ""
+        self.caps_label.setToolTip(f"{model} · {where}{address}\n{info.capabilities}")
         self.disconnect_action.setEnabled(True)
         self.servo_action.setEnabled(info.can_move)
         self.servo_action.setToolTip(

@@ -54,6 +54,15 @@ def test_panel_is_shown_and_servo_on_comes_from_cn2_only(window, qtbot):
     qtbot.waitUntil(lambda: SERVO_ON_NOTE not in window.caps_label.toolTip(), timeout=10000)
 
 
+def test_the_status_bar_names_the_embedded_drive_in_words_not_by_its_address(window):
+    """The documented profile says no model: the status bar names the drive by where it is, the
+    embedded simulated drive, not by an address full of options (an EEPROM file's path among
+    them); the address stays in the tooltip."""
+    assert window.caps_label.text().startswith("embedded simulated drive · ")
+    assert "sim://" not in window.caps_label.text()
+    assert URL in window.caps_label.toolTip()
+
+
 def test_idle_probe_is_dgr_about_once_a_second_and_at_most_once_a_second_with_servo_on(window, qtbot):
     sent: list[tuple[float, bytes]] = []
     client = window.link._worker._client
