@@ -86,6 +86,35 @@ def test_jog_shows_position_speed_and_current_live(qtbot, scope, sim_client):
     call(view, lambda c: c.servo(False))
 
 
+def test_a_live_plot_on_paper_says_which_now_its_time_axis_counts_back_from(
+        qtbot, scope, sim_client, fixed_clock, monkeypatch, tmp_path):
+    """A report's scope plot of the live view: "time before now" is read long after that now, so
+    the picture names it (the clock time of the newest drawing); the page keeps "time before now"."""
+    from pyqtgraph import exporters
+
+    from fha_studio import clock
+
+    view = scope(sim_client)
+    view.start_live()
+    with qtbot.waitSignal(view.sigFrame, timeout=10000):
+        pass
+    drawn_at = f"{clock.now_local():%H:%M:%S}"
+    fixed_clock.advance(3600.0)  # the report written an hour later
+    axis = view.time_plot._plots[-1].item.getAxis("bottom")
+    real_export = exporters.ImageExporter.export
+    on_paper = []
+
+    def export(exporter, *args, **kwargs):
+        on_paper.append(axis.labelText)
+        return real_export(exporter, *args, **kwargs)
+
+    monkeypatch.setattr(exporters.ImageExporter, "export", export)
+    view.set_paused(True)  # as the report script does: the picture is what the page showed
+    view.export_png(tmp_path / "live.png")
+    assert on_paper == [f"time before {drawn_at}"]
+    assert axis.labelText == "time before now"
+
+
 @pytest.mark.parametrize("packed", [True, False])
 def test_a_trace_read_out_shows_its_progress_and_time_left(qtbot, scope, packed):
     """On a paced line a read-out takes seconds: the view shows how far it is and how long is

@@ -27,7 +27,7 @@ from PySide6.QtCore import QBuffer, QIODevice, Qt, Signal
 from PySide6.QtGui import QColor, QImage, QImageWriter, QPainter, QTextDocument
 from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 
-from fha_studio import fileio
+from fha_studio import clock, fileio
 from fha_studio.logic.scope.channels import ScopeChannel
 from fha_studio.logic.scope.levels import MinMaxLevels
 
@@ -88,6 +88,8 @@ class TimePlot(QWidget):
         self._cursors_on = False
         self._cursor_t = (0.0, 0.0)  # the cursors' positions on the plots' x axis
         self._live = False
+        #: the clock time of the live view's newest drawing: "now" on its time axis
+        self._live_now = ""
         self._x_offset = 0.0  # live: the time shown as 0 (now) [s]; still data: 0
         self._live_span: float | None = None
         self.autoscale = True
@@ -245,6 +247,7 @@ class TimePlot(QWidget):
         t, y = levels.window(t0_s, t1_s, bins)
         t -= t1_s
         self._x_offset = t1_s
+        self._live_now = f"{clock.now_local():%H:%M:%S}"
         ranges: dict[str, tuple[float, float]] = {}
         for j, c in enumerate(channels):
             curve = self._curves.get(c.key)
@@ -446,10 +449,18 @@ class TimePlot(QWidget):
 
     def export_png(self, path) -> None:
         """The plots as a PNG with the legend above them (which curve is which channel, in its
-        colour: a report's reader has no channel table beside the picture)."""
+        colour: a report's reader has no channel table beside the picture). The live view's
+        "time before now" says which now on paper: the clock time of its newest drawing."""
         exporter = exporters.ImageExporter(self.plot.ci)
         exporter.parameters()["width"] = max(800, self.plot.width())
-        plots = exporter.export(toBytes=True)
+        bottom = self._plots[-1].item.getAxis("bottom")
+        shown = bottom.labelText
+        if self._live and self._live_now:
+            bottom.setLabel(f"time before {self._live_now}", units="s")
+        try:
+            plots = exporter.export(toBytes=True)
+        finally:
+            bottom.setLabel(shown, units="s")
         entries = self._legend_entries + self._bench_entries
         document = QTextDocument()
         document.setDefaultFont(self.legend.font())
