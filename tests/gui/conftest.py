@@ -53,6 +53,20 @@ def make_window(qtbot):
         yield factory
 
 
+@pytest.fixture
+def documented_window(make_window):
+    """Factory: documented_window(code) -> a shown window on the simulated drive ``code``'s documented
+    profile (tests/gui/controller.py), its actuator acknowledged."""
+    from tests.gui.controller import documented_url
+
+    def factory(code: str = "FHA-25C-50-US250"):
+        window = make_window(connect=documented_url(code))
+        window.state.set_actuator(code, acknowledged=True)
+        return window
+
+    return factory
+
+
 @pytest.fixture(scope="session")
 def friction_file(tmp_path_factory):
     """A recording of FHA-25C-50 moves (1.5 kg·m² load) with 8 N·m of Coulomb friction the

@@ -9,26 +9,16 @@ import re
 
 import pytest
 
-from fha_studio.gui.link import SimPanelRequest
 from fha_studio.gui.pages.base import PageId
 from fha_studio.logic.procedures.report_inputs import dgr_check_notes
+from tests.gui.controller import panel_done
 
 CODE = "FHA-25C-50-US250"
-URL = f"sim://{CODE}?paced=0&profile=documented"
-
-
-def _panel_done(window, qtbot, action) -> None:
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
-                          timeout=10000) as done:
-        action()
-    assert done.args[0].ok, done.args[0].error
 
 
 @pytest.fixture
-def window(make_window, qtbot):
-    w = make_window(connect=URL)
-    w.state.set_actuator(CODE, acknowledged=True)
-    return w
+def window(documented_window):
+    return documented_window(CODE)
 
 
 def test_a_controller_move_on_cn2_is_checked_and_recorded_with_its_source(window, qtbot):
@@ -40,12 +30,12 @@ def test_a_controller_move_on_cn2_is_checked_and_recorded_with_its_source(window
     with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
         bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,ALARM", "250k",
                     "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS", "ALARM")
-    _panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
+    panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
     qtbot.wait(300)  # standing under servo: what the move starts from
     window.sim_panel.command_spin.setValue(10.0)
     with qtbot.waitSignal(bench.sigChecks, timeout=30000) as checked:
-        _panel_done(window, qtbot, window.sim_panel.fwd_button.click)
+        panel_done(window, qtbot, window.sim_panel.fwd_button.click)
     checks = {c.check: c for c in checked.args[0]}
     assert {name: c.passed for name, c in checks.items()} == {
         "bench_encoder": True, "bench_direction": True, "bench_in_position": True, "bench_alarm": True}

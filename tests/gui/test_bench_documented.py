@@ -9,26 +9,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fha_studio.gui.link import SimPanelRequest
 from fha_studio.hardware.sim import cn2_live
+from tests.gui.controller import documented_url, panel_done
 
 CODE = "FHA-25C-50-US250"
-URL = f"sim://{CODE}?paced=0&profile=documented"
+URL = documented_url(CODE)
 COUNTS_PER_OUTPUT_TURN = 500000  # 10000 counts per motor turn (x4) x 50
 
 
-def _panel_done(window, qtbot, action) -> None:
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
-                          timeout=10000) as done:
-        action()
-    assert done.args[0].ok, done.args[0].error
-
-
 @pytest.fixture
-def window(make_window, qtbot):
-    w = make_window(connect=URL)
-    w.state.set_actuator(CODE, acknowledged=True)
-    return w
+def window(documented_window):
+    return documented_window(CODE)
 
 
 def test_a_controller_move_is_shown_live_from_cn2_with_the_move_tests_figures(window, qtbot):
@@ -48,13 +39,13 @@ def test_a_controller_move_is_shown_live_from_cn2_with_the_move_tests_figures(wi
     assert started.logic == ("ENC_A", "ENC_B", "CMD_A", "CMD_B", "IN_POS")
     assert bench.status_label.text().startswith("LIVE from the bench: sim-cn2 at 250 kHz")
 
-    _panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
+    panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
     qtbot.wait(300)  # standing under servo: what the move starts from
     with drive.lock:
         before = drive.axis.feedback_pulses
     window.sim_panel.command_spin.setValue(10.0)
-    _panel_done(window, qtbot, window.sim_panel.fwd_button.click)
+    panel_done(window, qtbot, window.sim_panel.fwd_button.click)
     qtbot.waitUntil(lambda: bench.move_figures is not None, timeout=30000)
     with drive.lock:
         after = drive.axis.feedback_pulses
@@ -101,10 +92,10 @@ def test_the_analysed_move_stays_on_the_plots_while_the_stream_goes_on(window, q
         bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS", "250k",
                     "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS")
     assert bench.hold_bar.isHidden()
-    _panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
+    panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
     window.sim_panel.command_spin.setValue(10.0)
-    _panel_done(window, qtbot, window.sim_panel.fwd_button.click)
+    panel_done(window, qtbot, window.sim_panel.fwd_button.click)
     qtbot.waitUntil(lambda: bench.move_figures is not None, timeout=30000)
     assert "Showing the move at " in bench.showing_label.text() and not bench.hold_bar.isHidden()
     ring = bench.source.started.ring

@@ -10,11 +10,10 @@ import itertools
 
 from PySide6.QtCore import QPointF
 
-from fha_studio.gui.link import SimPanelRequest
 from fha_studio.gui.pages.scope.bench_panel import LANE_PX, TRACE_VIEW_MIN_PX
+from tests.gui.controller import panel_done
 
 CODE = "FHA-25C-50-US250"
-URL = f"sim://{CODE}?paced=0&profile=documented"
 CHANNELS = "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,ALARM,ALM_A,ALM_B,ALM_C,ALM_D,SPD_MON"
 
 
@@ -42,11 +41,10 @@ def lane_problems(bench) -> list[str]:
     return found
 
 
-def test_the_bench_lanes_and_plots_fit_small_screens(make_window, qtbot):
+def test_the_bench_lanes_and_plots_fit_small_screens(documented_window, qtbot):
     from tests.gui.fit import cut_hints, cut_texts, hidden_actions
 
-    window = make_window(connect=URL)
-    window.state.set_actuator(CODE, acknowledged=True)
+    window = documented_window(CODE)
     scope = window.show_page("scope")
     bench = scope.bench
     scope.view.plots.setCurrentWidget(bench)
@@ -55,14 +53,10 @@ def test_the_bench_lanes_and_plots_fit_small_screens(make_window, qtbot):
     with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
         bench.start(bench.device_box.itemText(0), CHANNELS, "250k", "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS",
                     "ALARM", ("ALM_A", "ALM_B", "ALM_C", "ALM_D"))
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
-                          timeout=10000):
-        window.sim_panel.servo_check.setChecked(True)
+    panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
     window.sim_panel.command_spin.setValue(10.0)
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
-                          timeout=10000):
-        window.sim_panel.fwd_button.click()
+    panel_done(window, qtbot, window.sim_panel.fwd_button.click)
     # the worst case: the move on hold (its bar), its figures' lines and the alarm line shown
     qtbot.waitUntil(lambda: bench.move_figures is not None and bench.alarm_label.isVisible(), timeout=30000)
     assert not bench.hold_bar.isHidden()

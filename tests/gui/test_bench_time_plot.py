@@ -9,14 +9,11 @@ import pytest
 from fha_studio.gui.pages.base import PageId
 
 CODE = "FHA-25C-50-S248"  # absolute: CN3 gives the position (DGR) while the servo is off
-URL = f"sim://{CODE}?paced=0&profile=documented"
 
 
 @pytest.fixture
-def window(make_window, qtbot):
-    w = make_window(connect=URL)
-    w.state.set_actuator(CODE, acknowledged=True)
-    return w
+def window(documented_window):
+    return documented_window(CODE)
 
 
 def test_bench_traces_are_drawn_beside_cn3s_named_with_their_source(window, qtbot, tmp_path):

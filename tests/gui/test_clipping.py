@@ -117,14 +117,13 @@ def test_every_status_message_reads_whole(make_window, qtbot):
     link's state (servo on: CN3 silent) wrap onto another line instead of being cut, side by side
     without overlapping, and the window still fits the small screen. The scope's indicator says
     as much as its room holds, never a word cut in two."""
-    from fha_studio.gui.link import SERVO_ON_NOTE, SimPanelRequest
+    from fha_studio.gui.link import SERVO_ON_NOTE
     from fha_studio.gui.widgets import StopButton
+    from tests.gui.controller import documented_url, panel_done
     from tests.gui.fit import cut_texts
 
-    window = make_window(connect="sim://FHA-25C-50-S248?paced=0&profile=documented")
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
-                          timeout=10000):
-        window.sim_panel.servo_check.setChecked(True)  # the controller's servo-ON (CN2)
+    window = make_window(connect=documented_url("FHA-25C-50-S248"))
+    panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))  # servo-ON (CN2)
     qtbot.waitUntil(lambda: SERVO_ON_NOTE in window.caps_label.text(), timeout=10000)
     window.stop_axis()  # nothing can be sent: the message says what stops the axis
     assert StopButton.NO_STOP_TEXT in window.message_area.text_label.text()

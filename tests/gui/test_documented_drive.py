@@ -10,9 +10,10 @@ import time
 import pytest
 from PySide6.QtCore import Qt
 
-from fha_studio.gui.link import PROBE_INTERVAL_MS, SERVO_ON_NOTE, SERVO_ON_PROBE_MS, SimPanelRequest
+from fha_studio.gui.link import PROBE_INTERVAL_MS, SERVO_ON_NOTE, SERVO_ON_PROBE_MS
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.transport import pipe_pair
+from tests.gui.controller import panel, panel_done
 from tests.support.documented import DocumentedDrive
 from tests.support.scripted import ScriptedDrive
 
@@ -32,10 +33,7 @@ def window(make_window, qtbot):
 
 
 def switch_servo(window, qtbot, on: bool) -> None:
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
-                          timeout=10000) as done:
-        window.sim_panel.servo_check.setChecked(on)
-    assert done.args[0].ok, done.args[0].error
+    panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(on))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on is on,
                     timeout=10000)
 
@@ -135,16 +133,6 @@ def test_a_silent_drive_turns_the_link_lamp_red_at_its_first_unanswered_probe(ma
 
 
 SENSOR_URL = "sim://FHA-25C-50-S248?paced=0&profile=documented&oww_clear_s=1&sensors=1"
-
-
-def panel(window, qtbot, action, value):
-    from fha_studio.gui.link import SimPanelAction, SimPanelRequest
-
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
-                          timeout=10000) as done:
-        window.link.send(SimPanelRequest(SimPanelAction(action), value))
-    assert done.args[0].ok, done.args[0].error
-    return done.args[0].value
 
 
 def click_and_record(page, qtbot, button):

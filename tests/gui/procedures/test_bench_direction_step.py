@@ -8,22 +8,12 @@ from __future__ import annotations
 
 import re
 
-from fha_studio.gui.link import SimPanelRequest
+from tests.gui.controller import panel_done
 
 CODE = "FHA-25C-50-US250"
-URL = f"sim://{CODE}?paced=0&profile=documented"
 
-
-def _panel_done(window, qtbot, action) -> None:
-    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
-                          timeout=10000) as done:
-        action()
-    assert done.args[0].ok, done.args[0].error
-
-
-def test_the_fwd_step_and_the_flange_are_taken_from_the_bench(make_window, qtbot, tmp_path):
-    window = make_window(connect=URL)
-    window.state.set_actuator(CODE, acknowledged=True)
+def test_the_fwd_step_and_the_flange_are_taken_from_the_bench(documented_window, qtbot, tmp_path):
+    window = documented_window(CODE)
     page = window.show_page("procedures")
     page.operator_edit.setText("T. Technician")
     page.new_session(tmp_path / "axis.json", CODE)
@@ -44,12 +34,12 @@ def test_the_fwd_step_and_the_flange_are_taken_from_the_bench(make_window, qtbot
         "The bench watches CN2 on sim-cn2 (encoder ENC_A,ENC_B, command CMD_A,CMD_B): have the controller "
         "give servo-ON and a short FWD command: this step is taken from the encoder outputs once the move "
         "has settled.")
-    _panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
+    panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
     qtbot.wait(300)  # standing under servo: what the move starts from
     window.sim_panel.command_spin.setValue(10.0)
     with qtbot.waitSignal(bench.sigChecks, timeout=30000):
-        _panel_done(window, qtbot, window.sim_panel.fwd_button.click)
+        panel_done(window, qtbot, window.sim_panel.fwd_button.click)
     assert page.run.completed, page.message_label.text()
     jog, seen = page.run.state.records[-2:]
     assert (jog.step_id, jog.passed, jog.who) == ("jog-fwd", True, "T. Technician")

@@ -1,0 +1,31 @@
+"""The simulated controller of a drive on its documented profile, as the GUI tests work it: the sim
+panel's servo-ON and command pulses go to the drive's CN2 (CN3 answers only DGR and OWW, and is
+silent while the servo is on). Each action waits for the link's answer to the sim-panel request it
+sends."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from fha_studio.gui.link import SimPanelAction, SimPanelRequest
+
+
+def documented_url(code: str) -> str:
+    """The embedded simulated drive ``code`` on its documented profile, stepped as fast as it can."""
+    return f"sim://{code}?paced=0&profile=documented"
+
+
+def panel_done(window: Any, qtbot: Any, action: Callable[[], object]) -> Any:
+    """Runs ``action`` (a sim panel control: servo-ON, FWD, ...) and waits for the link's answer to
+    the sim-panel request it sent; the answer must be ok. Returns its value."""
+    with qtbot.waitSignal(window.link.sigResult, check_params_cb=lambda r: r.answers(SimPanelRequest),
+                          timeout=10000) as done:
+        action()
+    assert done.args[0].ok, done.args[0].error
+    return done.args[0].value
+
+
+def panel(window: Any, qtbot: Any, action: str, value: float) -> Any:
+    """Sends the sim-panel request ``action`` ("turn", "command", ...) with ``value``; its answer's value."""
+    return panel_done(window, qtbot, lambda: window.link.send(SimPanelRequest(SimPanelAction(action), value)))
