@@ -20,38 +20,9 @@ from fha_studio.logic.bench.importer import (
 )
 from fha_studio.physics import AxisModel, ServoAxis
 from fha_studio.recording import read_recording, write_recording
+from tests.support.cn2_capture import CHANNELS, CODE, recorded_move
 
-CODE = "FHA-25C-50-US250"
-CHANNELS = {
-    "encoder_a": "ENC_A",
-    "encoder_b": "ENC_B",
-    "encoder_z": "ENC_Z",
-    "command_a": "CMD_A",
-    "command_b": "CMD_B",
-    "in_position": "IN_POS",
-    "alarm": "ALARM",
-    "speed_monitor": "SPD_MON",
-}
 RPM = 2 * math.pi / 60
-
-
-def _drive(pulse_form=0, multiplication=4, gear=(1, 1), rate=200e3):
-    actuator = get_actuator(CODE)
-    model = AxisModel.from_actuator(actuator, load_inertia_kgm2=0.3)
-    axis = ServoAxis(model)
-    axis.set_settings(
-        axis.settings.replace(electronic_gear_numerator=gear[0], electronic_gear_denominator=gear[1])
-    )
-    axis.servo_on()
-    instrument = VirtualBenchInstrument(
-        axis, rate, Cn2Settings(pulse_form=pulse_form, multiplication=multiplication)
-    )
-    instrument.record(0.03)  # standing: where the monitor's offset is taken
-    axis.move_by_pulses(9000, speed_rad_s=8 * RPM)
-    instrument.record(0.45)
-    axis.move_by_pulses(-4000, speed_rad_s=5 * RPM)
-    instrument.record(0.3)
-    return axis, instrument
 
 
 def _lag_s(recorded: np.ndarray, truth: np.ndarray, idx: np.ndarray, rate_hz: float) -> float:
@@ -68,7 +39,7 @@ def _lag_s(recorded: np.ndarray, truth: np.ndarray, idx: np.ndarray, rate_hz: fl
 
 @pytest.fixture(scope="module")
 def drive():
-    return _drive(pulse_form=1, gear=(2, 1))
+    return recorded_move(pulse_form=1, gear=(2, 1))
 
 
 def _settings(pulse_form=1, multiplication=4, gear=(2, 1)):
@@ -118,8 +89,8 @@ def test_each_file_form_gives_the_drives_positions_back(drive, form, tmp_path):
 @pytest.mark.parametrize(("pulse_form", "multiplication"), [(0, 4), (2, 4), (2, 1)])
 def test_every_command_pulse_form_round_trips(pulse_form, multiplication, tmp_path):
     gear = (2, 1) if multiplication == 1 else (1, 1)  # x1: four command edges per pulse, two counts
-    axis, instrument = _drive(
-        pulse_form, multiplication, gear=gear, rate=400e3 if multiplication == 1 else 200e3
+    axis, instrument = recorded_move(
+        pulse_form, multiplication, gear=gear, rate_hz=400e3 if multiplication == 1 else 200e3
     )
     instrument.write(tmp_path / "c.sr", "sr")
     signals = [SignalSpec(r, str(tmp_path / "c.sr"), c) for r, c in CHANNELS.items()]

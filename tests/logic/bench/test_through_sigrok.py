@@ -5,7 +5,6 @@ within 1 % of the drive's; the channels keep the file's names and kinds (never D
 
 from __future__ import annotations
 
-import math
 import shutil
 
 import numpy as np
@@ -13,43 +12,19 @@ import pytest
 
 from fha_studio.hardware.bench import sigrok_input
 from fha_studio.hardware.bench.sigrok import SigrokError
-from fha_studio.hardware.sim.cn2 import Cn2Settings, VirtualBenchInstrument
+from fha_studio.hardware.sim.cn2 import VirtualBenchInstrument
 from fha_studio.logic.bench.display import LiveQuadrature
 from fha_studio.logic.bench.importer import AxisFacts, DriveSettings, SignalSpec, import_bench
-from fha_studio.physics import AxisModel, ServoAxis
+from tests.support.cn2_capture import CHANNELS, CODE, recorded_move
 
 pytestmark = pytest.mark.skipif(shutil.which("sigrok-cli") is None, reason="sigrok-cli is not installed")
 
-CODE = "FHA-25C-50-US250"
-CHANNELS = {
-    "encoder_a": "ENC_A",
-    "encoder_b": "ENC_B",
-    "encoder_z": "ENC_Z",
-    "command_a": "CMD_A",
-    "command_b": "CMD_B",
-    "in_position": "IN_POS",
-    "alarm": "ALARM",
-    "speed_monitor": "SPD_MON",
-}
-RPM = 2 * math.pi / 60
 NAMES = {"sr": "cn2.sr", "vcd": "cn2.vcd", "sigrok-csv": "cn2-sigrok.csv", "csv": "cn2.csv"}
 
 
 @pytest.fixture(scope="module")
 def drive():
-    from fha_studio.catalog import get_actuator
-
-    model = AxisModel.from_actuator(get_actuator(CODE), load_inertia_kgm2=0.3)
-    axis = ServoAxis(model)
-    axis.set_settings(axis.settings.replace(electronic_gear_numerator=2, electronic_gear_denominator=1))
-    axis.servo_on()
-    instrument = VirtualBenchInstrument(axis, 200e3, Cn2Settings(pulse_form=1))
-    instrument.record(0.03)
-    axis.move_by_pulses(9000, speed_rad_s=8 * RPM)
-    instrument.record(0.45)
-    axis.move_by_pulses(-4000, speed_rad_s=5 * RPM)
-    instrument.record(0.3)
-    return axis, instrument
+    return recorded_move(pulse_form=1, gear=(2, 1))
 
 
 def _through_sigrok(path: str):
