@@ -13,6 +13,7 @@ import pytest
 from fha_studio.logic.register import Register, RegisterError
 from fha_studio.logic.register import store as register_store
 from fha_studio.logic.register.schema import MIGRATIONS
+from tests.register.writers import EACH, NOTES, WRITERS, write_at_once
 from tests.support.processes import Child
 
 
@@ -186,52 +187,21 @@ def test_twenty_writers_at_once_on_a_register_file_leave_every_fact_once(tmp_pat
     """The server's twenty writers (test_roles.py) on a register file: twenty
     connections of their own write at once; every fact is there once, the check all of them
     answered once, and SQLite's own check holds."""
-    import threading
-
     path = tmp_path / "shared.sqlite"
     with Register(path) as reg:
         reg.add_machine("Cell 1")
         reg.add_axis("Cell 1", "rotary", "FHA-25C-50-US250", "HA-655-2-200", "/dev/ttyUSB0")
-    writers, each = 20, 6
-    start = threading.Barrier(writers, timeout=60)
-    failures: list[BaseException] = []
-
-    def write(n: int) -> None:
-        try:
-            with Register(path) as reg:
-                start.wait()
-                for k in range(each):
-                    values = [("tune", i, f"item_{i}", n * 100 + k) for i in range(20)]
-                    reg.record_snapshot("Cell 1/rotary", values, "link", who=f"writer {n}",
-                                        note=f"{n}/{k}")
-                    reg.record_alarm("Cell 1/rotary", 10 + k, "overspeed", who=f"writer {n}",
-                                     note=f"{n}/{k}")
-                    reg.record_checks("Cell 1/rotary", [_SameCheck()])  # one row whoever comes first
-        except BaseException as exc:  # reported by the test's thread
-            failures.append(exc)
-
-    threads = [threading.Thread(target=write, args=(n,), name=f"writer {n}") for n in range(writers)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join(timeout=120)
-    assert not [t.name for t in threads if t.is_alive()] and not failures, failures
-    expected = sorted(f"{n}/{k}" for n in range(writers) for k in range(each))
+    write_at_once(lambda: Register(path), "Cell 1/rotary")
     with Register(path) as reg:
         assert reg.integrity_check() == "ok"
         db = reg._db
-        assert sorted(r[0] for r in db.execute("SELECT note FROM snapshot")) == expected
-        assert sorted(r[0] for r in db.execute("SELECT note FROM alarm")) == expected
+        assert sorted(r[0] for r in db.execute("SELECT note FROM snapshot")) == NOTES
+        assert sorted(r[0] for r in db.execute("SELECT note FROM alarm")) == NOTES
         assert db.execute("SELECT count(*) FROM check_result").fetchone()[0] == 1
         values = db.execute("SELECT count(*), count(DISTINCT snapshot_id) FROM snapshot_value").fetchone()
-        assert tuple(values) == (writers * each * 20, writers * each)
+        assert tuple(values) == (WRITERS * EACH * 20, WRITERS * EACH)
         for table in ("snapshot", "alarm", "check_result"):
             uids = [r[0] for r in db.execute(f"SELECT uid FROM {table}")]
             assert len(uids) == len(set(uids)), f"{table}: a fact twice"
         assert db.execute("PRAGMA foreign_key_check").fetchall() == []
 
-
-class _SameCheck:
-    procedure_id, step_id, kind, section, text = "wiring", "w1", "confirm", "1-14", "Motor wired"
-    value, expected, unit, passed, who, detail = True, "", "", True, "Ana Lima", ""
-    at_utc = "2026-11-30T09:00:00Z"

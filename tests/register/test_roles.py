@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
-import threading
 from pathlib import Path
 from urllib.parse import urlsplit
 
@@ -20,6 +19,7 @@ from fha_studio.cli import main
 from fha_studio.logic.register import Register, RegisterError
 from fha_studio.logic.register.report_signing import sign_other_file
 from fha_studio.logic.register.signing import key_id_of, new_key, public_raw, write_private_key
+from tests.register.writers import EACH, NOTES, WRITERS, write_at_once
 from tests.support.clock import FakeClock
 from tests.support.postgres import PASSWORD, ROLE, SUPER_PASSWORD
 
@@ -252,41 +252,18 @@ def test_signing_as_someone_else_is_refused_by_the_server(plant, tmp_path, capsy
 
 
 def test_twenty_writers_at_once_leave_every_fact_once(plant, postgres_cluster):
-    writers, each = 20, 6
-    start = threading.Barrier(writers, timeout=60)
-    failures: list[BaseException] = []
-
-    def write(n: int) -> None:
-        try:
-            with Register(plant["ana"]) as reg:
-                start.wait()
-                for k in range(each):
-                    values = [("tune", i, f"item_{i}", n * 100 + k) for i in range(20)]
-                    reg.record_snapshot(TABLE, values, "link", who=f"writer {n}", note=f"{n}/{k}")
-                    reg.record_alarm(TABLE, 10 + k, "overspeed", who=f"writer {n}", note=f"{n}/{k}")
-                    # the same check answered by every writer: one row whoever comes first
-                    reg.record_checks(TABLE, [_SameCheck()])
-        except BaseException as exc:  # reported by the test's thread
-            failures.append(exc)
-
-    threads = [threading.Thread(target=write, args=(n,), name=f"writer {n}") for n in range(writers)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join(timeout=120)
-    assert not [t.name for t in threads if t.is_alive()] and not failures, failures
-    expected = {f"{n}/{k}" for n in range(writers) for k in range(each)}
+    write_at_once(lambda: Register(plant["ana"]), TABLE)
     super_url = postgres_cluster.url(_database(plant[ROLE]), "postgres", SUPER_PASSWORD)
     with psycopg.connect(super_url, autocommit=True) as db:
         notes = [r[0] for r in db.execute("SELECT note FROM snapshot")]
-        assert sorted(notes) == sorted(expected)  # every snapshot once
-        assert sorted(r[0] for r in db.execute("SELECT note FROM alarm")) == sorted(expected)
+        assert sorted(notes) == NOTES  # every snapshot once
+        assert sorted(r[0] for r in db.execute("SELECT note FROM alarm")) == NOTES
         assert db.execute("SELECT count(*) FROM check_result").fetchone() == (1,)
         assert db.execute("SELECT count(*), count(DISTINCT snapshot_id) FROM snapshot_value").fetchone() == (
-            writers * each * 20, writers * each)
+            WRITERS * EACH * 20, WRITERS * EACH)
         receipts = db.execute("SELECT fact_table, count(*) FROM register_receipt WHERE received_by = 'ana'"
                               " GROUP BY fact_table ORDER BY fact_table").fetchall()
-        assert receipts == [("alarm", writers * each), ("check_result", 1), ("snapshot", writers * each)]
+        assert receipts == [("alarm", WRITERS * EACH), ("check_result", 1), ("snapshot", WRITERS * EACH)]
         # the server's own checks: every constraint valid, every index's b-tree and its rows whole
         assert db.execute("SELECT count(*) FROM pg_constraint WHERE NOT convalidated").fetchone() == (0,)
         db.execute("CREATE EXTENSION IF NOT EXISTS amcheck")
@@ -298,11 +275,6 @@ def test_twenty_writers_at_once_leave_every_fact_once(plant, postgres_cluster):
             db.execute("SELECT bt_index_parent_check(%s::regclass, true)", (index,))
         assert len(indexes) > 20
 
-
-class _SameCheck:
-    procedure_id, step_id, kind, section, text = "wiring", "w1", "confirm", "1-14", "Motor wired"
-    value, expected, unit, passed, who, detail = True, "", "", True, "Ana Lima", ""
-    at_utc = "2026-11-30T09:00:00Z"
 
 
 def test_an_upgrade_is_the_owners_and_gives_new_facts_their_rights(plant, monkeypatch, capsys):
