@@ -125,6 +125,22 @@ def shown_paths(text: str, folder: str | None = None) -> str:
     return text
 
 
+def reports_show_plausible_paths() -> None:
+    """The commissioning reports this run writes name their parameter file as :func:`shown_paths`
+    does (a report is a PDF made into pictures: no widget text to change at the grab). The file
+    itself is written where it is."""
+    from fha_studio.logic.procedures import report_inputs
+
+    collect = report_inputs._parameters
+
+    def shown(session: Any, inputs: Any) -> dict[str, object]:
+        parameters = collect(session, inputs)
+        parameters["file"] = shown_paths(str(parameters["file"]))
+        return parameters
+
+    report_inputs._parameters = shown
+
+
 def _paths_shown_plausibly(widget: Any) -> Callable[[], None]:
     """Shows the run's folder as :func:`shown_paths` does in the texts of ``widget`` and its
     children (labels, fields, buttons, text views) without a signal; returns what

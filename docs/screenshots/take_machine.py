@@ -13,12 +13,13 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
-from shots import OUT, ScreenshotRun, private_folder
+from shots import OUT, ScreenshotRun, private_folder, reports_show_plausible_paths
 
 TMP = Path(private_folder())
 
 
 def main() -> int:
+    reports_show_plausible_paths()
     from fha_studio.gui.machine_window import MachineWindow
     from fha_studio.logic.machine import MachineProject
     from fha_studio.logic.register import Register

@@ -53,9 +53,12 @@ def main() -> int:
     from fha_studio.gui.register_dialog import RegisterDialog
     from fha_studio.logic.register import Register
     from fha_studio.logic.register.sync import sync_registers
+    from fha_studio.paths import user_data_dir
 
-    ana, ben = TMP / "register.sqlite", TMP / "ben" / "register.sqlite"
-    ben.parent.mkdir()
+    # Ben's register where FHA Studio keeps it (the dialog names it), Ana's brought on a stick
+    ana, ben = TMP / "ana" / "register.sqlite", user_data_dir() / "register.sqlite"
+    for path in (ana, ben):
+        path.parent.mkdir(parents=True)
     laptop(ana, "Ana Lima", 1, 10, "2026-12-05T08:12:40Z", "+0.01°")
     laptop(ben, "Ben Okafor", 0, 25, "2026-12-05T09:30:05Z", "+0.00°")
     sync_registers(ana, ben, who="Ben Okafor")

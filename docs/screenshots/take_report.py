@@ -13,7 +13,7 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
-from shots import OUT, ScreenshotRun, private_folder
+from shots import OUT, ScreenshotRun, private_folder, reports_show_plausible_paths
 
 TMP = private_folder()
 CODE = "FHA-25C-50-US250"
@@ -21,6 +21,7 @@ CODE = "FHA-25C-50-US250"
 
 def main() -> int:
     run = ScreenshotRun((1366, 740))
+    reports_show_plausible_paths()
     window = run.window
     from fha_studio.gui.link import Servo
     from fha_studio.logic.procedures import ProcedureRun, load_procedure

@@ -215,3 +215,11 @@ def test_the_pictures_show_a_technicians_folders_not_the_temporary_one(qtbot, mo
     assert (label.text(), field.text(), log.toPlainText()) == (
         f"Session {folder}/axis1.json", f"{folder}/capture.sr", f"Backup saved: {folder}/config/backup.toml")
     assert edits == []  # the page behind a field never saw the picture's text
+
+    # a report's parameter file, beside the session in the temporary folder
+    from fha_studio.logic.procedures import report_inputs
+
+    beside_the_session = {"file": f"{folder}/axis1.params"}
+    monkeypatch.setattr(report_inputs, "_parameters", lambda _session, _inputs: dict(beside_the_session))
+    shots.reports_show_plausible_paths()
+    assert report_inputs._parameters(None, None) == {"file": "/home/technician/commissioning/axis1.params"}
