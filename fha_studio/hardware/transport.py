@@ -15,6 +15,7 @@ through ``write_filter``, and ``unplug()`` makes both ends fail like a pulled ca
 from __future__ import annotations
 
 import contextlib
+import errno
 import socket
 import threading
 import time
@@ -33,6 +34,32 @@ try:  # pyserial's POSIX port lets termios.error (not an OSError) out of tcflush
     _PORT_ERRORS: tuple[type[BaseException], ...] = (serial.SerialException, OSError, termios.error)
 except ImportError:  # pragma: no cover - Windows
     _PORT_ERRORS = (serial.SerialException, OSError)
+
+#: Why a port did not open, in a technician's words, by the error number pyserial passes on (it
+#: repeats the port and the number: "[Errno 2] could not open port X: [Errno 2] No such file or
+#: directory: 'X'").
+_OPEN_FAILURES = {
+    errno.ENOENT: "no such port (is the USB-serial adapter plugged in, and is this its name?)",
+    errno.EACCES: "permission denied (on Linux: add the user to the dialout group and log in again)",
+    errno.EBUSY: "the port is in use by another program",
+    errno.ENXIO: "no device behind this port (an adapter unplugged, or a pty whose other side is gone)",
+}
+#: The same from pyserial's Windows port, which gives the error's repr, not its number.
+_WINDOWS_OPEN_FAILURES = {
+    "FileNotFoundError": _OPEN_FAILURES[errno.ENOENT],
+    "PermissionError": "access denied: the port is in use by another program",
+}
+
+
+def port_failure_words(exc: BaseException) -> str:
+    """Why a port did not open, in a technician's words where the error is one of
+    :data:`_OPEN_FAILURES`, else pyserial's own text."""
+    words = _OPEN_FAILURES.get(getattr(exc, "errno", None) or 0)
+    if words:
+        return words
+    text = str(exc)
+    return next((w for name, w in _WINDOWS_OPEN_FAILURES.items() if name in text), text)
+
 
 #: The package that holds ``protocol_sim`` for ``sim://`` URLs.
 SIM_HANDLER_PACKAGE = "fha_studio.hardware.sim"
@@ -231,7 +258,7 @@ def open_transport(
             ) from None
         raise ValueError(f"cannot open {url!r}: {exc}") from None
     except _PORT_ERRORS as exc:
-        raise LinkLost(f"cannot open {url}: {exc}", port=url) from exc
+        raise LinkLost(f"cannot open {url}: {port_failure_words(exc)}", port=url) from exc
     return GuardedTransport(port, name=url)
 
 

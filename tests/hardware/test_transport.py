@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import socket
 import threading
@@ -16,6 +17,7 @@ from fha_studio.hardware.transport import (
     corrupt_at,
     open_transport,
     pipe_pair,
+    port_failure_words,
     register_url_handlers,
     split_every,
 )
@@ -46,6 +48,24 @@ def test_missing_device_is_link_lost_naming_it():
     with pytest.raises(LinkLost, match="/dev/ttyNOPE0") as info:
         open_transport("/dev/ttyNOPE0")
     assert info.value.port == "/dev/ttyNOPE0"
+    # once, in words: not pyserial's "[Errno 2] could not open port X: [Errno 2] No such file ..."
+    assert str(info.value) == ("cannot open /dev/ttyNOPE0: no such port (is the USB-serial adapter "
+                               "plugged in, and is this its name?)")
+
+
+@pytest.mark.parametrize(("error", "words"), [
+    (serial.SerialException(errno.EACCES, "could not open port /dev/ttyS0: [Errno 13] Permission denied"),
+     "permission denied (on Linux: add the user to the dialout group and log in again)"),
+    (serial.SerialException(errno.EBUSY, "could not open port /dev/ttyUSB0: [Errno 16] busy"),
+     "the port is in use by another program"),
+    (serial.SerialException("could not open port 'COM3': PermissionError(13, 'Access is denied.', None, 5)"),
+     "access denied: the port is in use by another program"),
+    (serial.SerialException("could not open port 'COM9': FileNotFoundError(2, 'The system cannot find')"),
+     "no such port (is the USB-serial adapter plugged in, and is this its name?)"),
+    (serial.SerialException("something else"), "something else"),
+])
+def test_a_port_that_does_not_open_is_said_in_words(error, words):
+    assert port_failure_words(error) == words
 
 
 def test_pty_whose_other_side_closes_is_link_lost():
