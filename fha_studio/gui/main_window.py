@@ -531,6 +531,7 @@ class MainWindow(QMainWindow, PageLookup):
             self._set_caps("Could not connect: see the message at the left. Connect… (Ctrl+K)")
             self.caps_label.setToolTip(f"Could not connect: {result.error}")
             self.link_lamp.set_state(True, RED)
+            self.connection_page.link_disconnected(str(result.error), False)
         elif not isinstance(request, JogLease | SimPanelRequest):  # the panel says its own
             self.show_message(f"{request.words} failed: {result.error}", Level.ERROR)
 

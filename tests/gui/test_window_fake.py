@@ -135,3 +135,17 @@ def test_drive_without_parameter_access_says_so(make_window, qtbot):
     page = window.parameters_page
     assert "front panel" in page.message.text()
     assert not page.read_button.isEnabled()
+
+
+def test_a_port_that_does_not_open_is_said_once_where_the_link_is_shown(make_window, qtbot):
+    """Before any link the Connection page says "not connected" once; a port that does not open
+    is named there and in the message line with why, in words (not pyserial's errno text twice)."""
+    window = make_window()
+    page = window.connection_page
+    assert page.link_label.text() == "not connected"
+    window.connect_to("/dev/ttyNOPE0")
+    why = ("cannot open /dev/ttyNOPE0: no such port "
+           "(is the USB-serial adapter plugged in, and is this its name?)")
+    qtbot.waitUntil(lambda: page.link_label.text() != "not connected", timeout=10000)
+    assert page.link_label.text() == f"not connected: {why}"
+    assert window.message_area.messages[-1].text == f"Could not connect: {why}"

@@ -159,7 +159,10 @@ class ConnectionPage(BasePage):
             self.check_pairing()
 
     def link_disconnected(self, reason: str, lost: bool) -> None:
-        self.link_label.setText(("LINK LOST: " if lost else "not connected: ") + reason)
+        if lost:
+            self.link_label.setText(f"LINK LOST: {reason}")
+        else:  # "not connected" is said once
+            self.link_label.setText("not connected" + ("" if reason == "not connected" else f": {reason}"))
         self.link_label.setStyleSheet("color: #b00020; font-weight: bold;" if lost else "")
         self.disconnect_button.setEnabled(False)
 
