@@ -22,11 +22,11 @@ torque_limited_simple_pendulum, commit ed17ea2).
 
 from __future__ import annotations
 
-import gzip
 import sys
 from pathlib import Path
 
 import numpy as np
+from recording_gz import main, write_recording_gz
 
 #: DFKI's model of the pendulum (leaderboard/simulation/sim_parameters.py): mass at its length.
 MODEL_MASS_KG = 0.57288
@@ -61,11 +61,7 @@ def convert(run_dir: Path, out_path: Path) -> int:
         data.append(np.degrees(np.interp(t, td, pd)))
         fmt.append("%.9g")
     rate = 1.0 / float(np.median(np.diff(t)))
-    lines = [
-        "# format: fha-recording/1",
-        "# actuator: custom",
-        "# load_inertia_kgm2: 0",
-        "# supply_voltage: 200",  # the format asks for a driver voltage: not the AK80-6's 24 V
+    header = [
         f"# sample_rate_hz: {rate:.6g}",
         "# torque_constant_nm_per_a: 1",
         f"# actuator_inertia_kgm2: {DECLARED_INERTIA_KGM2:.6g}",
@@ -74,24 +70,10 @@ def convert(run_dir: Path, out_path: Path) -> int:
         f"{Path(__file__).name}",
         "# units: current = the actuator's torque reading in N m (torque constant 1); pos counter-clockwise,"
         " 0 = hanging down",
-        ",".join(columns),
     ]
-    body = np.column_stack(data)
-    text = "\n".join(lines) + "\n" + "\n".join(",".join(f % v for f, v in zip(fmt, row, strict=True))
-                                              for row in body) + "\n"
-    with open(out_path, "wb") as raw, gzip.GzipFile("", "wb", 9, raw, mtime=0) as fh:
-        fh.write(text.encode("utf-8"))
+    write_recording_gz(out_path, header, columns, data, fmt)
     return len(t)
 
 
-def main(argv: list[str]) -> int:
-    src = Path(argv[1])
-    out = Path(argv[2]) if len(argv) > 2 else Path(__file__).resolve().parent
-    for run, name in RUNS.items():
-        rows = convert(src / run, out / name)
-        print(f"{run} -> {out / name}: {rows} rows, {(out / name).stat().st_size} bytes")
-    return 0
-
-
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    sys.exit(main(sys.argv, RUNS, convert, __file__))

@@ -18,13 +18,13 @@ github.com/forgi86/sysid-neural-continuous, examples/EMPS/data/).
 
 from __future__ import annotations
 
-import gzip
 import math
 import sys
 from pathlib import Path
 
 import numpy as np
 import scipy.io
+from recording_gz import main, write_recording_gz
 
 #: The carriage's mass as declared to the check [kg]: the data set's own reference value (Janot,
 #: Gautier, Brunot, "Data set and reference models of EMPS", M1 = 95.1089 kg), rounded.
@@ -53,11 +53,7 @@ def convert(mat_path: Path, out_path: Path) -> int:
         columns.append("force_pulse_trigger")
         data.append(d["pulses_N"].ravel().astype(float))
         fmt.append("%.3g")
-    lines = [
-        "# format: fha-recording/1",
-        "# actuator: custom",
-        "# load_inertia_kgm2: 0",
-        "# supply_voltage: 200",
+    header = [
         "# sample_rate_hz: 1000",
         f"# torque_constant_nm_per_a: {gtau:.6g}",
         f"# actuator_inertia_kgm2: {DECLARED_MASS_KG:g}",
@@ -66,26 +62,12 @@ def convert(mat_path: Path, out_path: Path) -> int:
         "# units: a linear axis written 1 m = 1 rad, 1 N = 1 N m; current = controller output in V",
         f"# loop: position-velocity, kp {kp:g} 1/s, kv {kv:g} V/(m/s), "
         "the velocity loop differentiates 0.5 (q[k] + q[k-1])",
-        ",".join(columns),
     ]
-    body = np.column_stack(data)
-    text = "\n".join(lines) + "\n" + "\n".join(",".join(f % v for f, v in zip(fmt, row, strict=True))
-                                              for row in body) + "\n"
-    # mtime 0 and no file name in the header: the same .mat files give the same bytes
-    with open(out_path, "wb") as raw, gzip.GzipFile("", "wb", 9, raw, mtime=0) as fh:
-        fh.write(text.encode("utf-8"))
+    # no file name in the header (recording_gz): the same .mat files give the same bytes
+    write_recording_gz(out_path, header, columns, data, fmt)
     assert math.isclose(gtau, 35.15, rel_tol=1e-3)
     return len(t)
 
 
-def main(argv: list[str]) -> int:
-    src = Path(argv[1])
-    out = Path(argv[2]) if len(argv) > 2 else Path(__file__).resolve().parent
-    for mat, name in RUNS.items():
-        rows = convert(src / mat, out / name)
-        print(f"{mat} -> {out / name}: {rows} rows, {(out / name).stat().st_size} bytes")
-    return 0
-
-
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    sys.exit(main(sys.argv, RUNS, convert, __file__))
