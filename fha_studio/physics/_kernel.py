@@ -295,29 +295,25 @@ def run(p: KernelParams, s: KernelState, cmd: list[float] | None, n: int, servo_
             av = vm if vm >= 0.0 else -vm
             if av > pk_v:
                 pk_v = av
+        take = False  # this period is recorded: one of record_at's, or every rec_every-th
         if at is not None:
             if k == next_at:
                 next_at = next(at, -1)
-                r_t.append((k0 + k) * dt)
-                r_c.append(d * c)
-                r_xm.append(xm)
-                r_xl.append(xl)
-                r_vm.append(vm)
-                r_i.append(cur)
-                r_vr.append(vref)
-                r_tf.append(tg - flange_share * tl if compliant else j_sensed * (vm - v0) * rate + tload)
+                take = True
         elif rec is not None:
             rec_count += 1
             if rec_count >= rec_every:
                 rec_count = 0
-                r_t.append((k0 + k) * dt)
-                r_c.append(d * c)
-                r_xm.append(xm)
-                r_xl.append(xl)
-                r_vm.append(vm)
-                r_i.append(cur)
-                r_vr.append(vref)
-                r_tf.append(tg - flange_share * tl if compliant else j_sensed * (vm - v0) * rate + tload)
+                take = True
+        if take:
+            r_t.append((k0 + k) * dt)
+            r_c.append(d * c)
+            r_xm.append(xm)
+            r_xl.append(xl)
+            r_vm.append(vm)
+            r_i.append(cur)
+            r_vr.append(vref)
+            r_tf.append(tg - flange_share * tl if compliant else j_sensed * (vm - v0) * rate + tload)
 
     s.xm, s.vm, s.xl, s.vl = xm, vm, xl, vl
     s.integ, s.cprev, s.current, s.vref = integ, cprev, cur, vref
