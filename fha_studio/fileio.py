@@ -91,20 +91,31 @@ def os_reason(exc: OSError) -> str:
 # ------------------------------------------------------------------------------------------- reading
 
 
-def read_bytes(path: str | os.PathLike[str], *, limit_bytes: int = DEFAULT_READ_LIMIT_BYTES) -> bytes:
-    """The content of a regular file of at most ``limit_bytes``; :class:`FileProblem` otherwise."""
+def _open_to_read(path: str | os.PathLike[str]) -> tuple[str, int]:
+    """The file's name and a descriptor open for reading; :class:`FileProblem` when it cannot be."""
     name = os.fspath(path)
     if not name:
         raise FileProblem("''", "no file name given")
     try:
         # O_NONBLOCK: opening a FIFO must not wait for a writer; the kind is checked right after
-        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+        return name, os.open(name, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
     except OSError as exc:
         raise FileProblem(name, os_reason(exc)) from None
+
+
+def _regular(name: str, fd: int) -> os.stat_result:
+    """The open file's status; :class:`FileProblem` unless it is a regular file."""
+    info = os.fstat(fd)
+    if not stat.S_ISREG(info.st_mode):
+        raise FileProblem(name, f"is {_kind(info.st_mode)}, not a regular file: only files are read")
+    return info
+
+
+def read_bytes(path: str | os.PathLike[str], *, limit_bytes: int = DEFAULT_READ_LIMIT_BYTES) -> bytes:
+    """The content of a regular file of at most ``limit_bytes``; :class:`FileProblem` otherwise."""
+    name, fd = _open_to_read(path)
     try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise FileProblem(name, f"is {_kind(info.st_mode)}, not a regular file: only files are read")
+        info = _regular(name, fd)
         if info.st_size > limit_bytes:
             raise FileProblem(name, f"is {_size(info.st_size)}, more than the {_size(limit_bytes)} "
                               "such a file can be")
@@ -128,17 +139,9 @@ def read_bytes(path: str | os.PathLike[str], *, limit_bytes: int = DEFAULT_READ_
 
 def read_head(path: str | os.PathLike[str], max_bytes: int) -> bytes:
     """The first ``max_bytes`` (or fewer) of a regular file; :class:`FileProblem` otherwise."""
-    name = os.fspath(path)
-    if not name:
-        raise FileProblem("''", "no file name given")
+    name, fd = _open_to_read(path)
     try:
-        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
-    except OSError as exc:
-        raise FileProblem(name, os_reason(exc)) from None
-    try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise FileProblem(name, f"is {_kind(info.st_mode)}, not a regular file: only files are read")
+        _regular(name, fd)
         chunks: list[bytes] = []
         total = 0
         while total < max_bytes:
