@@ -4,6 +4,8 @@
     fha-studio sim --tcp 5000                  serves socket://127.0.0.1:5000
     fha-studio sim --pty --actuator FHA-32C-100-S248-B-L --load-inertia 4 \\
         --effect coulomb_friction:torque_nm=8 --eeprom my-drive.json --record run.csv
+    fha-studio sim --pty --catalogue-friction  the friction of the catalogue (TF, 2-4-4): after
+                                               an alarm the axis comes to rest, as a real one
 
 Point any serial terminal or FHA Studio at the printed address: the drive speaks CN3
 (docs/protocol.md) at the pace of a 19200 baud line (``--unpaced`` for memory speed).
@@ -24,6 +26,7 @@ from fha_studio.hardware.protocol import BAUDRATE
 
 if TYPE_CHECKING:
     from fha_studio.hardware.api import SimPanel
+    from fha_studio.hardware.sim import SimConfig
 
 ORDER = 30
 
@@ -49,6 +52,10 @@ def register(subparsers: Any) -> None:
                    help=f"load inertia [kg m^2], {plausible.LOAD_INERTIA_KGM2.allowed()}")
     p.add_argument("--effect", action="append", default=[], metavar="ID:NAME=VALUE,...",
                    help="switch on a physical effect, e.g. coulomb_friction:torque_nm=8 (repeatable)")
+    p.add_argument("--catalogue-friction", action="store_true",
+                   help="friction as the catalogue gives it: TF = Kt x Im - TM at maximum speed (FHA-C "
+                   "manual 2-4-4), half Coulomb, half viscous; an --effect of the same id wins. Without it "
+                   "the axis is frictionless: after an alarm it coasts on")
     p.add_argument("--brake", choices=("yes", "no"),
                    help="fit or leave out the motor brake (default: option B of the code)")
     p.add_argument("--sensors", choices=("yes", "no"),
@@ -82,25 +89,33 @@ def _flag(text: str | None) -> bool | None:
     return None if text is None else text == "yes"
 
 
-def run(args: Any) -> int:
-    from fha_studio.hardware.sim import EepromError, SimConfig, SimConfigError, SimDrive, SimProtocolServer
+def sim_config(args: Any) -> SimConfig:
+    """The simulated drive the parsed arguments ask for; SimConfigError names a bad option."""
+    from fha_studio.hardware.sim import SimConfig
     from fha_studio.hardware.sim.options import parse_effects
+
+    return SimConfig(
+        actuator=args.actuator,
+        driver=args.driver,
+        load_inertia_kgm2=args.load_inertia,
+        brake=_flag(args.brake),
+        sensors=_flag(args.sensors),
+        effects=parse_effects(args.effect),
+        catalogue_friction=args.catalogue_friction,
+        eeprom=args.eeprom or "user",
+        paced=not args.unpaced,
+        oww_clear_s=args.oww_seconds,
+        profile=args.profile,
+        packed_trace=not args.text_trace,
+    )
+
+
+def run(args: Any) -> int:
+    from fha_studio.hardware.sim import EepromError, SimConfigError, SimDrive, SimProtocolServer
     from fha_studio.hardware.sim.serve import serve_pty, serve_tcp
 
     try:
-        config = SimConfig(
-            actuator=args.actuator,
-            driver=args.driver,
-            load_inertia_kgm2=args.load_inertia,
-            brake=_flag(args.brake),
-            sensors=_flag(args.sensors),
-            effects=parse_effects(args.effect),
-            eeprom=args.eeprom or "user",
-            paced=not args.unpaced,
-            oww_clear_s=args.oww_seconds,
-            profile=args.profile,
-            packed_trace=not args.text_trace,
-        )
+        config = sim_config(args)
         drive = SimDrive(config=config)
     except (SimConfigError, EepromError) as exc:
         raise CliError(str(exc)) from None

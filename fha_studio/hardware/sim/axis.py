@@ -14,9 +14,13 @@ from typing import Any
 from fha_studio.catalog import get_actuator, parse_model_code
 from fha_studio.catalog.model_code import OPTION_ORDER
 from fha_studio.hardware.sim.options import SimConfig, SimConfigError
-from fha_studio.physics import AxisModel, Effects, ServoAxis, ServoSettings
+from fha_studio.physics import AxisModel, Effects, ServoAxis, ServoSettings, catalogue_effects
 
 DEFAULT_SERVO_RATE_HZ = 5000.0
+#: what ``catalogue_friction`` takes of the catalogue's effects: the friction, not the gear's
+#: compliance (the default gains make a compliant gear under a large load ring: that is tuning's
+#: business, turned on on purpose with ``effects=torsional_compliance``)
+CATALOGUE_FRICTION_IDS = ("coulomb_friction", "viscous_friction")
 
 
 @dataclass(frozen=True)
@@ -80,12 +84,24 @@ def resolve_actuator(config: SimConfig) -> ResolvedActuator:
     return ResolvedActuator(actuator, driver, has_sensors="L" in options)
 
 
+def catalogue_friction(model: AxisModel) -> dict[str, dict[str, float]]:
+    """The catalogue's friction of ``model`` as effects by id: TF = Kt x Im - TM at maximum speed
+    (FHA-C manual 2-4-4), split into Coulomb and viscous by ``physics.catalogue_effects``."""
+    catalogue = catalogue_effects(model.with_effects(Effects())).to_dict()
+    return {effect_id: catalogue[effect_id] for effect_id in CATALOGUE_FRICTION_IDS if effect_id in catalogue}
+
+
 def build_model(resolved: ResolvedActuator, config: SimConfig) -> AxisModel:
-    """The physics model: catalogue actuator, declared load inertia, switched-on effects."""
+    """The physics model: catalogue actuator, declared load inertia, switched-on effects (with
+    ``catalogue_friction``, the catalogue's friction under the explicit ones: those win)."""
     try:
-        effects = Effects.from_dict(config.effects, where="sim effects")
-        return AxisModel.from_actuator(resolved.actuator, load_inertia_kgm2=config.load_inertia_kgm2,
-                                       effects=effects)
+        explicit = Effects.from_dict(config.effects, where="sim effects")
+        model = AxisModel.from_actuator(resolved.actuator, load_inertia_kgm2=config.load_inertia_kgm2,
+                                        effects=explicit)
+        if not config.catalogue_friction:
+            return model
+        merged = {**catalogue_friction(model), **config.effects}
+        return model.with_effects(Effects.from_dict(merged, where="sim effects"))
     except (TypeError, ValueError) as exc:
         raise SimConfigError(f"simulated drive: {exc}") from None
 

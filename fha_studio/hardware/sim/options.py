@@ -4,6 +4,7 @@ URL form (docs/protocol.md, transports)::
 
     sim://FHA-25C-50-US250?load_inertia=1.5&brake=1&sensors=1&paced=0&eeprom=PATH
         &effects=coulomb_friction:torque_nm=8;viscous_friction:coefficient_nm_s_per_rad=2
+    sim://FHA-25C-50-US250?catalogue_friction=1
 
 Options (all optional):
 
@@ -17,6 +18,13 @@ Options (all optional):
 ``ls1_deg``,       limit switch 2 (CW end), output flange, CW positive seen from the flange
 ``ls2_deg``
 ``effects``        physical effects, ``ID:NAME=VALUE,NAME=VALUE;ID...``; ``effect=`` may repeat
+``catalogue_friction``
+                   1: the actuator's friction as the catalogue gives it: TF = Kt x Im - TM, the
+                   friction torque at maximum speed (FHA-C manual 2-4-4), half Coulomb and half
+                   viscous (``physics.catalogue_effects``; the split is an assumption), merged
+                   with ``effects`` (an effect given there wins over the catalogue's of the same
+                   id). 0 (default): frictionless, the model check's nominal axis: after an
+                   alarm it coasts on for ever, and a steady jog draws no current
 ``eeprom``         EEPROM file; ``user`` = the user data directory; default: a temporary file
                    removed when the drive closes
 ``paced``          1 (default): replies paced like a 19200 baud line; 0: at memory speed
@@ -109,6 +117,8 @@ class SimConfig:
     ls1_deg: float | None = None
     ls2_deg: float | None = None
     effects: dict[str, dict[str, float]] = field(default_factory=dict)
+    #: the catalogue's friction (TF of 2-4-4) under the explicit effects (see the table above)
+    catalogue_friction: bool = False
     eeprom: str | None = None
     paced: bool = True
     #: the drive's time advances only by SimDrive.advance (no real-time thread)
@@ -287,8 +297,8 @@ def public_url(url: str) -> str:
 
 _URL_KEYS = {
     "driver", "load_inertia", "load_inertia_kgm2", "brake", "sensors", "origin_deg", "ls1_deg",
-    "ls2_deg", "effects", "effect", "eeprom", "paced", "stepped", "quantised", "oww_clear_s",
-    "packed_trace", "profile", "wiring", "brake_supply", "battery", "preset", "training",
+    "ls2_deg", "effects", "effect", "catalogue_friction", "eeprom", "paced", "stepped", "quantised",
+    "oww_clear_s", "packed_trace", "profile", "wiring", "brake_supply", "battery", "preset", "training",
 }
 
 
@@ -324,7 +334,7 @@ def config_from_url(url: str) -> SimConfig:
     inertia = last("load_inertia_kgm2") if last("load_inertia_kgm2") is not None else last("load_inertia")
     if inertia is not None:
         values["load_inertia_kgm2"] = _ranged("load_inertia", inertia, plausible.LOAD_INERTIA_KGM2)
-    for key in ("brake", "sensors", "paced", "stepped", "quantised", "packed_trace"):
+    for key in ("brake", "sensors", "paced", "stepped", "quantised", "packed_trace", "catalogue_friction"):
         flag = last(key)
         if flag is not None:
             values[key] = _flag(key, flag)
