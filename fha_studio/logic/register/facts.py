@@ -19,6 +19,20 @@ from fha_studio.logic.register.records import SOURCES, Axis, file_sha256, utc_st
 class Facts(Axes):
     """Recording facts: every write is one transaction."""
 
+    def _insert_fact(self, db: Any, table: str, current: Axis, at_utc: str, who: str, corrects: int | None,
+                     **columns: Any) -> int:
+        """A fact's row in ``table`` (one with an axis): ``columns`` with what every such row holds
+        (the axis, the time, who, the fact of the axis it corrects, its identity: FACT_IDS); its
+        row id."""
+        names = ["axis_id", "at_utc", "who", *columns, "corrects"]
+        values = (current.id, at_utc, who, *columns.values(), self._corrected(table, corrects, current))
+        cursor = db.execute(
+            f"INSERT INTO {table} ({', '.join(names)}, {FACT_IDS})"
+            f" VALUES ({', '.join('?' for _ in names)}, {FACT_ID_MARKS})",
+            (*values, *self._fact_ids()),
+        )
+        return int(cursor.lastrowid or 0)
+
     def record_snapshot(
         self,
         axis: Axis | str | int,
@@ -49,13 +63,9 @@ class Facts(Axes):
             raise RegisterError("a parameter snapshot needs at least one value")
         current = self.axis(axis)
         with self._transaction() as db:
-            cursor = db.execute(
-                "INSERT INTO snapshot (axis_id, at_utc, who, source, driver_model, file, note, corrects,"
-                f" {FACT_IDS}) VALUES (?, ?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
-                (current.id, utc_stamp(at_utc), who, source, driver_model, str(file), note,
-                 self._corrected("snapshot", corrects, current), *self._fact_ids()),
-            )
-            snapshot_id = int(cursor.lastrowid or 0)
+            snapshot_id = self._insert_fact(db, "snapshot", current, utc_stamp(at_utc), who, corrects,
+                                            source=source, driver_model=driver_model, file=str(file),
+                                            note=note)
             db.executemany(
                 "INSERT INTO snapshot_value (snapshot_id, mode, number, key, value) VALUES (?, ?, ?, ?, ?)",
                 [(snapshot_id, *row) for row in rows.values()],
@@ -80,27 +90,11 @@ class Facts(Axes):
         """One parameter write and whether the read-back verified it. Returns its row id."""
         current = self.axis(axis)
         with self._transaction() as db:
-            cursor = db.execute(
-                "INSERT INTO parameter_write (axis_id, at_utc, who, mode, number, key, old, new, read_back,"
-                f" verified, error, corrects, {FACT_IDS}) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?,"
-                f" {FACT_ID_MARKS})",
-                (
-                    current.id,
-                    utc_stamp(at_utc),
-                    who,
-                    str(mode),
-                    int(number),
-                    key,
-                    old,
-                    int(new),
-                    read_back,
-                    int(bool(verified)),
-                    error or "",
-                    self._corrected("parameter_write", corrects, current),
-                    *self._fact_ids(),
-                ),
+            return self._insert_fact(
+                db, "parameter_write", current, utc_stamp(at_utc), who, corrects, mode=str(mode),
+                number=int(number), key=key, old=old, new=int(new), read_back=read_back,
+                verified=int(bool(verified)), error=error or "",
             )
-        return int(cursor.lastrowid or 0)
 
     def record_checks(
         self,
@@ -184,13 +178,8 @@ class Facts(Axes):
     ) -> int:
         current = self.axis(axis)
         with self._transaction() as db:
-            cursor = db.execute(
-                f"INSERT INTO alarm (axis_id, at_utc, who, code, name, note, corrects, {FACT_IDS})"
-                f" VALUES (?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
-                (current.id, utc_stamp(at_utc), who, int(code), name, note,
-                 self._corrected("alarm", corrects, current), *self._fact_ids()),
-            )
-        return int(cursor.lastrowid or 0)
+            return self._insert_fact(db, "alarm", current, utc_stamp(at_utc), who, corrects, code=int(code),
+                                     name=name, note=note)
 
     def record_report(
         self,
@@ -252,13 +241,8 @@ class Facts(Axes):
         path = Path(file)
         digest = file_sha256(path) if path.is_file() else ""
         with self._transaction() as db:
-            cursor = db.execute(
-                f"INSERT INTO recording (axis_id, at_utc, who, file, sha256, summary, corrects, {FACT_IDS})"
-                f" VALUES (?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
-                (current.id, utc_stamp(at_utc), who, str(path.resolve()), digest, summary,
-                 self._corrected("recording", corrects, current), *self._fact_ids()),
-            )
-        return int(cursor.lastrowid or 0)
+            return self._insert_fact(db, "recording", current, utc_stamp(at_utc), who, corrects,
+                                     file=str(path.resolve()), sha256=digest, summary=summary)
 
     def record_model_check(
         self,
@@ -273,10 +257,5 @@ class Facts(Axes):
         """A model-check result: its summary, the report or model file it wrote, the recording."""
         current = self.axis(axis)
         with self._transaction() as db:
-            cursor = db.execute(
-                "INSERT INTO model_check (axis_id, at_utc, who, file, recording_file, summary, corrects,"
-                f" {FACT_IDS}) VALUES (?, ?, ?, ?, ?, ?, ?, {FACT_ID_MARKS})",
-                (current.id, utc_stamp(at_utc), who, str(file), str(recording_file), summary,
-                 self._corrected("model_check", corrects, current), *self._fact_ids()),
-            )
-        return int(cursor.lastrowid or 0)
+            return self._insert_fact(db, "model_check", current, utc_stamp(at_utc), who, corrects,
+                                     file=str(file), recording_file=str(recording_file), summary=summary)
