@@ -29,3 +29,13 @@ def panel_done(window: Any, qtbot: Any, action: Callable[[], object]) -> Any:
 def panel(window: Any, qtbot: Any, action: str, value: float) -> Any:
     """Sends the sim-panel request ``action`` ("turn", "command", ...) with ``value``; its answer's value."""
     return panel_done(window, qtbot, lambda: window.link.send(SimPanelRequest(SimPanelAction(action), value)))
+
+
+def bench_streaming(qtbot: Any, bench: Any, *start: Any) -> None:
+    """The scope's Bench tab lists the instruments and streams from the first listed (the running
+    simulated drive's ``sim-cn2``): ``start`` is what ``bench.start`` takes after the device
+    (channels, rate, encoder, command, ...)."""
+    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
+        bench.scan()
+    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
+        bench.start(bench.device_box.itemText(0), *start)

@@ -11,7 +11,7 @@ import pytest
 
 from fha_studio.gui.pages.base import PageId
 from fha_studio.logic.procedures.report_inputs import dgr_check_notes
-from tests.gui.controller import panel_done
+from tests.gui.controller import bench_streaming, panel_done
 
 CODE = "FHA-25C-50-US250"
 
@@ -25,11 +25,8 @@ def test_a_controller_move_on_cn2_is_checked_and_recorded_with_its_source(window
     bench = window.show_page("scope").bench
     window.state.enter_front_panel("system", 8, 0, "T. Technician")  # rotary direction, from the panel
     assert bench.parameter_8 == 0
-    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
-        bench.scan()
-    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
-        bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,ALARM", "250k",
-                    "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS", "ALARM")
+    bench_streaming(qtbot, bench, "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,ALARM", "250k", "ENC_A,ENC_B",
+                    "CMD_A,CMD_B", "IN_POS", "ALARM")
     panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
     qtbot.wait(300)  # standing under servo: what the move starts from

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from fha_studio.hardware.sim import cn2_live
-from tests.gui.controller import documented_url, panel_done
+from tests.gui.controller import bench_streaming, documented_url, panel_done
 
 CODE = "FHA-25C-50-US250"
 URL = documented_url(CODE)
@@ -86,11 +86,8 @@ def test_the_analysed_move_stays_on_the_plots_while_the_stream_goes_on(window, q
     from fha_studio.gui.pages.scope.bench_panel import STEP_S, WINDOW_S
 
     bench = window.show_page("scope").bench
-    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
-        bench.scan()
-    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
-        bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS", "250k",
-                    "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS")
+    bench_streaming(qtbot, bench, "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS", "250k", "ENC_A,ENC_B", "CMD_A,CMD_B",
+                    "IN_POS")
     assert bench.hold_bar.isHidden()
     panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)

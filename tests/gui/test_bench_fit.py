@@ -11,7 +11,7 @@ import itertools
 from PySide6.QtCore import QPointF
 
 from fha_studio.gui.pages.scope.bench_panel import LANE_PX, TRACE_VIEW_MIN_PX
-from tests.gui.controller import panel_done
+from tests.gui.controller import bench_streaming, panel_done
 
 CODE = "FHA-25C-50-US250"
 CHANNELS = "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,ALARM,ALM_A,ALM_B,ALM_C,ALM_D,SPD_MON"
@@ -48,11 +48,8 @@ def test_the_bench_lanes_and_plots_fit_small_screens(documented_window, qtbot):
     scope = window.show_page("scope")
     bench = scope.bench
     scope.view.plots.setCurrentWidget(bench)
-    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
-        bench.scan()
-    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
-        bench.start(bench.device_box.itemText(0), CHANNELS, "250k", "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS",
-                    "ALARM", ("ALM_A", "ALM_B", "ALM_C", "ALM_D"))
+    bench_streaming(qtbot, bench, CHANNELS, "250k", "ENC_A,ENC_B", "CMD_A,CMD_B", "IN_POS", "ALARM",
+                    ("ALM_A", "ALM_B", "ALM_C", "ALM_D"))
     panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
     window.sim_panel.command_spin.setValue(10.0)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 
 from fha_studio.gui.pages.base import PageId
+from tests.gui.controller import bench_streaming
 
 CODE = "FHA-25C-50-S248"  # absolute: CN3 gives the position (DGR) while the servo is off
 
@@ -21,10 +22,7 @@ def test_bench_traces_are_drawn_beside_cn3s_named_with_their_source(window, qtbo
     view, bench = page.view, page.bench
     view.start_live()
     qtbot.waitUntil(lambda: view.time_plot.live, timeout=10000)
-    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
-        bench.scan()
-    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
-        bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,IN_POS,SPD_MON", "100k", "ENC_A,ENC_B")
+    bench_streaming(qtbot, bench, "ENC_A,ENC_B,IN_POS,SPD_MON", "100k", "ENC_A,ENC_B")
     label = "bench sim-cn2: ENC_A/ENC_B position (output) [deg]"
     plot = view.time_plot
     qtbot.waitUntil(lambda: label in plot._bench and plot._bench[label][0].getData()[0] is not None,
@@ -60,10 +58,7 @@ def test_the_scopes_recording_takes_the_bench_stream_beside_its_cn3_channels(mak
     view, bench = page.view, page.bench
     view.start_live()
     qtbot.waitUntil(lambda: view.time_plot.live, timeout=10000)
-    with qtbot.waitSignal(bench.sigDevicesListed, timeout=20000):
-        bench.scan()
-    with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
-        bench.start(bench.device_box.itemText(0), "ENC_A,ENC_B,SPD_MON", "100k", "ENC_A,ENC_B")
+    bench_streaming(qtbot, bench, "ENC_A,ENC_B,SPD_MON", "100k", "ENC_A,ENC_B")
     qtbot.waitUntil(lambda: len(bench.source.started.ring) > 100, timeout=10000)
     path = tmp_path / "live.csv"
     view.start_recording(path)
