@@ -52,6 +52,7 @@ CORPUS = ROOT / "tests" / "corpus"
 ACTUATOR = "FHA-25C-50-US250"
 sys.path.insert(0, str(ROOT))
 
+from tests.support.killed_writer import KILLED_WRITER  # noqa: E402
 from tests.support.read_only import seal, unseal, without_overrides  # noqa: E402
 
 # --- what a case is ---------------------------------------------------------------------------------
@@ -466,20 +467,7 @@ def refusal_bounded(d: Path, done: subprocess.CompletedProcess[str], state: dict
     return ""
 
 
-# class 6: the real command, stopped in its write of $HOLD (fsync: after the data, before the rename)
-# and killed
-KILLED_WRITER = """
-import os, sys, time
-real_fsync = os.fsync
-def hold(fd):
-    real_fsync(fd)
-    if os.path.basename(os.readlink(f"/proc/self/fd/{fd}")).startswith("." + os.environ["HOLD"] + "."):
-        print("writing", flush=True)
-        time.sleep(600)
-os.fsync = hold
-from fha_studio.main import main
-sys.exit(main(sys.argv[1:]))
-"""
+# class 6: the real command, stopped in its write and killed (tests/support/killed_writer.py)
 
 
 def kill_cases() -> list[Case]:

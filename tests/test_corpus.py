@@ -12,6 +12,7 @@ import pytest
 from corpus_readers import READERS
 
 from fha_studio.main import main as cli_main
+from tests.support.killed_writer import KILLED_WRITER
 from tests.support.processes import Child
 
 CORPUS = Path(__file__).parent / "corpus"
@@ -72,22 +73,6 @@ def test_a_malformed_command_line_is_refused_with_one_line(case, scratch, capsys
 
 def _corpus_bytes() -> dict[str, bytes]:
     return {str(p.relative_to(CORPUS)): p.read_bytes() for p in CORPUS.rglob("*") if p.is_file()}
-
-
-#: The real command, stopped in its write of $HOLD (fsync: after the data, before the rename) to be
-#: killed.
-KILLED_WRITER = """
-import os, sys, time
-real_fsync = os.fsync
-def hold(fd):
-    real_fsync(fd)
-    if os.path.basename(os.readlink(f"/proc/self/fd/{fd}")).startswith("." + os.environ["HOLD"] + "."):
-        print("writing", flush=True)
-        time.sleep(600)
-os.fsync = hold
-from fha_studio.main import main
-sys.exit(main(sys.argv[1:]))
-"""
 
 
 @pytest.mark.parametrize("case", MANIFEST["killed"], ids=[c["output"] for c in MANIFEST["killed"]])
