@@ -60,7 +60,8 @@ def _parser() -> argparse.ArgumentParser:
         default=None,
         type=_url,
         help=f"drive to connect to at start (default: the embedded simulated drive, {DEFAULT_SIM_URL}, "
-        "with the declared load inertia); a serial device, a pty path or socket://host:port",
+        "with the catalogue's friction and the declared load inertia); a serial device, a pty path or "
+        "socket://host:port",
     )
     parser.add_argument(
         "--baud",

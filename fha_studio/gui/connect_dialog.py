@@ -40,10 +40,14 @@ def catalogue_codes() -> list[str]:
     return all_model_codes()
 
 
-def sim_url(actuator_code: str, load_inertia_kgm2: float = 0.0, documented: bool = False) -> str:
+def sim_url(actuator_code: str, load_inertia_kgm2: float = 0.0, documented: bool = False,
+            catalogue_friction: bool = True) -> str:
     """The embedded simulated drive for ``actuator_code`` with the declared load inertia [kg m^2]
-    on its output (none when 0); ``documented``: its profile of a real HA-655 (DGR and OWW only)."""
+    on its output (none when 0); ``documented``: its profile of a real HA-655 (DGR and OWW only);
+    ``catalogue_friction``: the friction the catalogue gives (TF, 2-4-4), on for a person (the
+    tool's default axis is a realistic one); off, the axis is frictionless (a bare sim://)."""
     query = ([f"load_inertia={load_inertia_kgm2!r}"] if load_inertia_kgm2 > 0 else []) + (
+        ["catalogue_friction=1"] if catalogue_friction else []) + (
         ["profile=documented"] if documented else [])
     url = f"sim://{actuator_code.strip().upper()}"
     return f"{url}?{'&'.join(query)}" if query else url
@@ -73,6 +77,7 @@ class ConnectDialog(QDialog):
         self.serial_radio = child(self.form, QRadioButton, "serialRadio")
         self.address_radio = child(self.form, QRadioButton, "addressRadio")
         self.sim_actuator = child(self.form, QComboBox, "simActuatorCombo")
+        self.sim_friction = child(self.form, QCheckBox, "simFrictionCheck")
         self.sim_documented = child(self.form, QCheckBox, "simDocumentedCheck")
         self.port_combo = child(self.form, QComboBox, "portCombo")
         self.refresh_button = child(self.form, QPushButton, "refreshButton")
@@ -89,6 +94,7 @@ class ConnectDialog(QDialog):
         self.port_combo.activated.connect(lambda: self.serial_radio.setChecked(True))
         self.address_edit.textEdited.connect(lambda: self.address_radio.setChecked(True))
         self.sim_actuator.activated.connect(lambda: self.sim_radio.setChecked(True))
+        self.sim_friction.toggled.connect(lambda: self.sim_radio.setChecked(True))
         self.sim_documented.toggled.connect(lambda: self.sim_radio.setChecked(True))
         self.refresh_ports(ports)
         self._restore()
@@ -112,6 +118,7 @@ class ConnectDialog(QDialog):
         kind = str(settings.value("connect/kind", "sim"))
         actuator = settings.value("connect/actuator", DEFAULT_ACTUATOR)
         self.sim_actuator.setCurrentText(str(actuator))
+        self.sim_friction.setChecked(str(settings.value("connect/sim_friction", "true")) == "true")
         self.sim_documented.setChecked(str(settings.value("connect/sim_documented", "false")) == "true")
         port = settings.value("connect/port", "")
         index = self.port_combo.findData(port)
@@ -135,6 +142,7 @@ class ConnectDialog(QDialog):
         )
         settings.setValue("connect/kind", kind)
         settings.setValue("connect/actuator", self.sim_actuator.currentText().strip())
+        settings.setValue("connect/sim_friction", "true" if self.sim_friction.isChecked() else "false")
         settings.setValue("connect/sim_documented", "true" if self.sim_documented.isChecked() else "false")
         if self.port_combo.currentData():
             settings.setValue("connect/port", self.port_combo.currentData())
@@ -157,7 +165,8 @@ class ConnectDialog(QDialog):
         if self.address_radio.isChecked():
             return self.address_edit.text().strip()
         return sim_url(self.sim_actuator.currentText(), self.load_inertia_kgm2,
-                       documented=self.sim_documented.isChecked())
+                       documented=self.sim_documented.isChecked(),
+                       catalogue_friction=self.sim_friction.isChecked())
 
     def baud_rate(self) -> int:
         return int(self.baud_combo.currentData() or BAUDRATE)

@@ -371,7 +371,8 @@ class MainWindow(QMainWindow, PageLookup):
 
     def connect_to(self, url: str | None = None, baud_rate: int = BAUDRATE) -> bool:
         """Connects (after asking, when the axis is live); False when the user said no. Without a
-        URL: the embedded simulated drive, carrying the axis's declared load inertia."""
+        URL: the embedded simulated drive, carrying the axis's declared load inertia and the
+        catalogue's friction (a realistic axis, as the Connect dialog's default)."""
         if url is None:
             from fha_studio.gui.connect_dialog import sim_url
 

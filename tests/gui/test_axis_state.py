@@ -9,6 +9,7 @@ import pytest
 from fha_studio.gui.connect_dialog import ConnectDialog
 from fha_studio.gui.link import MoveBy, Servo
 from fha_studio.hardware.client import DriveClient
+from fha_studio.hardware.sim.options import config_from_url
 from fha_studio.hardware.transport import pipe_pair
 from fha_studio.recording import RecordingMetadata, make_recording, read_recording, write_recording
 from tests.support.documented import DocumentedDrive
@@ -138,7 +139,7 @@ def test_the_load_inertia_typed_once_is_what_every_page_uses(make_window, qtbot,
     # the simulated drive the GUI builds carries the same load
     dialog = ConnectDialog(window, ports=[], load_inertia_kgm2=window.state.load_inertia_kgm2)
     dialog.sim_radio.setChecked(True)
-    assert dialog.url().endswith("?load_inertia=2.5")
+    assert config_from_url(dialog.url()).load_inertia_kgm2 == 2.5
     dialog.deleteLater()
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from PySide6.QtCore import QSettings
 
 from fha_studio.gui.connect_dialog import ConnectDialog
+from fha_studio.hardware.sim import SimDrive
 
 
 def test_sizing_page_adds_parts_checks_and_suggests(make_window, qtbot):
@@ -37,7 +38,7 @@ def test_connect_dialog_defaults_to_the_simulated_drive_and_remembers(qtbot):
     dialog = ConnectDialog(ports=[("/dev/ttyUSB0", "FT232R USB UART")])
     qtbot.addWidget(dialog)
     assert dialog.sim_radio.isChecked()
-    assert dialog.url().startswith("sim://FHA-25C-50-US250")
+    assert dialog.url() == "sim://FHA-25C-50-US250?catalogue_friction=1"  # a realistic axis
     assert dialog.baud_rate() == 19200
     assert dialog.port_combo.itemText(0) == "/dev/ttyUSB0 — FT232R USB UART"
     dialog.address_radio.setChecked(True)
@@ -60,11 +61,45 @@ def test_connect_dialog_offers_the_simulated_drive_as_a_real_ha655_and_remembers
     dialog.address_radio.setChecked(True)
     dialog.sim_documented.setChecked(True)  # the simulated drive is meant
     assert dialog.sim_radio.isChecked()
-    assert dialog.url() == "sim://FHA-25C-50-US250?load_inertia=0.5&profile=documented"
+    assert dialog.url() == "sim://FHA-25C-50-US250?load_inertia=0.5&catalogue_friction=1&profile=documented"
     dialog._accept()
     again = ConnectDialog(ports=[])
     qtbot.addWidget(again)
-    assert again.sim_documented.isChecked() and again.url() == "sim://FHA-25C-50-US250?profile=documented"
+    assert again.sim_documented.isChecked()
+    assert again.url() == "sim://FHA-25C-50-US250?catalogue_friction=1&profile=documented"
+
+
+def test_connect_dialog_offers_the_catalogue_friction_on_by_default_and_remembers_it(qtbot):
+    """The simulated drive a person connects to stops like a real axis: the friction the catalogue
+    gives (TF, 2-4-4) is on unless they turn it off, and the dialog says what it is."""
+    dialog = ConnectDialog(ports=[], load_inertia_kgm2=1.5)
+    qtbot.addWidget(dialog)
+    assert dialog.sim_friction.isChecked()
+    assert "Friction as the catalogue gives it (TF, 2-4-4)" in dialog.sim_friction.text().replace("&", "")
+    assert "TF = KT × Im − TM" in dialog.sim_friction.toolTip()
+    with SimDrive.from_url(dialog.url() + "&stepped=1") as drive:  # the drive that address builds
+        assert drive.model.effects.enabled() == ["coulomb_friction", "viscous_friction"]
+        assert drive.model.load_inertia_kgm2 == 1.5
+    dialog.address_radio.setChecked(True)
+    dialog.sim_friction.setChecked(False)  # a frictionless axis: the simulated drive is meant
+    assert dialog.sim_radio.isChecked()
+    assert dialog.url() == "sim://FHA-25C-50-US250?load_inertia=1.5"
+    with SimDrive.from_url(dialog.url() + "&stepped=1") as drive:
+        assert drive.model.effects.enabled() == []
+    dialog._accept()
+    again = ConnectDialog(ports=[])
+    qtbot.addWidget(again)
+    assert not again.sim_friction.isChecked() and again.url() == "sim://FHA-25C-50-US250"
+
+
+def test_a_window_connected_without_an_address_gets_the_catalogue_friction(make_window):
+    """fha-studio without --url connects to the embedded drive as the dialog's default has it."""
+    window = make_window(show=False)
+    window.state.set_load_inertia(0.5)
+    opened = []
+    window.link.open = lambda url, baud: opened.append(url)
+    assert window.connect_to()
+    assert opened == ["sim://FHA-25C-50-US250?load_inertia=0.5&catalogue_friction=1"]
 
 
 def test_window_layout_and_page_are_remembered(make_window):
