@@ -20,7 +20,9 @@ from fha_studio.hardware.client import DriveClient
 from fha_studio.hardware.parameters import MonitorItem
 from fha_studio.hardware.sim import SimDrive
 from fha_studio.hardware.sim.options import SimConfigError, config_from_url
+from fha_studio.logic.modelcheck import run_modelcheck
 from fha_studio.physics.model import COULOMB_SHARE_OF_TF
+from fha_studio.recording import read_recording
 from tests.sim.conftest import advance
 
 ACTUATOR = "FHA-25C-50-US250"
@@ -141,3 +143,30 @@ def test_a_steady_jog_draws_the_current_of_the_friction(speed_rpm, friction_nm):
     expected_a = friction_nm / KT_NM_PER_A
     assert all(a == pytest.approx(expected_a, rel=0.02) for a in currents["catalogue_friction=1"])
     assert all(abs(a) < 0.02 * expected_a for a in currents["catalogue_friction=0"])
+
+
+def test_the_model_check_names_the_friction_of_a_recording_of_such_a_drive(tmp_path):
+    """A recording of moves at several speeds on the drive with the catalogue's friction: the model
+    check finds Coulomb and viscous friction of the catalogue's size. Over the recorded speeds it
+    may trade a little of one for the other (both within 10 %); their sum at maximum speed, TF,
+    within 5 %."""
+    path = tmp_path / "friction.csv"
+    with SimDrive(ACTUATOR, load_inertia_kgm2=1.5, catalogue_friction=True, stepped=True) as drive:
+        drive.set_servo(True)
+        drive.start_recording(path, 1000.0)
+        drive.advance(0.2)
+        for angle_deg, speed_rpm in [(200, 80), (-120, 20), (300, 60), (-250, 40), (90, 10), (-330, 90)]:
+            drive.set_move_speed(speed_rpm)
+            drive.move_by(angle_deg)
+            while drive.moving:
+                drive.advance(0.05)
+            drive.advance(0.2)
+        drive.stop_recording()
+    result = run_modelcheck(read_recording(path), resimulate=False)
+    found = {e.id: e.params for e in result.effects}
+    assert set(found) == {"coulomb_friction", "viscous_friction"}, result.summary_lines()
+    coulomb = found["coulomb_friction"]["torque_nm"]
+    viscous = found["viscous_friction"]["coefficient_nm_s_per_rad"]
+    assert coulomb == pytest.approx(COULOMB_NM, rel=0.10)
+    assert viscous == pytest.approx(VISCOUS_NM_S_PER_RAD, rel=0.10)
+    assert coulomb + viscous * MAX_RAD_S == pytest.approx(TF_NM, rel=0.05)
