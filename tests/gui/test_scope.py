@@ -6,6 +6,7 @@ the test talks to the drive only through the driver (CALL), never from the GUI t
 
 from __future__ import annotations
 
+import itertools
 import threading
 import time
 
@@ -84,6 +85,41 @@ def test_jog_shows_position_speed_and_current_live(qtbot, scope, sim_client):
     assert view.indicator_text().startswith("PAUSED")
     view.set_paused(False)
     call(view, lambda c: c.servo(False))
+
+
+def _left_tick_labels(plot_item):
+    """The left axis' drawn tick labels (text, rectangle in the scene)."""
+    from PySide6.QtGui import QImage, QPainter
+
+    axis = plot_item.getAxis("left")
+    image = QImage(10, 10, QImage.Format.Format_RGB32)
+    painter = QPainter(image)
+    try:
+        _axis, _ticks, texts = axis.generateDrawSpecs(painter)
+    finally:
+        painter.end()
+    return [(text, axis.mapRectToScene(rect)) for rect, _flags, text in texts]
+
+
+@pytest.mark.parametrize("live", [False, True])
+def test_the_stacked_plots_tick_labels_do_not_overlap(qtbot, scope, sim_client, live):
+    """One plot per unit, stacked: a plot's top tick label never sits on the one above's bottom
+    label (empty plots read "1.0" over "0" where they met)."""
+    view = scope(sim_client)
+    view.show()
+    qtbot.waitExposed(view)
+    if live:
+        view.start_live()
+        for _ in range(3):
+            with qtbot.waitSignal(view.sigFrame, timeout=10000):
+                pass
+    items = view.time_plot.plot_items()
+    assert len(items) >= 3
+    labels = [_left_tick_labels(item) for item in items]
+    assert all(labels)
+    for above, below in itertools.pairwise(labels):
+        clashes = [(a, b) for a, ra in above for b, rb in below if ra.intersects(rb)]
+        assert not clashes, clashes
 
 
 def test_a_live_plot_on_paper_says_which_now_its_time_axis_counts_back_from(

@@ -134,6 +134,9 @@ class TimePlot(QWidget):
                 axis.setTextPen(FOREGROUND)
             item.getAxis("left").setWidth(64)  # the same for all: the time axes line up
             item.getAxis("left").enableAutoSIPrefix(False)  # degrees stay degrees, not "kdeg"
+            # stacked plots: a tick label at a plot's edge would sit on the next plot's ("1.0"
+            # over "0"); only the labels within their own plot's height are drawn
+            item.getAxis("left").setStyle(hideOverlappingLabels=True)
             item.setLabel("left", unit or "value")
             self.plot.addItem(item, row=row, col=0)
             plot = _UnitPlot(item, unit)
