@@ -214,8 +214,8 @@ def _wrong_label_session(axis: str):
 @pytest.fixture
 def filled_register(tmp_path):
     """A register with one of everything an axis's history holds, as the GUI records it."""
+    from fha_studio.logic.procedures.session import CheckRecord
     from fha_studio.logic.register import Register
-    from fha_studio.logic.register.facts_from_session import CheckFact
     from fha_studio.logic.register.importers import record_session
     from fha_studio.logic.register.store import utc_stamp
 
@@ -237,8 +237,8 @@ def filled_register(tmp_path):
     at = utc_stamp()
     reg.record_checks(
         "Cell 2/x",
-        [CheckFact("dgr-checks", "absolute_origin", "dgr", "Absolute origin", {"position_deg": 0.01}, True,
-                   "ana", at, "")],
+        [CheckRecord("dgr-checks", "absolute_origin", "dgr", "", "Absolute origin", {"position_deg": 0.01},
+                     "", "", True, "ana", at, "")],
     )
     reg.record_origin("Cell 2/x", "absolute origin set (OWW), read back at +0.01°", who="ana")
     recording = tmp_path / "move.csv"

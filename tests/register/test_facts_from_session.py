@@ -34,7 +34,7 @@ def test_every_kind_of_fact_has_its_writer():
 def test_an_absolute_origin_is_a_check_and_the_axis_origin(line3):
     facts = f.facts_from_dgr_check(_dgr("absolute_origin", {"position_deg": 0.01}))
     assert [type(x) for x in facts] == [f.CheckFact, f.OriginFact]
-    check = facts[0]
+    check = facts[0].record
     assert (check.procedure_id, check.step_id, check.text, check.passed) == (
         "dgr-checks", "absolute_origin", "Absolute origin (OWW)", True
     )
@@ -62,7 +62,7 @@ def test_the_origin_sensor_angle_is_the_origin_another_sensor_is_not():
 def test_a_rotary_direction_check_enters_parameter_8_from_the_front_panel(line3):
     facts = f.facts_from_dgr_check(_dgr("rotary_direction", {"rotary_direction": 1}, by_hand=True))
     check, panel = facts
-    assert check.text == "Rotary direction (1-10) (given by hand)"
+    assert check.record.text == "Rotary direction (1-10) (given by hand)"
     assert panel.rows == (("system", 8, "rotary_direction", 1),) and panel.what == "front-panel value"
     _record(line3, facts)
     (snapshot,) = line3.snapshots(AXIS)

@@ -24,7 +24,7 @@ from typing import Any
 from fha_studio.hardware.parameters import ParameterModel, load_alarm_table
 from fha_studio.logic.absolute import CHECK_TITLES, DgrCheckRecord
 from fha_studio.logic.procedures.report import build_report
-from fha_studio.logic.procedures.session import ProcedureSession
+from fha_studio.logic.procedures.session import CheckRecord, ProcedureSession
 from fha_studio.logic.register.importers import record_session
 from fha_studio.logic.register.store import Register, RegisterError
 
@@ -116,22 +116,11 @@ class AlarmFact:
     what: str = "alarm"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CheckFact:
-    """A check with its verdict, in the fields the register takes for a procedure check."""
+    """A check with its verdict: a procedure check's record, as a session holds one."""
 
-    procedure_id: str
-    step_id: str
-    kind: str
-    text: str
-    value: object
-    passed: bool
-    who: str
-    at_utc: str
-    detail: str
-    section: str = ""
-    expected: str = ""
-    unit: str = ""
+    record: CheckRecord
     what: str = "check"
 
 
@@ -338,17 +327,20 @@ def facts_from_dgr_check(record: DgrCheckRecord) -> list[Fact]:
         facts.append(NoteFact(f"{title}{by_hand}: {record.detail}", record.who, record.at, what="check"))
     else:
         facts.append(
-            CheckFact(
+            CheckFact(CheckRecord(
                 procedure_id=DGR_PROCEDURE_ID,
                 step_id=record.check,
                 kind="dgr",
+                section="",
                 text=title + by_hand,
                 value=dict(record.values),
+                expected="",
+                unit="",
                 passed=bool(record.passed),
                 who=record.who,
                 at_utc=record.at,
                 detail=record.detail,
-            )
+            ))
         )
     if record.check == "absolute_origin" and record.passed:
         where = record.values.get("position_deg")
@@ -434,7 +426,7 @@ def _alarm(register: Register, axis: str, f: AlarmFact) -> None:
 
 
 def _check(register: Register, axis: str, f: CheckFact) -> None:
-    register.record_checks(axis, [f])
+    register.record_checks(axis, [f.record])
 
 
 def _note(register: Register, axis: str, f: NoteFact) -> None:
