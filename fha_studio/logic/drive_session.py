@@ -16,7 +16,7 @@ import logging
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import Protocol, TypedDict
+from typing import Any, Protocol, TypedDict
 
 from fha_studio import clock
 from fha_studio.hardware.api import (
@@ -122,19 +122,8 @@ class PolledDrive(DriveLink, ManualCommands, ExtensionCommands, Protocol):
     """What the status poll asks of a drive: what it is, DGR, alarm, I/O and monitors."""
 
 
-@dataclass
-class _Fields:
-    """The fields of one poll as they are learnt."""
-
-    servo_on: bool | None = None
-    alarm_code: int | None = None
-    io_bits: int | None = None
-    speed_rpm: float | None = None
-    position_pulse: int | None = None
-    current_a: float | None = None
-    refused: bool = False
-    absolute_counts: int | None = None
-    note: str = ""
+#: The fields of one poll as they are learnt (DriveStatus's names: the rest keep its defaults).
+_Fields = dict[str, Any]
 
 
 class StatusPoller:
@@ -157,50 +146,45 @@ class StatusPoller:
     def poll(self, jogging: bool = False, time_s: float | None = None) -> tuple[DriveStatus, int]:
         """One pass: (the status, ms until the next pass). ``jogging``: a jog is being held."""
         stamp = time.monotonic() if time_s is None else time_s
-        got = _Fields()
+        got: _Fields = {}
         interval_ms = self.interval_ms
         try:
             if not self.drive.capabilities.supports(Command.IOS):
                 interval_ms = self._probe(got)
             else:
                 try:
-                    got.alarm_code = self.drive.alarm()
+                    got["alarm_code"] = self.drive.alarm()
                     io = self.drive.io_state()
-                    got.io_bits = io.raw
-                    got.servo_on = io.servo_on
+                    got["io_bits"] = io.raw
+                    got["servo_on"] = io.servo_on
                     if self.monitors_ok:
                         self._poll_monitors(got)
                 except ServoOnRefused:
-                    got.refused = True
-                    got.servo_on = True  # a drive refuses CN3 commands while the servo is on
-                    got.note = SERVO_ON_NOTE
+                    got["refused"] = True
+                    got["servo_on"] = True  # a drive refuses CN3 commands while the servo is on
+                    got["note"] = SERVO_ON_NOTE
                     interval_ms = max(interval_ms, SERVO_ON_PROBE_MS)
         except LinkLost:
             raise
         except LinkError as exc:
             log.info("poll failed: %s", exc)
-        status = DriveStatus(
-            time_s=stamp, servo_on=got.servo_on, alarm_code=got.alarm_code, io_bits=got.io_bits,
-            speed_rpm=got.speed_rpm, position_pulse=got.position_pulse, current_a=got.current_a,
-            jogging=jogging, refused=got.refused, absolute_counts=got.absolute_counts, note=got.note,
-        )
-        return status, interval_ms
+        return DriveStatus(time_s=stamp, jogging=jogging, **got), interval_ms
 
     def _probe(self, got: _Fields) -> int:
         """The idle probe of a drive without status commands: one DGR. Data, s and x all prove
         the drive is there; silence is the link's failure. Returns the next pass's delay."""
         try:
-            got.absolute_counts = self.drive.absolute_position()
-            got.servo_on = False
+            got["absolute_counts"] = self.drive.absolute_position()
+            got["servo_on"] = False
         except ServoOnRefused:
-            got.servo_on = True
-            got.refused = True
-            got.note = SERVO_ON_NOTE
+            got["servo_on"] = True
+            got["refused"] = True
+            got["note"] = SERVO_ON_NOTE
             return max(self.interval_ms, SERVO_ON_PROBE_MS)
         except CommandRejected as exc:
             # s comes to everything while the servo is on, so x means: servo off, no DGR
-            got.servo_on = False
-            got.note = refusal_text(exc, Command.DGR)
+            got["servo_on"] = False
+            got["note"] = refusal_text(exc, Command.DGR)
         return max(self.interval_ms, PROBE_INTERVAL_MS)
 
     def _poll_monitors(self, got: _Fields) -> None:
@@ -217,9 +201,9 @@ class StatusPoller:
             wire = values.get(item)
             return None if wire is None else self.drive.model.item(Mode.MONITOR, item).to_unit(wire)
 
-        got.position_pulse = values.get(MonitorItem.FEEDBACK_POSITION)
-        got.speed_rpm = scaled(MonitorItem.OUTPUT_SPEED)
-        got.current_a = scaled(MonitorItem.MOTOR_CURRENT_MEAN)
+        got["position_pulse"] = values.get(MonitorItem.FEEDBACK_POSITION)
+        got["speed_rpm"] = scaled(MonitorItem.OUTPUT_SPEED)
+        got["current_a"] = scaled(MonitorItem.MOTOR_CURRENT_MEAN)
 
 
 @dataclass(frozen=True)
