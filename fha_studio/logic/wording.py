@@ -16,6 +16,7 @@ UNIT_WORDS = {
     "m^2": "m²",
     "N m s/rad": "N·m·s/rad",
     "N m/rad": "N·m/rad",
+    "rad/s^2": "rad/s²",
     "deg": "°",
     "arcsec": "arc-sec",
 }

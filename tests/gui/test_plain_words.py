@@ -37,6 +37,7 @@ LEAKS = (
         "a unit not as the manual writes it (N·m, kg·m², N·m·s/rad, arc-sec)",
     ),
     (re.compile(r" -> "), "an ASCII arrow (the manual's →)"),
+    (re.compile(r"\w\^ ?\d"), "an ASCII power (I^2 t: the manual writes I²t, m²)"),
 )
 #: snake_case words (two or more parts); a path, a URL or a file name may hold them.
 SNAKE = re.compile(r"(?<![\w/.:?=&-])[a-z][a-z0-9]*(?:_[a-z0-9]+)+(?![\w/.=-])")
