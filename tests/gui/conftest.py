@@ -54,6 +54,22 @@ def make_window(qtbot):
 
 
 @pytest.fixture
+def make_cli_window(qtbot):
+    """Factory: make_cli_window(*options) -> the single-axis window ``fha-studio OPTIONS`` makes
+    (the register line included), shown, not connected; torn down as every window of the tests."""
+    from fha_studio.gui.app import parse_arguments, single_axis_window
+
+    def factory(*options: str):
+        window = single_axis_window(parse_arguments([*options, "--no-connect"]))
+        window.show()
+        windows.append(window)
+        return window
+
+    with torn_down(lambda window: [window.link]) as windows:
+        yield factory
+
+
+@pytest.fixture
 def documented_window(make_window):
     """Factory: documented_window(code) -> a shown window on the simulated drive ``code``'s documented
     profile (tests/gui/controller.py), its actuator acknowledged."""

@@ -10,7 +10,6 @@ import pytest
 from fha_studio.logic.register import Register
 from fha_studio.logic.register.window_axis import default_machine_name
 from tests.gui.fit import cut_texts, hidden_actions
-from tests.support.windows import torn_down
 
 FULL = "sim://FHA-25C-50-US250?paced=0"
 #: As a real HA-655: DGR and OWW only; the drive names no actuator.
@@ -19,19 +18,9 @@ ROTARY_DIRECTION_WRITTEN = "parameter 8 Rotary direction: 0 → 1: FWD turns CCW
 
 
 @pytest.fixture
-def make_window(qtbot):
-    """Factory: make_window(*options) -> the window ``fha-studio OPTIONS`` makes (the register
-    line included), shown, not connected; torn down as every window of the tests."""
-    from fha_studio.gui.app import parse_arguments, single_axis_window
-
-    def factory(*options: str):
-        window = single_axis_window(parse_arguments([*options, "--no-connect"]))
-        window.show()
-        windows.append(window)
-        return window
-
-    with torn_down(lambda window: [window.link]) as windows:
-        yield factory
+def make_window(make_cli_window):
+    """Factory: make_window(*options) -> the window ``fha-studio OPTIONS`` makes (conftest)."""
+    return make_cli_window
 
 
 def _connect(window, qtbot, url: str) -> None:

@@ -30,22 +30,12 @@ HUNG_AT_MOST_S = 60.0
 
 
 @pytest.fixture
-def make_window(qtbot, monkeypatch):
-    """Factory: make_window(*options) -> the window ``fha-studio OPTIONS`` makes, shown, not
-    connected; a slow server is said after 0.5 s here (5 s in use)."""
-    from fha_studio.gui.app import parse_arguments, single_axis_window
-
+def make_window(monkeypatch, make_cli_window):
+    """Factory: make_window(*options) -> the window ``fha-studio OPTIONS`` makes (conftest); a
+    slow server is said after 0.5 s here (5 s in use)."""
     monkeypatch.setattr(register_worker, "SLOW_S", 0.5)
     monkeypatch.setattr(register_worker, "RETRY_MIN_S", 0.5)
-
-    def factory(*options: str):
-        window = single_axis_window(parse_arguments([*options, "--no-connect"]))
-        window.show()
-        windows.append(window)
-        return window
-
-    with torn_down(lambda window: [window.link]) as windows:
-        yield factory
+    return make_cli_window
 
 
 class GuiThreadWatch:

@@ -15,31 +15,25 @@ from fha_studio.gui import register_questions
 from fha_studio.logic.procedures import ProcedureSession
 from tests.gui.procedures.test_signed_report import _finished_session
 from tests.gui.test_window_register_server import GuiThreadWatch, _hung
-from tests.support.windows import torn_down
 
 SIGNER = "A. Reviewer"
 
 
 @pytest.fixture
-def signing_window(qtbot, tmp_path, monkeypatch, postgres_cluster):
+def signing_window(qtbot, tmp_path, monkeypatch, postgres_cluster, make_cli_window):
     """The single-axis window on a new database of the tests' server, whose register keeps the
-    signer's key (without a passphrase); its Procedures page with a finished session open."""
-    from fha_studio.gui.app import parse_arguments, single_axis_window
-
+    signer's key (without a passphrase); its Procedures page with a finished session open (the
+    window closed before the settings above are undone: make_cli_window comes after them)."""
     monkeypatch.setattr(register_questions, "SLOW_S", 0.3)
     monkeypatch.setattr(register_questions, "GIVE_UP_S", 1.0)
     url = postgres_cluster.new_database()
     monkeypatch.setenv("FHA_STUDIO_KEY_PASSPHRASE", "")
     assert main(["register", "--register", url, "keys", "add", "--name", SIGNER]) == 0
     _finished_session(tmp_path / "axis1.json")
-    with torn_down(lambda window: [window.link]) as windows:
-        window = single_axis_window(parse_arguments(["--register", url, "--machine", "Line 3", "--axis",
-                                                     "table", "--no-connect"]))
-        windows.append(window)
-        window.show()
-        page = window.show_page("procedures")
-        page.open_session(tmp_path / "axis1.json")
-        yield window, page, url
+    window = make_cli_window("--register", url, "--machine", "Line 3", "--axis", "table")
+    page = window.show_page("procedures")
+    page.open_session(tmp_path / "axis1.json")
+    return window, page, url
 
 
 def _unsigned(path) -> bool:
