@@ -216,7 +216,7 @@ def sign(
         raise SignError("a report is signed with a name")
     report = build_report(session, context)
     if report.warnings:
-        raise SignError("cannot sign while these are open: " + " | ".join(report.warnings))
+        raise SignError("cannot sign while these are open: " + "; ".join(report.warnings))
     session.signature = {"who": who.strip(), "at_utc": utc_now()}
     if key_id:
         session.signature["key_id"] = key_id

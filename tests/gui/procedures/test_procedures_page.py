@@ -146,7 +146,9 @@ def test_sensor_dogs_set_on_the_simulated_drive_and_the_report_prints(window, qt
         ).stdout
         assert "Rotary position sensor set adjustment" in pdf_text and CODE in pdf_text
     assert not page.sign()  # the other procedures are still open
-    assert "cannot sign while these are open" in page.message_label.text()
+    said = page.message_label.text()  # a sentence, the open procedures one after another
+    assert said.startswith("Cannot sign while these are open: ") and " | " not in said
+    assert "; Rotary direction (1-10): not done" in said
 
 
 @pytest.mark.slow

@@ -537,7 +537,8 @@ class ProceduresPage(BasePage):
         try:
             said = self.signer.sign(session, who or self.who, self.context, ask, done)
         except ValueError as exc:  # open checks, a key that cannot be used, a wrong passphrase
-            self._message(str(exc))
+            said = str(exc)
+            self._message(said[:1].upper() + said[1:])  # a sentence in the message line
             return False
         if said is None:
             self._message("Signing: asking the register on the server for the signer's key…")
