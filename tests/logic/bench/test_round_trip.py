@@ -20,7 +20,14 @@ from fha_studio.logic.bench.importer import (
 )
 from fha_studio.physics import AxisModel, ServoAxis
 from fha_studio.recording import read_recording, write_recording
-from tests.support.cn2_capture import CHANNELS, CODE, recorded_move
+from tests.support.cn2_capture import (
+    CHANNELS,
+    CODE,
+    controller_move,
+    drive_settings,
+    expected_speed_rpm,
+    recorded_move,
+)
 
 RPM = 2 * math.pi / 60
 
@@ -124,31 +131,13 @@ def test_a_capture_too_slow_for_the_encoder_is_refused_with_both_figures(drive, 
 def test_the_simulated_drive_on_the_documented_profile_through_the_instrument(tmp_path):
     """A stepped SimDrive whose CN3 is silent in motion (documented profile): the controller's
     pulse train moves it, the instrument samples CN2, and the import gives its counts back."""
-    from fha_studio.hardware.sim.drive import SimDrive
-
-    drive = SimDrive(CODE, profile="documented", stepped=True, eeprom=str(tmp_path / "eeprom.json"))
-    try:
-        instrument = VirtualBenchInstrument.on_drive(drive, 400e3)
-        drive.set_servo(True)
-        instrument.record(0.03)
-        drive.set_move_speed(10.0)
-        drive.controller_command(12.0)
+    with controller_move(tmp_path) as (drive, instrument):
         blocks = list(instrument.stream(0.6, block_s=0.02))  # as a live stream delivers it
         assert [b.first_sample for b in blocks[1:]] == [a.first_sample + a.samples for a in blocks[:-1]]
         instrument._blocks.extend(blocks)
         instrument.write(tmp_path / "cn2.sr", "sr")
         signals = [SignalSpec(role, str(tmp_path / "cn2.sr"), channel) for role, channel in CHANNELS.items()]
-        values = {
-            ("system", n): drive.memory.value(key)
-            for n, key in (
-                (1, "command_pulse_configuration"),
-                (2, "two_phase_pulse_multiplication"),
-                (3, "electronic_gear_numerator"),
-                (4, "electronic_gear_denominator"),
-                (9, "speed_conversion_factor"),
-            )
-        }
-        result = import_bench(signals, AxisFacts.for_actuator(CODE), DriveSettings.from_values(values))
+        result = import_bench(signals, AxisFacts.for_actuator(CODE), drive_settings(drive))
         truth = instrument.truth.arrays()
         assert truth["encoder_counts"][-1] == drive.axis.feedback_pulses
         assert np.array_equal(
@@ -157,13 +146,10 @@ def test_the_simulated_drive_on_the_documented_profile_through_the_instrument(tm
         assert result.summary["command_counts"] == drive.axis.command_pulses == round(12.0 / 360 * 500000)
         assert abs(result.recording.pos_deg[-1] - 12.0) < 0.01
         recording = result.recording
-        idx = np.rint(recording.t_s * instrument.sample_rate_hz).astype(int)
-        expected = truth["motor_rpm"][idx] / 50.0
+        expected = expected_speed_rpm(recording, truth, instrument.sample_rate_hz)
         peak = float(np.max(np.abs(expected)))
         assert peak > 9.0
         assert float(np.max(np.abs(recording.vel_rpm - expected))) < 0.01 * peak
-    finally:
-        drive.close()
 
 
 def test_an_encoder_on_the_load_gives_the_flange_after_the_gear(tmp_path):

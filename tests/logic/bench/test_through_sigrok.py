@@ -12,10 +12,16 @@ import pytest
 
 from fha_studio.hardware.bench import sigrok_input
 from fha_studio.hardware.bench.sigrok import SigrokError
-from fha_studio.hardware.sim.cn2 import VirtualBenchInstrument
 from fha_studio.logic.bench.display import LiveQuadrature
 from fha_studio.logic.bench.importer import AxisFacts, DriveSettings, SignalSpec, import_bench
-from tests.support.cn2_capture import CHANNELS, CODE, recorded_move
+from tests.support.cn2_capture import (
+    CHANNELS,
+    CODE,
+    controller_move,
+    drive_settings,
+    expected_speed_rpm,
+    recorded_move,
+)
 
 pytestmark = pytest.mark.skipif(shutil.which("sigrok-cli") is None, reason="sigrok-cli is not installed")
 
@@ -32,13 +38,6 @@ def _through_sigrok(path: str):
         return sigrok_input.read_through_sigrok(path)
     except SigrokError as exc:  # as the importer's own loader: one line
         raise ValueError(str(exc)) from None
-
-
-def _expected_speed(recording, truth, rate):
-    """The drive's output r/min at each recording instant (the speed column is taken at the
-    position's instants)."""
-    idx = np.rint(recording.t_s * rate).astype(int)
-    return truth["motor_rpm"][idx] / 50.0
 
 
 @pytest.mark.parametrize("form", list(NAMES))
@@ -79,7 +78,7 @@ def test_each_file_form_through_sigrok_cli_gives_the_drives_positions_back(drive
     if form == "vcd":
         return
     recording = result.recording
-    expected = _expected_speed(recording, truth, instrument.sample_rate_hz)
+    expected = expected_speed_rpm(recording, truth, instrument.sample_rate_hz)
     peak = float(np.max(np.abs(expected)))
     assert peak > 7.5
     assert float(np.max(np.abs(recording.vel_rpm - expected))) < 0.01 * peak
@@ -88,34 +87,20 @@ def test_each_file_form_through_sigrok_cli_gives_the_drives_positions_back(drive
 def test_the_documented_drive_moved_by_the_controller_through_sigrok_cli(tmp_path):
     """The stepped SimDrive on the documented profile (CN3 silent in motion), moved by the
     controller's pulses: its CN2 as a sigrok session, streamed back through sigrok-cli."""
-    from fha_studio.hardware.sim.drive import SimDrive
-
-    drive = SimDrive(CODE, profile="documented", stepped=True, eeprom=str(tmp_path / "eeprom.json"))
-    try:
-        instrument = VirtualBenchInstrument.on_drive(drive, 400e3)
-        drive.set_servo(True)
-        instrument.record(0.03)
-        drive.set_move_speed(10.0)
-        drive.controller_command(12.0)
+    with controller_move(tmp_path) as (drive, instrument):
         instrument.record(0.6)
         instrument.write(tmp_path / "cn2.sr", "sr")
-        values = {("system", n): drive.memory.value(key) for n, key in (
-            (1, "command_pulse_configuration"), (2, "two_phase_pulse_multiplication"),
-            (3, "electronic_gear_numerator"), (4, "electronic_gear_denominator"),
-            (9, "speed_conversion_factor"))}
         signals = [SignalSpec(role, str(tmp_path / "cn2.sr"), channel) for role, channel in CHANNELS.items()]
-        result = import_bench(signals, AxisFacts.for_actuator(CODE), DriveSettings.from_values(values),
+        result = import_bench(signals, AxisFacts.for_actuator(CODE), drive_settings(drive),
                               loader=_through_sigrok)
         truth = instrument.truth.arrays()
         counts = truth["encoder_counts"]
         assert np.array_equal(result.decoded.encoder.counts, counts - counts[0])
         assert result.summary["command_counts"] == drive.axis.command_pulses == round(12.0 / 360 * 500000)
-        expected = _expected_speed(result.recording, truth, instrument.sample_rate_hz)
+        expected = expected_speed_rpm(result.recording, truth, instrument.sample_rate_hz)
         peak = float(np.max(np.abs(expected)))
         assert peak > 9.0
         assert float(np.max(np.abs(result.recording.vel_rpm - expected))) < 0.01 * peak
-    finally:
-        drive.close()
 
 
 def test_a_decimal_comma_csv_is_refused_for_sigrok_cli_in_one_line(drive, tmp_path):
