@@ -74,7 +74,27 @@ def read_capture(path: str | os.PathLike[str]) -> Capture:
     if name.lower().endswith((".sr", ".vcd")):
         kind = "sigrok session (a zip)" if name.lower().endswith(".sr") else "VCD ($ keywords first)"
         raise CaptureError(f"{name}: line 1: not a {kind}")
+    layout = instrument_layout(data[:4096])
+    if layout == "Rigol CSV":
+        return parse_rigol_csv(data, name)
+    if layout == "Tektronix TDS/TBS CSV":
+        return parse_tek_tds_csv(data, name)
     return parse_csv(data, name)
+
+
+def instrument_layout(head: bytes) -> str | None:
+    """The oscilloscope CSV layouts that are not a header row over columns of time and values
+    (:func:`parse_csv` reads those, preamble or not), found from the file's first bytes: a Rigol
+    DS1000Z/MSO5000 export (``X,CH1,...,Start,Increment``) or an older Tektronix TDS/TBS one
+    (metadata beside the data, ``Record Length`` first); None for any other."""
+    first = head.lstrip(b"\xef\xbb\xbf \t\r\n").split(b"\n", 1)[0].decode("utf-8", "replace")
+    fields = [f.strip().strip('"') for f in first.split(",")]
+    if fields[:1] == ["X"] and "Start" in fields and "Increment" in fields:
+        return "Rigol CSV"
+    if (fields[:1] == ["Record Length"] and len(fields) >= 5 and not fields[2]
+            and _numbers_like(fields[3]) and _numbers_like(fields[4])):
+        return "Tektronix TDS/TBS CSV"
+    return None
 
 
 def parse_rate(text: str) -> float | None:
@@ -531,11 +551,21 @@ def _csv_layout(lines: Sequence[bytes], name: str) -> CsvLayout:
         header_text = _line(lines, index).decode("utf-8").strip().lstrip("\ufeff")
     except UnicodeDecodeError:
         raise CaptureError(f"{name}: line {index + 1}: not UTF-8 text: is it a capture file?") from None
-    delimiter = ";" if ";" in header_text else ("\t" if "\t" in header_text else ",")
+    delimiter = _delimiter(header_text)
     header = [c.strip().strip('"') for c in header_text.split(delimiter)]
     if all(_numbers_like(c) for c in header if c):
         raise CaptureError(f"{name}: line {index + 1}: numbers where the header row was expected "
                            "(names of the columns, one of them the time, like 'time [s],CH1 [V]')")
+    preamble_end = index
+    if not _names_time(header):
+        # an oscilloscope's preamble (Tektronix: 'Model,...', 'Sample Interval,...'; Siglent:
+        # 'Record Length,...', 'Source,CH1'): the header is the row over the first numbers
+        found = _header_after_preamble(lines, index)
+        if found is not None:
+            index = preamble_end = found
+            header_text = _line(lines, index).decode("utf-8", "replace").strip()
+            delimiter = _delimiter(header_text)
+            header = [c.strip().strip('"') for c in header_text.split(delimiter)]
     comment = "#" if delimiter == ";" else "#;"
     after = _first_content_line(lines, index + 1, comment)
     units: list[str] = [""] * len(header)
@@ -543,19 +573,23 @@ def _csv_layout(lines: Sequence[bytes], name: str) -> CsvLayout:
     if after is not None:
         row = [c.strip().strip('"') for c in _line(lines, after).decode("utf-8", "replace").split(delimiter)]
         if row and not any(_numbers_like(c) for c in row if c) and len(row) == len(header):
-            units = row  # a units row under the header ("s,V,V")
+            # a units row under the header: "s,V,V", Keysight's "second,Volt,Volt", PicoScope's
+            # "(ms),(V),(V)"
+            units = [_unit_word(c.strip("()[]")) for c in row]
             data_start = after + 1
     names: list[str] = []
     column_units: list[str] = []
     for raw, unit_row in zip(header, units, strict=True):
         label, unit = _split_unit(raw)
         names.append(label)
-        column_units.append(unit or unit_row)
+        column_units.append(_unit_word(unit) or unit_row)
     # trailing empty columns (a separator at the end of each row) are not channels
     while names and not names[-1]:
         names.pop()
         column_units.pop()
     time_column = next((i for i, n in enumerate(names) if _is_time_name(n)), None)
+    if time_column is not None and preamble_end > 0:
+        _name_by_preamble(lines, preamble_end, names, column_units, time_column)
     if time_column is None:
         raise CaptureError(f"{name}: line {index + 1}: no time column (named time, t or x-axis, in s or "
                            f"ms); the header has {', '.join(n or '(empty)' for n in names)}")
@@ -572,6 +606,77 @@ def _csv_layout(lines: Sequence[bytes], name: str) -> CsvLayout:
     decimal_comma = delimiter == ";" and _has_decimal_comma(lines, data_start)
     return CsvLayout(delimiter, decimal_comma, comment, index, data_start, tuple(names),
                      tuple(column_units), time_column, len(header))
+
+
+def _delimiter(header_text: str) -> str:
+    return ";" if ";" in header_text else ("\t" if "\t" in header_text else ",")
+
+
+def _names_time(header: Sequence[str]) -> bool:
+    return any(_is_time_name(_split_unit(c)[0]) for c in header)
+
+
+def _header_after_preamble(lines: Sequence[bytes], start: int) -> int | None:
+    """The header row of a CSV with a preamble: the last row of names before the first row of
+    numbers, or the one before that when it is a units row; None if neither names the time."""
+    first_numbers = None
+    for i in range(start, min(len(lines) - 1, HEAD_LINES)):
+        text = lines[i].decode("utf-8", "replace").strip()
+        fields = [f.strip().strip('"') for f in text.split(_delimiter(text)) if f.strip()]
+        if fields and all(_numbers_like(f) for f in fields):
+            first_numbers = i
+            break
+    if first_numbers is None:
+        return None
+    candidates = []
+    for i in range(first_numbers - 1, start - 1, -1):
+        text = lines[i].decode("utf-8", "replace").strip()
+        fields = [f.strip().strip('"') for f in text.split(_delimiter(text))]
+        if any(fields):  # a row of separators only (Tektronix writes ',,') is no row
+            candidates.append((i, fields))
+            if len(candidates) == 2:
+                break
+    for i, fields in candidates:
+        if _names_time(fields):
+            return i
+    return None
+
+
+#: Units as oscilloscopes spell them in a header or units row.
+_UNIT_WORDS = {"volt": "V", "volts": "V", "v": "V", "value": "", "amp": "A", "ampere": "A",
+               "amps": "A", "second": "s", "seconds": "s", "sec": "s"}
+_SOURCE_RE = re.compile(r"^\s*(C\d+|CH\d+|Ch\d+|Channel\s*[A-H0-9]+|MATH\d*|M\d+|D\d+|REF\d*)\s*:")
+
+
+def _unit_word(unit: str) -> str:
+    return _UNIT_WORDS.get(unit.strip().lower(), unit.strip())
+
+
+def _name_by_preamble(lines: Sequence[bytes], end: int, names: list[str], units: list[str],
+                      time_column: int) -> None:
+    """Siglent names its columns by their unit (``Second,Volt,Volt`` or ``Second,Value``) and the
+    channels in its preamble (``Source,CH1,CH2``, or ``CH1:`` in ``Vertical Units,CH1:V``): the
+    columns take the channels' names, the unit word becomes the unit."""
+    value_columns = [i for i in range(len(names)) if i != time_column]
+    unit_named = [i for i in value_columns if names[i].lower() in _UNIT_WORDS]
+    if not unit_named:
+        return
+    sources: list[str] = []
+    prefixed: list[str] = []
+    for i in range(end):
+        text = _line(lines, i).decode("utf-8", "replace").strip()
+        fields = [f.strip().strip('"') for f in text.split(",")]
+        if fields[0].lower() == "source":
+            sources = [f for f in fields[1:] if f]
+        for f in fields[1:]:
+            match = _SOURCE_RE.match(f)
+            if match and match.group(1) not in prefixed:
+                prefixed.append(match.group(1))
+    found = sources if len(sources) == len(value_columns) else prefixed
+    for k, i in enumerate(value_columns):
+        if i in unit_named:
+            units[i] = units[i] or _unit_word(names[i])
+            names[i] = found[k] if len(found) == len(value_columns) else f"CH{k + 1}"
 
 
 def time_unit_s(layout: CsvLayout) -> float:
@@ -593,6 +698,9 @@ def parse_csv(data: bytes, name: str) -> Capture:
     if table.shape[0] < 2:
         raise CaptureError(f"{name}: line {data_start + 1}: fewer than 2 rows of samples")
     t = table[:, time_column] * time_unit_s(layout)
+    if _is_change_list(table, time_column):
+        return _changes(table, t, names, time_column, name, lines, data_start, comment)
+    _not_a_change(table, names, time_column, name, lines, data_start, comment)
     rate = _steady_rate(t, name, lines, data_start, comment)
     analog: dict[str, np.ndarray] = {}
     unit_of: dict[str, str] = {}
@@ -689,3 +797,173 @@ def _steady_rate(t: np.ndarray, name: str, lines: Sequence[bytes], start: int, c
             f"{t[i - 1]:.9g} s: off the steady rate of {_rate_text(1.0 / step)} (a sample every "
             f"{step:.6g} s): a capture at one sample rate is expected")
     return float(f"{(n - 1) / (t[-1] - t[0]):.9g}")
+
+
+# --------------------------------------------------------------------- a logic analyzer's changes
+
+
+def _is_change_list(table: np.ndarray, time_column: int) -> bool:
+    """A logic analyzer's export of changes (Saleae Logic 2's and Logic 1.x's digital CSV): every
+    channel 0 or 1 and each row differs from the one before in some channel (the last may repeat
+    the state: the capture's end). A file sampled at one rate repeats rows while nothing changes."""
+    levels = np.delete(table, time_column, axis=1)
+    if levels.shape[1] == 0 or table.shape[0] < 2 or not np.all((levels == 0) | (levels == 1)):
+        return False
+    same = np.all(levels[1:] == levels[:-1], axis=1)
+    return not np.any(same[:-1])
+
+
+def _not_a_change(table: np.ndarray, names: list[str], time_column: int, name: str,
+                  lines: Sequence[bytes], start: int, comment: str) -> None:
+    """A file whose channels are 0 and 1 but for one value or a few: a logic analyzer's export
+    of changes with a bad value, named (not read as analog channels, nor refused for its rate)."""
+    levels = np.delete(table, time_column, axis=1)
+    bad = ~((levels == 0) | (levels == 1) | np.isnan(levels))  # an empty field is said below
+    if levels.size and 0 < np.count_nonzero(bad) <= max(1.0, 0.01 * levels.size):
+        row, column = (int(k[0]) for k in np.nonzero(bad))
+        label = [n for k, n in enumerate(names) if k != time_column][column]
+        raise CaptureError(f"{name}: line {_data_line(lines, start, row, comment)}: {label} is "
+                           f"{levels[row, column]:g}, expected 0 or 1 (a logic analyzer's export of changes)")
+
+
+def _changes(table: np.ndarray, t: np.ndarray, names: list[str], time_column: int, name: str,
+             lines: Sequence[bytes], start: int, comment: str) -> Capture:
+    """Changes put on a sample grid, each state held until the next change. Saleae's export states
+    no sample rate: the grid is the finest interval between changes (6 significant digits: the
+    file's times are printed to the ns), so no two changes share a sample."""
+    steps = np.diff(t)
+    if not np.all(steps > 0):
+        i = int(np.flatnonzero(~(steps > 0))[0]) + 1
+        raise CaptureError(f"{name}: line {_data_line(lines, start, i, comment)}: time {t[i]:.9g} s after "
+                           f"{t[i - 1]:.9g} s: the changes of a logic analyzer's export go forward in time")
+    step = float(f"{float(steps.min()):.6g}")
+    rate = 1.0 / step
+    span = float(t[-1] - t[0])
+    n = round(span / step) + 1
+    if n > MAX_SAMPLES:
+        grid = _rate_text(float(f"{rate:.9g}"))
+        raise CaptureError(f"{name}: changes {step:.6g} s apart at the closest over {span:.6g} s: {n} "
+                           f"samples on that grid ({grid}), more than the {MAX_SAMPLES} a capture may hold")
+    at = np.rint((t - t[0]) / step).astype(np.int64)
+    logic_names = [label for column, label in enumerate(names) if column != time_column]
+    bits = [_held(at, table[:, column] == 1, n, bool)
+            for column in range(len(names)) if column != time_column]
+    block = SampleBlock(rate, tuple(logic_names), pack_logic(bits), {})
+    form = (f"logic analyzer CSV of changes, sampled at {_rate_text(float(f'{rate:.9g}'))} (the finest "
+            "interval between them)")
+    return Capture(name, block, {}, float(t[0]), form)
+
+
+# ------------------------------------------------------------------------- oscilloscopes' layouts
+
+
+def parse_rigol_csv(data: bytes, name: str) -> Capture:
+    """A Rigol DS1000Z (and MSO5000, DS2000) CSV export. Its layout, as the scope writes it (and
+    as readers of such files on GitHub take it, e.g. ``X,CH1,CH2,Start,Increment,`` over
+    ``Sequence,Volt,Volt,-5.999998e-02,2.000000e-05``): a header naming the channels between
+    ``X`` and ``Start,Increment``; a second row with each channel's unit, then the time of sample
+    0 and the sample interval [s]; then one row per sample, its index first (each row ends in a
+    separator). The time of a sample is Start + index x Increment."""
+    lines = _head_lines(data)
+    header = [f.strip().strip('"') for f in _line(lines, 0).decode("utf-8", "replace").strip()
+              .lstrip("\ufeff").split(",")]
+    at = header.index("Start")
+    if header[at + 1 : at + 2] != ["Increment"] or at < 2:
+        raise CaptureError(f"{name}: line 1: expected 'X,CH1,...,Start,Increment' (Rigol), not "
+                           f"'{','.join(header)}'")
+    channels = header[1:at]
+    if len(lines) < 3:
+        raise CaptureError(f"{name}: line 2: expected the units, Start and Increment "
+                           "('Sequence,Volt,...,-6.0e-03,2.0e-06'), then the samples")
+    second = [f.strip() for f in _line(lines, 1).decode("utf-8", "replace").strip().split(",")]
+    try:
+        start_s, increment_s = float(second[at]), float(second[at + 1])
+    except (IndexError, ValueError):
+        raise CaptureError(f"{name}: line 2: expected the units, then Start and Increment as numbers "
+                           f"('Sequence,Volt,...,-6.0e-03,2.0e-06'), not '{','.join(second)}'") from None
+    if not (increment_s > 0 and math.isfinite(increment_s) and math.isfinite(start_s)):
+        raise CaptureError(f"{name}: line 2: Increment {second[at + 1]}: a sample interval > 0 s "
+                           "is expected")
+    units = [_unit_word(u) or "V" for u in second[1:at]]
+    first_row = _line(lines, 2).decode("utf-8", "replace").strip()
+    width = len(first_row.split(","))
+    if width not in (len(channels) + 1, len(channels) + 2):
+        raise CaptureError(f"{name}: line 3: {width} fields, expected the index and "
+                           f"{len(channels)} values ({', '.join(channels)})")
+    table = _table(lines, 2, width, name, b",", comment="#")
+    if table.shape[0] < 2:
+        raise CaptureError(f"{name}: line 3: fewer than 2 rows of samples")
+    index = table[:, 0]
+    jump = np.flatnonzero(np.diff(index) != 1)
+    if jump.size:
+        i = int(jump[0]) + 1
+        raise CaptureError(f"{name}: line {_data_line(lines, 2, i, '#')}: sample index {index[i]:g} "
+                           f"after {index[i - 1]:g}: the samples of one acquisition, one after another, "
+                           "are expected")
+    analog: dict[str, np.ndarray] = {}
+    for k, channel in enumerate(channels, 1):
+        col = table[:, k]
+        if np.any(np.isnan(col)):
+            i = int(np.flatnonzero(np.isnan(col))[0])
+            raise CaptureError(f"{name}: line {_data_line(lines, 2, i, '#')}: {channel} is empty, "
+                               "expected a number")
+        analog[channel] = col.astype(np.float32)
+    rate = 1.0 / increment_s
+    block = SampleBlock(rate, (), np.zeros(0, np.uint8), analog)
+    return Capture(name, block, dict(zip(channels, units, strict=True)), start_s + index[0] * increment_s,
+                   "Rigol CSV")
+
+
+def parse_tek_tds_csv(data: bytes, name: str) -> Capture:
+    """An older Tektronix scope's CSV (TDS1000/2000, TPS2000, TBS1000: one file per channel, as
+    the scope saves it to its USB stick, and as readers of such files on GitHub take it): the
+    settings in the first three columns (``Record Length,2.500000e+03,``, ``Sample
+    Interval,4.000000e-06,``, ``Source,CH1,``, ``Vertical Units,V,``, ``Horizontal Units,s,``...),
+    the samples beside them in columns 4 and 5 (time, value) on every row."""
+    rows = data.decode("utf-8", "replace").lstrip("\ufeff").split("\n")
+    settings: dict[str, str] = {}
+    times: list[str] = []
+    values: list[str] = []
+    line_of: list[int] = []
+    for i, raw in enumerate(rows):
+        text = raw.strip()
+        if not text:
+            continue
+        fields = [f.strip() for f in text.split(",")]
+        if len(fields) < 5:
+            raise CaptureError(f"{name}: line {i + 1}: {len(fields)} fields, expected 5 (a setting, its "
+                               "value, an empty column, the time and the value)")
+        if fields[0]:
+            settings.setdefault(fields[0].lower(), fields[1])
+        if not (_numbers_like(fields[3]) and _numbers_like(fields[4])):
+            raise CaptureError(f"{name}: line {i + 1}: '{fields[3]}', '{fields[4]}' in columns 4 and 5, "
+                               "expected the time and the value (numbers)")
+        times.append(fields[3])
+        values.append(fields[4])
+        line_of.append(i + 1)
+    channel = settings.get("source", "") or "CH1"
+    unit_s = _TIME_UNITS.get(settings.get("horizontal units", "s").lower())
+    if unit_s is None:
+        raise CaptureError(f"{name}: Horizontal Units '{settings.get('horizontal units')}' is not s, ms, "
+                           "us or ns")
+    t = np.array([float(x) for x in times]) * unit_s
+    v = np.array([float(x) for x in values], np.float32)
+    stated = settings.get("record length", "")
+    if _numbers_like(stated) and round(float(stated)) != t.size:
+        raise CaptureError(f"{name}: line {line_of[-1] if line_of else 1}: {t.size} samples, but Record "
+                           f"Length says {stated}: the file is cut short or has more than one record")
+    if t.size < 2:
+        raise CaptureError(f"{name}: line 1: fewer than 2 samples")
+    steps = np.diff(t)
+    step = float(np.median(steps))
+    off = np.abs(steps - step) > TIME_JITTER * step if step > 0 else np.ones(steps.size, bool)
+    if np.any(off):
+        i = int(np.flatnonzero(off)[0]) + 1
+        raise CaptureError(f"{name}: line {line_of[i]}: time {t[i]:.9g} s after {t[i - 1]:.9g} s: off "
+                           "the steady rate of the record")
+    interval = settings.get("sample interval", "")
+    rate = 1.0 / (float(interval) * unit_s) if _numbers_like(interval) and float(interval) > 0 else \
+        float(f"{(t.size - 1) / (t[-1] - t[0]):.9g}")
+    unit = _unit_word(settings.get("vertical units", "V")) or "V"
+    block = SampleBlock(rate, (), np.zeros(0, np.uint8), {channel: v})
+    return Capture(name, block, {channel: unit}, float(t[0]), "Tektronix TDS/TBS CSV")

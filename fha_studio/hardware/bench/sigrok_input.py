@@ -201,11 +201,19 @@ def _sigrok_csv_order(head: bytes) -> list[str]:
 
 
 def _plan_csv(name: str, head: bytes) -> InputPlan:
+    kind = readers.instrument_layout(head)
+    if kind is not None:
+        raise SigrokError(f"{name}: line 1: a {kind}; sigrok-cli's CSV input cannot take its layout (FHA "
+                          "Studio reads this file itself)")
     layout = readers.csv_layout(head, name)
     if layout.decimal_comma:
         raise SigrokError(f"{name}: line {layout.data_start + 1}: decimal commas; sigrok-cli's CSV input "
                           "reads decimal points only (FHA Studio reads this file itself)")
     capture = readers.parse_csv(_whole_lines(head), name)
+    if capture.block.logic_channels:
+        raise SigrokError(f"{name}: line {layout.data_start + 1}: a logic analyzer's export of changes, not "
+                          "samples at one rate; sigrok-cli's CSV input cannot take it (FHA Studio reads this "
+                          "file itself)")
     rate = capture.sample_rate_hz
     kinds = []
     logic: list[str] = []
