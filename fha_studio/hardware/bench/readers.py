@@ -18,7 +18,29 @@
   ``ms``, ``us`` or ``ns`` (``Time [ms]``, ``time (s)``, ``time_ms``); optionally a units row after
   the header; comment lines starting with ``#`` (or ``;`` when ``;`` is not the separator);
   ``,``, ``;`` (then decimal commas are read) or tab separated. Every other column is an analog
-  channel named by its header; the samples must be at one rate.
+  channel named by its header; the samples must be at one rate. Oscilloscopes' variants of it:
+  a preamble before the header (Tektronix MSO/MDO/DPO: ``Model,...``, ``Sample Interval,...``,
+  ``Record Length,...`` rows, then ``TIME,CH1,CH2``; Siglent: ``Record Length,Analog:N``... then
+  ``Second,Volt``, the channels named by its ``Source,CH1`` row or the ``CH1:`` of its settings);
+  a units row in parentheses and an empty line (PicoScope: ``Time,Channel A`` over ``(ms),(V)``);
+  Keysight's ``x-axis,1,2`` over ``second,Volt,Volt``.
+- **a logic analyzer's export of changes** (Saleae Logic 2 and 1.x, File > Export Data > CSV of
+  digital channels: ``Time [s],Channel 0,...`` or the channels' own names, ``Time[s], Channel 0``
+  in Logic 1.x): every channel 0 or 1, one row per change, the first row the state at the start.
+  It states no sample rate: the changes are put on a grid of the finest interval between them
+  (the capture's ``form`` says the rate), refused when that grid exceeds :data:`MAX_SAMPLES`.
+  Saleae's analog export is one row per sample: a generic CSV.
+- **Rigol** (DS1000Z, MSO5000, DS2000): ``X,CH1,CH2,Start,Increment,`` over
+  ``Sequence,Volt,Volt,START,INCREMENT``, then rows ``index,value,...,``; a sample's time is
+  Start + index x Increment.
+- **older Tektronix** (TDS1000/2000, TPS2000, TBS1000; one file per channel): the settings in
+  columns 1-3 (``Record Length``, ``Sample Interval``, ``Source,CH1``, ``Vertical Units``...),
+  each row's sample in columns 4-5 (time, value); a file shorter than its Record Length is refused.
+
+Where each layout comes from: the makers' exports as public files and readers of them on GitHub
+show them (Rigol ``X,CH1,CH2,Start,Increment``; Saleae ``Time [s],Channel 0,...`` of changes;
+Siglent SDS1000X-E ``Record Length,Analog:14000`` ... ``Second,Volt``; PicoScope ``(ms),(V)``;
+Tektronix TDS files read from columns 4 and 5).
 
 Everything is read through :mod:`fha_studio.fileio` (regular files only, at most
 :data:`MAX_CAPTURE_BYTES`). A file of another shape raises :class:`~.capture.CaptureError`: one
@@ -61,7 +83,8 @@ _TIME_NAMES = ("time", "t", "x-axis", "x_axis", "timestamp", "zeit", "temps")
 
 def read_capture(path: str | os.PathLike[str]) -> Capture:
     """The capture in ``path``, its form found from its content (a zip is a sigrok session, a
-    ``$`` keyword first is VCD, ``libsigrok`` in the first comment is sigrok's CSV, else CSV)."""
+    ``$`` keyword first is VCD, ``libsigrok`` in the first comment is sigrok's CSV, ``X,...,Start,
+    Increment`` a Rigol CSV, ``Record Length`` beside samples an older Tektronix one, else CSV)."""
     name = os.fspath(path)
     data = fileio.read_bytes(name, limit_bytes=MAX_CAPTURE_BYTES)
     if data.startswith(b"PK\x03\x04"):
