@@ -456,6 +456,15 @@ def _forget_dummy_thread() -> None:
             threading._active.pop(threading.get_ident(), None)  # type: ignore[attr-defined]
 
 
+def end_worker_thread(worker: QObject) -> None:
+    """Called in a worker's thread at its end (its stop slot): Python forgets the thread, and the
+    thread's event loop quits."""
+    _forget_dummy_thread()
+    thread = worker.thread()
+    if thread is not None:
+        thread.quit()
+
+
 class LinkController(QObject):
     """The GUI-thread face of the link: sends requests (each reply to its sender), re-emits what
     the worker says, and keeps the last known state for the pages. Never blocks."""

@@ -30,7 +30,7 @@ from typing import Any
 
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
-from fha_studio.gui.link import _forget_dummy_thread
+from fha_studio.gui.link import end_worker_thread
 from fha_studio.gui.messages import Level
 from fha_studio.gui.register_connection import (
     CLOSE_WAIT_MS,
@@ -195,10 +195,7 @@ class QuestionWorker(QObject):
     @Slot()
     def stop(self) -> None:
         self._close()
-        _forget_dummy_thread()
-        thread = self.thread()
-        if thread is not None:
-            thread.quit()
+        end_worker_thread(self)
 
 
 def _broken(register: Register) -> bool:

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QObject, QThread, QTimer, Signal, Slot
 
 from fha_studio.gui.axis_recorder import login_name
-from fha_studio.gui.link import _forget_dummy_thread
+from fha_studio.gui.link import end_worker_thread
 from fha_studio.gui.messages import Level
 from fha_studio.gui.register_connection import (
     CLOSE_WAIT_MS,
@@ -189,10 +189,7 @@ class QueueWorker(QObject):
         if self._queue is not None:
             self._queue.close()
             self._queue = None
-        _forget_dummy_thread()
-        thread = self.thread()
-        if thread is not None:
-            thread.quit()
+        end_worker_thread(self)
 
 
 def _machine_fact_written(queue: Register, fact: MachineLevelFact) -> str:
@@ -340,10 +337,7 @@ class DeliveryWorker(QObject):
         if self._queue is not None:
             self._queue.close()
             self._queue = None
-        _forget_dummy_thread()
-        thread = self.thread()
-        if thread is not None:
-            thread.quit()
+        end_worker_thread(self)
 
 
 class ServerWriter(RegisterWriter):
