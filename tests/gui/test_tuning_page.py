@@ -18,19 +18,22 @@ CODE = "FHA-25C-50-US250"
 URL = f"sim://{CODE}?load_inertia=0.81&effects=torsional_compliance&paced=0&stepped=1"
 
 
-def _servo_on(window, qtbot) -> None:
+def _planned(make_window, qtbot):
+    """The Tuning page on the simulated axis (0.81 kg m^2 declared), servo on, its excitation
+    planned: (window, page)."""
+    window = make_window(connect=URL)
+    page = window.show_page(PageId.TUNING)
+    page.load_spin.setValue(0.81)
     window.servo_action.trigger()
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
+    with qtbot.waitSignal(window.link.sigResult, timeout=20000):
+        page.plan_button.click()
+    return window, page
 
 
 @pytest.mark.slow
 def test_measure_propose_apply_end_to_end(make_window, qtbot, tmp_path):
-    window = make_window(connect=URL)
-    page = window.show_page(PageId.TUNING)
-    page.load_spin.setValue(0.81)
-    _servo_on(window, qtbot)
-    with qtbot.waitSignal(window.link.sigResult, timeout=20000):
-        page.plan_button.click()
+    window, page = _planned(make_window, qtbot)
     qtbot.waitUntil(page.start_button.isEnabled, timeout=10000)
     # the manual's symbols on a page, not the terminal's ASCII
     assert "r/min" in page.plan_label.text() and "°" in page.plan_label.text()
@@ -78,12 +81,7 @@ def test_measure_propose_apply_end_to_end(make_window, qtbot, tmp_path):
 
 @pytest.mark.parametrize("let_go", ["release", "leave the page"])
 def test_hold_to_run_excites_only_while_held(make_window, qtbot, let_go):
-    window = make_window(connect=URL)
-    page = window.show_page(PageId.TUNING)
-    page.load_spin.setValue(0.81)
-    _servo_on(window, qtbot)
-    with qtbot.waitSignal(window.link.sigResult, timeout=20000):
-        page.plan_button.click()
+    window, page = _planned(make_window, qtbot)
     qtbot.waitUntil(page.hold_button.isEnabled, timeout=10000)
     drive = window.link._worker._client.transaction.transport.inner.sim_drive
     qtbot.mousePress(page.hold_button, Qt.MouseButton.LeftButton)
