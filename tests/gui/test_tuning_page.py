@@ -8,6 +8,7 @@ manual's commands gets a front-panel worksheet."""
 
 from __future__ import annotations
 
+import pyqtgraph as pg
 import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QImage
@@ -112,3 +113,35 @@ def test_documented_drive_gets_a_front_panel_worksheet(make_window, qtbot):
     assert not page.apply_button.isEnabled()
     warning = page.warning_label.text()
     assert page.warning_label.isVisible() and "2-1" in warning and "softer" in warning, warning
+
+
+@pytest.mark.parametrize("size", [(1366, 768), (1280, 720)])
+def test_the_resonance_labels_are_not_crossed_by_the_other_markers(make_window, qtbot, size):
+    """A resonance is marked with its label on the higher side of its line, an anti-resonance on
+    the lower side: neither label straddles the other marker's line (at 38 and 54 Hz a label on
+    the same side read through the other line)."""
+    import numpy as np
+
+    window = make_window()
+    window.resize(*size)
+    page = window.show_page(PageId.TUNING)
+    qtbot.waitExposed(window)
+    f = np.geomspace(1.0, 500.0, 200)
+    response = {"freq_hz": list(f), "magnitude_db": list(-20 * np.log10(1 + f / 30)),
+                "phase_deg": list(-np.degrees(np.arctan(f / 30)))}
+    page.show_result({"frequency_response": response, "plant_response": response, "resonance_hz": 54.3,
+                      "antiresonance_hz": 38.0, "predicted_resonance_hz": 54.2,
+                      "predicted_antiresonance_hz": 38.0})
+    assert len(page.markers) == 4
+    view = page.mag_plot.getViewBox()
+    qtbot.waitUntil(lambda: view.viewRange()[0][1] > 2.5, timeout=5000)  # the data's range: to 500 Hz
+    def x_of(line):
+        return view.mapViewToScene(pg.Point(line.value(), 0)).x()
+
+    for marker in page.markers:
+        text = marker.label.mapRectToScene(marker.label.boundingRect())
+        for other in page.markers:  # a line beside its own (54.3 and 54.2 Hz) is the same place
+            if abs(x_of(other) - x_of(marker)) > 5:
+                crossed = text.left() < x_of(other) < text.right()
+                assert not crossed, (marker.label.toPlainText(), other.value())
+        assert view.sceneBoundingRect().contains(text), marker.label.toPlainText()  # whole, in the plot

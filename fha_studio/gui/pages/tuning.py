@@ -309,8 +309,9 @@ class TuningPage(BasePage):
         self.worksheet.setPlaceholderText("The front-panel worksheet appears here for a drive without "
                                           "parameter access over CN3.")
         # the plots take the width, the figures and the worksheet a column beside them; below
-        # these heights the page scrolls instead of squeezing three plots into one line each
-        self.plots.setMinimumHeight(420)
+        # these heights the page scrolls instead of squeezing three plots into one line each (at
+        # 420 px the magnitude plot was 80 px high: its resonance labels did not fit in it)
+        self.plots.setMinimumHeight(640)
         self.table.setMinimumHeight(230)
         self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         self.table.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
@@ -507,19 +508,23 @@ class TuningPage(BasePage):
         for marker in self.markers:
             self.mag_plot.removeItem(marker)
         self.markers = []
-        for key, colour, style, label, where in (
-            # each label at a height of its own: the two frequencies are often close on the axis
-            ("resonance_hz", "#008000", None, "resonance", 0.95),
-            ("antiresonance_hz", "#800080", None, "anti-resonance", 0.78),
-            ("predicted_resonance_hz", "#008000", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.29),
-            ("predicted_antiresonance_hz", "#800080", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.12),
+        # each label at a height of its own (the two frequencies are often close on the axis), a
+        # resonance's on the higher side of its line, an anti-resonance's on the lower side: a
+        # label never reads through the other marker's line
+        above, below = [(0.0, 0.5)] * 2, [(1.0, 0.5)] * 2
+        for key, colour, style, label, where, side in (
+            ("resonance_hz", "#008000", None, "resonance", 0.88, above),
+            ("antiresonance_hz", "#800080", None, "anti-resonance", 0.70, below),
+            ("predicted_resonance_hz", "#008000", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.30, above),
+            ("predicted_antiresonance_hz", "#800080", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.12,
+             below),
         ):
             value = result.get(key)
             if value:
                 pen = pg.mkPen(colour, width=2, style=style) if style else pg.mkPen(colour, width=2)
                 line = pg.InfiniteLine(pos=np.log10(value), angle=90, pen=pen,
                                        label=f"{label} {value:.1f} Hz",
-                                       labelOpts={"position": where, "color": colour})
+                                       labelOpts={"position": where, "color": colour, "anchors": side})
                 self.mag_plot.addItem(line)
                 self.markers.append(line)
 
