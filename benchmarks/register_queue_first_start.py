@@ -123,12 +123,9 @@ def main() -> None:
     per_day = numbers[1] if len(numbers) > 1 else 1
     with contextlib.ExitStack() as stack:
         stack.callback(shutil.rmtree, TMP, ignore_errors=True)  # this computer's queue with it
-        if not url:
-            from tests.support.postgres import throwaway_cluster
+        from tests.support.postgres import given_or_throwaway
 
-            cluster = stack.enter_context(throwaway_cluster())
-            url = cluster.new_database()
-        measure(url, axes, per_day)
+        measure(stack.enter_context(given_or_throwaway(url)), axes, per_day)
 
 
 if __name__ == "__main__":

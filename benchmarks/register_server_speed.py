@@ -12,7 +12,6 @@ the best of three.
 
 from __future__ import annotations
 
-import contextlib
 import random
 import sys
 import time
@@ -109,13 +108,10 @@ def main() -> None:
     numbers = [int(a) for a in sys.argv[1:] if a.isdigit()]
     axes = numbers[0] if numbers else 1000
     per_day = numbers[1] if len(numbers) > 1 else 1
-    with contextlib.ExitStack() as stack:
-        if not url:
-            from tests.support.postgres import throwaway_cluster
+    from tests.support.postgres import given_or_throwaway
 
-            cluster = stack.enter_context(throwaway_cluster())
-            url = cluster.new_database()
-        measure(url, axes, per_day)
+    with given_or_throwaway(url) as server:
+        measure(server, axes, per_day)
 
 
 if __name__ == "__main__":

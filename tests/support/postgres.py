@@ -151,3 +151,14 @@ def postgres_cluster() -> Iterator[Cluster]:
     """One throw-away PostgreSQL cluster for the whole test session."""
     with throwaway_cluster() as cluster:
         yield cluster
+
+
+@contextlib.contextmanager
+def given_or_throwaway(url: str) -> Iterator[str]:
+    """``url`` when one is given (a benchmark's command line); else a new database on a throwaway
+    cluster, stopped afterwards."""
+    if url:
+        yield url
+        return
+    with throwaway_cluster() as cluster:
+        yield cluster.new_database()
