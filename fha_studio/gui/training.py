@@ -114,8 +114,9 @@ class TrainingController(QObject):
         window.show_message(f"Training started: {scenario.title}. Connecting to the training drive …")
         self._folder = tempfile.TemporaryDirectory(prefix="fha-training-")
         procedures = window.procedures_page
-        procedures.new_session(
-            Path(self._folder.name) / "training-session.json", scenario.actuator, self.trainee
+        procedures.new_session(  # in a folder that goes with the training: not a path to show
+            Path(self._folder.name) / "training-session.json", scenario.actuator, self.trainee,
+            shown_as="of this training (not kept as a commissioning record)",
         )
         self._hook_modelcheck()
         self.sigStarted.emit(scenario)

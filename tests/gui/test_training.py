@@ -51,6 +51,9 @@ def test_a_trainee_finds_one_fault_and_misses_the_other(make_window, qtbot, tmp_
     for text in seen:
         assert not GIVEAWAYS.search(text), text
     assert "FHA-25C-50-US250-B-L" in window.connection_page.link_label.text()
+    # the trainee's procedure session is named as the training's, not by its temporary folder
+    assert window.procedures_page.session_label.text() == (
+        "Session of this training (not kept as a commissioning record) — FHA-25C-50-US250-B-L")
     assert not GIVEAWAYS.search(briefing_html(scenario))
 
     # the trainee reads parameter 6, sees it is far too low and writes the default back

@@ -84,6 +84,8 @@ class ProceduresPage(BasePage):
         self.state = gui_session.state  # the axis: its actuator is the one on the Connection page
         self.link = gui_session.link
         self.main_window = main_window
+        #: what the session line calls the session instead of its path ("" = its path)
+        self._session_shown = ""
         self.session: ProcedureSession | None = None
         self.context: dict | None = None
         self.procedures: list[Procedure] = []
@@ -271,9 +273,12 @@ class ProceduresPage(BasePage):
             "url": info.url,
         }
 
-    def new_session(self, path: str | Path, actuator_code: str = "", operator: str = "") -> None:
+    def new_session(self, path: str | Path, actuator_code: str = "", operator: str = "",
+                    shown_as: str = "") -> None:
         """Start a commissioning session for the axis's actuator saved at ``path``; an
-        ``actuator_code`` given here becomes the axis's (ModelCodeError when it is not valid)."""
+        ``actuator_code`` given here becomes the axis's (ModelCodeError when it is not valid).
+        ``shown_as``: what the page calls the session instead of its path (a training's, in a
+        temporary folder that goes with the training)."""
         from fha_studio.logic.procedures.context import build_context
 
         if actuator_code:
@@ -287,6 +292,7 @@ class ProceduresPage(BasePage):
         context = build_context(code)  # ModelCodeError (a ValueError) says what is wrong with the code
         session = ProcedureSession(actuator_code=code, operator=operator, driver=self._identity())
         session.save(path)
+        self._session_shown = shown_as
         self._use(session, context)
 
     def open_session(self, path: str | Path) -> None:
@@ -297,6 +303,7 @@ class ProceduresPage(BasePage):
         context = build_context(session.actuator_code)
         # resuming the commissioning of that axis: its actuator is the axis's again
         self.state.set_actuator(session.actuator_code)
+        self._session_shown = ""
         self._use(session, context)
 
     def _use(self, session: ProcedureSession, context: dict) -> None:
@@ -631,7 +638,7 @@ class ProceduresPage(BasePage):
         if has_session:
             signed = self.session.signature
             self.session_label.setText(
-                f"Session {self.session.path} — {self.session.actuator_code}"
+                f"Session {self._session_shown or self.session.path} — {self.session.actuator_code}"
                 + (f" — signed by {signed['who']}" if signed else "")
                 + (" — NOT the axis's actuator" if self.axis_mismatch() else "")
             )
