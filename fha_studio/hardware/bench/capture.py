@@ -109,13 +109,16 @@ class Capture:
 
     ``units``: analog channel -> unit as the file states it (``"V"`` when it does not).
     ``start_s``: the time of the first sample in the file's own time base.
+    ``changes``: the file holds changes (VCD, a logic analyzer's export of changes), each state
+    held until the next, so it may be sampled at another rate without losing anything.
     """
 
     source: str
     block: SampleBlock
     units: Mapping[str, str] = field(default_factory=dict)
     start_s: float = 0.0
-    form: str = ""  # "sigrok session", "VCD", "sigrok CSV", "CSV"
+    form: str = ""  # "sigrok session", "VCD", "sigrok CSV", "CSV", "Rigol CSV", ...
+    changes: bool = False
 
     @property
     def sample_rate_hz(self) -> float:

@@ -28,8 +28,9 @@
   digital channels: ``Time [s],Channel 0,...`` or the channels' own names, ``Time[s], Channel 0``
   in Logic 1.x): every channel 0 or 1, one row per change, the first row the state at the start.
   It states no sample rate: the changes are put on a grid of the finest interval between them
-  (the capture's ``form`` says the rate), refused when that grid exceeds :data:`MAX_SAMPLES`.
-  Saleae's analog export is one row per sample: a generic CSV.
+  (the capture's ``form`` says the rate), refused when that grid exceeds :data:`MAX_SAMPLES`;
+  :func:`on_grid` samples it (or a VCD) at another file's rate. Saleae's analog export is one row
+  per sample: a generic CSV.
 - **Rigol** (DS1000Z, MSO5000, DS2000): ``X,CH1,CH2,Start,Increment,`` over
   ``Sequence,Volt,Volt,START,INCREMENT``, then rows ``index,value,...,``; a sample's time is
   Start + index x Increment.
@@ -351,7 +352,7 @@ def parse_vcd(data: bytes, name: str) -> Capture:
                     sample_of_time[(np.cumsum(is_time) - 1)[real_value]], n, name)
     logic = pack_logic(bits) if bits else np.zeros(0, np.uint8)
     block = SampleBlock(rate, tuple(names), logic, analog)
-    return Capture(name, block, {a: "V" for a in analog}, t0 * timescale, "VCD")
+    return Capture(name, block, {a: "V" for a in analog}, t0 * timescale, "VCD", changes=True)
 
 
 def _reals(data: bytes, body_start: int, tokens: np.ndarray, real_value: np.ndarray,
@@ -869,12 +870,12 @@ def _changes(table: np.ndarray, t: np.ndarray, names: list[str], time_column: in
                            f"samples on that grid ({grid}), more than the {MAX_SAMPLES} a capture may hold")
     at = np.rint((t - t[0]) / step).astype(np.int64)
     logic_names = [label for column, label in enumerate(names) if column != time_column]
-    bits = [_held(at, table[:, column] == 1, n, bool)
-            for column in range(len(names)) if column != time_column]
-    block = SampleBlock(rate, tuple(logic_names), pack_logic(bits), {})
+    # each change's state packed first (one word per row), then held: n words, not n per channel
+    words = pack_logic([table[:, column] == 1 for column in range(len(names)) if column != time_column])
+    block = SampleBlock(rate, tuple(logic_names), _held(at, words, n, words.dtype.type), {})
     form = (f"logic analyzer CSV of changes, sampled at {_rate_text(float(f'{rate:.9g}'))} (the finest "
             "interval between them)")
-    return Capture(name, block, {}, float(t[0]), form)
+    return Capture(name, block, {}, float(t[0]), form, changes=True)
 
 
 # ------------------------------------------------------------------------- oscilloscopes' layouts
@@ -990,3 +991,22 @@ def parse_tek_tds_csv(data: bytes, name: str) -> Capture:
     unit = _unit_word(settings.get("vertical units", "V")) or "V"
     block = SampleBlock(rate, (), np.zeros(0, np.uint8), {channel: v})
     return Capture(name, block, {channel: unit}, float(t[0]), "Tektronix TDS/TBS CSV")
+
+
+def on_grid(capture: Capture, rate_hz: float, start_s: float, samples: int) -> Capture:
+    """A capture of changes (:attr:`~.capture.Capture.changes`) sampled at another rate: ``samples``
+    samples from ``start_s`` (the file's own time) at ``rate_hz``, each the state held at that
+    instant (the first state before the capture starts, the last after its last change), so
+    that it lines up with a capture of another instrument's rate (Saleae's analog export beside
+    its digital one)."""
+    if not capture.changes:
+        raise ValueError(f"{capture.source}: samples at one rate, not changes: it is not put on another grid")
+    block = capture.block
+    t = start_s + np.arange(samples) / rate_hz
+    index = np.floor((t - capture.start_s) * block.sample_rate_hz + 1e-6).astype(np.int64)
+    index = np.clip(index, 0, block.samples - 1)
+    logic = block.logic[index] if block.logic_channels else block.logic
+    analog = {k: v[index] for k, v in block.analog.items()}
+    moved = SampleBlock(rate_hz, block.logic_channels, logic, analog)
+    form = f"{capture.form}, resampled at {_rate_text(float(f'{rate_hz:.9g}'))}"
+    return Capture(capture.source, moved, capture.units, start_s, form, changes=True)

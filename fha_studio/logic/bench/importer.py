@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from fha_studio.hardware.bench.capture import Capture
-from fha_studio.hardware.bench.readers import read_capture
+from fha_studio.hardware.bench.readers import on_grid, read_capture
 from fha_studio.logic.bench import decode
 from fha_studio.logic.bench.alarm_code import LINES, alarms_of_code
 from fha_studio.logic.bench.edges import Lines
@@ -240,6 +240,7 @@ def import_bench(
     for spec in roles.values():
         if spec.path not in captures:
             captures[spec.path] = load(spec.path)
+    grid_notes = _on_one_grid(captures)
     rates = {path: c.sample_rate_hz for path, c in captures.items()}
     first_path, rate = next(iter(rates.items()))
     for path, r in rates.items():
@@ -304,7 +305,7 @@ def import_bench(
     if "load_encoder_a" in roles:
         load_encoder = decode.quadrature_lines(lines("load_encoder_a", "load_encoder_b"))
     decoded = Decoded(rate, n, encoder, z, command, speed, load_encoder)
-    return _make(
+    result = _make(
         decoded,
         roles,
         channel_of,
@@ -316,6 +317,27 @@ def import_bench(
         {role: analog(role) for role in ("current_probe",) if role in roles},
         {role: lines(role) for role in ("in_position", "alarm", *ALM_ROLES) if role in roles},
     )
+    result.notes[:0] = grid_notes
+    return result
+
+
+def _on_one_grid(captures: dict[str, Capture]) -> list[str]:
+    """Files of changes (a logic analyzer's digital export, VCD) sampled at the rate of the one
+    file of samples at a fixed rate beside them (its analog export, an oscilloscope's CSV), from
+    that file's start: an instrument writes its digital and analog channels apart. What was done,
+    in a note per file."""
+    sampled = [(path, c) for path, c in captures.items() if not c.changes]
+    if not sampled or any(abs(c.sample_rate_hz / sampled[0][1].sample_rate_hz - 1.0) > 1e-9
+                          for _, c in sampled):
+        return []  # nothing to line up with, or files of two fixed rates: refused below
+    ref_path, ref = sampled[0]
+    notes = []
+    for path, capture in list(captures.items()):
+        if capture.changes and abs(capture.sample_rate_hz / ref.sample_rate_hz - 1.0) > 1e-9:
+            captures[path] = on_grid(capture, ref.sample_rate_hz, ref.start_s, ref.samples)
+            notes.append(f"{path}: its changes sampled at {decode._hz(ref.sample_rate_hz)} from "
+                         f"{ref.start_s:.9g} s, as {ref_path}")
+    return notes
 
 
 def _read(path: str) -> Capture:

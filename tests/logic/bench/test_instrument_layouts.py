@@ -142,3 +142,46 @@ def test_a_saleae_analog_export_reads_at_its_rate(drive, tmp_path):
     assert capture.channels == ("Channel 0",) and capture.form == "CSV"
     assert capture.sample_rate_hz == pytest.approx(instrument.sample_rate_hz, rel=1e-6)
     assert np.allclose(capture.analog("Channel 0"), block.analog["SPD_MON"], atol=1e-6)
+
+
+def test_a_saleae_capture_of_digital_and_analog_at_their_own_rates(drive, tmp_path):
+    """Logic 2 writes digital (changes) and analog (its own rate, here 400 kHz) apart: the changes
+    are sampled at the analog rate from the analog file's start, counts exact, speed within 1 %."""
+    axis, instrument = drive
+    block = instrument.capture()
+    digital = layouts.write_saleae_digital(tmp_path / "digital.csv", block)
+    twice = type(block)(2 * block.sample_rate_hz, analog={"SPD_MON": np.repeat(block.analog["SPD_MON"], 2)})
+    analog = layouts.write_saleae_analog(tmp_path / "analog.csv", twice, {"Channel 0": "SPD_MON"})
+    roles = {r: c for r, c in {**SCOPE_A, **SCOPE_B}.items() if r != "speed_monitor"}
+    signals = [SignalSpec(role, str(digital), c) for role, c in roles.items()]
+    signals.append(SignalSpec("speed_monitor", str(analog), "Channel 0"))
+    result = import_bench(signals, AxisFacts.for_actuator(CODE), _settings())
+    assert result.decoded.sample_rate_hz == pytest.approx(400e3)
+    assert result.notes[0] == f"{digital}: its changes sampled at 400 kHz from 0 s, as {analog}"
+    truth = instrument.truth.arrays()
+    # every second sample is one of the instrument's: the counts there are its counts
+    assert np.array_equal(
+        result.decoded.encoder.counts[::2], truth["encoder_counts"] - truth["encoder_counts"][0]
+    )
+    assert result.summary["command_counts"] == 2 * sum(PULSES) == axis.command_pulses
+    rec = result.recording
+    expected = truth["motor_rpm"][np.minimum(np.rint(rec.t_s * 200e3).astype(int), block.samples - 1)] / 50.0
+    peak = float(np.max(np.abs(expected)))
+    assert peak > 3.0 and float(np.max(np.abs(rec.vel_rpm - expected))) < 0.01 * peak
+
+
+def test_two_scopes_at_two_rates_are_still_refused(tmp_path):
+    """Only changes are put on another grid: samples at two fixed rates are not made to line up."""
+    from fha_studio.logic.bench.importer import BenchImportError
+
+    rigol = tmp_path / "rigol.csv"
+    rigol.write_text("X,CH1,CH2,Start,Increment,\nSequence,Volt,Volt,0,5.0e-06\n0,0,0,\n1,5,0,\n2,5,5,\n")
+    pico = tmp_path / "pico.csv"
+    pico.write_text("Time,Channel A\n(ms),(V)\n\n0.0000,0.1\n0.0025,0.2\n0.0050,0.3\n")
+    signals = [SignalSpec("encoder_a", str(rigol), "CH1"), SignalSpec("encoder_b", str(rigol), "CH2")]
+    signals.append(SignalSpec("speed_monitor", str(pico), "Channel A"))
+    with pytest.raises(BenchImportError) as err:
+        import_bench(signals, AxisFacts.for_actuator(CODE), _settings())
+    assert str(err.value) == (
+        f"{pico}: sampled at 400 kHz but {rigol} at 200 kHz: the signals of one import must come at one rate"
+    )
