@@ -513,7 +513,10 @@ class MachineWindow(QMainWindow):
         window = self.axis_windows[index]
         state, _ = self._axis_state(index)
         driver = window.link.info.driver_model if window.link.info else axis.driver_model
-        where = axis.port_url or "no port given"
+        # an embedded drive in words: its address carries options (a file's path among them)
+        port = axis.port_url
+        where = "embedded simulated drive" if port.lower().startswith("sim://") else (port or "no port given")
+        self.banner.setToolTip(f"Port: {port}" if port else "")
         self.banner.setText(
             f"Axis {axis.name} — {axis.actuator_code or 'actuator not given'}"
             f"{' on ' + driver if driver else ''} — {where} — {state}"

@@ -91,6 +91,10 @@ def test_a_three_axis_machine_is_commissioned_into_the_register(make_machine, qt
     # the pages act on the chosen axis, and the banner says which
     assert window.select_axis("table") is table and window.current_window is table
     assert window.banner.text().startswith(f"Axis table — {TABLE} on HA-655")
+    # the embedded drive in words, its address (with its EEPROM file's path) in the tooltip
+    banner = window.banner.text()
+    assert " — embedded simulated drive — connected" in banner and "sim://" not in banner
+    assert window.banner.toolTip().startswith(f"Port: sim://{TABLE}?")
     table.show_page("parameters")
     window.select_axis("tilt")
     assert window.current_window is tilt and tilt.tabs.currentIndex() == table.tabs.currentIndex()
