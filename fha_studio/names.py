@@ -70,3 +70,17 @@ def check_name(value: str, what: str, limit: int = NAME_MAX, empty_ok: bool = Fa
         raise NameProblem(f"{what} {quoted(stripped)} holds characters that are not text "
                           "(line breaks, tabs, terminal escape sequences)")
     return stripped
+
+
+def kind_of(value: object) -> str:
+    """What a JSON value is, as a refusal says it ("got the text 'x'"): the text quoted and
+    escaped like every refusal, so a line break or escape sequence in a file stays one line."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return f"the number {value:g}"
+    if isinstance(value, str):
+        return f"the text {quoted(value, 30)}"
+    return "a list" if isinstance(value, list) else "a table"

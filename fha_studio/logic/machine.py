@@ -21,7 +21,7 @@ from typing import Any
 
 from fha_studio import fileio, names, plausible
 from fha_studio.logic.commissioning import CommissioningState
-from fha_studio.names import quoted
+from fha_studio.names import kind_of, quoted
 
 FORMAT = "fha-machine/1"
 
@@ -190,7 +190,7 @@ class MachineProject:
         texts = {k: _field_text(data.get(k, ""), f"{where}: field {k}") for k in MACHINE_FIELDS}
         axes = data.get("axes", [])
         if not isinstance(axes, list):
-            raise MachineError(f"{where}: field axes: must be a list of axes, got {_kind(axes)}")
+            raise MachineError(f"{where}: field axes: must be a list of axes, got {kind_of(axes)}")
         try:
             project = cls(texts["name"], texts["site"], texts["notes"])
         except ValueError as exc:
@@ -198,7 +198,7 @@ class MachineProject:
         for number, axis in enumerate(axes, start=1):
             at = f"{where}: axis {number}"
             if not isinstance(axis, dict):
-                raise MachineError(f"{at}: must be a table of fields, got {_kind(axis)}")
+                raise MachineError(f"{at}: must be a table of fields, got {kind_of(axis)}")
             _known(axis, (*AXIS_FIELDS, "load_inertia_kgm2"), at)
             if "name" not in axis:
                 raise MachineError(f"{at}: no name")
@@ -208,7 +208,7 @@ class MachineProject:
                 inertia = 0.0
             if isinstance(inertia, bool) or not isinstance(inertia, int | float):
                 raise MachineError(f"{at}: field load_inertia_kgm2: must be a number of kg m^2, "
-                                   f"got {_kind(inertia)}")
+                                   f"got {kind_of(inertia)}")
             if not plausible.LOAD_INERTIA_KGM2.contains(float(inertia)):
                 raise MachineError(f"{at}: field load_inertia_kgm2: {inertia:g} is outside "
                                    f"{plausible.LOAD_INERTIA_KGM2.allowed()}")
@@ -291,21 +291,9 @@ def _reason(exc: BaseException) -> str:
     return str(exc)
 
 
-def _kind(value: Any) -> str:
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int | float):
-        return f"the number {value:g}"
-    if isinstance(value, str):
-        return f"the text {quoted(value, 30)}"
-    return "a list" if isinstance(value, list) else "a table"
-
-
 def _field_text(value: Any, where: str) -> str:
     if not isinstance(value, str):
-        raise MachineError(f"{where}: must be text, got {_kind(value)}")
+        raise MachineError(f"{where}: must be text, got {kind_of(value)}")
     if len(value) > MAX_FIELD_TEXT:
         raise MachineError(f"{where}: is {len(value)} characters long; at most {MAX_FIELD_TEXT}")
     return value

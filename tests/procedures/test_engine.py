@@ -211,8 +211,8 @@ def test_session_file_errors_name_the_file(tmp_path):
     ("change", "words"),
     [
         ({"runs": [1]}, 'field runs: must be a table of procedure runs by procedure id, got a list'),
-        ({"notes": "x"}, 'field notes: must be a list of tables (who, at_utc, text), got the text "x"'),
-        ({"signature": "me"}, 'field signature: must be a table of texts (who, at_utc), got the text "me"'),
+        ({"notes": "x"}, "field notes: must be a list of tables (who, at_utc, text), got the text 'x'"),
+        ({"signature": "me"}, "field signature: must be a table of texts (who, at_utc), got the text 'me'"),
         ({"driver": [1]}, "field driver: must be a table of texts, got a list"),
         ({"actuator_code": 5}, "field actuator_code: must be text, got the number 5"),
         ({"actuator_code": "FHA-99C-50-US250"}, "field actuator_code: "),
@@ -221,6 +221,8 @@ def test_session_file_errors_name_the_file(tmp_path):
         ({"runs": {"p": {"procedure_id": "p", "position": 7}}}, "field runs.p.position: must be a whole"),
         ({"sensor_angles_deg": {"origin_sensor": 1e308}}, "outside -360 ... 360 deg"),
         ({"colour": "red"}, "field colour: unknown; allowed:"),
+        # a line break or escape sequence in the file stays escaped: the refusal is one line
+        ({"notes": "a\nb\x1b[2J"}, "got the text 'a\\nb\\x1b[2J'"),
     ],
 )
 def test_a_session_file_of_the_wrong_shape_is_refused_naming_the_field(tmp_path, change, words):

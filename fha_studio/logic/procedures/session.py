@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from fha_studio import clock, fileio, plausible
+from fha_studio.names import kind_of
 
 FORMAT = "fha-session/1"
 #: Bound on a session file's size: a fully walked session is some tens of kB.
@@ -178,36 +179,21 @@ class _ShapeError(Exception):
 
 def _text(value: Any, where: str) -> str:
     if not isinstance(value, str):
-        raise _ShapeError(where, f"must be text, got {_kind(value)}")
+        raise _ShapeError(where, f"must be text, got {kind_of(value)}")
     if len(value) > MAX_TEXT:
         raise _ShapeError(where, f"is {len(value)} characters long; at most {MAX_TEXT}")
     return value
 
 
-def _kind(value: Any) -> str:
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int | float):
-        return f"the number {value:g}"
-    if isinstance(value, str):
-        shown = value if len(value) <= 30 else value[:29] + "…"
-        return f'the text "{shown}"'
-    if isinstance(value, list):
-        return "a list"
-    return "a table"
-
-
 def _table(value: Any, where: str, what: str) -> dict[str, Any]:
     if not isinstance(value, dict):
-        raise _ShapeError(where, f"must be a table of {what}, got {_kind(value)}")
+        raise _ShapeError(where, f"must be a table of {what}, got {kind_of(value)}")
     return value
 
 
 def _list(value: Any, where: str, what: str) -> list[Any]:
     if not isinstance(value, list):
-        raise _ShapeError(where, f"must be a list of {what}, got {_kind(value)}")
+        raise _ShapeError(where, f"must be a list of {what}, got {kind_of(value)}")
     return value
 
 
@@ -256,7 +242,7 @@ def _session_from_json(data: dict[str, Any]) -> ProcedureSession:
         for name, value in _table(data["sensor_angles_deg"], "sensor_angles_deg", "angles").items():
             where = f"sensor_angles_deg.{name}"
             if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-                raise _ShapeError(where, f"must be a number of degrees, got {_kind(value)}")
+                raise _ShapeError(where, f"must be a number of degrees, got {kind_of(value)}")
             if not plausible.SENSOR_ANGLE_DEG.contains(value):
                 raise _ShapeError(where, f"{value:g} deg is outside {plausible.SENSOR_ANGLE_DEG.allowed()}")
             angles[name] = float(value)
@@ -284,7 +270,7 @@ def _parameters(data: Any) -> dict[str, Any]:
         for key, wire in found.items():
             if isinstance(wire, bool) or not isinstance(wire, int):
                 raise _ShapeError(f"parameters.values.{key}", f"must be a whole number (the drive's value), "
-                                  f"got {_kind(wire)}")
+                                  f"got {kind_of(wire)}")
             if not -(2**31) <= wire < 2**31:
                 raise _ShapeError(f"parameters.values.{key}", f"{wire:g} is no value a drive holds")
         out["values"] = dict(found)
@@ -318,7 +304,7 @@ def _run_from_json(data: Any, where: str) -> RunState:
     if "status" in table:
         status = table["status"]
         if status not in _STATUSES:
-            raise _ShapeError(f"{where}.status", f"is {_kind(status)}; allowed: {', '.join(_STATUSES)}")
+            raise _ShapeError(f"{where}.status", f"is {kind_of(status)}; allowed: {', '.join(_STATUSES)}")
         values["status"] = status
     if "step_ids" in table:
         step_ids = _list(table["step_ids"], f"{where}.step_ids", "step ids")
@@ -328,7 +314,7 @@ def _run_from_json(data: Any, where: str) -> RunState:
         limit = len(values.get("step_ids", []))
         if isinstance(position, bool) or not isinstance(position, int) or not 0 <= position <= limit:
             raise _ShapeError(f"{where}.position", f"must be a whole number 0 ... {limit} (a step), "
-                              f"got {_kind(position)}")
+                              f"got {kind_of(position)}")
         values["position"] = position
     if "answers" in table:  # any JSON value: what a step recorded (engine._plain)
         values["answers"] = _table(table["answers"], f"{where}.answers", "answers by step id")
@@ -353,7 +339,7 @@ def _record_from_json(data: Any, where: str) -> CheckRecord:
         value = table[name]
         if name == "passed":
             if not isinstance(value, bool):
-                raise _ShapeError(f"{where}.passed", f"must be true or false, got {_kind(value)}")
+                raise _ShapeError(f"{where}.passed", f"must be true or false, got {kind_of(value)}")
         elif name == "value":
             pass  # any JSON value: what the step recorded
         else:
