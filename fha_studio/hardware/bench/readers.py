@@ -830,24 +830,40 @@ def _is_change_list(table: np.ndarray, time_column: int) -> bool:
     """A logic analyzer's export of changes (Saleae Logic 2's and Logic 1.x's digital CSV): every
     channel 0 or 1 and each row differs from the one before in some channel (the last may repeat
     the state: the capture's end). A file sampled at one rate repeats rows while nothing changes."""
-    levels = np.delete(table, time_column, axis=1)
-    if levels.shape[1] == 0 or table.shape[0] < 2 or not np.all((levels == 0) | (levels == 1)):
+    if table.shape[1] < 2 or table.shape[0] < 2 or not _mostly_bits(table, time_column, 0):
         return False
-    same = np.all(levels[1:] == levels[:-1], axis=1)
+    columns = [c for c in range(table.shape[1]) if c != time_column]
+    same = np.ones(table.shape[0] - 1, bool)
+    for c in columns:
+        if not np.all((table[:, c] == 0) | (table[:, c] == 1)):
+            return False
+        same &= table[1:, c] == table[:-1, c]
     return not np.any(same[:-1])
+
+
+def _mostly_bits(table: np.ndarray, time_column: int, allowed: float) -> bool:
+    """Whether the first rows' channels are 0 or 1 but for ``allowed`` of them (a quick look
+    before the whole of a large table is looked at)."""
+    head = np.delete(table[:1000], time_column, axis=1)
+    bad = ~((head == 0) | (head == 1) | np.isnan(head))
+    return bool(np.count_nonzero(bad) <= max(1.0, allowed * head.size) if allowed else not bad.any())
 
 
 def _not_a_change(table: np.ndarray, names: list[str], time_column: int, name: str,
                   lines: Sequence[bytes], start: int, comment: str) -> None:
     """A file whose channels are 0 and 1 but for one value or a few: a logic analyzer's export
     of changes with a bad value, named (not read as analog channels, nor refused for its rate)."""
-    levels = np.delete(table, time_column, axis=1)
-    bad = ~((levels == 0) | (levels == 1) | np.isnan(levels))  # an empty field is said below
-    if levels.size and 0 < np.count_nonzero(bad) <= max(1.0, 0.01 * levels.size):
-        row, column = (int(k[0]) for k in np.nonzero(bad))
-        label = [n for k, n in enumerate(names) if k != time_column][column]
+    if table.shape[1] < 2 or not _mostly_bits(table, time_column, 0.01):
+        return
+    columns = [c for c in range(table.shape[1]) if c != time_column]
+    # an empty field is said by the caller
+    bad = [~((table[:, c] == 0) | (table[:, c] == 1) | np.isnan(table[:, c])) for c in columns]
+    count = sum(int(np.count_nonzero(b)) for b in bad)
+    if 0 < count <= max(1.0, 0.01 * table.shape[0] * len(columns)):
+        row, k = min((int(np.flatnonzero(b)[0]), k) for k, b in enumerate(bad) if b.any())
+        label, value = names[columns[k]], table[row, columns[k]]
         raise CaptureError(f"{name}: line {_data_line(lines, start, row, comment)}: {label} is "
-                           f"{levels[row, column]:g}, expected 0 or 1 (a logic analyzer's export of changes)")
+                           f"{value:g}, expected 0 or 1 (a logic analyzer's export of changes)")
 
 
 def _changes(table: np.ndarray, t: np.ndarray, names: list[str], time_column: int, name: str,
@@ -891,8 +907,8 @@ def parse_rigol_csv(data: bytes, name: str) -> Capture:
     lines = _head_lines(data)
     header = [f.strip().strip('"') for f in _line(lines, 0).decode("utf-8", "replace").strip()
               .lstrip("\ufeff").split(",")]
-    at = header.index("Start")
-    if header[at + 1 : at + 2] != ["Increment"] or at < 2:
+    at = header.index("Start") if "Start" in header else 0
+    if header[at + 1 : at + 2] != ["Increment"] or at < 2 or header[0] != "X":
         raise CaptureError(f"{name}: line 1: expected 'X,CH1,...,Start,Increment' (Rigol), not "
                            f"'{','.join(header)}'")
     channels = header[1:at]
