@@ -146,16 +146,25 @@ def simulate(model: AxisModel, servo: ServoSettings | None, t_s: np.ndarray, com
         if current_average:  # the charge needs every period's current
             keep, record_at = np.arange(m + 1), None
         else:
-            # np.interp reads only the two periods a sample falls between: record those (and the
-            # chunk's last, where the next chunk starts); the samples come out bit for bit the same
-            j = np.searchsorted(ts, rel, side="right") - 1
-            keep = np.unique(np.concatenate(([0, m], np.clip(j, 0, m), np.clip(j + 1, 0, m))))
+            # np.interp reads only the two periods a sample falls between, and only the one it
+            # falls on exactly (as a sample at whole milliseconds does, the servo at 5 kHz): record
+            # those (and the chunk's last, where the next chunk starts); the samples come out bit
+            # for bit the same, at half the periods recorded on such a grid
+            j = np.clip(np.searchsorted(ts, rel, side="right") - 1, 0, m)
+            after = np.clip(j + 1, 0, m)
+            # the periods to keep, in order and once each (a mask: np.unique would sort them again)
+            marked = np.zeros(m + 1, dtype=bool)
+            marked[[0, m]] = True
+            marked[j] = True
+            marked[after[ts[j] != rel]] = True
+            keep = np.flatnonzero(marked)
             record_at = (keep[1:] - 1).tolist()
         rec: tuple[list, ...] = ([], [], [], [], [], [], [], [])
         _kernel.run(p, state, cmd_servo, m, True, rec, 1, record_at=record_at, accounting=False)
         ts = ts[keep]
-        # the lists to arrays with their dtype stated: numpy then skips its type discovery per item
-        recorded = [np.array(r, dtype=float) for r in rec[1:]]
+        # the lists to arrays through fromiter with their dtype and length stated: numpy then skips
+        # its type discovery per item (a quarter less than np.array(list, dtype=float))
+        recorded = [np.fromiter(r, dtype=float, count=len(r)) for r in rec[1:]]
         for j_key, key in enumerate(keys):
             out[key][done:stop] = np.interp(rel, ts, np.concatenate(([last[j_key]], recorded[j_key])))
         if current_average:
