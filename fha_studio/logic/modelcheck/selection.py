@@ -37,6 +37,7 @@ least squares; the final fit refines all parameters together (scipy.optimize.lea
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -188,6 +189,9 @@ class ChannelSelector:
         # the same model, and the model a step chose is the next step's (the value keeps the columns,
         # so their ids stay theirs while cached)
         self._cv_cache: dict[tuple[int, ...], tuple[list[np.ndarray], float]] = {}
+        # trials by (candidate, the terms with their shapes, the one it replaces): the selection's
+        # forward steps and substitutes() try some of the same candidates beside the same model
+        self._trial_cache: dict[tuple[object, ...], tuple[Trial, tuple[float, ...], np.ndarray]] = {}
 
     # --- columns
     def cols(self, cand: Candidate, shape: tuple[float, ...]) -> np.ndarray:
@@ -279,6 +283,15 @@ class ChannelSelector:
         replace: a chosen term cand extends (a refinement, e.g. friction by direction for Coulomb
         friction): cand takes its place and must beat the model that holds it.
         """
+        key = (cand.id, *((t.id, t.shape, t is replace) for t in terms))
+        if key not in self._trial_cache:
+            trial, term = self._try_add(cand, terms, replace)
+            self._trial_cache[key] = (trial, term.shape, term.cols)
+        trial, shape, cols = self._trial_cache[key]
+        # new objects each time: final_fit() refines the chosen terms' shapes in place
+        return copy.copy(trial), Term(cand, shape, cols)
+
+    def _try_add(self, cand: Candidate, terms: list[Term], replace: Term | None) -> tuple[Trial, Term]:
         kept = [t for t in terms if t is not replace]
         shape = self.best_shape(cand, kept)
         term = Term(cand, shape, self.cols(cand, shape))
