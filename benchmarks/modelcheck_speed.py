@@ -41,6 +41,11 @@ CODE = "FHA-25C-50-US250"
 # reading the file; interleaved with f6f9799 at load 3.9-4.6) from 0.71-0.82 to 0.61-0.71 s with
 # torque, 0.80-0.90 to 0.73-0.87 s with load_pos; this script at load 3.9-4.5, reading included:
 # 0.82-0.87, 0.57, 0.85-0.89, 0.60-0.63, 0.48-0.60, 0.49-0.55; at load 7 the first was 1.09-1.14.
+# Recording only the servo periods np.interp reads, reading the rows in whole-list passes and one
+# trial per candidate beside the same model (a7a63ec..89e4883; every answer bit for bit the same)
+# then took this script, interleaved with 98ec1a8 at load 1.2-1.4, from 0.70-0.73, 0.48-0.54,
+# 0.80-0.90, 0.58-0.61, 0.46-0.49, 0.46-0.49 to 0.58-0.64, 0.42-0.46, 0.72-0.73, 0.52-0.56,
+# 0.45-0.48, 0.46-0.50 s (reading 0.08-0.11 -> 0.04-0.06 s of it).
 BEFORE_CPU_S = {
     ("torque: coulomb + gravity", True): (1.60, 1.67),
     ("torque: coulomb + gravity", False): (1.02, 1.10),
