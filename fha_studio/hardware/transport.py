@@ -43,6 +43,10 @@ _OPEN_FAILURES = {
     errno.EACCES: "permission denied (on Linux: add the user to the dialout group and log in again)",
     errno.EBUSY: "the port is in use by another program",
     errno.ENXIO: "no device behind this port (an adapter unplugged, or a pty whose other side is gone)",
+    errno.ECONNREFUSED: "nothing accepts connections there (connection refused: is the server running, "
+                        "and is this its port?)",
+    errno.EHOSTUNREACH: "the host cannot be reached (check the network and the address)",
+    errno.ENETUNREACH: "the network cannot be reached (check the network and the address)",
 }
 #: The same from pyserial's Windows port, which gives the error's repr, not its number.
 _WINDOWS_OPEN_FAILURES = {
@@ -54,7 +58,9 @@ _WINDOWS_OPEN_FAILURES = {
 def port_failure_words(exc: BaseException) -> str:
     """Why a port did not open, in a technician's words where the error is one of
     :data:`_OPEN_FAILURES`, else pyserial's own text."""
-    words = _OPEN_FAILURES.get(getattr(exc, "errno", None) or 0)
+    # pyserial's socket port gives the socket's error as the cause, not as its own number
+    number = getattr(exc, "errno", None) or getattr(exc.__context__, "errno", None) or 0
+    words = _OPEN_FAILURES.get(number)
     if words:
         return words
     text = str(exc)

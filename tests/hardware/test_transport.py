@@ -53,6 +53,16 @@ def test_missing_device_is_link_lost_naming_it():
                                "plugged in, and is this its name?)")
 
 
+def test_a_socket_nothing_listens_on_is_said_in_words():
+    with socket.socket() as bound:  # bound, not listening (held: nobody else can take the port)
+        bound.bind(("127.0.0.1", 0))
+        port = bound.getsockname()[1]
+        with pytest.raises(LinkLost) as info:
+            open_transport(f"socket://127.0.0.1:{port}")
+    assert str(info.value) == (f"cannot open socket://127.0.0.1:{port}: nothing accepts connections there "
+                               "(connection refused: is the server running, and is this its port?)")
+
+
 @pytest.mark.parametrize(("error", "words"), [
     (serial.SerialException(errno.EACCES, "could not open port /dev/ttyS0: [Errno 13] Permission denied"),
      "permission denied (on Linux: add the user to the dialout group and log in again)"),
