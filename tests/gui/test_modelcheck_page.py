@@ -80,6 +80,9 @@ def test_a_move_captured_in_the_scope_tells_the_missing_friction(make_window, qt
     assert page.where_variable.currentData() == "speed"
     assert "torque" in page.gap_plots
     assert len(page.torque_plot.getPlotItem().listDataItems()) == 2
+    # drawn plots have their numbers back and no "nothing yet" note
+    assert page.torque_plot.empty_note is None and page.resim_pos_plot.empty_note is None
+    assert page.torque_plot.getPlotItem().getAxis("left").style["showValues"] and page.gap_empty.isHidden()
     # and the updated model and the report are written
     model = page.save_model(tmp_path / "axis.toml")
     assert "coulomb_friction" in model.read_text()

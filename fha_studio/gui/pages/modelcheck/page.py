@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import QObject, QStandardPaths, QThread, Signal, Slot
-from PySide6.QtGui import QFont
+from PySide6.QtGui import QFont, QPalette
 from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
@@ -84,7 +84,70 @@ NO_EFFECT = ("No missing effect named: the nominal model explains this recording
              "cannot show.")
 
 
-def _plot(title: str, left: str, bottom: str = "time (s)") -> pg.PlotWidget:
+#: What an empty plot says instead of a made-up 0 to 1 range.
+EMPTY_PLOT = "Nothing yet: open a recording and run the model check"
+
+
+class _WholeLinesText(QPlainTextEdit):
+    """A read-only text box that shows whole lines only: whatever height the splitter gives it,
+    the part of a line that would not fit is left blank below the text instead of cut. The pad
+    round the text is a viewport margin, not the document's (that one scrolls away, and a line
+    scrolled to the top would then be cut at the bottom)."""
+
+    PAD_PX = 4
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.setReadOnly(True)
+        self.document().setDocumentMargin(0)
+        self.setBackgroundRole(QPalette.ColorRole.Base)  # the pad is the text's white, not the window's
+        self.setAutoFillBackground(True)
+
+    def line_height(self) -> int:
+        layout = self.document().firstBlock().layout()
+        if layout is not None and layout.lineCount() > 0:
+            return max(1, round(layout.lineAt(0).height()))
+        return max(1, self.fontMetrics().lineSpacing())
+
+    def resizeEvent(self, event) -> None:
+        self._fit_whole_lines()
+        super().resizeEvent(event)
+
+    def _fit_whole_lines(self) -> None:
+        pad = self.PAD_PX
+        inner = max(0, self.contentsRect().height() - 2 * pad)
+        self.setViewportMargins(pad, pad, pad, pad + inner % self.line_height())
+
+    def setPlainText(self, text: str) -> None:
+        super().setPlainText(text)
+        self._fit_whole_lines()
+
+
+def _show_empty(widget: pg.PlotWidget, words: str = EMPTY_PLOT) -> None:
+    """``words`` in the middle of the plot and no numbers on its axes: an empty plot says there is
+    nothing yet rather than show a range nothing measured."""
+    item = widget.getPlotItem()
+    item.clear()
+    for side in ("left", "bottom"):
+        item.getAxis(side).setStyle(showValues=False)
+    note = pg.TextItem(words, color="#555", anchor=(0.5, 0.5))
+    item.addItem(note, ignoreBounds=True)
+    note.setPos(0.5, 0.5)
+    item.getViewBox().setRange(xRange=(0.0, 1.0), yRange=(0.0, 1.0), padding=0.0)
+    widget.empty_note = note  # what the tests read
+
+
+def _clear(widget: pg.PlotWidget) -> None:
+    """An empty plot about to be drawn: its axes get their numbers back."""
+    item = widget.getPlotItem()
+    item.clear()
+    for side in ("left", "bottom"):
+        item.getAxis(side).setStyle(showValues=True)
+    item.enableAutoRange()  # the empty plot's fixed range turned it off
+    widget.empty_note = None
+
+
+def _plot(title: str, left: str, bottom: str = "time (s)", *, empty: bool = True) -> pg.PlotWidget:
     widget = pg.PlotWidget(background="w")
     item = widget.getPlotItem()
     item.setTitle(title, color="#222", size="10pt")
@@ -96,6 +159,10 @@ def _plot(title: str, left: str, bottom: str = "time (s)") -> pg.PlotWidget:
     item.addLegend(offset=(10, 5), labelTextColor="#222")
     item.setClipToView(True)
     item.setDownsampling(auto=True, mode="peak")
+    if empty:
+        _show_empty(widget)
+    else:
+        widget.empty_note = None
     return widget
 
 
@@ -177,8 +244,7 @@ class ModelCheckPage(BasePage):
         self.source_label = QLabel("No recording loaded. Open an fha-recording/1 file, or capture a move "
                                    "in the Scope page and take it from there.")
         self.source_label.setWordWrap(True)
-        self.summary = QPlainTextEdit()
-        self.summary.setReadOnly(True)
+        self.summary = _WholeLinesText()
         self.summary.setFont(QFont("monospace", 9))
         self.summary.setPlaceholderText("The findings appear here: which effect is missing, its "
                                         "parameters, and the gap before and after on held-out data.")
@@ -249,7 +315,9 @@ class ModelCheckPage(BasePage):
     def _build_gap_tab(self) -> QWidget:
         self.gap_plots: dict[str, pg.PlotWidget] = {}
         self.gap_box = QWidget()
-        QVBoxLayout(self.gap_box)
+        self.gap_empty = QLabel(EMPTY_PLOT)  # no plot before a run: no made-up axes either
+        self.gap_empty.setAlignment(pg.QtCore.Qt.AlignmentFlag.AlignCenter)
+        QVBoxLayout(self.gap_box).addWidget(self.gap_empty, 1)
         return self.gap_box
 
     def _build_resim_tab(self) -> QWidget:
@@ -418,7 +486,7 @@ class ModelCheckPage(BasePage):
     def _draw_residual(self, r: ModelCheckResult) -> None:
         res = r.residual
         t = res["t_s"]
-        self.torque_plot.clear()
+        _clear(self.torque_plot)
         # without a current the motor's torque is read through the speed loop, not measured
         measured = "measured (Kt x current)" if self._ran_with_current else NO_CURRENT_TORQUE
         self.torque_plot.getPlotItem().setTitle(
@@ -427,7 +495,7 @@ class ModelCheckPage(BasePage):
                               name=measured)
         self.torque_plot.plot(t, res["torque_nominal_nm"], pen=pg.mkPen(COLORS["nominal"], width=1),
                               name="nominal model (J x acceleration)")
-        self.residual_plot.clear()
+        _clear(self.residual_plot)
         self.residual_plot.plot(t, res["torque_residual_nm"], pen=pg.mkPen(COLORS["residual"], width=1),
                                 name=f"torque residual ({unit_words('N m')})")
         if "load_diff_arcsec" in res:
@@ -472,7 +540,7 @@ class ModelCheckPage(BasePage):
             return
         where = self.result.where[channel]
         plot = self.where_plot
-        plot.clear()
+        _clear(plot)
         unit = unit_words(where.variable_units.get(var, ""))
         plot.getPlotItem().setTitle(f"{channel} residual against {VARIABLE_LABELS.get(var, var)}",
                                     color="#222", size="10pt")
@@ -521,11 +589,12 @@ class ModelCheckPage(BasePage):
             layout.removeWidget(plot)
             plot.deleteLater()
         self.gap_plots.clear()
+        self.gap_empty.setVisible(not r.gap)
         for name, gap in r.gap.items():
             unit = unit_words(gap.unit)
             plot = _plot(f"{_channel_name(name, r)}: {_num(gap.rms_before)} → {_num(gap.rms_after)} "
                          f"{unit} rms on held-out stretches (shaded): how much better the updated model "
-                         "explains data it was not fitted on", unit)
+                         "explains data it was not fitted on", unit, empty=False)
             for start, stop in gap.blocks:
                 region = pg.LinearRegionItem((start, stop), movable=False,
                                              brush=pg.mkBrush(255, 200, 0, 40), pen=pg.mkPen(None))
@@ -538,11 +607,13 @@ class ModelCheckPage(BasePage):
             layout.addWidget(plot, 1)
 
     def _draw_resimulation(self, r: ModelCheckResult) -> None:
-        self.resim_torque_plot.clear()
-        self.resim_pos_plot.clear()
+        _clear(self.resim_torque_plot)
+        _clear(self.resim_pos_plot)
         s = r.resimulation
         if s is None:
             self.resim_torque_plot.getPlotItem().setTitle("No re-simulation for this recording")
+            for plot in (self.resim_torque_plot, self.resim_pos_plot):
+                _show_empty(plot, "No re-simulation for this recording")
             return
         column, _, how = s.command.partition(" ")  # "cmd_pos through the loop identified ..."
         command = " ".join([COMMAND_WORDS.get(column, column), *([how] if how else [])])
