@@ -85,6 +85,8 @@ class TrainingController(QObject):
         self._folder: tempfile.TemporaryDirectory[str] | None = None
         self._modelcheck_hooked = False
         self.draft_findings = ""  # what the trainee wrote so far (kept between two looks)
+        self._connecting = False  # "Connecting to the training drive …" is on show
+        window.link.sigConnected.connect(self._on_connected)
 
     @property
     def pages(self) -> PageLookup:
@@ -109,6 +111,7 @@ class TrainingController(QObject):
         window.state.set_actuator(scenario.actuator, acknowledged=True)
         window.state.set_load_inertia(scenario.load_inertia_kgm2)
         url = f"sim://{scenario.actuator}?training={self._registration.token}" + ("" if paced else "&paced=0")
+        self._connecting = True
         window.link.open(url)
         window.link_lamp.set_state(None)
         window.show_message(f"Training started: {scenario.title}. Connecting to the training drive …")
@@ -120,6 +123,17 @@ class TrainingController(QObject):
         )
         self._hook_modelcheck()
         self.sigStarted.emit(scenario)
+
+    @Slot(object)
+    def _on_connected(self, info: object) -> None:
+        # the message line says what is true now: connected, not still connecting (and only for
+        # the training's drive, not another one connected after its opening failed)
+        training_drive = str(getattr(info, "url", "")).endswith("(training)")
+        if self._connecting and training_drive and self.scenario is not None:
+            self._connecting = False
+            self.window.show_message(
+                f"Training: {self.scenario.title}. Connected to the training drive: "
+                "the axis is yours to commission.")
 
     def _hook_modelcheck(self) -> None:
         page = self.pages.built_page(PageId.MODELCHECK)

@@ -36,6 +36,10 @@ def test_a_trainee_finds_one_fault_and_misses_the_other(make_window, qtbot, tmp_
     with qtbot.waitSignal(window.link.sigConnected, timeout=WAIT_MS):
         window.training.start(scenario, "Ann", paced=False)
     assert window.training.running
+    # once connected, the message line says so instead of "Connecting to the training drive …"
+    qtbot.waitUntil(lambda: "Connected to the training drive" in window.message_area.latest().text,
+                    timeout=WAIT_MS)
+    assert "Connecting" not in window.message_area.text_label.text()
 
     # nothing on screen gives the faults away: every page, the title, tooltips, messages
     window.show_page("connection")
