@@ -149,3 +149,16 @@ def test_a_port_that_does_not_open_is_said_once_where_the_link_is_shown(make_win
     qtbot.waitUntil(lambda: page.link_label.text() != "not connected", timeout=10000)
     assert page.link_label.text() == f"not connected: {why}"
     assert window.message_area.messages[-1].text == f"Could not connect: {why}"
+
+
+def test_a_bad_sim_option_is_one_line_naming_it_and_where_the_options_are(make_window, qtbot):
+    """The address once (where the link is shown), the option no simulated drive has, a close
+    known name, and where the options are documented; not the address twice nor every option."""
+    window = make_window()
+    url = "sim://FHA-25C-50-US250?colour=red&inertia=1"
+    window.connect_to(url)
+    qtbot.waitUntil(lambda: window.message_area.latest() is not None
+                    and window.message_area.latest().text.startswith("Could not connect"), timeout=10000)
+    text = window.message_area.latest().text
+    assert text == (f"Could not connect: cannot open {url}: the simulated drive has no options 'colour', "
+                    "'inertia' (did you mean 'load_inertia'?); its options are listed in docs/sim.md")

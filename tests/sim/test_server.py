@@ -64,7 +64,7 @@ def test_sim_url_options_are_parsed_and_checked():
         "viscous_friction": {"coefficient_nm_s_per_rad": 2.0},
         "gravity_load": {"amplitude_nm": 20.0, "phase_deg": 90.0},
     }
-    with pytest.raises(SimConfigError, match=r"unknown option.*inertia"):
+    with pytest.raises(SimConfigError, match=r"no option 'inertia' \(did you mean 'load_inertia'\?\)"):
         config_from_url("sim://FHA-25C-50-US250?inertia=1")
     with pytest.raises(SimConfigError, match="load_inertia"):
         config_from_url("sim://FHA-25C-50-US250?load_inertia=-1")
@@ -117,7 +117,8 @@ def test_paced_url_reads_wait_for_the_line(tmp_path):
 
 def test_bad_sim_url_is_a_serial_exception_naming_the_option():
     register_url_handler()
-    with pytest.raises(serial.SerialException, match="unknown option"):
+    with pytest.raises(serial.SerialException,
+                       match=r"no option 'colour'; its options are listed in docs/sim\.md"):
         serial.serial_for_url("sim://FHA-25C-50-US250?colour=red")
 
 

@@ -56,6 +56,7 @@ Options (all optional):
 
 from __future__ import annotations
 
+import difflib
 import math
 import re
 import secrets
@@ -302,6 +303,23 @@ _URL_KEYS = {
 }
 
 
+#: Where a person reads what each option means (the options are too many for one message line).
+OPTIONS_DOCUMENTED_IN = "docs/sim.md"
+
+
+def unknown_options_words(unknown: set[str]) -> str:
+    """One line naming the options no simulated drive knows, a close known name where there is
+    one, and where the options are documented. The address is not repeated: whoever shows the
+    line names the port it could not open."""
+    words = []
+    for name in sorted(unknown):
+        near = difflib.get_close_matches(name, sorted(_URL_KEYS), n=1)
+        words.append(f"{name!r}" + (f" (did you mean {near[0]!r}?)" if near else ""))
+    option = "option" if len(words) == 1 else "options"
+    return (f"the simulated drive has no {option} {', '.join(words)}; "
+            f"its options are listed in {OPTIONS_DOCUMENTED_IN}")
+
+
 def config_from_url(url: str) -> SimConfig:
     """A SimConfig from ``sim://ACTUATOR?options``; SimConfigError names a bad option."""
     parts = urlsplit(url)
@@ -309,13 +327,11 @@ def config_from_url(url: str) -> SimConfig:
         raise SimConfigError(f"{url!r} is not a sim:// URL")
     actuator = unquote(parts.netloc or parts.path.lstrip("/")).strip()
     if not actuator:
-        raise SimConfigError(f"{url!r}: the actuator model code is missing, e.g. sim://FHA-25C-50-US250")
+        raise SimConfigError("the actuator model code is missing, e.g. sim://FHA-25C-50-US250")
     query = parse_qs(parts.query, keep_blank_values=True)
     unknown = set(query) - _URL_KEYS
     if unknown:
-        raise SimConfigError(
-            f"{url!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_URL_KEYS))}"
-        )
+        raise SimConfigError(unknown_options_words(unknown))
     token = query["training"][-1] if "training" in query else None
     if token is not None:
         registration = training_registration(token)
