@@ -192,3 +192,19 @@ def test_the_machine_window_fits_with_every_axis_and_says_it_whole(qtbot, tmp_pa
                 found = hidden_actions(window) + cut_texts(window) + cut_hints(window)
                 problems += [f"{name}, {size[0]} x {size[1]}: {p}" for p in found]
         assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize("size", [(1024, 600), (1280, 720)])
+def test_every_parameter_name_and_value_is_whole_on_a_small_screen(window, qtbot, size):
+    """At 1024 x 600 (the machine window's page at 1280 x 720 is about as wide) every name and value
+    fits its column; only the default, which the tooltip repeats, may be elided."""
+    window.resize(*size)
+    page = window.show_page("parameters")
+    table = page.table
+    qtbot.waitUntil(lambda: window.width() <= size[0] and table.isVisible(), timeout=10000)
+    assert table.horizontalScrollBar().maximum() == 0
+    for column in (2, 3):  # Name, Value
+        needed = table.sizeHintForColumn(column)
+        assert table.columnWidth(column) >= needed, (column, table.columnWidth(column), needed)
+    right = table.columnViewportPosition(7) + table.columnWidth(7)
+    assert right <= table.viewport().width()  # the State column in view

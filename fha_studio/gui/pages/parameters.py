@@ -166,8 +166,10 @@ class ParametersPage(BasePage):
         self.table.setAlternatingRowColors(True)
         header = self.table.horizontalHeader()
         header.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
-        # the value is what matters: it is shown whole; the name takes the room that is left
-        header.setSectionResizeMode(2, QHeaderView.ResizeMode.Stretch)
+        # the name and the value are what matter: both are shown whole; the default takes the room
+        # that is left (a long choice such as "0: FWD turns CW (seen from the flange)" is elided
+        # there, and the row's tooltip lists every choice)
+        header.setSectionResizeMode(6, QHeaderView.ResizeMode.Stretch)
         header.setMinimumSectionSize(self.table.fontMetrics().averageCharWidth() * 4)
         splitter.addWidget(self.table)
         # the manual's description beside the session log (not above it): the table keeps the height,
