@@ -49,4 +49,34 @@ def plain_number(value: float, significant: int = 4) -> str:
     return f"{value:.{significant - 1 - exponent}f}".rstrip("0").rstrip(".")
 
 
-__all__ = ["UNIT_WORDS", "plain_number", "unit_words", "with_unit"]
+#: Decimals a read-out of a quantity in this unit shows, whatever its size: a column of cursor
+#: values lines up and no figure claims more than the signal resolves (an output angle to about
+#: 0.4 arc-sec, the speed monitor to 0.01 r/min, the current monitor to 1 mA; a trace's time to its
+#: 0.2 ms servo period).
+UNIT_DECIMALS = {
+    "s": 4, "ms": 1, "Hz": 2,
+    "deg": 4, "°": 4, "arcsec": 1, "arc-sec": 1, "rad": 5, "pulse": 0, "bit": 0,
+    "r/min": 2, "rad/s": 3,
+    "A": 3, "mA": 1, "V": 3, "mV": 1,
+    "N m": 2, "N·m": 2, "%": 1,
+}
+
+
+def fixed_number(value: float, unit: str) -> str:
+    """``value`` with the fixed decimals of ``unit`` (a rate ``X/s`` as ``X``), its unit after it:
+    "0.32 r/min" whatever the value's size. A unit without its decimals gets four significant
+    digits (:func:`plain_number`)."""
+    unit = unit.strip()
+    decimals = UNIT_DECIMALS.get(unit)
+    if decimals is None and unit.endswith("/s"):
+        decimals = UNIT_DECIMALS.get(unit[:-2])
+    if decimals is None or not math.isfinite(value):
+        text = plain_number(value, 4)
+    else:
+        text = f"{value:.{decimals}f}"
+        if float(text) == 0.0:
+            text = text.lstrip("-")  # "-0.00" reads as a sign the signal does not have
+    return f"{text} {unit}".strip()
+
+
+__all__ = ["UNIT_DECIMALS", "UNIT_WORDS", "fixed_number", "plain_number", "unit_words", "with_unit"]

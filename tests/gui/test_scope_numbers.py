@@ -9,7 +9,7 @@ import numpy as np
 from fha_studio.gui.pages.scope.cursor_table import CursorRow, CursorTable
 from fha_studio.gui.pages.scope.spectrum_panel import SpectrumPanel
 from fha_studio.logic.scope.analysis import spectrum
-from fha_studio.logic.wording import plain_number
+from fha_studio.logic.wording import fixed_number, plain_number
 
 
 def test_plain_numbers_never_use_exponent_notation():
@@ -21,12 +21,34 @@ def test_plain_numbers_never_use_exponent_notation():
 
 
 def test_the_cursor_table_writes_a_small_current_in_plain_figures(qtbot):
+    """Fixed decimals per unit: no exponent, no "-0.000" for a current below the monitor's 1 mA."""
     table = CursorTable()
     qtbot.addWidget(table)
-    table.show_rows(-6.0, -3.5, [CursorRow("Motor current", "A", "#9467bd", 7.933e-05, -0.28355, -0.11345)])
+    table.show_rows(-6.0, -3.5, [CursorRow("Motor current", "A", "#9467bd", -7.933e-05, -0.28355, -0.11345)])
     cells = [table.cell_text(1, column) for column in range(1, 5)]
-    assert cells == ["0.00007933 A", "-0.28355 A", "-0.28363 A", "-0.11345 A/s"]
-    assert table.cell_text(0, 1) == "-6 s"
+    assert cells == ["0.000 A", "-0.284 A", "-0.283 A", "-0.113 A/s"]
+    assert [table.cell_text(0, column) for column in range(1, 5)] == [
+        "-6.0000 s", "-3.5000 s", "2500.0 ms", "1/Δt = 0.40 Hz"]
+
+
+def test_the_cursor_table_gives_each_unit_its_own_fixed_digits(qtbot):
+    """A speed reads "0.32 r/min" (not "0.32499 r/min") and "12.00 r/min": a column's digits line up."""
+    table = CursorTable()
+    qtbot.addWidget(table)
+    table.show_rows(0.0, 0.5, [
+        CursorRow("Output speed", "r/min", "#1f77b4", 0.32499, 12.0, 23.35002),
+        CursorRow("Output position", "deg", "#ff7f0e", 1.0 / 3.0, 90.0, 179.33333),
+        CursorRow("Position error", "pulse", "#2ca02c", 3.0, -12.0, -30.0),
+        CursorRow("Output torque", "N·m", "#d62728", 0.123456, 7.0, 13.753088),
+    ])
+    got = {table.cell_text(r, 0): [table.cell_text(r, c) for c in range(1, 5)] for r in range(1, 5)}
+    assert got == {
+        "Output speed": ["0.32 r/min", "12.00 r/min", "11.68 r/min", "23.35 r/min/s"],
+        "Output position": ["0.3333 deg", "90.0000 deg", "89.6667 deg", "179.3333 deg/s"],
+        "Position error": ["3 pulse", "-12 pulse", "-15 pulse", "-30 pulse/s"],
+        "Output torque": ["0.12 N·m", "7.00 N·m", "6.88 N·m", "13.75 N·m/s"],
+    }
+    assert fixed_number(0.5, "furlong") == "0.5 furlong"  # a unit without its decimals: 4 digits
 
 
 def test_a_spectrum_of_an_angle_names_its_lines_in_arc_sec(qtbot):

@@ -143,11 +143,12 @@ def test_the_cursor_table_has_a_row_per_channel_with_the_values_at_a_and_b(scope
     view.set_cursors(1.0, 3.0)
     table = view.time_plot.cursor_table
     assert table.isVisible() and table.rowCount() == 1 + len(channels)
-    assert table.cell_text(0, 3).startswith("2000 ms")
+    assert table.cell_text(0, 3) == "2000.0 ms"
     got = {table.cell_text(r, 0): [table.cell_text(r, c) for c in range(1, 5)] for r in range(1, 4)}
-    assert got["Feedback position (output)"] == ["100 deg", "300 deg", "200 deg", "100 deg/s"]
-    assert got["Output speed"] == ["10 r/min", "10 r/min", "0 r/min", "0 r/min/s"]
-    assert got["Motor current"] == ["0.5 A", "1.5 A", "1 A", "0.5 A/s"]
+    assert got["Feedback position (output)"] == ["100.0000 deg", "300.0000 deg", "200.0000 deg",
+                                                 "100.0000 deg/s"]
+    assert got["Output speed"] == ["10.00 r/min", "10.00 r/min", "0.00 r/min", "0.00 r/min/s"]
+    assert got["Motor current"] == ["0.500 A", "1.500 A", "1.000 A", "0.500 A/s"]
     # each unit its own plot, time axes linked for still data too
     assert len(view.time_plot.plot_items()) == 3
 

@@ -7,9 +7,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import pyqtgraph as pg
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableWidget, QTableWidgetItem
 
-from fha_studio.logic.wording import plain_number
+from fha_studio.logic.wording import fixed_number
 
 COLUMNS = ("Channel", "At A", "At B", "Δ (B − A)", "Slope")
 #: Rows on show before the table scrolls (the plots keep the rest of the height).
@@ -29,7 +30,7 @@ class CursorRow:
 
 
 def _number(value: float, unit: str) -> str:
-    return f"{plain_number(value, 5)} {unit}".strip()  # "0.00007933 A", not "7.933e-05 A"
+    return fixed_number(value, unit)  # "0.325 A" and "12.000 A": the digits line up, no exponent
 
 
 class CursorTable(QTableWidget):
@@ -54,8 +55,8 @@ class CursorTable(QTableWidget):
                   time_name: str = "Time") -> None:
         """The cursors at ``t_a_s`` and ``t_b_s`` as the time axis reads them, and ``rows``."""
         dt = t_b_s - t_a_s
-        table = [(time_name, "", _number(t_a_s, "s"), _number(t_b_s, "s"), f"{dt * 1000:.4g} ms",
-                  f"1/Δt = {1 / abs(dt):.4g} Hz" if dt else "—")]
+        table = [(time_name, "", _number(t_a_s, "s"), _number(t_b_s, "s"), _number(dt * 1000, "ms"),
+                  f"1/Δt = {_number(1 / abs(dt), 'Hz')}" if dt else "—")]
         for r in rows:
             slope = "—" if r.slope_per_s is None else _number(r.slope_per_s, f"{r.unit}/s")
             table.append((r.name, r.color, _number(r.at_a, r.unit), _number(r.at_b, r.unit),
@@ -73,7 +74,9 @@ class CursorTable(QTableWidget):
                 item.setForeground(pg.mkColor(color))
             self.setItem(row, 0, item)
             for column, text in enumerate(cells, start=1):
-                self.setItem(row, column, QTableWidgetItem(text))
+                cell = QTableWidgetItem(text)
+                cell.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+                self.setItem(row, column, cell)
         rows_shown = min(len(table), MAX_VISIBLE_ROWS)
         height = self.horizontalHeader().height() + 2 * self.frameWidth()
         height += sum(self.rowHeight(r) for r in range(rows_shown))
