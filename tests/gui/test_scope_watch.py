@@ -180,3 +180,21 @@ def test_space_on_the_scope_page_acts_only_on_the_jog_buttons(scope_window, qtbo
     assert panel.fwd_button.held  # but it holds a jog button
     qtbot.keyRelease(panel.fwd_button, Qt.Key.Key_Space)
     assert not panel.fwd_button.held
+
+
+def test_an_empty_live_view_shows_its_time_base_before_now(make_window, qtbot):
+    """Before any sample the time axis reads the time base (10 s before now to now), not 0 to 1 s;
+    another time base is shown at once, and still data still gets its own range."""
+    window = make_window()
+    view = window.show_page("scope").view
+    plot = view.time_plot
+    assert plot.live and "time before now" in plot.plot_items()[-1].getAxis("bottom").labelText
+    assert plot.view_box.viewRange()[0] == pytest.approx([-10.0, 0.0])
+    view.time_base.setCurrentIndex(view.time_base.findData(2.0))
+    assert plot.view_box.viewRange()[0] == pytest.approx([-2.0, 0.0])
+    by_key = {c.key: c for c in view.all_channels}
+    t = np.linspace(3.0, 7.0, 41)
+    view.show_static([by_key["output_speed"]], np.column_stack([t, t]), "a test capture", 10.0)
+    view.time_base.setCurrentIndex(view.time_base.findData(30.0))  # not live: the data's range stays
+    x0, x1 = plot.view_box.viewRange()[0]
+    assert 2.8 < x0 < 3.0 and 7.0 < x1 < 7.2

@@ -230,6 +230,13 @@ class TimePlot(QWidget):
         self._legend_entries = entries
         self.set_note(note)
 
+    def show_time_base(self, span_s: float) -> None:
+        """Live: the time axis shows the time base, ``span_s`` before now to now, also before the
+        first sample (an empty live view read 0 to 1 s "before now" under a 10 s time base)."""
+        if self._live:
+            self._live_span = span_s
+            self.view_box.setXRange(-span_s, 0.0, padding=0)
+
     def set_note(self, note: str) -> None:
         """The line under the legend: what the plots show, and why."""
         self._note = note

@@ -207,6 +207,8 @@ class ScopeView(QWidget):
         self.step_angle, self.result_labels = self.tests.step_angle, self.tests.result_labels
         self.load_inertia = self.tests.load_inertia
         self.live_button, self.time_base = bar.live_button, bar.time_base
+        self.time_base.currentIndexChanged.connect(
+            lambda _i: self.time_plot.show_time_base(self.toolbar.time_base_s()))
         self.cursors_box, self.record_button = bar.cursors_box, bar.record_button
         self.plot = self.time_plot.plot
         self.spectrum_channel = self.spectrum_panel.spectrum_channel
@@ -260,6 +262,7 @@ class ScopeView(QWidget):
     def _rebuild_curves(self) -> None:
         self.time_plot.set_curves(self._shown_channels(), self._visible, self._scale, self._color,
                                   live=self._static is None, note=self._shown_note())
+        self.time_plot.show_time_base(self.toolbar.time_base_s())
 
     def _shown_note(self) -> str:
         """What the plots show, in a line under the legend."""
