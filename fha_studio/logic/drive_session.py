@@ -16,7 +16,7 @@ import logging
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import Any, Protocol, TypedDict
+from typing import Protocol, TypedDict
 
 from fha_studio import clock
 from fha_studio.hardware.api import (
@@ -122,8 +122,19 @@ class PolledDrive(DriveLink, ManualCommands, ExtensionCommands, Protocol):
     """What the status poll asks of a drive: what it is, DGR, alarm, I/O and monitors."""
 
 
-#: The fields of one poll as they are learnt (DriveStatus's names: the rest keep its defaults).
-_Fields = dict[str, Any]
+class _Fields(TypedDict, total=False):
+    """The fields of one poll as they are learnt, by DriveStatus's own names (the rest keep its
+    defaults); a TypedDict so the type checker holds each name and type to DriveStatus's."""
+
+    servo_on: bool | None
+    alarm_code: int | None
+    io_bits: int | None
+    speed_rpm: float | None
+    position_pulse: int | None
+    current_a: float | None
+    refused: bool
+    absolute_counts: int | None
+    note: str
 
 
 class StatusPoller:
