@@ -61,3 +61,44 @@ def test_empty_plots_say_nothing_is_there_yet(make_window, qtbot):
         for side in ("left", "bottom"):
             assert not plot.getPlotItem().getAxis(side).style["showValues"]  # no 0 to 1 on show
     assert page.gap_plots == {} and page.gap_empty.text() == EMPTY_PLOT
+
+
+def _nothing_on_show(page) -> bool:
+    plots = (page.torque_plot, page.residual_plot, page.where_plot, page.resim_torque_plot,
+             page.resim_pos_plot)
+    return (all(p.empty_note is not None and not p.getPlotItem().listDataItems() for p in plots)
+            and page.gap_plots == {} and not page.gap_empty.isHidden()
+            and page.effects_table.rowCount() == 0 and page.where_channel.count() == 0
+            and page.findings.toPlainText() == "" and page.result is None
+            and not page.save_report_button.isEnabled())
+
+
+def test_a_new_recording_or_a_failed_run_takes_the_old_result_off_show(make_window, qtbot, friction_file,
+                                                                         tmp_path):
+    # the old curves beside "Not run yet" (or a failure) would be read as the new recording's
+    window = make_window()
+    page = window.show_page("modelcheck")
+    window.session.state.set_load_inertia(1.5)
+    page.load_recording(friction_file)
+    with qtbot.waitSignal(page.sigFinished, timeout=60000):
+        page.run()
+    assert not _nothing_on_show(page)  # the result is drawn
+    assert page.torque_plot.getPlotItem().listDataItems() and page.gap_plots
+
+    page.load_recording(friction_file)  # a new recording (the same file again: still not run)
+    assert page.summary.toPlainText().startswith("Not run yet")
+    assert _nothing_on_show(page)
+    assert page.torque_plot.getPlotItem().titleLabel.text == page.torque_plot.default_words[0]
+
+    with qtbot.waitSignal(page.sigFinished, timeout=60000):
+        page.run()
+    short = tmp_path / "short.csv"  # reads, but is too short to check
+    short.write_text("# format: fha-recording/1\n# actuator: FHA-25C-50-US250\n# load_inertia_kgm2: 1.5\n"
+                     "t,pos,current\n"
+                     + "".join(f"{n / 1000:.3f},{n * 0.01:.2f},0.{n % 7}\n" for n in range(50)),
+                     encoding="utf-8")
+    page.load_recording(short)
+    with qtbot.waitSignal(page.sigFailed, timeout=60000):
+        page.run()
+    assert page.summary.toPlainText().startswith("Cannot run the model check")
+    assert _nothing_on_show(page)

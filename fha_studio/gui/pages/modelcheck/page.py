@@ -159,6 +159,7 @@ def _plot(title: str, left: str, bottom: str = "time (s)", *, empty: bool = True
     item.addLegend(offset=(10, 5), labelTextColor="#222")
     item.setClipToView(True)
     item.setDownsampling(auto=True, mode="peak")
+    widget.default_words = (title, left, bottom)  # what an emptied plot goes back to
     if empty:
         _show_empty(widget)
     else:
@@ -363,6 +364,7 @@ class ModelCheckPage(BasePage):
             f"The analysis bandwidth: by default the highest at which the rigid model still explains "
             f"the recording; this recording supports {low:.2g} to {high:.3g} Hz")
         self._describe_recording()
+        self._show_nothing_yet()
         self.summary.setPlainText("Not run yet: press Run model check.")
         self._update_buttons()
 
@@ -455,6 +457,7 @@ class ModelCheckPage(BasePage):
         recording = self.declared_recording()
         self._ran_with_current = recording.has_current
         self._running = True
+        self._show_nothing_yet()
         self._update_buttons()
         self.summary.setPlainText("Running the model check…")
         self.sigRequestRun.emit((recording, self.analysis_window()))
@@ -479,8 +482,38 @@ class ModelCheckPage(BasePage):
         self._show_error(message)
 
     def _show_error(self, message: str) -> None:
+        self._show_nothing_yet()
+        self._update_buttons()
         self.summary.setPlainText(f"Cannot run the model check:\n{message}")
         self.sigFailed.emit(message)
+
+    def _show_nothing_yet(self) -> None:
+        """Every step back to its empty state: once the summary no longer describes the result on
+        show (a new recording, a run started or refused), its curves would be read as the new one's."""
+        self.result = None
+        for plot in (self.torque_plot, self.residual_plot, self.where_plot, self.resim_torque_plot,
+                     self.resim_pos_plot):
+            title, left, bottom = plot.default_words
+            item = plot.getPlotItem()
+            item.setTitle(title, color="#222", size="10pt")
+            item.setLabel("left", left)
+            item.setLabel("bottom", bottom)
+            _show_empty(plot)
+        self.burst_regions: list[pg.LinearRegionItem] = []
+        for combo in (self.where_channel, self.where_variable):
+            combo.blockSignals(True)
+            combo.clear()
+            combo.blockSignals(False)
+        self.effects_table.clearSpans()
+        self.effects_table.setRowCount(0)
+        self.findings.clear()
+        layout = self.gap_box.layout()
+        assert isinstance(layout, QVBoxLayout)
+        for plot in self.gap_plots.values():
+            layout.removeWidget(plot)
+            plot.deleteLater()
+        self.gap_plots.clear()
+        self.gap_empty.setVisible(True)
 
     # ---------------------------------------------------------------- drawing
     def _draw_residual(self, r: ModelCheckResult) -> None:
