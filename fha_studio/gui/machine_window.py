@@ -62,6 +62,7 @@ from fha_studio.gui.register_questions import (
 )
 from fha_studio.gui.register_worker import ServerWriter
 from fha_studio.gui.widgets import StopButton, hint_whole
+from fha_studio.hardware.sim.options import drive_words
 from fha_studio.logic.machine import MachineAxis, MachineProject
 from fha_studio.logic.procedures import ProcedureSession
 from fha_studio.logic.register import Register, RegisterError
@@ -515,7 +516,7 @@ class MachineWindow(QMainWindow):
         driver = window.link.info.driver_model if window.link.info else axis.driver_model
         # an embedded drive in words: its address carries options (a file's path among them)
         port = axis.port_url
-        where = "embedded simulated drive" if port.lower().startswith("sim://") else (port or "no port given")
+        where = drive_words(port) if port else "no port given"
         self.banner.setToolTip(f"Port: {port}" if port else "")
         self.banner.setText(
             f"Axis {axis.name} — {axis.actuator_code or 'actuator not given'}"

@@ -45,6 +45,7 @@ from fha_studio.gui.session import Session, new_axis_state
 from fha_studio.gui.state import AxisState
 from fha_studio.gui.widgets import AMBER, GREEN, RED, Lamp, StopButton, WrappingLabel
 from fha_studio.hardware.protocol import BAUDRATE
+from fha_studio.hardware.sim.options import drive_words
 from fha_studio.logic.commissioning import CommissioningState
 
 if TYPE_CHECKING:
@@ -435,14 +436,13 @@ class MainWindow(QMainWindow, PageLookup):
         self.link_lamp.set_state(True, GREEN)
         # the embedded drive in words, also as a drive of the manual's commands: its address
         # carries its options (a file of the run among them), which say nothing in the status bar
-        simulated = info.is_simulated or info.embedded_sim
-        where = "embedded simulated drive" if simulated else info.url
+        where = drive_words(info.url)
         model = info.driver_model or "driver model unknown"
         self.link_lamp.setToolTip(f"Link: connected to {where} ({model})")
         summary = info.capabilities_summary or "what it supports is unknown"
         # a drive that does not say its model (a real HA-655) is named by where it is
         self._set_caps(" · ".join(([info.driver_model] if info.driver_model else []) + [where, summary]))
-        address = f" ({info.url})" if simulated else ""
+        address = f" ({info.url})" if where != info.url else ""
         self.caps_label.setToolTip(f"{model} · {where}{address}\n{info.capabilities}")
         self.disconnect_action.setEnabled(True)
         self.servo_action.setEnabled(info.can_move)

@@ -273,3 +273,16 @@ def test_the_message_line_keeps_room_on_a_1024_pixel_screen(window, qtbot):
     qtbot.waitUntil(lambda: window.message_area.text_label.width() >= 200, timeout=10000)
     assert window.caps_label.width() <= 1024 * 0.25 + 1
     assert not window.message_area.text_label.visibleRegion().isEmpty()
+
+
+@pytest.mark.parametrize("friction", [True, False])
+def test_the_connection_page_names_the_embedded_drive_in_words(make_window, qtbot, friction):
+    # the address full of options is the tooltip's; the words say whether the catalogue's friction is on
+    url = f"sim://FHA-25C-50-US250?paced=0&catalogue_friction={int(friction)}"
+    window = make_window(connect=url)
+    page = window.show_page("connection")
+    text = page.link_label.text()
+    assert text == ("embedded simulated drive FHA-25C-50-US250, "
+                    f"{'with' if friction else 'without'} the catalogue's friction (TF, 2-4-4)")
+    assert url in page.link_label.toolTip()
+    assert window.caps_label.text().split(" · ")[1] == "embedded simulated drive"  # the status bar's words

@@ -170,3 +170,17 @@ def test_the_model_check_names_the_friction_of_a_recording_of_such_a_drive(tmp_p
     assert coulomb == pytest.approx(COULOMB_NM, rel=0.10)
     assert viscous == pytest.approx(VISCOUS_NM_S_PER_RAD, rel=0.10)
     assert coulomb + viscous * MAX_RAD_S == pytest.approx(TF_NM, rel=0.05)
+
+
+def test_a_drive_in_words_says_whether_it_has_the_catalogues_friction():
+    from fha_studio.hardware.sim.options import drive_words
+
+    assert drive_words("sim://FHA-25C-50-US250?catalogue_friction=1&eeprom=/tmp/x") == (
+        "embedded simulated drive")
+    assert drive_words("sim://FHA-25C-50-US250?catalogue_friction=1", detail=True) == (
+        "embedded simulated drive FHA-25C-50-US250, with the catalogue's friction (TF, 2-4-4)")
+    assert drive_words("sim://FHA-17C-100-US200", detail=True).endswith(
+        "without the catalogue's friction (TF, 2-4-4)")
+    assert drive_words("sim://FHA-25C-50-US250 (training)", detail=True) == (
+        "embedded simulated drive FHA-25C-50-US250 (training)")
+    assert drive_words("/dev/ttyUSB0", detail=True) == "/dev/ttyUSB0"

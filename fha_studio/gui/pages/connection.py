@@ -17,6 +17,7 @@ from fha_studio.gui.connect_dialog import catalogue_codes
 from fha_studio.gui.link import LinkInfo
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.session import Session
+from fha_studio.hardware.sim.options import drive_words
 from fha_studio.logic.pairing import PairingCheck
 
 
@@ -146,7 +147,9 @@ class ConnectionPage(BasePage):
 
     # -- behaviour --------------------------------------------------------------------------------
     def link_connected(self, info: LinkInfo) -> None:
-        self.link_label.setText(("embedded simulated drive — " if info.is_simulated else "") + info.url)
+        # an embedded drive in words (its address, options and all, is the tooltip's)
+        self.link_label.setText(drive_words(info.url, detail=True))
+        self.link_label.setToolTip(f"Address: {info.url}")
         self.driver_label.setText(info.driver_model or "not reported by this drive")
         self.adjusted_label.setText(info.adjusted_for or "not reported: read it from the driver's label")
         self.firmware_label.setText(info.firmware or "—")
@@ -163,6 +166,7 @@ class ConnectionPage(BasePage):
             self.link_label.setText(f"LINK LOST: {reason}")
         else:  # "not connected" is said once
             self.link_label.setText("not connected" + ("" if reason == "not connected" else f": {reason}"))
+            self.link_label.setToolTip("")
         self.link_label.setStyleSheet("color: #b00020; font-weight: bold;" if lost else "")
         self.disconnect_button.setEnabled(False)
 

@@ -296,6 +296,34 @@ def public_url(url: str) -> str:
     return f"sim://{parts.netloc or parts.path.lstrip('/')} (training)"
 
 
+#: What the status bar, the machine window's banner and the Connection page call a sim:// drive.
+EMBEDDED_DRIVE = "embedded simulated drive"
+
+
+def drive_words(url: str, *, detail: bool = False) -> str:
+    """A drive's address as a person reads it: an embedded simulated drive in words, not by its
+    address full of options (an EEPROM file's path among them); any other address as it is.
+
+    ``detail`` adds its actuator and whether it has the friction the catalogue gives (TF, FHA-C
+    manual 2-4-4), which decides how it moves. A training drive says only that it is one: its
+    options could name the hidden faults."""
+    parts = urlsplit(url)
+    if parts.scheme.lower() != "sim":
+        return url
+    if not detail:
+        return EMBEDDED_DRIVE
+    actuator = unquote(parts.netloc or parts.path.lstrip("/")).split(" ")[0].strip()
+    named = f"{EMBEDDED_DRIVE} {actuator}" if actuator else EMBEDDED_DRIVE
+    query = parse_qs(parts.query)
+    if "training" in query or url.endswith("(training)"):  # public_url's form of a training drive
+        return f"{named} (training)"
+    try:
+        friction = _flag("catalogue_friction", query.get("catalogue_friction", ["0"])[-1])
+    except SimConfigError:  # not a drive that connected: nothing to say of its friction
+        return named
+    return f"{named}, {'with' if friction else 'without'} the catalogue's friction (TF, 2-4-4)"
+
+
 _URL_KEYS = {
     "driver", "load_inertia", "load_inertia_kgm2", "brake", "sensors", "origin_deg", "ls1_deg",
     "ls2_deg", "effects", "effect", "catalogue_friction", "eeprom", "paced", "stepped", "quantised",
