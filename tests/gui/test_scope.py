@@ -104,7 +104,7 @@ def _left_tick_labels(plot_item):
 @pytest.mark.parametrize("live", [False, True])
 def test_the_stacked_plots_tick_labels_do_not_overlap(qtbot, scope, sim_client, live):
     """One plot per unit, stacked: a plot's top tick label never sits on the one above's bottom
-    label (empty plots read "1.0" over "0" where they met)."""
+    label; empty plots have no tick labels (they read "1.0" over "0" where they met)."""
     view = scope(sim_client)
     view.show()
     qtbot.waitExposed(view)
@@ -116,6 +116,9 @@ def test_the_stacked_plots_tick_labels_do_not_overlap(qtbot, scope, sim_client, 
     items = view.time_plot.plot_items()
     assert len(items) >= 3
     labels = [_left_tick_labels(item) for item in items]
+    if not live:  # no sample yet: no numbers on the value axes, so none to clash
+        assert not any(labels), labels
+        return
     assert all(labels)
     for above, below in itertools.pairwise(labels):
         clashes = [(a, b) for a, ra in above for b, rb in below if ra.intersects(rb)]

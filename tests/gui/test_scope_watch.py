@@ -198,3 +198,37 @@ def test_an_empty_live_view_shows_its_time_base_before_now(make_window, qtbot):
     view.time_base.setCurrentIndex(view.time_base.findData(30.0))  # not live: the data's range stays
     x0, x1 = plot.view_box.viewRange()[0]
     assert 2.8 < x0 < 3.0 and 7.0 < x1 < 7.2
+
+
+def _values_shown(plot) -> bool:
+    return plot.getAxis("left").style["showValues"]
+
+
+def test_an_empty_plot_shows_no_value_range_until_its_data_arrives(make_window, qtbot):
+    """Without a sample each plot's value axis has no numbers (its 0 to 1 would read as a channel
+    measuring 0 to 1): the numbers come with the data, plot by plot, and go when it goes."""
+    window = make_window()
+    view = window.show_page("scope").view
+    plot = view.time_plot
+    items = plot.plot_items()
+    assert len(items) >= 2  # one plot per unit of the ticked channels
+    assert not any(_values_shown(item) for item in items)
+    by_key = {c.key: c for c in view.all_channels}
+    speed, position = by_key["output_speed"], by_key["feedback_position"]
+    t = np.linspace(3.0, 7.0, 41)
+    view.show_static([speed, position], np.column_stack([t, 10 * t, t + 90]), "a test capture", 10.0)
+    shown = plot.plot_items()
+    assert [plot.plot_of(c.key) is not None for c in (speed, position)] == [True, True]
+    assert all(_values_shown(item) for item in shown)
+    y0, y1 = plot.plot_of("output_speed").vb.viewRange()[1]
+    assert y0 < 30.0 and y1 > 70.0  # the data's range, not 0 to 1
+    view.back_to_live()  # no link: nothing arrives
+    assert not any(_values_shown(item) for item in plot.plot_items())
+
+
+def test_live_samples_give_each_plot_its_numbers(scope_window, qtbot):
+    _window, page = scope_window
+    view = page.view
+    view.start_live()
+    qtbot.waitUntil(lambda: all(_values_shown(item) for item in view.time_plot.plot_items()), timeout=20000)
+    view.stop_live()

@@ -51,6 +51,22 @@ class _UnitPlot:
         self.y_range: tuple[float, float] | None = None
         self.grid_lines: list[pg.InfiniteLine] = []
         self.cursors: tuple[pg.InfiniteLine, pg.InfiniteLine] | None = None
+        #: a curve of this plot holds a sample: until then its value axis has no numbers (an
+        #: empty plot's 0 to 1 would read as a channel that measures 0 to 1)
+        self.has_data = True
+        self._tick_length = item.getAxis("left").style["tickLength"]
+        self.show_data(False)
+
+    def show_data(self, has_data: bool) -> None:
+        """The value axis' numbers and ticks with data; neither without (no made-up divisions)."""
+        if has_data == self.has_data:
+            return
+        self.has_data = has_data
+        self.item.getAxis("left").setStyle(showValues=has_data,
+                                           tickLength=self._tick_length if has_data else 0)
+
+    def holds_samples(self) -> bool:
+        return any(curve.xData is not None and len(curve.xData) > 0 for curve in self.item.listDataItems())
 
     @property
     def view_box(self) -> pg.ViewBox:
@@ -174,7 +190,7 @@ class TimePlot(QWidget):
         for line in plot.grid_lines:
             plot.item.removeItem(line)
         plot.grid_lines = []
-        if not self._grid_on:
+        if not self._grid_on or not plot.has_data:  # an empty plot's lines would mark 0 to 1
             return
         _, (y0, y1) = plot.view_box.viewRange()
         levels = plot.item.getAxis("left").tickValues(y0, y1, max(50, plot.view_box.height()))
@@ -229,6 +245,16 @@ class TimePlot(QWidget):
                            f"{html.escape(label)}")
         self._legend_entries = entries
         self.set_note(note)
+        self._show_which_hold_data()
+
+    def _show_which_hold_data(self) -> None:
+        """Each plot's value axis gets its numbers with its first sample, and loses them when
+        its curves are emptied."""
+        for plot in self._plots:
+            had = plot.has_data
+            plot.show_data(plot.holds_samples())
+            if plot.has_data != had:
+                self._update_grid_lines(plot)
 
     def show_time_base(self, span_s: float) -> None:
         """Live: the time axis shows the time base, ``span_s`` before now to now, also before the
@@ -281,6 +307,7 @@ class TimePlot(QWidget):
                     self._follow_y(plot, lo, hi)
         if self._cursors_on:
             self._place_cursors()
+        self._show_which_hold_data()
 
     @staticmethod
     def _follow_y(plot: _UnitPlot, lo: float, hi: float) -> None:
@@ -301,6 +328,7 @@ class TimePlot(QWidget):
             curve = self._curves.get(c.key)
             if curve is not None:
                 curve.setData(rows[:, 0], rows[:, j + 1] * scale.get(c.key, 1.0))
+        self._show_which_hold_data()
 
     def fit(self, rows: np.ndarray | None, columns: Mapping[str, Sequence[int]] | Sequence[int],
             factors: Mapping[str, Sequence[float]] | Sequence[float], autoscale: bool) -> None:
@@ -326,6 +354,7 @@ class TimePlot(QWidget):
         self._live_span = None  # live: the next frame shows the time base again
         for plot in self._plots:
             plot.y_range = None
+        self._show_which_hold_data()
 
     def set_autoscale(self, on: bool) -> None:
         self.autoscale = bool(on)
@@ -452,6 +481,7 @@ class TimePlot(QWidget):
         if entries != self._bench_entries:
             self._bench_entries = entries
             self.set_note(self._note)
+        self._show_which_hold_data()
 
     def cursor_times(self) -> tuple[float, float]:
         """The cursors' times in the data's own time [s]."""
