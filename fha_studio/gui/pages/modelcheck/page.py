@@ -507,12 +507,7 @@ class ModelCheckPage(BasePage):
         self.effects_table.clearSpans()
         self.effects_table.setRowCount(0)
         self.findings.clear()
-        layout = self.gap_box.layout()
-        assert isinstance(layout, QVBoxLayout)
-        for plot in self.gap_plots.values():
-            layout.removeWidget(plot)
-            plot.deleteLater()
-        self.gap_plots.clear()
+        self._remove_gap_plots()
         self.gap_empty.setVisible(True)
 
     # ---------------------------------------------------------------- drawing
@@ -615,13 +610,19 @@ class ModelCheckPage(BasePage):
         table.resizeRowsToContents()
         self.findings.setPlainText("\n".join(_findings_in_words(r)))
 
-    def _draw_gap(self, r: ModelCheckResult) -> None:
+    def _remove_gap_plots(self) -> None:
+        """Take the held-out gap plots of the last result off the gap tab."""
         layout = self.gap_box.layout()
         assert isinstance(layout, QVBoxLayout)
         for plot in self.gap_plots.values():
             layout.removeWidget(plot)
             plot.deleteLater()
         self.gap_plots.clear()
+
+    def _draw_gap(self, r: ModelCheckResult) -> None:
+        self._remove_gap_plots()
+        layout = self.gap_box.layout()
+        assert isinstance(layout, QVBoxLayout)
         self.gap_empty.setVisible(not r.gap)
         for name, gap in r.gap.items():
             unit = unit_words(gap.unit)
