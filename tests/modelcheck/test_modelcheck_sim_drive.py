@@ -7,22 +7,14 @@ import pytest
 from fha_studio.hardware.sim import SimDrive
 from fha_studio.logic.modelcheck import run_modelcheck
 from fha_studio.recording import read_recording
+from tests.support.recorded_moves import record_moves
 
 
 def test_the_simulated_drive_recording_reveals_its_hidden_effect(tmp_path):
     path = tmp_path / "sim.csv"
     effects = {"coulomb_friction": {"torque_nm": 5.0}}
     with SimDrive("FHA-25C-50-US250", load_inertia_kgm2=1.5, effects=effects) as drive:
-        drive.set_servo(True)
-        drive.start_recording(path, 1000.0)
-        drive.advance(0.2)
-        for angle_deg, speed_rpm in [(120, 40), (-80, 20), (150, 60), (-190, 30), (60, 10)]:
-            drive.set_move_speed(speed_rpm)
-            drive.move_by(angle_deg)
-            while drive.moving:
-                drive.advance(0.05)
-            drive.advance(0.2)
-        drive.stop_recording()
+        record_moves(drive, path, [(120, 40), (-80, 20), (150, 60), (-190, 30), (60, 10)])
     result = run_modelcheck(read_recording(path), resimulate=False)
     assert [e.id for e in result.effects] == ["coulomb_friction"], result.summary_lines()
     assert abs(result.effects[0].params["torque_nm"] - 5.0) < 0.5
@@ -41,16 +33,7 @@ def test_the_simulated_drives_torque_sensor_tells_the_gear_from_the_load(tmp_pat
     effects = {"coulomb_friction": {"torque_nm": 5.0},
                "gravity_load": {"amplitude_nm": 20.0, "phase_deg": 30.0}}
     with SimDrive("FHA-25C-50-US250", load_inertia_kgm2=1.5, effects=effects) as drive:
-        drive.set_servo(True)
-        drive.start_recording(path, 1000.0, torque_sensor=True)
-        drive.advance(0.2)
-        for angle_deg, speed_rpm in [(120, 40), (-80, 20), (150, 60), (-190, 30), (60, 10)]:
-            drive.set_move_speed(speed_rpm)
-            drive.move_by(angle_deg)
-            while drive.moving:
-                drive.advance(0.05)
-            drive.advance(0.2)
-        drive.stop_recording()
+        record_moves(drive, path, [(120, 40), (-80, 20), (150, 60), (-190, 30), (60, 10)], torque_sensor=True)
     recording = read_recording(path)
     assert "torque" in recording.channels
     result = run_modelcheck(recording, resimulate=False)

@@ -24,6 +24,7 @@ from fha_studio.logic.modelcheck import run_modelcheck
 from fha_studio.physics.model import COULOMB_SHARE_OF_TF
 from fha_studio.recording import read_recording
 from tests.sim.conftest import advance
+from tests.support.recorded_moves import record_moves
 
 ACTUATOR = "FHA-25C-50-US250"
 JA_KGM2, KT_NM_PER_A = 0.81, 22.0
@@ -152,16 +153,7 @@ def test_the_model_check_names_the_friction_of_a_recording_of_such_a_drive(tmp_p
     within 5 %."""
     path = tmp_path / "friction.csv"
     with SimDrive(ACTUATOR, load_inertia_kgm2=1.5, catalogue_friction=True, stepped=True) as drive:
-        drive.set_servo(True)
-        drive.start_recording(path, 1000.0)
-        drive.advance(0.2)
-        for angle_deg, speed_rpm in [(200, 80), (-120, 20), (300, 60), (-250, 40), (90, 10), (-330, 90)]:
-            drive.set_move_speed(speed_rpm)
-            drive.move_by(angle_deg)
-            while drive.moving:
-                drive.advance(0.05)
-            drive.advance(0.2)
-        drive.stop_recording()
+        record_moves(drive, path, [(200, 80), (-120, 20), (300, 60), (-250, 40), (90, 10), (-330, 90)])
     result = run_modelcheck(read_recording(path), resimulate=False)
     found = {e.id: e.params for e in result.effects}
     assert set(found) == {"coulomb_friction", "viscous_friction"}, result.summary_lines()

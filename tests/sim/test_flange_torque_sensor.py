@@ -12,6 +12,7 @@ import pytest
 
 from fha_studio.hardware.parameters import MonitorItem
 from fha_studio.recording import read_recording
+from tests.support.recorded_moves import record_moves
 
 LOAD_KGM2 = 1.5
 GRAVITY_NM, PHASE_DEG, FRICTION_NM = 20.0, 30.0, 5.0
@@ -36,16 +37,7 @@ def test_monitor_111_reads_the_load_the_flange_holds_in_the_physical_sense(make_
 def test_the_recording_carries_the_sensors_torque_column(make_drive, tmp_path):
     drive = _drive(make_drive)
     path = tmp_path / "sensor.csv"
-    drive.set_servo(True)
-    drive.start_recording(path, 1000.0, torque_sensor=True)
-    drive.advance(0.2)
-    for angle_deg, speed_rpm in [(90, 30), (-60, 15)]:
-        drive.set_move_speed(speed_rpm)
-        drive.move_by(angle_deg)
-        while drive.moving:
-            drive.advance(0.05)
-        drive.advance(0.2)
-    drive.stop_recording()
+    record_moves(drive, path, [(90, 30), (-60, 15)], torque_sensor=True)
     rec = read_recording(path)
     torque = rec.channels["torque"]
     x = np.radians(rec.channels["load_pos"])
