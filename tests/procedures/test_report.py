@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from fha_studio.logic.procedures import ProcedureRun, ProcedureSession, load_procedure
-from fha_studio.logic.procedures.report import SignError, build_report, render_html, sign
+from fha_studio.logic.procedures.report import SignError, build_report, render_html, report_title, sign
 from tests.procedures.walk import walk
 
 ALL = ["receiving-inspection", "installation", "wiring", "sensor-adjustment", "rotary-direction"]
@@ -88,3 +88,15 @@ def test_options_that_do_not_apply_say_so(make_context):
     assert sensor.status == "not applicable"
     assert not any("Rotary position sensor" in w for w in report.warnings)
     assert "Does not apply to this actuator" in render_html(report)
+
+
+@pytest.mark.parametrize(("axis", "code", "title"), [
+    ("table", "FHA-25C-50-US250", "Commissioning report — table — FHA-25C-50-US250"),
+    # an axis nobody named is called by its actuator's code: the title says it once
+    ("FHA-25C-50-US250 (simulated)", "FHA-25C-50-US250",
+     "Commissioning report — FHA-25C-50-US250 (simulated)"),
+    ("fha-17c-100 on line 3", "FHA-17C-100", "Commissioning report — fha-17c-100 on line 3"),
+    ("axis 1", "", "Commissioning report — axis 1"),
+])
+def test_the_title_names_the_actuator_once(axis, code, title):
+    assert report_title(axis, code) == title

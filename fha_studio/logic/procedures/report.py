@@ -151,6 +151,15 @@ def _parameter_rows(session: ProcedureSession) -> tuple[str, tuple[ParameterRow,
     return str(params.get("file", "")), tuple(rows), problems
 
 
+def report_title(axis: str, actuator_code: str) -> str:
+    """The report's title: the axis and the actuator, the code once (an axis nobody named is
+    called by its actuator's code, and a title saying it twice reads as two actuators)."""
+    parts = [part for part in (axis.strip(), actuator_code.strip()) if part]
+    if len(parts) == 2 and parts[1].upper() in parts[0].upper():
+        parts.pop()
+    return " — ".join(["Commissioning report", *parts])
+
+
 def build_report(session: ProcedureSession, context: Mapping[str, Any] | None = None) -> CommissioningReport:
     """The report of ``session``; ``context`` defaults to the catalogue's for its actuator."""
     context = context if context is not None else _context_for(session)
@@ -185,7 +194,7 @@ def build_report(session: ProcedureSession, context: Mapping[str, Any] | None = 
         if not Path(plot["path"]).is_file():
             warnings.append(f"plot '{plot['title']}': file {plot['path']} is missing")
     return CommissioningReport(
-        title=f"Commissioning report — {session.axis} — {session.actuator_code}",
+        title=report_title(session.axis, session.actuator_code),
         axis=session.axis,
         site=session.site,
         operator=session.operator,
