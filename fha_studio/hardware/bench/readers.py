@@ -28,7 +28,9 @@
   digital channels: ``Time [s],Channel 0,...`` or the channels' own names, ``Time[s], Channel 0``
   in Logic 1.x): every channel 0 or 1, one row per change, the first row the state at the start.
   It states no sample rate: the changes are put on a grid of the finest interval between them
-  (the capture's ``form`` says the rate), refused when that grid exceeds :data:`MAX_SAMPLES`;
+  (the capture's ``form`` says the rate), or, where that grid would exceed
+  :data:`CHANGES_GRID_MAX_SAMPLES` (a glitch of a few ns in a long capture), on a coarser one that
+  drops pulses shorter than its step, counted;
   :func:`on_grid` samples it (or a VCD) at another file's rate. Saleae's analog export is one row
   per sample: a generic CSV.
 - **Rigol** (DS1000Z, MSO5000, DS2000): ``X,CH1,CH2,Start,Increment,`` over
@@ -70,6 +72,10 @@ from fha_studio.hardware.bench.capture import Capture, CaptureError, SampleBlock
 MAX_CAPTURE_BYTES = 4 * 1024**3
 #: Samples a capture may expand to (VCD and CSV): a minute at 24 MS/s and more.
 MAX_SAMPLES = 2_000_000_000
+#: Samples a logic analyzer's export of changes is put on at most: finer than its finest interval
+#: between changes would be, it takes a coarser grid (a glitch of a few ns in a long capture would
+#: otherwise ask for billions of samples), as an analyzer sampling at that rate would see it.
+CHANGES_GRID_MAX_SAMPLES = 50_000_000
 #: A generic CSV's time column may stray this fraction of a sample interval from a steady rate.
 TIME_JITTER = 0.5
 
@@ -870,28 +876,50 @@ def _changes(table: np.ndarray, t: np.ndarray, names: list[str], time_column: in
              lines: Sequence[bytes], start: int, comment: str) -> Capture:
     """Changes put on a sample grid, each state held until the next change. Saleae's export states
     no sample rate: the grid is the finest interval between changes (6 significant digits: the
-    file's times are printed to the ns), so no two changes share a sample."""
+    file's times are printed to the ns), so no two changes share a sample. Where that grid would
+    hold more than :data:`CHANGES_GRID_MAX_SAMPLES` (a glitch of a few ns in a long capture), it is
+    the coarsest 1-2-5 step within them: changes closer than one step share a sample, the last one
+    holding (a pulse that short is dropped, as an analyzer at that rate would not see it), counted
+    in the capture's ``form``."""
     steps = np.diff(t)
     if not np.all(steps > 0):
         i = int(np.flatnonzero(~(steps > 0))[0]) + 1
         raise CaptureError(f"{name}: line {_data_line(lines, start, i, comment)}: time {t[i]:.9g} s after "
                            f"{t[i - 1]:.9g} s: the changes of a logic analyzer's export go forward in time")
-    step = float(f"{float(steps.min()):.6g}")
-    rate = 1.0 / step
+    finest = float(f"{float(steps.min()):.6g}") if steps.size else 1.0
     span = float(t[-1] - t[0])
-    n = round(span / step) + 1
-    if n > MAX_SAMPLES:
-        grid = _rate_text(float(f"{rate:.9g}"))
-        raise CaptureError(f"{name}: changes {step:.6g} s apart at the closest over {span:.6g} s: {n} "
-                           f"samples on that grid ({grid}), more than the {MAX_SAMPLES} a capture may hold")
+    step = finest
+    if round(span / finest) + 1 > CHANGES_GRID_MAX_SAMPLES:
+        step = max(finest, _step_up(span / (CHANGES_GRID_MAX_SAMPLES - 1)))
+    rate = 1.0 / step
     at = np.rint((t - t[0]) / step).astype(np.int64)
+    merged = int(np.count_nonzero(at[1:] == at[:-1]))
+    n = int(at[-1]) + 1
     logic_names = [label for column, label in enumerate(names) if column != time_column]
     # each change's state packed first (one word per row), then held: n words, not n per channel
     words = pack_logic([table[:, column] == 1 for column in range(len(names)) if column != time_column])
     block = SampleBlock(rate, tuple(logic_names), _held(at, words, n, words.dtype.type), {})
     form = (f"logic analyzer CSV of changes, sampled at {_rate_text(float(f'{rate:.9g}'))} (the finest "
             "interval between them)")
+    if step > finest:
+        form = (f"logic analyzer CSV of changes, sampled at {_rate_text(float(f'{rate:.9g}'))}: its finest "
+                f"interval, {_seconds_text(finest)}, would make {round(span / finest) + 1} samples; "
+                f"{merged} {'change' if merged == 1 else 'changes'} within {_seconds_text(step)} of the "
+                "next dropped (a pulse that short is a glitch)")
     return Capture(name, block, {}, float(t[0]), form, changes=True)
+
+
+def _step_up(seconds: float) -> float:
+    """The 1-2-5 step at or above ``seconds``: a grid a person reads as a rate."""
+    decade = 10.0 ** math.floor(math.log10(seconds))
+    return next(float(f"{m * decade:.3g}") for m in (1, 2, 5, 10) if m * decade >= seconds * (1 - 1e-9))
+
+
+def _seconds_text(seconds: float) -> str:
+    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("µs", 1e-6)):
+        if seconds >= scale:
+            return f"{seconds / scale:.3g} {unit}"
+    return f"{seconds / 1e-9:.3g} ns"
 
 
 # ------------------------------------------------------------------------- oscilloscopes' layouts

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from fha_studio.catalog import get_actuator
+from fha_studio.hardware.bench import readers
 from fha_studio.hardware.bench.readers import read_capture
 from fha_studio.hardware.sim.cn2 import RAD_S_PER_RPM, Cn2Settings, VirtualBenchInstrument
 from fha_studio.logic.bench.importer import AxisFacts, DriveSettings, SignalSpec, import_bench
@@ -129,6 +130,38 @@ def test_a_saleae_export_of_changes_is_put_on_the_finest_interval(drive, logic1,
     roles = {r: c for r, c in {**SCOPE_A, **SCOPE_B}.items() if r != "speed_monitor"}
     index = {c: names[block.logic_channels.index(c)] for c in roles.values()}
     signals = [SignalSpec(role, str(path), index[c]) for role, c in roles.items()]
+    result = import_bench(signals, AxisFacts.for_actuator(CODE), _settings())
+    _check(result, instrument, axis, speed=False)
+
+
+def test_a_glitch_of_a_few_ns_in_a_saleae_export_is_dropped_not_refused(drive, tmp_path, monkeypatch):
+    """A 2 ns spike on ENC_A (line ringing): its finest interval would put the capture on billions
+    of samples in a long capture; it is put on the coarsest 1-2-5 grid within the limit (here made
+    small, so that the grid is the instrument's own 5 us), the spike dropped and said."""
+    axis, instrument = drive
+    block = instrument.capture()
+    path = layouts.write_saleae_digital(tmp_path / "digital.csv", block)
+    lines = path.read_text().splitlines()
+    column = lines[0].split(",").index("ENC_A")
+    k = len(lines) // 2
+    fields = lines[k].split(",")
+    spike = list(fields)
+    spike[column] = "1" if fields[column] == "0" else "0"
+    at_s = float(fields[0])
+    lines[k + 1 : k + 1] = [
+        ",".join([f"{at_s + 2e-9:.9f}", *spike[1:]]), ",".join([f"{at_s + 4e-9:.9f}", *fields[1:]])
+    ]
+    path.write_text("\n".join(lines) + "\n")
+    last_change = int(np.flatnonzero(np.diff(block.logic.astype(np.int64)))[-1]) + 1
+    # a limit that makes the grid a 4 us step at the finest, so 5 us on the 1-2-5 series
+    monkeypatch.setattr(readers, "CHANGES_GRID_MAX_SAMPLES", round(last_change * 5e-6 / 4e-6) + 1)
+    capture = read_capture(path)
+    assert capture.sample_rate_hz == pytest.approx(instrument.sample_rate_hz, rel=1e-9)
+    assert "its finest interval, 2 ns," in capture.form
+    assert "2 changes within 5 µs of the next dropped (a pulse that short is a glitch)" in capture.form
+    assert np.array_equal(capture.block.logic, block.logic[: last_change + 1])
+    roles = {r: c for r, c in {**SCOPE_A, **SCOPE_B}.items() if r != "speed_monitor"}
+    signals = [SignalSpec(role, str(path), c) for role, c in roles.items()]
     result = import_bench(signals, AxisFacts.for_actuator(CODE), _settings())
     _check(result, instrument, axis, speed=False)
 
