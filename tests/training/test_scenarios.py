@@ -55,7 +55,7 @@ def _write(tmp_path: Path, text: str, name: str = "error-allowance") -> Path:
     [
         (
             ('kind = "position_error_allowance"', 'kind = "gremlins"'),
-            r":23: \[\[fault\]\] allowance: kind 'gremlins' is not one of rotary_direction, ",
+            r":24: \[\[fault\]\] allowance: kind 'gremlins' is not one of rotary_direction, ",
         ),
         (
             ('sim = { preset = "system.6=1" }', 'sim = { wiring = "motor_open" }'),
