@@ -76,6 +76,17 @@ def private_folder() -> str:
     return folder
 
 
+def users_sim_drive(actuator_code: str, load_inertia_kgm2: float = 0.0, documented: bool = False,
+                    **options: str) -> str:
+    """The simulated drive a person gets from the Connect dialog as it is first shown (its
+    defaults, the catalogue's friction among them: ``connect_dialog.sim_url``), for
+    ``actuator_code``, with ``options`` added (``paced="0"``: the pictures need no 19200 baud
+    pacing). Call it after :func:`private_folder` (it imports FHA Studio)."""
+    from fha_studio.gui.connect_dialog import sim_url
+
+    return sim_url(actuator_code, load_inertia_kgm2, documented=documented, **options)
+
+
 def _exit_on_signal(number: int, _frame: Any) -> None:
     raise SystemExit(128 + number)
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from shots import ScreenshotRun, private_folder
+from shots import ScreenshotRun, private_folder, users_sim_drive
 
 TMP = private_folder()
 
@@ -22,7 +22,7 @@ def main() -> int:
     window, wait_until, settle, shot = run.window, run.wait_until, run.settle, run.shot
     from fha_studio.gui.link import Servo
 
-    window.connect_to("sim://FHA-25C-50-US250?paced=0")
+    window.connect_to(users_sim_drive("FHA-25C-50-US250", paced="0"))
     wait_until(lambda: len(window.state.drive_values) >= 14, "the drive's values", 60.0)
     window.show_page("connection")
     shot("connection")

@@ -15,11 +15,11 @@ temporary directory, never the user's.
 
 from __future__ import annotations
 
-from shots import ScreenshotRun, private_folder
+from shots import ScreenshotRun, private_folder, users_sim_drive
 
 TMP = private_folder()
 CODE = "FHA-25C-50-S248"  # absolute: CN3 gives the position (DGR) while the servo is off
-URL = f"sim://{CODE}?paced=0&profile=documented"
+URL = users_sim_drive(CODE, documented=True, paced="0")
 
 
 def main() -> int:

@@ -9,10 +9,11 @@ data go to a temporary directory, never the user's.
 
 from __future__ import annotations
 
-from shots import ScreenshotRun, private_folder
+from shots import ScreenshotRun, private_folder, users_sim_drive
 
 TMP = private_folder()
-URL = f"sim://FHA-25C-50-S248?paced=0&profile=documented&sensors=1&oww_clear_s=5&eeprom={TMP}/eeprom.json"
+URL = users_sim_drive("FHA-25C-50-S248", documented=True, paced="0", sensors="1", oww_clear_s="5",
+                      eeprom=f"{TMP}/eeprom.json")
 
 
 def main() -> int:

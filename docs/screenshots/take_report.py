@@ -13,7 +13,7 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
-from shots import OUT, ScreenshotRun, private_folder, reports_show_plausible_paths
+from shots import OUT, ScreenshotRun, private_folder, reports_show_plausible_paths, users_sim_drive
 
 TMP = private_folder()
 CODE = "FHA-25C-50-US250"
@@ -27,7 +27,7 @@ def main() -> int:
     from fha_studio.logic.procedures import ProcedureRun, load_procedure
     from tests.procedures.walk import walk
 
-    window.connect_to(f"sim://{CODE}?paced=0")
+    window.connect_to(users_sim_drive(CODE, paced="0"))
     run.wait_until(lambda: len(window.state.drive_values) >= 14, "the drive's values", 20.0)
     direction = window.show_page("direction")
     direction.answer("cw")  # FWD turned the flange CW, as parameter 8 = 0 says

@@ -9,10 +9,11 @@ Settings and data go to a temporary directory, never the user's.
 
 from __future__ import annotations
 
-from shots import ScreenshotRun, private_folder
+from shots import ScreenshotRun, private_folder, users_sim_drive
 
 TMP = private_folder()
-URL = "sim://FHA-25C-50-US250?load_inertia=0.5&effects=kinematic_error:amplitude_arcsec=40,cycles_per_motor_rev=2"
+URL = users_sim_drive("FHA-25C-50-US250", 0.5,
+                      effects="kinematic_error:amplitude_arcsec=40,cycles_per_motor_rev=2")
 
 
 def main() -> int:

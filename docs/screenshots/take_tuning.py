@@ -9,10 +9,10 @@ Settings and data go to a temporary directory, never the user's.
 
 from __future__ import annotations
 
-from shots import ScreenshotRun, private_folder
+from shots import ScreenshotRun, private_folder, users_sim_drive
 
 TMP = private_folder()
-URL = "sim://FHA-25C-50-US250?paced=0&load_inertia=0.81&effects=torsional_compliance"
+URL = users_sim_drive("FHA-25C-50-US250", 0.81, paced="0", effects="torsional_compliance")
 
 
 def main() -> int:

@@ -10,11 +10,11 @@ Settings and data go to a temporary directory, never the user's.
 
 from __future__ import annotations
 
-from shots import ScreenshotRun, private_folder
+from shots import ScreenshotRun, private_folder, users_sim_drive
 
 TMP = private_folder()
 CODE = "FHA-25C-50-US250"
-URL = f"sim://{CODE}?paced=0&profile=documented"
+URL = users_sim_drive(CODE, documented=True, paced="0")
 LOAD = 0.81
 
 
@@ -23,6 +23,7 @@ def main() -> int:
     window, wait_until = run.window, run.wait_until
     from fha_studio.hardware.sim.cn2 import record_playback
     from fha_studio.hardware.sim.drive import SimDrive
+    from fha_studio.hardware.sim.options import config_from_url
 
     window.connect_to(URL)
     wait_until(lambda: window.link.connected, "the connection", 20.0)
@@ -33,7 +34,9 @@ def main() -> int:
     bench = page.bench
     excitation = bench.write_excitation(f"{TMP}/excitation.csv")
     print("playing the excitation on the simulated bench", flush=True)
+    # the bench's axis is the window's drive (its friction too), in speed mode, on the gear's spring
     with SimDrive(CODE, load_inertia_kgm2=LOAD, effects={"torsional_compliance": {}},
+                  catalogue_friction=config_from_url(URL).catalogue_friction,
                   preset=(("system", 0, 1),)) as drive:
         drive.set_servo(True)
         drive.advance(0.05)

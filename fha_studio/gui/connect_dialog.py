@@ -40,15 +40,20 @@ def catalogue_codes() -> list[str]:
     return all_model_codes()
 
 
+#: A person's simulated drive has the friction the catalogue gives (TF, 2-4-4) unless they
+#: untick it: the tool's default axis is a realistic one (a bare sim:// is frictionless).
+SIM_FRICTION_BY_DEFAULT = True
+
+
 def sim_url(actuator_code: str, load_inertia_kgm2: float = 0.0, documented: bool = False,
-            catalogue_friction: bool = True) -> str:
+            catalogue_friction: bool = SIM_FRICTION_BY_DEFAULT, **options: str) -> str:
     """The embedded simulated drive for ``actuator_code`` with the declared load inertia [kg m^2]
     on its output (none when 0); ``documented``: its profile of a real HA-655 (DGR and OWW only);
-    ``catalogue_friction``: the friction the catalogue gives (TF, 2-4-4), on for a person (the
-    tool's default axis is a realistic one); off, the axis is frictionless (a bare sim://)."""
+    ``catalogue_friction``: the friction the catalogue gives (TF, 2-4-4); ``options``: any other
+    sim:// option (docs/sim.md), e.g. ``paced="0"``, added as given."""
     query = ([f"load_inertia={load_inertia_kgm2!r}"] if load_inertia_kgm2 > 0 else []) + (
         ["catalogue_friction=1"] if catalogue_friction else []) + (
-        ["profile=documented"] if documented else [])
+        ["profile=documented"] if documented else []) + [f"{key}={value}" for key, value in options.items()]
     url = f"sim://{actuator_code.strip().upper()}"
     return f"{url}?{'&'.join(query)}" if query else url
 
@@ -118,7 +123,8 @@ class ConnectDialog(QDialog):
         kind = str(settings.value("connect/kind", "sim"))
         actuator = settings.value("connect/actuator", DEFAULT_ACTUATOR)
         self.sim_actuator.setCurrentText(str(actuator))
-        self.sim_friction.setChecked(str(settings.value("connect/sim_friction", "true")) == "true")
+        default_friction = "true" if SIM_FRICTION_BY_DEFAULT else "false"
+        self.sim_friction.setChecked(str(settings.value("connect/sim_friction", default_friction)) == "true")
         self.sim_documented.setChecked(str(settings.value("connect/sim_documented", "false")) == "true")
         port = settings.value("connect/port", "")
         index = self.port_combo.findData(port)
