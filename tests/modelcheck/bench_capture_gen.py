@@ -17,6 +17,7 @@ from pathlib import Path
 from fha_studio.hardware.parameters import load_parameter_model
 from fha_studio.hardware.sim.cn2 import VirtualBenchInstrument
 from fha_studio.hardware.sim.drive import SimDrive
+from fha_studio.hardware.sim.io import BIT_BRAKE_RELEASED
 from fha_studio.logic.bench.importer import AxisFacts, DriveSettings, SignalSpec, import_bench
 from fha_studio.logic.paramfile import dump_parameter_file
 from fha_studio.recording import Recording, read_recording, write_recording
@@ -36,6 +37,10 @@ PARAMETERS = {
     4: "electronic_gear_denominator",
     9: "speed_conversion_factor",
 }
+#: the ALARM line, recorded when a case ends in an alarm (the axis then coasts)
+ALARM_ROLES = {"alarm": "ALARM"}
+#: the alarm raised at speed (60: the deviation counter overflowed, as a blocked or runaway axis trips it)
+COAST_ALARM = 60
 #: the lines of an external encoder on the output flange, when the bench has one
 LOAD_ROLES = {"load_encoder_a": "LOAD_A", "load_encoder_b": "LOAD_B"}
 #: its counts per output turn (x4): a 131072-line encoder, 2.5 arcsec a count
@@ -64,15 +69,31 @@ class BenchCase:
     axis: BenchAxis
     effects: dict[str, dict[str, float]] = field(default_factory=dict)
     load_encoder: bool = False  # an external encoder on the output flange
+    #: after the program, a move at ``coast_rpm`` (output r/min), an alarm at that speed and this
+    #: much more recorded while the de-energised axis coasts (0: no alarm, no ALARM line recorded)
+    coast_s: float = 0.0
+    coast_rpm: float = 0.0
+    #: the controller drops the brake's 24 V with the alarm (an actuator with the brake option)
+    brake: bool = False
+    catalogue_friction: bool = False
 
     @property
     def name(self) -> str:
-        return f"{self.axis.name}-{'+'.join(self.effects) or 'none'}{'-loadenc' if self.load_encoder else ''}"
+        name = f"{self.axis.name}-{'+'.join(self.effects) or 'none'}{'-loadenc' if self.load_encoder else ''}"
+        if self.catalogue_friction:
+            name += "-catalogue"
+        if self.coast_s:
+            name += f"-coast{self.coast_s:g}s-{self.coast_rpm:g}rpm{'-brake' if self.brake else ''}"
+        return name
 
     def url(self) -> str:
         url = f"sim://{self.axis.code}?load_inertia={self.axis.load_kgm2:g}&stepped=1&paced=0"
         if self.axis.preset:
             url += f"&preset={self.axis.preset}"
+        if self.catalogue_friction:
+            url += "&catalogue_friction=1"
+        if self.brake:
+            url += "&brake=1"
         if self.effects:
             url += "&effects=" + ";".join(
                 f"{effect}:" + ",".join(f"{k}={v:g}" for k, v in params.items())
@@ -118,7 +139,7 @@ def make_capture(case: BenchCase, directory: Path) -> BenchCapture:
     try:
         model = drive.model
         counts_per_motor_turn = round(model.output_resolution_ppr / (model.ratio or 1))
-        top_motor_rpm = case.axis.top_rpm * (model.ratio or 1)
+        top_motor_rpm = max(case.axis.top_rpm, case.coast_rpm) * (model.ratio or 1)
         edges = VirtualBenchInstrument.fastest_edges_hz(top_motor_rpm, counts_per_motor_turn)
         load_counts = LOAD_COUNTS_PER_TURN if case.load_encoder else None
         if load_counts:
@@ -129,6 +150,8 @@ def make_capture(case: BenchCase, directory: Path) -> BenchCapture:
         instrument = VirtualBenchInstrument.on_drive(
             drive, rate, load_counts_per_turn=load_counts, speed_monitor=False
         )
+        if case.brake:
+            drive.set_inputs(1 << BIT_BRAKE_RELEASED)  # 24 V on the brake: released while the servo runs
         drive.set_servo(True)
         instrument.keep(0.4)  # standing: the servo holds, the integrator settles
         accel = ACCEL_SHARE_OF_MAX_TORQUE * model.max_torque_nm / model.total_inertia_kgm2 * 30.0 / math.pi
@@ -139,6 +162,8 @@ def make_capture(case: BenchCase, directory: Path) -> BenchCapture:
             while drive.moving:
                 instrument.keep(0.02)
             instrument.keep(dwell)
+        if case.coast_s:
+            _coast(drive, instrument, case, accel)
         instrument.write(capture, "sr")
         values = {("system", n): drive.memory.value(key) for n, key in PARAMETERS.items()}
         parameters = directory / f"{case.name}.params.toml"
@@ -151,7 +176,7 @@ def make_capture(case: BenchCase, directory: Path) -> BenchCapture:
         parameters.write_text(dump_parameter_file(model_items, items, case.axis.code, drive.resolved.driver))
     finally:
         drive.close()
-    roles = {**ROLES, **(LOAD_ROLES if case.load_encoder else {})}
+    roles = {**ROLES, **(LOAD_ROLES if case.load_encoder else {}), **(ALARM_ROLES if case.coast_s else {})}
     result = import_bench(
         [SignalSpec(role, str(capture), channel) for role, channel in roles.items()],
         AxisFacts.for_actuator(case.axis.code),
@@ -161,3 +186,17 @@ def make_capture(case: BenchCase, directory: Path) -> BenchCapture:
     path = directory / f"{case.name}.csv"
     write_recording(path, result.recording)
     return BenchCapture(read_recording(path).with_declared_load(case.axis.load_kgm2), capture, parameters)
+
+
+def _coast(drive: SimDrive, instrument: VirtualBenchInstrument, case: BenchCase, accel_rpm_s: float) -> None:
+    """A long move at the case's coast speed, the alarm once the axis runs steadily at it, and the
+    coast recorded (the controller stops sending pulses: the drive is in alarm)."""
+    drive.write_parameter("test", 1, max(1, round(accel_rpm_s)))
+    drive.set_move_speed(case.coast_rpm)
+    drive.controller_command(720.0)
+    instrument.keep(case.coast_rpm / accel_rpm_s + 0.15)  # up to speed, the loop settled
+    assert drive.moving, "the coast's move ended before the alarm"
+    drive.raise_alarm(COAST_ALARM)
+    if case.brake:
+        drive.set_inputs(0)  # the controller takes the brake's 24 V away with the alarm: it holds
+    instrument.keep(case.coast_s)

@@ -214,13 +214,21 @@ def loop_of(fit: LoopFit, model: AxisModel, panel: ServoSettings | None, inertia
     )
 
 
-def not_identifiable_lines(axis: DeclaredAxis, sensor: bool = False, load_encoder: bool = True) -> list[str]:
+def not_identifiable_lines(
+    axis: DeclaredAxis, sensor: bool = False, load_encoder: bool = True, coast: bool = False
+) -> list[str]:
     """What a recording without current cannot show; ``sensor``: it has an output torque sensor,
     which measures the load's side (then only the gear is read through the loop); ``load_encoder``:
-    it has the load's position (else the gear's own errors are not seen either)."""
+    it has the load's position (else the gear's own errors are not seen either); ``coast``: a coast
+    after an alarm showed viscous friction (coast.py)."""
     viscous = (
         "viscous friction reads like the lag of the drive's speed detection (a lag makes the loop "
         "push as a drag would pull), so it trades off against the loop's gains"
+        + (
+            " (with the servo on: the coast after the alarm shows it, above)"
+            if coast
+            else "; a coast from speed after an alarm, with the ALARM line recorded, shows it"
+        )
     )
     gear = (
         []

@@ -59,6 +59,7 @@ class Effect:
     size: float  # typical magnitude in the channel unit
     alternatives: list[str] = field(default_factory=list)  # not separable from these
     advice: str = ""  # one line for a person: what to do next
+    basis: str = ""  # where it was read, when not from the whole recording (a coast after an alarm)
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -71,6 +72,7 @@ class Effect:
             "size": self.size,
             "not_separable_from": list(self.alternatives),
             "what_to_do_next": self.advice,
+            **({"read_from": self.basis} if self.basis else {}),
         }
 
 
@@ -129,6 +131,28 @@ class Gap:
     measured: np.ndarray  # residual of the nominal model (what the updated model must explain)
     predicted_heldout: np.ndarray  # the updated model's held-out prediction of it
     blocks: list[tuple[float, float]]  # time spans of the held-out blocks
+
+
+@dataclass
+class CoastGap:
+    """A coast after an alarm (servo off): its speed from its start, recorded and as the nominal
+    model (no friction) and the updated one give it, in output r/min."""
+
+    alarm_s: float
+    t_s: np.ndarray
+    speed_measured_rpm: np.ndarray
+    speed_nominal_rpm: np.ndarray
+    speed_updated_rpm: np.ndarray
+    rms_before_rpm: float
+    rms_after_rpm: float
+
+    def line(self, to: str) -> str:
+        return (
+            f"Coast after the alarm at {self.alarm_s:.2f} s ({self.t_s[-1] - self.t_s[0]:.2f} s from "
+            f"{abs(self.speed_nominal_rpm[0]):.3g} r/min): speed against the recorded one "
+            f"{fmt(self.rms_before_rpm)}{to}{fmt(self.rms_after_rpm)} r/min rms "
+            f"(nominal model, no friction{to}updated model, from the coast's start)"
+        )
 
 
 @dataclass
@@ -225,6 +249,7 @@ class ModelCheckResult:
     not_seen: list[str] = field(default_factory=list)  # what this recording cannot show, and what would
     torque_basis: str = ""  # what the torques in N m rest on, when no torque was measured
     loop: Any = None  # the closed loop identified from a recording without current (closedloop.Loop)
+    coasts: list[CoastGap] = field(default_factory=list)  # the coasts after alarms that told something
 
     @property
     def found(self) -> bool:
@@ -239,7 +264,8 @@ class ModelCheckResult:
         lines = self._status_lines()
         by_channel: dict[str, Effect] = {}
         for e in self.effects:
-            by_channel.setdefault(e.channel, e)
+            if not e.basis:  # one read elsewhere (a coast) is not what the channel's gap measures
+                by_channel.setdefault(e.channel, e)
         for e in self.effects:
             p = next(iter(e.params))
             main = fmt_pm(e.params[p], e.uncertainty[p], unit(e.units[p]))
@@ -248,7 +274,9 @@ class ModelCheckResult:
                 for k, v in e.params.items()
                 if k != p
             )
-            if self.torque_basis and e.units.get(p) == "N m" and not e.label.endswith(" at the load"):
+            if e.basis:
+                main += f" ({e.basis})"
+            elif self.torque_basis and e.units.get(p) == "N m" and not e.label.endswith(" at the load"):
                 main += f" ({self.torque_basis})"
             text = f"{e.label} missing: {main}" + (f" ({others})" if others else "")
             if e.alternatives:
@@ -323,6 +351,7 @@ class ModelCheckResult:
                 f"Re-simulation of the recorded {r.command}: torque {fmt(r.rms_nominal_nm)}{to}"
                 f"{fmt(r.rms_updated_nm)} {unit('N m')} rms (nominal{to}updated model)"
             )
+        lines.extend(c.line(to) for c in self.coasts)
         lines.extend(self.notes)
         return lines
 
@@ -423,6 +452,11 @@ class ModelCheckResult:
                 "feed_forward": self.loop.feed_forward,
             },
             "torque_basis": self.torque_basis,
+            "coasts": [
+                {"alarm_s": c.alarm_s, "speed_rms_nominal_rpm": c.rms_before_rpm,
+                 "speed_rms_updated_rpm": c.rms_after_rpm}
+                for c in self.coasts
+            ],
             "not_named": [r.to_json() for r in self.refused],
             "not_seen": list(self.not_seen),
             "notes": list(self.notes),

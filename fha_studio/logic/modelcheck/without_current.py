@@ -18,6 +18,7 @@ from fha_studio.logic.modelcheck.closedloop import (
     loop_of,
     not_identifiable_lines,
 )
+from fha_studio.logic.modelcheck.coast import coast_gaps, coast_spans, name_from_coasts
 from fha_studio.logic.modelcheck.consistency import RESIM_TOLERANCE_OF_FLOOR, Refused, settle
 from fha_studio.logic.modelcheck.excitation import excitation_of
 from fha_studio.logic.modelcheck.loopfit import (
@@ -53,8 +54,16 @@ TARGET_DECIMATED = 1000
 def run_without_current(
     rec: Recording, axis: DeclaredAxis, notes: list[str], *, servo: ServoSettings | None, resimulate: bool
 ) -> ModelCheckResult:
-    """The model check of a recording that has the command and the position but no current."""
+    """The model check of a recording that has the command and the position but no current.
+
+    The closed loop is read before the first alarm: from it on the servo is off and the axis
+    coasts (coast.py reads friction from the coasts)."""
     model = axis.model
+    whole = rec
+    coasts = coast_spans(rec)
+    if coasts:
+        rec = rec.slice(0, coasts[0].onset)
+        notes = [_servo_on_line(whole, coasts), *notes]
     sig = closed_loop_signals(rec, axis)
     n = len(sig.t_s)
     # the following error the loop leaves is smooth (the analysis bandwidth): decimated to about
@@ -200,6 +209,9 @@ def run_without_current(
     wf._hold_to_the_set(found, None, floor_t)
     if found.effects and not loop.plausible:
         _refuse(found, "the closed loop is not pinned down by this recording")
+    from_coasts = name_from_coasts(whole, coasts, axis, floor_t, found.effects)
+    found.effects.extend(from_coasts.effects)
+    notes = [*from_coasts.lines, *notes]
     updated = wf._updated_model(model, found.effects)
     filt = sig.filt
     return ModelCheckResult(
@@ -224,14 +236,31 @@ def run_without_current(
         window_reason="fixed without a current: the acceleration sets what the loop's torque can show",
         refused=found.refused,
         not_seen=[
-            *not_identifiable_lines(axis, sensor is not None, rec.load_pos_deg is not None),
+            *not_identifiable_lines(
+                axis, sensor is not None, rec.load_pos_deg is not None, coast=from_coasts.viscous_shown
+            ),
             *_saturation(sig, axis),
             *excitation.lines(),
         ],
         torque_basis=f"on the declared {'' if sensor is None else 'actuator '}inertia "
         f"{(j if sensor is None else j_gear):.4g} kg m^2",
         loop=loop,
+        coasts=coast_gaps(from_coasts.fits, j, found.effects),
     )
+
+
+def _servo_on_line(rec: Recording, coasts) -> str:
+    """Where the closed loop was read, and what of the recording it leaves out."""
+    t = rec.t_s
+    first = float(t[coasts[0].onset])
+    text = f"The closed loop is read from the recording before the alarm at {first:.2f} s (the servo was on)"
+    after = coasts[-1].stop < len(t)
+    if after:
+        text += (
+            f"; after the ALARM line went off at {float(t[coasts[-1].stop]):.2f} s the recording does "
+            "not say when the servo came back on: that part is left out"
+        )
+    return text + "."
 
 
 #: the loop is linear only while the current stays within its limit
