@@ -10,7 +10,7 @@ from fha_studio.catalog import get_actuator
 from fha_studio.gui.pages.base import PageId
 from fha_studio.hardware.sim.cn2 import Cn2Settings, VirtualBenchInstrument
 from fha_studio.logic.bench.importer import AxisFacts, DriveSettings, SignalSpec, import_bench
-from fha_studio.physics import AxisModel, ServoAxis
+from fha_studio.physics import AxisModel, Effects, ServoAxis
 from fha_studio.recording import write_recording
 
 CODE = "FHA-25C-50-US250"
@@ -100,3 +100,44 @@ def test_a_model_check_plot_of_hundredths_of_a_newton_metre_reads_them_as_they_a
     qtbot.waitUntil(lambda: plot.getPlotItem().viewRange()[1][1] < 1.0, timeout=10000)
     label = plot.getPlotItem().getAxis("left").labelString()
     assert "N·m" in label and "(x" not in label
+
+
+def test_the_coast_after_an_alarm_is_shown_beside_the_gaps(make_window, qtbot, tmp_path):
+    """A capture with the ALARM line: the move, an alarm at speed and the axis coasting with a
+    viscous drag the servo-on part cannot see. The page names it with where it was read, and the
+    gap tab shows the coast's speed, recorded and from each model, in r/min."""
+    model = AxisModel.from_actuator(get_actuator(CODE), load_inertia_kgm2=0.3)
+    drag = Effects().with_effect("viscous_friction", coefficient_nm_s_per_rad=2.0)
+    axis = ServoAxis(model.with_effects(drag))
+    axis.servo_on()
+    alarm = [0]
+    instrument = VirtualBenchInstrument(axis, 200e3, Cn2Settings(pulse_form=0), alarm=lambda: alarm[0])
+    instrument.record(0.03)
+    axis.move_by_pulses(90000, speed_rad_s=8 * RPM)
+    instrument.record(0.3)
+    alarm[0] = 60  # the deviation counter overflowed: the drive de-energises the motor
+    axis.servo_off()
+    instrument.record(0.4)
+    capture = tmp_path / "coast.sr"
+    instrument.write(capture, "sr")
+    roles = {"encoder_a": "ENC_A", "encoder_b": "ENC_B", "command_a": "CMD_A", "command_b": "CMD_B",
+             "in_position": "IN_POS", "alarm": "ALARM"}
+    result = import_bench([SignalSpec(r, str(capture), c) for r, c in roles.items()],
+                          AxisFacts.for_actuator(CODE), DriveSettings(0, 4, 1, 1, 3000.0))
+    path = tmp_path / "coast.csv"
+    write_recording(path, result.recording)
+    window = make_window()
+    window.session.state.set_load_inertia(0.3)
+    page = window.page(PageId.MODELCHECK)
+    page.load_recording(path)
+    with qtbot.waitSignal(page.sigFinished, timeout=60000):
+        page.run()
+    table = page.effects_table
+    rows = {table.item(r, 0).text(): table.item(r, 1).text() for r in range(table.rowCount())}
+    assert "from the coast after the alarm at 0.33 s" in rows["Viscous friction"], rows
+    assert "N·m·s/rad" in rows["Viscous friction"] or "N m s/rad" in rows["Viscous friction"], rows
+    titles = [p.getPlotItem().titleLabel.text for p in page.gap_plots.values()]
+    coast = next(t for t in titles if t.startswith("Coast after the alarm at 0.33 s"))
+    assert "r/min rms against the recorded one" in coast
+    assert not page.gap_empty.isVisible()
+    assert "Coast after the alarm at 0.33 s" in page.summary.toPlainText(), page.summary.toPlainText()

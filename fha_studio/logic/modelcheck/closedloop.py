@@ -15,10 +15,10 @@ the following error); an inertia error trades off against the loop's gain scale 
 only as g / J); viscous friction trades off against the speed loop's gain and the lag of the
 drive's speed detection (a lag tau reads as viscous friction -g tau / Tv, which no recording of
 command and position separates from a real one: on the simulated drive a viscous drag of 1 N m
-s/rad came out as a 5 % larger Kv and no friction); every torque in N m rests on the declared
-inertia; a torque-constant error has no current to act on. Without an encoder on the load, the
-gear's kinematic error, lost motion and wind-up are not seen either: the motor's encoder sits
-before the gear.
+s/rad came out as a 5 % larger Kv and no friction; a coast after an alarm shows it, coast.py);
+every torque in N m rests on the declared inertia; a torque-constant error has no current to act
+on. Without an encoder on the load, the gear's kinematic error, lost motion and wind-up are not
+seen either: the motor's encoder sits before the gear.
 """
 
 from __future__ import annotations

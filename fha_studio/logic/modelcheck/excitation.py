@@ -60,8 +60,9 @@ class Excitation:
         """Candidates this motion cannot show (not tried)."""
         return frozenset(NEEDS_BOTH_DIRECTIONS) if self.one_way else frozenset()
 
-    def lines(self) -> list[str]:
-        """What cannot be seen for lack of excitation, each with the recording that would show it."""
+    def lines(self, coast: bool = False) -> list[str]:
+        """What cannot be seen for lack of excitation, each with the recording that would show it;
+        ``coast``: a coast after an alarm slowed through the speeds and told the frictions apart."""
         out = []
         if self.one_way:
             out.append(
@@ -74,7 +75,7 @@ class Excitation:
                 "Breakaway from rest cannot be seen: the axis never stood still for "
                 f"{STANDSTILL_MIN_S:g} s. Record moves that start from a standstill with the servo on."
             )
-        if self.one_speed:
+        if self.one_speed and not coast:
             rpm = 0.5 * (self.speed_low_rad_s + self.speed_high_rad_s) * 30.0 / math.pi
             out.append(
                 "Coulomb and viscous friction cannot be told apart: the axis moved at about one speed "

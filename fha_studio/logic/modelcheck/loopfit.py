@@ -36,7 +36,8 @@ negative viscous friction (g lag / Tv); a free viscous column trades off against
 without it, within 1 %). Nor with the lag held at the simulated drive's detection (0.33 ms): each
 0.1 ms off moves the drag by g x 0.1 ms / Tv, the lag at which nothing hidden reads as no drag
 ranges over 0.27-0.41 ms from axis to axis, and with 50 % feed-forward the drag trades off against
-Kp, FF and g (docs/physics.md).
+Kp, FF and g (docs/physics.md). A coast after an alarm shows it, with the loop out of the
+picture (coast.py).
 """
 
 from __future__ import annotations

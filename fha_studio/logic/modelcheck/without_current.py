@@ -240,7 +240,7 @@ def run_without_current(
                 axis, sensor is not None, rec.load_pos_deg is not None, coast=from_coasts.viscous_shown
             ),
             *_saturation(sig, axis),
-            *excitation.lines(),
+            *excitation.lines(coast=from_coasts.viscous_shown),
         ],
         torque_basis=f"on the declared {'' if sensor is None else 'actuator '}inertia "
         f"{(j if sensor is None else j_gear):.4g} kg m^2",

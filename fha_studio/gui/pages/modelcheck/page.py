@@ -594,6 +594,8 @@ class ModelCheckPage(BasePage):
             size = "; ".join(
                 param_words(k, v, e.units.get(k, ""), e.uncertainty.get(k)) for k, v in e.params.items()
             )
+            if e.basis:  # read from a part of the recording (a coast), not the whole
+                size += f" ({e.basis})"
             also = " or ".join(label_of(a) for a in e.alternatives) or "—"
             for col, text in enumerate((e.label, size, also, e.advice)):
                 item = QTableWidgetItem(text)
@@ -623,7 +625,7 @@ class ModelCheckPage(BasePage):
         self._remove_gap_plots()
         layout = self.gap_box.layout()
         assert isinstance(layout, QVBoxLayout)
-        self.gap_empty.setVisible(not r.gap)
+        self.gap_empty.setVisible(not r.gap and not r.coasts)
         for name, gap in r.gap.items():
             unit = unit_words(gap.unit)
             plot = _plot(f"{_channel_name(name, r)}: {_num(gap.rms_before)} → {_num(gap.rms_after)} "
@@ -638,6 +640,18 @@ class ModelCheckPage(BasePage):
             plot.plot(gap.t_s, gap.predicted_heldout, pen=pg.mkPen(COLORS["updated"], width=2),
                       name="predicted by the added effects (not fitted on these blocks)")
             self.gap_plots[name] = plot
+            layout.addWidget(plot, 1)
+        for coast in r.coasts:  # a coast after an alarm: the servo off, friction alone slows the axis
+            before, after = _num(coast.rms_before_rpm), _num(coast.rms_after_rpm)
+            title = (f"Coast after the alarm at {coast.alarm_s:.2f} s: speed {before} → {after} r/min rms "
+                     "against the recorded one, each model from the coast's start")
+            plot = _plot(title, "output speed (r/min)", empty=False)
+            curves = ((coast.speed_measured_rpm, COLORS["measured"], 1, "measured"),
+                      (coast.speed_nominal_rpm, COLORS["nominal"], 2, "nominal model (no friction)"),
+                      (coast.speed_updated_rpm, COLORS["updated"], 2, "updated model"))
+            for y, color, width, label in curves:
+                plot.plot(coast.t_s, y, pen=pg.mkPen(color, width=width), name=label)
+            self.gap_plots[f"coast {coast.alarm_s}"] = plot
             layout.addWidget(plot, 1)
 
     def _draw_resimulation(self, r: ModelCheckResult) -> None:
