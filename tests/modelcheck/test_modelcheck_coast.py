@@ -18,7 +18,7 @@ import pytest
 from bench_capture_gen import BenchCase, make_capture
 from test_modelcheck_bench_captures import MEDIUM_17C, MEDIUM_40C
 
-from fha_studio.logic.modelcheck import run_modelcheck
+from fha_studio.logic.modelcheck import ModelCheckError, run_modelcheck
 from fha_studio.main import main as cli_main
 from fha_studio.physics import AxisModel, catalogue_effects
 from fha_studio.recording import Recording
@@ -147,3 +147,21 @@ def test_the_command_line_shows_the_coast(checked, tmp_path, capsys):
     (viscous,) = [e for e in data["effects"] if e["id"] == "viscous_friction"]
     assert ON_THE_COAST in viscous["read_from"]
     assert data["coasts"][0]["speed_rms_updated_rpm"] < data["coasts"][0]["speed_rms_nominal_rpm"]
+
+
+def test_the_command_during_the_alarm_and_too_little_before_it(checked):
+    """The command is not compared with a coasting axis (a drive in alarm ignores the pulses a
+    controller may still send), and a recording with too little before its alarm gets one line."""
+    capture, result = checked(VISCOUS_17C)
+    rec = capture.recording
+    alarm = rec.channels["alarm"] > 0.5
+    onset = int(np.flatnonzero(alarm)[0])
+    channels = dict(rec.channels)
+    channels["cmd_pos"] = np.where(alarm, rec.channels["cmd_pos"] + 3600.0, rec.channels["cmd_pos"])
+    sent_on = run_modelcheck(Recording(rec.metadata, channels, rec.source))
+    assert [(e.id, e.params) for e in sent_on.effects] == [(e.id, e.params) for e in result.effects]
+    refused = r"the recording before the alarm at \d+\.\d\d s \(the servo on\) cannot be checked"
+    for start, said in ((onset - 5, "5 samples"), (onset, "the ALARM line is on from the first sample")):
+        with pytest.raises(ModelCheckError, match=refused) as err:
+            run_modelcheck(rec.slice(start, len(rec)))
+        assert said in str(err.value)

@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 
 from fha_studio.logic.modelcheck import workflow as wf
-from fha_studio.logic.modelcheck.axis import DeclaredAxis, rms
+from fha_studio.logic.modelcheck.axis import DeclaredAxis, ModelCheckError, check_plausible, rms
 from fha_studio.logic.modelcheck.candidates import CHANNEL_UNITS, POSITION, TORQUE, Candidate, ChannelContext
 from fha_studio.logic.modelcheck.closedloop import (
     CANDIDATES_WITHOUT_CURRENT,
@@ -64,7 +64,20 @@ def run_without_current(
     if coasts:
         rec = rec.slice(0, coasts[0].onset)
         notes = [_servo_on_line(whole, coasts), *notes]
-    sig = closed_loop_signals(rec, axis)
+    try:
+        if coasts:  # the part before the alarm must be a recording the check can read on its own
+            if not len(rec):
+                raise ModelCheckError("the ALARM line is on from the first sample")
+            check_plausible(rec, axis)
+        sig = closed_loop_signals(rec, axis)
+    except ModelCheckError as exc:
+        if not coasts:
+            raise
+        at = float(whole.t_s[coasts[0].onset])
+        raise ModelCheckError(
+            f"the recording before the alarm at {at:.2f} s (the servo on) cannot be checked: {exc}; "
+            "record moves with the servo on before the alarm"
+        ) from None
     n = len(sig.t_s)
     # the following error the loop leaves is smooth (the analysis bandwidth): decimated to about
     # TARGET_DECIMATED rows, never below two per smoothing window half-width
