@@ -74,6 +74,20 @@ class Lamp(QLabel):
         painter.end()
 
 
+class HiddenWhileEmptyLabel(QLabel):
+    """A word-wrapped label of a page's outcomes that takes no line while it has nothing to say
+    (an empty line is height a plot below it needs)."""
+
+    def __init__(self, text: str = "", parent: QWidget | None = None):
+        super().__init__(text, parent)
+        self.setWordWrap(True)
+        self.setVisible(bool(text))
+
+    def setText(self, text: str) -> None:
+        super().setText(text)
+        self.setVisible(bool(text))
+
+
 class WrappingLabel(QLabel):
     """A word-wrapped label that asks its layout for the height its text needs, also in a layout
     that does not ask for height-for-width (the status bar): a long message takes another line

@@ -138,10 +138,101 @@ def test_the_resonance_labels_are_not_crossed_by_the_other_markers(make_window, 
     def x_of(line):
         return view.mapViewToScene(pg.Point(line.value(), 0)).x()
 
-    for marker in page.markers:
+    for marker in (m for m in page.markers if m.label.isVisible()):  # a prediction at its place: said there
         text = marker.label.mapRectToScene(marker.label.boundingRect())
         for other in page.markers:  # a line beside its own (54.3 and 54.2 Hz) is the same place
             if abs(x_of(other) - x_of(marker)) > 5:
                 crossed = text.left() < x_of(other) < text.right()
                 assert not crossed, (marker.label.toPlainText(), other.value())
         assert view.sceneBoundingRect().contains(text), marker.label.toPlainText()  # whole, in the plot
+
+
+def _two_mass_result(predicted_antiresonance_hz: float, predicted_resonance_hz: float, top_hz: float):
+    """What a measurement of an axis on the gear's spring shows: the closed speed loop near 0 dB
+    up to its anti-resonance (38 Hz) and resonance (54.3 Hz), the plant falling through both."""
+    import numpy as np
+
+    f = np.geomspace(1.2, top_hz, 400)
+    s = 2j * np.pi * f
+    wa, wr = 2 * np.pi * 38.0, 2 * np.pi * 54.3
+    plant = 0.9 / s * (s**2 + 0.06 * wa * s + wa**2) / (s**2 + 0.1 * wr * s + wr**2) * (wr**2 / wa**2)
+    loop = 170.0 * (1 + 1 / (0.02 * s)) * plant
+    closed = loop / (1 + loop)
+
+    def response(h):
+        return {"freq_hz": list(f), "magnitude_db": list(20 * np.log10(abs(h))),
+                "phase_deg": list(np.degrees(np.angle(h))), "coherence": list(np.ones_like(f))}
+
+    return {"frequency_response": response(closed), "plant_response": response(plant),
+            "resonance_hz": 54.3, "antiresonance_hz": 38.0, "predicted_resonance_hz": predicted_resonance_hz,
+            "predicted_antiresonance_hz": predicted_antiresonance_hz}
+
+
+@pytest.mark.parametrize("size", [(1366, 768), (1280, 720)])
+@pytest.mark.parametrize("predicted_hz", [(38.0, 54.2, 500.0), (33.0, 62.0, 500.0), (38.0, 54.2, 70.0)],
+                         ids=["at the measured", "apart", "measured to 70 Hz"])
+def test_the_marker_labels_keep_off_the_curves_and_the_page_fits(make_window, qtbot, size, predicted_hz):
+    """No curve runs through a resonance marker's label (the closed loop near 0 dB ran through the
+    one put at the top), and the page shows the excitation, a warning, the outcome and the three
+    plots whole without a vertical scroll bar. A prediction at the measured place is said in the
+    measured marker's label (two labels there found no room between the curves)."""
+    import itertools
+
+    import numpy as np
+    from PySide6.QtCore import QPoint, QPointF
+    from PySide6.QtWidgets import QScrollArea
+
+    window = make_window()
+    window.resize(*size)
+    page = window.show_page(PageId.TUNING)
+    qtbot.waitExposed(window)
+    result = _two_mass_result(*predicted_hz)
+    page.plan_label.setText("excitation: PRBS of ±0.753 r/min on the speed command, bits of 4 servo periods, "
+                            "5 records of 4092 samples (4.8 s); the output travels at most ±0.113° (the "
+                            "drive stops at 0.236°), current at most 2.77 A. Servo on, the axis free to move "
+                            "that far; STOP ends it at once.")
+    page.show_result(result)
+    page.warning_label.setText("Warning: the load is 10 x the actuator's inertia, beyond the about 3 x "
+                               "of 2-1: tuned softer")
+    view = page.mag_plot.getViewBox()
+    lowest_db = min(result["plant_response"]["magnitude_db"])
+    highest = np.log10(predicted_hz[2]) - 0.1
+    qtbot.waitUntil(lambda: view.viewRange()[0][1] > highest and view.viewRange()[1][0] < lowest_db,
+                    timeout=5000)
+
+    area = page.findChild(QScrollArea)
+    line_px = page.plan_label.fontMetrics().lineSpacing()
+
+    def whole_without_scrolling() -> bool:
+        if page.plan_label.height() < 2 * line_px or page.warning_label.height() < line_px:
+            return False  # the new texts not laid out yet
+        bottom = page.plots.mapTo(area.viewport(), QPoint(0, page.plots.height())).y()
+        return (area.verticalScrollBar().maximum() == 0
+                and bottom <= area.viewport().height()  # the plots not cut off below
+                and page.plots.ci.geometry().height() <= page.plots.height())  # the frequency axis in
+
+    qtbot.waitUntil(whole_without_scrolling, timeout=5000)
+    assert page.warning_label.isVisible() and page.plan_label.isVisible()
+
+    shown = [m.label.toPlainText() for m in page.markers if m.label.isVisible()]
+    if predicted_hz == (38.0, 54.2, 500.0):
+        assert shown == ["resonance 54.3 Hz (predicted 54.2 Hz)",
+                         "anti-resonance 38.0 Hz (predicted 38.0 Hz)"]
+    elif predicted_hz[2] < 100.0:  # no room right of 54.3 Hz for the prediction: the line above says it
+        assert shown[0] == "resonance 54.3 Hz" and shown[1].startswith("anti-resonance 38.0 Hz")
+    else:
+        assert shown == ["resonance 54.3 Hz", "anti-resonance 38.0 Hz", "predicted 62.0 Hz",
+                         "predicted 33.0 Hz"]
+    for marker in (m for m in page.markers if m.label.isVisible()):
+        box = marker.label.mapRectToScene(marker.label.boundingRect())
+        assert view.sceneBoundingRect().contains(box), marker.label.toPlainText()
+        for key in ("frequency_response", "plant_response"):
+            x = np.log10(result[key]["freq_hz"])
+            y = np.asarray(result[key]["magnitude_db"])
+            # the curve as drawn, a point per pixel across the label: no segment reaches into it
+            columns = np.arange(np.floor(box.left()) - 1, np.ceil(box.right()) + 2)
+            at = np.interp([view.mapSceneToView(QPointF(c, 0)).x() for c in columns], x, y)
+            rows = [view.mapViewToScene(QPointF(0, v)).y() for v in at]
+            for top, low in itertools.pairwise(rows):
+                crossed = min(top, low) < box.bottom() and box.top() < max(top, low)
+                assert not crossed, (marker.label.toPlainText(), key)

@@ -26,13 +26,14 @@ from PySide6.QtCore import QBuffer, QIODevice, QRectF, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
-    QFormLayout,
+    QGridLayout,
     QHBoxLayout,
     QHeaderView,
     QLabel,
     QLineEdit,
     QPlainTextEdit,
     QPushButton,
+    QSizePolicy,
     QSplitter,
     QTableWidget,
     QTableWidgetItem,
@@ -46,7 +47,7 @@ from fha_studio.gui.link_requests import Call, LinkInfo, LinkReply
 from fha_studio.gui.motion_controls import HoldButton
 from fha_studio.gui.pages.base import BasePage
 from fha_studio.gui.pages.tuning_bench import BenchTuningPanel
-from fha_studio.gui.widgets import scrolling
+from fha_studio.gui.widgets import HiddenWhileEmptyLabel, scrolling
 from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
 from fha_studio.logic.tuning.excitation import plan_excitation
@@ -57,6 +58,17 @@ from fha_studio.logic.tuning.response import COHERENCE_TRUSTED
 from fha_studio.logic.tuning.session import declared_model, drive_clock, measure_report, tuner_for
 
 COUNTDOWN_S = 3
+#: the plots' rows (magnitude, phase, coherence): the least height of each [px] and its share of more;
+#: the magnitude plot keeps room for its four markers' labels beside its curves
+PLOT_ROWS = {1: (135, 5), 2: (68, 3), 3: (92, 2)}
+#: the clear space kept around a marker's label [px]
+MARKER_LABEL_MARGIN_PX = 3.0
+#: a marker label's line with its margins above and below [px]
+MARKER_LABEL_ROOM_PX = 28
+#: the plots' margin and the space between their rows [px]
+PLOTS_SPACING_PX = 2
+#: the plots' least height: the rows', the legend's line (22 px), the spaces between and the margins
+PLOTS_MIN_HEIGHT_PX = sum(least_px for least_px, _stretch in PLOT_ROWS.values()) + 22 + 5 * PLOTS_SPACING_PX
 HOLD_TIP = ("Hold (mouse or Space key) to run the excitation until the measurement is done; letting go, "
             "leaving the page or the window ends it")
 FIGURE_ROWS = ("gain_margin_db", "phase_margin_deg", "overshoot_pct", "settling_ms")
@@ -165,6 +177,16 @@ def export_response_png(record: TuningRecord, title: str, path: Path) -> Path:
     return path
 
 
+def _same_place(measured_hz: float, predicted_hz: float) -> bool:
+    """A prediction that marks the measured place on the plot (within 3 %, a few pixels)."""
+    return abs(predicted_hz / measured_hz - 1.0) <= 0.03
+
+
+def _overlaps(bands: list[tuple[float, float]], low: float, high: float) -> int:
+    """How many of the (bottom, top) ``bands`` reach into ``low`` ... ``high``."""
+    return sum(1 for bottom, top in bands if bottom < high and low < top)
+
+
 class FrequencyAxis(pg.AxisItem):
     """A logarithmic frequency axis labelled 1, 2, 5 per decade in plain numbers (pyqtgraph labels
     every minor tick as 2·10¹, 3·10¹, ..., which run into each other)."""
@@ -198,26 +220,33 @@ class TuningPage(BasePage):
         self._timer.timeout.connect(self._tick)
         self._excitable = False
 
-        form = QFormLayout()
+        # two fields a row: four rows of one field took the height the plots need at 1280 x 720
+        form = QGridLayout()
         self.actuator_edit = QLineEdit(session.state.actuator_code or "")
         self.actuator_edit.setPlaceholderText("model code, e.g. FHA-25C-50-US250")
-        form.addRow("Actuator", self.actuator_edit)
         self.load_spin = QDoubleSpinBox()
         self.load_spin.setRange(0.0, 1.0e5)
         self.load_spin.setDecimals(4)
         self.load_spin.setSuffix(" kg·m²")
         self.load_spin.setValue(float(session.state.load_inertia_kgm2))
-        form.addRow("Declared load inertia", self.load_spin)
         self.aim_combo = QComboBox()
         self.aim_combo.addItems(list(AIMS))
         self.aim_combo.setCurrentText("standard")
-        form.addRow("Aim", self.aim_combo)
         self.amplitude_spin = QDoubleSpinBox()
         self.amplitude_spin.setRange(0.0, 100.0)
         self.amplitude_spin.setDecimals(4)
         self.amplitude_spin.setSpecialValueText("the largest the axis allows")
         self.amplitude_spin.setSuffix(" r/min")
-        form.addRow("Excitation amplitude", self.amplitude_spin)
+        for n, (words, field) in enumerate((("Actuator", self.actuator_edit),
+                                            ("Declared load inertia", self.load_spin),
+                                            ("Aim", self.aim_combo),
+                                            ("Excitation amplitude", self.amplitude_spin))):
+            label = QLabel(words)
+            label.setBuddy(field)
+            form.addWidget(label, n // 2, 2 * (n % 2))
+            form.addWidget(field, n // 2, 2 * (n % 2) + 1)
+        form.setColumnStretch(1, 1)
+        form.setColumnStretch(3, 1)
 
         buttons = QHBoxLayout()
         self.plan_button = QPushButton("Show the excitation")
@@ -252,12 +281,9 @@ class TuningPage(BasePage):
 
         self.plan_label = QLabel("Connect a drive, then show the excitation before it starts.")
         self.plan_label.setWordWrap(True)
-        self.status_label = QLabel("")
-        self.status_label.setWordWrap(True)
-        self.result_label = QLabel("")
-        self.result_label.setWordWrap(True)
-        self.warning_label = QLabel("")
-        self.warning_label.setWordWrap(True)
+        self.status_label = HiddenWhileEmptyLabel()
+        self.result_label = HiddenWhileEmptyLabel()
+        self.warning_label = HiddenWhileEmptyLabel()
         self.warning_label.setStyleSheet("color: #b00000; font-weight: bold")
 
         self.plots = pg.GraphicsLayoutWidget()
@@ -265,19 +291,27 @@ class TuningPage(BasePage):
         # the legend in a row of its own above the plots (as the scope's): inside the magnitude
         # plot it covered the resonance markers' labels
         self.legend = pg.LegendItem(colCount=3, labelTextColor="#303030")
+        self.legend.layout.setContentsMargins(4, 0, 4, 0)  # a line of its own, no more
         self.plots.addItem(self.legend, row=0, col=0)
-        self.mag_plot = self.plots.addPlot(row=1, col=0, title="Magnitude [dB]",
-                                           axisItems={"bottom": FrequencyAxis("bottom")})
-        self.phase_plot = self.plots.addPlot(row=2, col=0, title="Phase [°]",
-                                             axisItems={"bottom": FrequencyAxis("bottom")})
-        self.coh_plot = self.plots.addPlot(row=3, col=0, title="Coherence",
-                                           axisItems={"bottom": FrequencyAxis("bottom")})
-        for plot in (self.mag_plot, self.phase_plot, self.coh_plot):
+        # each plot's quantity on its value axis, not in a title line of its own: the page fits
+        # at 1280 x 720 with the magnitude plot high enough for its markers' labels
+        self.mag_plot = self.plots.addPlot(row=1, col=0, axisItems={"bottom": FrequencyAxis("bottom")})
+        self.phase_plot = self.plots.addPlot(row=2, col=0, axisItems={"bottom": FrequencyAxis("bottom")})
+        self.coh_plot = self.plots.addPlot(row=3, col=0, axisItems={"bottom": FrequencyAxis("bottom")})
+        for plot, words, units in ((self.mag_plot, "Magnitude", "dB"), (self.phase_plot, "Phase", "°"),
+                                   (self.coh_plot, "Coherence", None)):
             plot.setLogMode(x=True, y=False)
             plot.showGrid(x=True, y=True, alpha=0.3)
+            plot.setLabel("left", words, units=units)
+            plot.getAxis("left").setWidth(62)  # the three value axes line up
+            plot.getAxis("left").enableAutoSIPrefix(False)  # dB and degrees take no k or m
         self.phase_plot.setXLink(self.mag_plot)
         self.coh_plot.setXLink(self.mag_plot)
         self.coh_plot.setLabel("bottom", "frequency", units="Hz")
+        for plot in (self.mag_plot, self.phase_plot):  # one frequency scale, under the three (a Bode plot's)
+            plot.getAxis("bottom").setStyle(showValues=False)
+        self.mag_plot.getViewBox().sigRangeChanged.connect(self._place_marker_labels)
+        self.mag_plot.getViewBox().sigResized.connect(self._magnitude_resized)
         self.coh_plot.setYRange(0.0, 1.05)
         self.curves = {
             "closed": (self.mag_plot.plot(pen=pg.mkPen("#1f4e9c", width=2)),
@@ -308,11 +342,17 @@ class TuningPage(BasePage):
         self.worksheet.setReadOnly(True)
         self.worksheet.setPlaceholderText("The front-panel worksheet appears here for a drive without "
                                           "parameter access over CN3.")
-        # the plots take the width, the figures and the worksheet a column beside them; below
-        # these heights the page scrolls instead of squeezing three plots into one line each (at
-        # 420 px the magnitude plot was 80 px high: its resonance labels did not fit in it)
-        self.plots.setMinimumHeight(640)
-        self.table.setMinimumHeight(230)
+        # the plots take the width, the figures and the worksheet a column beside them; the
+        # magnitude plot (where the resonances are marked) has half the plots' height, the
+        # coherence (0 to 1) the least. Below these heights the page scrolls instead of squeezing
+        # the plots into a line each: the page fits at 1280 x 720
+        self.plots.setMinimumHeight(PLOTS_MIN_HEIGHT_PX)
+        self.plots.ci.setContentsMargins(*(PLOTS_SPACING_PX,) * 4)
+        self.plots.ci.layout.setSpacing(PLOTS_SPACING_PX)
+        for row, (least_px, stretch) in PLOT_ROWS.items():
+            self.plots.ci.layout.setRowMinimumHeight(row, least_px)
+            self.plots.ci.layout.setRowStretchFactor(row, stretch)
+        self.table.setMinimumHeight(200)
         self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         self.table.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         side = QWidget()
@@ -326,6 +366,10 @@ class TuningPage(BasePage):
         lower.setStretchFactor(0, 1)
         lower.setStretchFactor(1, 1)
         lower.setSizes([760, 560])
+        # the height left over, down to the plots' least: their preferred height (a page's worth)
+        # would make the scroll area scroll (its wrapped labels ask it for the preferred height)
+        lower.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Ignored)
+        lower.setMinimumHeight(PLOTS_MIN_HEIGHT_PX)
 
         self.bench = BenchTuningPanel(self)
         panel = QWidget()
@@ -334,8 +378,10 @@ class TuningPage(BasePage):
         layout.addLayout(buttons)
         layout.addWidget(self.bench)
         layout.addWidget(self.plan_label)
-        layout.addWidget(self.warning_label)
-        layout.addWidget(self.status_label)
+        said = QHBoxLayout()  # the outcome and its warning on one line: the plots keep their height
+        said.addWidget(self.status_label)
+        said.addWidget(self.warning_label, 1)
+        layout.addLayout(said)
         layout.addWidget(self.result_label)
         layout.addWidget(lower, 1)
         outer = QVBoxLayout(self)
@@ -508,25 +554,37 @@ class TuningPage(BasePage):
         for marker in self.markers:
             self.mag_plot.removeItem(marker)
         self.markers = []
-        # each label at a height of its own (the two frequencies are often close on the axis), a
-        # resonance's on the higher side of its line, an anti-resonance's on the lower side: a
-        # label never reads through the other marker's line
+        # a resonance's label on the higher side of its line, an anti-resonance's on the lower side
+        # (a label never reads through the other marker's line); the measured ones in a line kept
+        # free above the curves, each at the height nearest its own where no curve runs through
+        # it (_place_marker_labels). A prediction at the measured place is said in its label: two
+        # labels there left no room between the curves
         above, below = [(0.0, 0.5)] * 2, [(1.0, 0.5)] * 2
         for key, colour, style, label, where, side in (
-            ("resonance_hz", "#008000", None, "resonance", 0.88, above),
-            ("antiresonance_hz", "#800080", None, "anti-resonance", 0.70, below),
-            ("predicted_resonance_hz", "#008000", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.30, above),
-            ("predicted_antiresonance_hz", "#800080", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.12,
+            ("resonance_hz", "#008000", None, "resonance", 1.0, above),
+            ("antiresonance_hz", "#800080", None, "anti-resonance", 1.0, below),
+            ("predicted_resonance_hz", "#008000", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.0, above),
+            ("predicted_antiresonance_hz", "#800080", pg.QtCore.Qt.PenStyle.DashLine, "predicted", 0.0,
              below),
         ):
             value = result.get(key)
-            if value:
-                pen = pg.mkPen(colour, width=2, style=style) if style else pg.mkPen(colour, width=2)
-                line = pg.InfiniteLine(pos=np.log10(value), angle=90, pen=pen,
-                                       label=f"{label} {value:.1f} Hz",
-                                       labelOpts={"position": where, "color": colour, "anchors": side})
-                self.mag_plot.addItem(line)
-                self.markers.append(line)
+            if not value:
+                continue
+            words = f"{label} {value:.1f} Hz"
+            prediction = result.get(f"predicted_{key}")
+            if prediction and _same_place(value, prediction):
+                words += f" (predicted {prediction:.1f} Hz)"
+            measured = result.get(key.removeprefix("predicted_")) if key.startswith("predicted_") else None
+            pen = pg.mkPen(colour, width=2, style=style) if style else pg.mkPen(colour, width=2)
+            line = pg.InfiniteLine(pos=np.log10(value), angle=90, pen=pen, label=words,
+                                   labelOpts={"position": where, "color": colour, "anchors": side})
+            line.preferred_height = where  # the share of the view's height it is put nearest
+            line.words, line.short_words, line.side = words, f"{label} {value:.1f} Hz", side[0][0]
+            if measured and _same_place(measured, value):
+                line.label.setVisible(False)  # the measured marker's label says it
+            self.mag_plot.addItem(line)
+            self.markers.append(line)
+        self._magnitude_resized()
 
         def fmt(key: str, unit: str) -> str:
             return result_figure_words(result, key, unit, manual_units=True)
@@ -542,6 +600,121 @@ class TuningPage(BasePage):
             f"gain margin {fmt('gain_margin_db', 'dB')}, "
             f"phase margin {fmt('phase_margin_deg', 'deg')}, crossover {fmt('crossover_hz', 'Hz')}, "
             f"bandwidth {fmt('bandwidth_hz', 'Hz')}")
+
+    def _magnitude_resized(self) -> None:
+        """A new result or size: the room above the curves, then the labels in it."""
+        self._leave_room_for_labels()
+        self._place_marker_labels()
+
+    def _leave_room_for_labels(self) -> None:
+        """With markers, the magnitude plot's values from the curves' lowest to a label's line
+        above their highest (near 0 dB the closed loop left no room at the top for a label), two
+        lines where the measured markers' labels must sit on the same side (a resonance at the
+        end of the measured band); without, its values follow the curves. Again when the plot is
+        resized."""
+        view = self.mag_plot.getViewBox()
+        values = [np.asarray(curves[0].getData()[1] if curves[0].getData()[1] is not None else [], float)
+                  for curves in self.curves.values()]
+        finite = np.concatenate([v[np.isfinite(v)] for v in values]) if values else np.array([])
+        height_px = view.boundingRect().height()
+        shown = [m for m in self.markers if m.label.isVisible()]
+        if not shown or not finite.size or height_px < 4 * MARKER_LABEL_ROOM_PX:
+            view.enableAutoRange(axis=pg.ViewBox.YAxis)
+            return
+        room_px = MARKER_LABEL_ROOM_PX * self._measured_label_lines()
+        low, high = float(finite.min()), float(finite.max())
+        margin = 0.03 * max(high - low, 1.0)
+        per_px = (high - low + 2 * margin) / max(height_px - room_px, MARKER_LABEL_ROOM_PX)
+        view.setYRange(low - margin, high + margin + room_px * per_px, padding=0.0)
+
+    def _measured_label_lines(self) -> int:
+        """How many lines the measured markers' labels take above the curves: one, or two where
+        they reach over each other (``_fit_beside`` put one on the other's side)."""
+        view = self.mag_plot.getViewBox()
+        (x0, x1), _ = view.viewRange()
+        try:
+            x_per_px, y_per_px = view.viewPixelSize()
+        except (ZeroDivisionError, ValueError):
+            return 1
+        spans = [self._fit_beside(m, float(m.value()), x0, x1, x_per_px, y_per_px, MARKER_LABEL_MARGIN_PX)[:2]
+                 for m in self.markers if m.label.isVisible() and m.preferred_height == 1.0]
+        over = any(a[0] < b[1] and b[0] < a[1] for i, a in enumerate(spans) for b in spans[i + 1:])
+        return 2 if over else 1
+
+    @staticmethod
+    def _fit_beside(marker: Any, at: float, x0: float, x1: float, x_per_px: float, y_per_px: float,
+                    margin_px: float) -> tuple[float, float, float]:
+        """Puts ``marker``'s label on its own side of its line with its words (the prediction at
+        its place included); where that runs out of the plot, without the prediction (the
+        outcome's line above says it), then on the other side. Its (left, right, half height)."""
+        label = marker.label
+        for words, side in ((marker.words, marker.side), (marker.short_words, marker.side),
+                            (marker.short_words, 1.0 - marker.side)):
+            if label.format != words:
+                label.setFormat(words)
+            if label.anchors[0][0] != side:
+                label.anchors = [(side, 0.5)] * 2
+                label.updatePosition()
+            size = label.mapRectToScene(label.boundingRect())
+            width = (size.width() + margin_px) * x_per_px
+            left, right = (at, at + width) if side == 0.0 else (at - width, at)
+            if x0 <= left and right <= x1:
+                break
+        return left, right, (size.height() / 2 + margin_px) * y_per_px
+
+    def _place_marker_labels(self) -> None:
+        """Each marker's label beside its line at the height nearest its preferred one where no
+        curve of the magnitude plot and no label placed before it runs through it, whole in the
+        plot (the closed loop near 0 dB ran through a resonance label put at the top). Again
+        whenever the plot's range or size changes."""
+        view = self.mag_plot.getViewBox()
+        (x0, x1), (y0, y1) = view.viewRange()
+        try:
+            x_per_px, y_per_px = view.viewPixelSize()
+        except (ZeroDivisionError, ValueError):  # not laid out yet: placed when it is
+            return
+        if not self.markers or not (x_per_px > 0 and y_per_px > 0 and y1 > y0):
+            return
+        curves = []
+        for key in ("closed", "plant", "predicted"):
+            x, y = self.curves[key][0].getData()  # as drawn: log10 of the frequency
+            if x is not None and len(x):
+                curves.append((np.asarray(x, float), np.asarray(y, float)))
+        margin_px = MARKER_LABEL_MARGIN_PX
+        placed: list[tuple[float, float, float, float]] = []  # labels' (left, right, bottom, top)
+        for marker in self.markers:
+            label = marker.label
+            if not label.isVisible():
+                continue
+            at = float(marker.value())
+            left, right, half = self._fit_beside(marker, at, x0, x1, x_per_px, y_per_px, margin_px)
+            # the heights the curves take between the label's left and right edges
+            taken: list[tuple[float, float]] = []
+            for x, y in curves:
+                ends = np.column_stack((x[:-1], x[1:], y[:-1], y[1:]))
+                near = ends[(np.maximum(ends[:, 0], ends[:, 1]) >= left)
+                            & (np.minimum(ends[:, 0], ends[:, 1]) <= right)]
+                near = near[np.isfinite(near).all(axis=1)]
+                taken += [(min(a, b), max(a, b)) for a, b in near[:, 2:]]
+            labels = [(bottom, top) for l_, r_, bottom, top in placed if l_ < right and left < r_]
+            span = y1 - y0
+            lowest, highest = half / span, 1.0 - half / span
+            if highest <= lowest:
+                continue
+            best, best_cost = None, None
+            for share in np.linspace(lowest, highest, 61):
+                centre = y0 + share * span
+                low, high = centre - half, centre + half
+                # a label over another cannot be read at all; over a curve it can
+                cost = (_overlaps(labels, low, high), _overlaps(taken, low, high),
+                        abs(share - marker.preferred_height))
+                if best_cost is None or cost < best_cost:
+                    best, best_cost = float(share), cost
+            if best is None:
+                continue
+            label.setPosition(best)
+            centre = y0 + best * span
+            placed.append((left, right, centre - half, centre + half))
 
     # ----- proposal, apply, worksheet ------------------------------------------------------------
     def _offline_items(self) -> dict[str, int]:

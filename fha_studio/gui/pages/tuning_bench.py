@@ -134,8 +134,6 @@ class BenchTuningPanel(QGroupBox):
         self.status = QLabel("Write the excitation file for a DAQ's or generator's output on SPD-CMD, or "
                              "capture a move of the controller; then choose the capture.")
         self.status.setWordWrap(True)
-        # room for three lines: in the page's scroll area a wrapped label is not given its height
-        self.status.setMinimumHeight(3 * self.status.fontMetrics().lineSpacing() + 4)
 
         files = QHBoxLayout()
         files.addWidget(self.write_button)
