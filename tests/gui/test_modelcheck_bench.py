@@ -141,3 +141,4 @@ def test_the_coast_after_an_alarm_is_shown_beside_the_gaps(make_window, qtbot, t
     assert "r/min rms against the recorded one" in coast
     assert not page.gap_empty.isVisible()
     assert "Coast after the alarm at 0.33 s" in page.summary.toPlainText(), page.summary.toPlainText()
+    assert "Viscous friction: named from the coast after the alarm at 0.33 s" in page.findings.toPlainText()

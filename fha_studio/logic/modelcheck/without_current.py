@@ -224,6 +224,8 @@ def run_without_current(
         _refuse(found, "the closed loop is not pinned down by this recording")
     from_coasts = name_from_coasts(whole, coasts, axis, floor_t, found.effects)
     found.effects.extend(from_coasts.effects)
+    # the servo-on part's detection limit does not stand beside the same effect named from a coast
+    found.limits = [d for d in found.limits if d.id not in {e.id for e in from_coasts.effects}]
     notes = [*from_coasts.lines, *notes]
     updated = wf._updated_model(model, found.effects)
     filt = sig.filt

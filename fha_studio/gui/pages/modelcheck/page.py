@@ -594,8 +594,8 @@ class ModelCheckPage(BasePage):
             size = "; ".join(
                 param_words(k, v, e.units.get(k, ""), e.uncertainty.get(k)) for k, v in e.params.items()
             )
-            if e.basis:  # read from a part of the recording (a coast), not the whole
-                size += f" ({e.basis})"
+            if e.basis:  # read from a part of the recording (a coast), not the whole: a line each
+                size += "\n" + e.basis.replace("; ", ";\n")
             also = " or ".join(label_of(a) for a in e.alternatives) or "—"
             for col, text in enumerate((e.label, size, also, e.advice)):
                 item = QTableWidgetItem(text)
@@ -809,6 +809,9 @@ def _findings_in_words(r: ModelCheckResult) -> list[str]:
                     continue
                 why = "; ".join(GATE_WORDS.get(g, g) for g in t.failed) or "another explains it better"
                 out.append(f"      {label_of(t.id)}: not named: {why}.")
+    for e in r.effects:
+        if e.basis:  # not one of the channel's steps above
+            out.append(f"{e.label}: named {e.basis}.")
     for a in r.ambiguities:
         out.append(f"{label_of(a.chosen)} or {label_of(a.alternative)}: the data cannot tell them apart. "
                    f"To tell them apart: {a.separating_test}.")
