@@ -45,7 +45,7 @@ from fha_studio.hardware.sim.axis import (
 )
 from fha_studio.hardware.sim.constants import SimConstants, load_sim_constants
 from fha_studio.hardware.sim.eeprom import EepromFile, eeprom_path
-from fha_studio.hardware.sim.excitation import SimExcitation
+from fha_studio.hardware.sim.excitation import SimExcitation, excitation_offset_rad
 from fha_studio.hardware.sim.io import SimIo
 from fha_studio.hardware.sim.memory import ItemId, ParameterMemory, PersistentState
 from fha_studio.hardware.sim.monitors import monitor_wire
@@ -632,7 +632,7 @@ class SimDrive:
         axis = self.axis
         if self._oww_done_at is not None and t >= self._oww_done_at:
             self._finish_oww()
-        self.excitation.supervise(t, self.servo_on and not self.alarm, axis.output_pos_rad)
+        self.excitation.supervise(t, self.servo_on and not self.alarm, excitation_offset_rad(self))
         motion = self.motion
         motion.supervise(t)
         if self.wiring_trip.active and self.wiring_trip.tick(

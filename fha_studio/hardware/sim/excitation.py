@@ -3,9 +3,12 @@
 A pseudo-random binary sequence (PRBS: a maximum-length shift register, period 2^bits - 1 bits,
 the register as long as one period still fits a trace: ``protocol.excitation_register_bits``) of
 +/- the amplitude, each bit held ``hold`` servo periods, is added to the
-speed command at the speed loop's summing point while the position loop holds the axis. It runs
-only while renewed: without an ``EXG`` for ``watchdog_s`` (the jog watchdog's 100 ms) it stops,
-and it stops when the output has travelled more than the limit from where it started.
+speed command at the speed loop's summing point while the position loop holds the axis, or on
+top of a JOG (a bias speed: the axis then turns one way throughout, never sticking on its
+friction at a reversal). It runs only while renewed: without an ``EXG`` for ``watchdog_s`` (the
+jog watchdog's 100 ms) it stops, and it stops when the output has travelled more than the limit
+from where it started; on a jog, from where the jog's command takes it (the output's distance to
+the position command, against that distance when the excitation started).
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from fha_studio.hardware.protocol import EXCITATION_STEP_RPM, excitation_register_bits
+from fha_studio.hardware.sim.motion import MotionKind
 from fha_studio.hardware.sim.reply import rejected
 
 RPM = 2.0 * math.pi / 60.0
@@ -52,7 +56,7 @@ class SimExcitation:
     travel_limit_rad: float = 0.0
     hold_periods: int = 0  # 0: not running
     deadline_s: float = 0.0
-    start_rad: float = 0.0
+    start_rad: float = 0.0  # the output's distance to the position command when it started
     _state: int = 1
     _phase: int = 0
     _bit: int = 0
@@ -62,7 +66,8 @@ class SimExcitation:
         return self.hold_periods > 0
 
     def start(self, hold_periods: int, now_s: float, deadline_s: float, position_rad: float) -> None:
-        """Start (or renew: the sequence goes on) with each bit held ``hold_periods`` periods."""
+        """Start (or renew: the sequence goes on) with each bit held ``hold_periods`` periods;
+        ``position_rad``: the output's distance to the position command (physical frame)."""
         if not self.active or hold_periods != self.hold_periods:
             self._state, self._phase = 1, 0
             self._bit = 0
@@ -75,7 +80,8 @@ class SimExcitation:
 
     def supervise(self, now_s: float, may_run: bool, position_rad: float) -> None:
         """Every 1 ms: stop without a renewal (watchdog), with the servo off or an alarm, or past
-        the travel limit from where it started."""
+        the travel limit from where it started (``position_rad``: the output's distance to the
+        position command, as for ``start``)."""
         if self.active and (now_s >= self.deadline_s or not may_run
                             or abs(position_rad - self.start_rad) > self.travel_limit_rad):
             self.stop()
@@ -114,8 +120,8 @@ def set_travel_limit(drive: Any, value: int) -> None:
 
 def run(drive: Any, value: int) -> None:
     """EXG: run (or keep running: like JOG, for the jog watchdog's time) the excitation with bits of ``value``
-    servo periods; 0 stops it. Refused with the servo off, an alarm, a motion, or without an
-    amplitude and a travel limit."""
+    servo periods; 0 stops it. Refused with the servo off, an alarm, a motion other than a JOG
+    (on a jog it adds to the jog's speed command), or without an amplitude and a travel limit."""
     exc: SimExcitation = drive.excitation
     if value == 0:
         exc.stop()
@@ -124,10 +130,17 @@ def run(drive: Any, value: int) -> None:
         raise rejected(f"EXG: alarm {drive.supervisor.describe()} is active")
     if not drive.servo_on:
         raise rejected("EXG: the servo is off")
-    if drive.moving:
-        raise rejected("EXG: the axis is moving (STP first)")
+    if drive.moving and drive.motion.kind is not MotionKind.JOG:
+        raise rejected("EXG: the axis is moving (STP first; on a JOG it may run)")
     if not 1 <= value <= MAX_HOLD_PERIODS:
         raise rejected(f"EXG {value}: bits of 1 ... {MAX_HOLD_PERIODS} servo periods")
     if exc.amplitude_rad_s <= 0 or exc.travel_limit_rad <= 0:
         raise rejected("EXG: set the amplitude (EXA) and the travel limit (EXL) first")
-    exc.start(value, drive.time_s, drive.time_s + drive.constants.jog_watchdog_s, drive.axis.output_pos_rad)
+    deadline_s = drive.time_s + drive.constants.jog_watchdog_s
+    exc.start(value, drive.time_s, deadline_s, excitation_offset_rad(drive))
+
+
+def excitation_offset_rad(drive: Any) -> float:
+    """The output's distance to the position command (physical frame, rad): what the excitation's
+    travel limit is measured on (standing still, the command stands still too)."""
+    return float(drive.axis.output_pos_rad - drive.axis.command_pos_rad)
