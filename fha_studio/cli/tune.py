@@ -1,7 +1,8 @@
 """``fha-studio tune measure|propose|excitation|analyse``: the speed loop's frequency response and
 proposed gains, over CN3 or from the bench.
 
-    fha-studio tune measure --url URL --actuator CODE --load-inertia KGM2 [--amplitude-rpm R] [--json OUT]
+    fha-studio tune measure --url URL --actuator CODE --load-inertia KGM2 [--amplitude-rpm R] [--in-place]
+                            [--json OUT]
     fha-studio tune propose --url URL --actuator CODE --load-inertia KGM2 [--aim stiff|standard|soft]
                             [--json OUT]
     fha-studio tune excitation --actuator CODE --parameters P.toml --load-inertia KGM2
@@ -59,6 +60,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         if name == "measure":
             q.add_argument("--amplitude-rpm", type=float, metavar="R",
                            help="excitation amplitude [r/min] (default: the largest the axis allows)")
+            q.add_argument("--in-place", action="store_true",
+                           help="excite about standstill, not on a slow FWD jog (the bias speed that keeps "
+                           "the axis from sticking on its friction): for an axis that may not turn that "
+                           "far; the friction then spoils the response at low frequency (warned of)")
             q.set_defaults(func=run_measure)
         else:
             q.add_argument("--aim", choices=("stiff", "standard", "soft"), default="standard")
@@ -149,7 +154,7 @@ def run_measure(args: argparse.Namespace) -> int:
             tuner = tuner_for(client, parameters, model)
             pace, now = drive_clock(client)
             result = measure_report(client, tuner, pace, now, args.amplitude_rpm,
-                                    announce=lambda s: print(s, file=sys.stderr))
+                                    announce=lambda s: print(s, file=sys.stderr), bias=not args.in_place)
     except _TuneStop as stop:
         return _stopped("measure", stop, stop.code)
     except ValueError as exc:
@@ -163,6 +168,8 @@ def run_measure(args: argparse.Namespace) -> int:
              f"load inertia {f('load_inertia_estimate_kgm2', 'kg m^2')}",
              f"gain margin {f('gain_margin_db', 'dB')}", f"phase margin {f('phase_margin_deg', 'deg')}",
              f"crossover {f('crossover_hz', 'Hz')}", f"bandwidth {f('bandwidth_hz', 'Hz')}"]
+    if result.get("stick_slip_warning"):
+        print(f"warning: {result['stick_slip_warning']}", file=sys.stderr)
     _emit(args, result, ", ".join(words))
     return 0
 

@@ -6,11 +6,13 @@ test_tuning_cases.py."""
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
 from fha_studio.cli import main as cli_main
 from fha_studio.hardware.client import DriveClient
+from fha_studio.hardware.errors import DriveRefused
 from fha_studio.hardware.parameters import load_parameter_model
 from fha_studio.logic.tuning.excitation import NotExcitable, plan_excitation
 from fha_studio.logic.tuning.measure import measure
@@ -49,6 +51,33 @@ def test_stp_and_servo_off_end_the_excitation() -> None:
         assert not drive.excitation.active
 
 
+def test_the_excitation_rides_on_a_jog_its_travel_limit_about_the_jogs_path() -> None:
+    """EXG on a JOG (the bias speed that keeps a real axis off its friction's stick-slip): the
+    axis turns far past the travel limit along the jog, the excitation runs on; a move refuses
+    it; STP ends both."""
+    with DriveClient.open(_url(CODE, 0.81, "&catalogue_friction=1")) as client:
+        drive = _sim(client)
+        client.servo(True)
+        client.set_excitation(0.2, 0.5)
+        start = drive.axis.output_pos_rad
+        for _ in range(20):  # 1 s of a 3 r/min jog (its ramp and the loop's lag settle)
+            client.jog(3.0)
+            drive.advance(0.05)
+        for _ in range(20):  # 1 s more, excited
+            client.jog(3.0)
+            client.excite(4)
+            drive.advance(0.05)
+            assert drive.excitation.active
+        assert math.degrees(drive.axis.output_pos_rad - start) > 20.0  # 2 s at 18 deg/s, far past 0.5 deg
+        client.stop()
+        assert not drive.excitation.active
+        drive.advance(0.5)
+        client.move_by(10.0)
+        with pytest.raises(DriveRefused, match="excitation"):
+            client.excite(4)
+        assert not drive.excitation.active
+
+
 def test_servo_off_is_refused_and_nothing_moves() -> None:
     with DriveClient.open(_url(CODE, 0.81)) as client:
         drive = _sim(client)
@@ -84,6 +113,7 @@ def test_cli_measure_runs_to_completion_with_the_contract(drives, tmp_path,
     (drive,) = drives
     assert said.count("\n") == 1 and said.startswith("resonance ") and "load inertia" in said
     assert "excitation:" in err and "0.3 r/min" in err and "travels at most" in err
+    assert "on a jog of" in err and "FWD" in err  # the bias speed, and how far it turns the axis
     result = json.loads(out.read_text())
     for key in ("resonance_hz", "antiresonance_hz", "load_inertia_estimate_kgm2", "gain_margin_db",
                 "phase_margin_deg", "crossover_hz", "bandwidth_hz"):
@@ -97,3 +127,29 @@ def test_cli_measure_runs_to_completion_with_the_contract(drives, tmp_path,
     assert result["load_inertia_estimate_kgm2"] == pytest.approx(0.81, rel=0.1)
     assert result["phase_margin_deg"] > 0 and result["bandwidth_hz"] > 0
     assert not drive.excitation.active  # ended with the command
+
+
+def test_in_place_on_friction_warns_of_stick_slip(drives, tmp_path,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """``tune measure --in-place`` (no bias speed) on a drive with the catalogue's friction: the axis
+    sticks at each reversal, the response loses its gain at low frequency, and the measurement says why
+    (the coherence would not: the stick-slip repeats with the periodic excitation). The same axis on
+    its bias speed is in test_tuning_cases.py's friction cases."""
+    out = tmp_path / "measure.json"
+    url = _url(CODE, 0.81, "&catalogue_friction=1")
+    code = cli_main(["tune", "measure", "--url", url, "--actuator", CODE, "--load-inertia", "0.81",
+                     "--in-place", "--json", str(out)])
+    _said, err = capsys.readouterr()
+    assert code == 0, err
+    result = json.loads(out.read_text())
+    assert result["excitation"]["bias_rpm"] == 0.0 and "jog" not in err.split("\n")[0]
+    assert "warning:" in err and "friction" in result["stick_slip_warning"]
+    # the plant (torque -> speed) at its lowest bin far below the rigid body's 1/(J w): what the
+    # stick-slip does to it (about 16 dB here; on a bias speed the response is within 1 dB of the
+    # loop's linearisation, test_tuning_cases.py)
+    plant = result["plant_response"]
+    inertia = declared_model(CODE, 0.81).total_inertia_kgm2
+    rigid_db = -20.0 * math.log10(inertia * 2.0 * math.pi * plant["freq_hz"][0])
+    assert plant["magnitude_db"][0] < rigid_db - 6.0
+    (drive,) = drives
+    assert not drive.excitation.active and not drive.moving

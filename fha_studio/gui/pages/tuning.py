@@ -590,6 +590,8 @@ class TuningPage(BasePage):
             return result_figure_words(result, key, unit, manual_units=True)
 
         self.status_label.setText("Measured.")
+        if result.get("stick_slip_warning"):  # measured about standstill: the friction shows
+            self.warning_label.setText(f"Warning: {result['stick_slip_warning']}.")
         uncertainty = result.get("load_inertia_uncertainty_kgm2")  # a bench measurement says it
         spread = f" ± {uncertainty:.2g}" if uncertainty and result.get("load_inertia_estimate_kgm2") else ""
         self.use_inertia_button.setEnabled(result.get("load_inertia_estimate_kgm2") is not None)

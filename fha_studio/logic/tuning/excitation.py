@@ -10,6 +10,21 @@ L1 norm from the added speed command to the position (the position loop closed: 
 axis). The drive stops the excitation if the output ever travels farther than that bound (with
 a margin) from where it started.
 
+The axis turns one way throughout (a bias speed): a real axis has friction, and Coulomb friction
+flips at every reversal of the speed, where the axis sticks until the loop's torque breaks it away
+again, so the torque -> speed response of an excitation about standstill loses its gain at low
+frequency and what is fitted to it (inertia, resonance) is wrong. The excitation therefore runs
+on top of a slow JOG whose speed is ``BIAS_MARGIN`` x the largest speed the excitation itself
+can reach (A x the L1 norm from the added speed command to the motor-side speed), so the speed
+never crosses zero: the Coulomb friction is then a constant torque (no part of the response) and
+the viscous friction a linear damping (``linear`` models it and ``response.fit_two_mass`` fits
+it). The axis then travels the bias speed x the duration besides the excitation's own bound, which
+the plan states; the drive measures the travel limit from the jog's command path. The current
+bound keeps the catalogue's friction torque (TF, FHA-C manual 2-4-4) in reserve. A bias of 0
+excites about standstill (an axis that may not turn that far): where the output speed then
+reverses, ``session`` warns (the coherence does not show it: the stick-slip repeats with the
+periodic excitation).
+
 Only a stable loop is excited: with the present tune items and the declared load the linearised
 loops must be stable (:func:`check_stable`), or the drive is not excitable (the speed loop gain is
 set on the actuator's own inertia, ``physics.PanelGains``: a heavy load can lower the speed
@@ -28,7 +43,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from fha_studio.hardware.protocol import excitation_period_periods
+from fha_studio.hardware.protocol import SPEED_STEP_RPM, excitation_period_periods
 from fha_studio.logic.tuning.linear import LoopModel, LoopPolynomials, two_mass_prediction
 from fha_studio.logic.wording import with_unit
 from fha_studio.physics import PanelGains
@@ -48,6 +63,11 @@ RECORDS = 5
 SETTLE_TAIL = 0.005
 #: the impulse responses are followed this long at most (s)
 HORIZON_S = 30.0
+#: the bias speed is this many times the largest speed the excitation can reach (linear bound, a
+#: worst case over every input: a PRBS reaches a fraction of it)
+BIAS_MARGIN = 1.2
+#: the bias speed at most this share of the maximum speed (the amplitude is lowered to keep it)
+BIAS_SHARE = 0.05
 
 
 class NotExcitable(Exception):
@@ -81,10 +101,18 @@ class ExcitationPlan:
     records: int
     travel_bound_deg: float  # the linear bound of the angle travelled (either way)
     travel_limit_deg: float  # where the drive stops it
-    peak_current_a: float  # the linear bound of the current
+    peak_current_a: float  # the linear bound of the current (and the friction the bias turns against)
     f_max_hz: float
     settle_s: float  # before each record: the slowest closed-loop mode decays (6 time constants)
     duration_s: float
+    bias_rpm: float = 0.0  # the JOG the excitation rides on (0: about standstill)
+    speed_bound_rpm: float = 0.0  # the linear bound of the excitation's own speed (either way)
+
+    @property
+    def bias_travel_deg(self) -> float:
+        """The angle the bias speed turns the axis through during the measurement (its start's
+        settling included)."""
+        return self.bias_rpm * 6.0 * (self.duration_s + self.settle_s)
 
     def describe(self, manual_units: bool = False) -> str:
         """The excitation in a line. ``manual_units``: "±" and "°" as the FHA-C manual prints them
@@ -95,10 +123,16 @@ class ExcitationPlan:
             return with_unit(f"{value:.3g}", "deg") if manual_units else f"{value:.3g} deg"
 
         periods = f"{self.hold_periods} servo period" + ("" if self.hold_periods == 1 else "s")
-        return (f"excitation: PRBS of {pm}{self.amplitude_rpm:.3g} r/min on the speed command, bits of "
-                f"{periods}, {self.records} records of {self.period_samples} "
+        if self.bias_rpm > 0:
+            where = (f" on a jog of {self.bias_rpm:.3g} r/min FWD (so the axis never reverses and sticks on "
+                     f"its friction; it turns about {deg(self.bias_travel_deg)})")
+            about = " about the jog's path"
+        else:
+            where = about = ""
+        return (f"excitation: PRBS of {pm}{self.amplitude_rpm:.3g} r/min on the speed command{where}, bits "
+                f"of {periods}, {self.records} records of {self.period_samples} "
                 f"samples ({self.duration_s:.1f} s); the output travels at most "
-                f"{pm}{deg(self.travel_bound_deg)} (the drive stops at {deg(self.travel_limit_deg)}), "
+                f"{pm}{deg(self.travel_bound_deg)}{about} (the drive stops at {deg(self.travel_limit_deg)}), "
                 f"current at most {self.peak_current_a:.3g} A")
 
 
@@ -131,11 +165,12 @@ def _settle_s(h: np.ndarray, rate: float) -> float:
     return settle
 
 
-def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> ExcitationPlan:
+def plan_excitation(lm: LoopModel, requested_rpm: float | None = None, bias: bool = True) -> ExcitationPlan:
     """The excitation for ``lm``'s axis: bits held so that the PRBS covers ~5 x the predicted
     resonance (or 2 x the speed loop's reach), the largest amplitude within the current and speed
     shares and the gear's torque on its first slope (or ``requested_rpm`` when lower; a higher
-    request raises ValueError; an unstable loop NotExcitable)."""
+    request raises ValueError; an unstable loop NotExcitable), on a bias speed that keeps the axis
+    turning one way (``bias=False``: about standstill)."""
     check_stable(lm)
     model = lm.model
     rate = lm.settings.servo_rate_hz
@@ -147,23 +182,33 @@ def plan_excitation(lm: LoopModel, requested_rpm: float | None = None) -> Excita
         hold *= 2
     h = _impulse(lm)
     per_rad = float(np.abs(h[:, 0]).sum())
+    per_speed = float(np.abs(np.diff(h[:, 0], prepend=0.0)).sum()) * rate  # motor-side speed per rad/s
     speed_loop = LoopModel(model, replace(lm.settings, position_loop_gain_per_s=0.0)).polynomials()
     per_a, per_nm = (float(v) for v in np.abs(_followed(speed_loop, rate)[:, 1:]).sum(axis=0))
-    top_rpm = min(CURRENT_SHARE * model.max_current_a / per_a / RPM,
+    # the friction the bias speed turns against is drawn too: TF (2-4-4) kept in reserve
+    friction_a = (model.friction_torque_nm or 0.0) / model.torque_constant_nm_per_a if bias else 0.0
+    top_rpm = min(max(CURRENT_SHARE * model.max_current_a - friction_a, 0.0) / per_a / RPM,
                   SPEED_SHARE * (model.max_speed_rpm or 60.0))
     if model.stiffness is not None and per_nm > 0.0:  # the gear stays on its first slope (K1, 1-9-2)
         top_rpm = min(top_rpm, GEAR_TORQUE_SHARE * model.stiffness.t1_nm / per_nm / RPM)
+    if bias:  # a lightly damped loop swings far: a smaller amplitude keeps the bias within its share
+        top_rpm = min(top_rpm, BIAS_SHARE * (model.max_speed_rpm or 60.0) / (BIAS_MARGIN * per_speed))
     amplitude = top_rpm if requested_rpm is None else float(requested_rpm)
     if not 0.0 < amplitude <= top_rpm * (1 + 1e-9):
         raise ValueError(f"excitation amplitude {amplitude:g} r/min: allowed 0 ... {top_rpm:.3g} r/min "
                          f"for this axis (current within {CURRENT_SHARE:.0%} of {model.max_current_a:g} A, "
-                         f"speed within {SPEED_SHARE:.0%} of the maximum)")
+                         f"speed within {SPEED_SHARE:.0%} of the maximum"
+                         + (f", the bias speed within {BIAS_SHARE:.0%} of it)" if bias else ")"))
     travel = math.degrees(amplitude * RPM * per_rad)
     period = excitation_period_periods(hold)
     settle = min(max(_settle_s(h, rate), 0.1), HORIZON_S)
+    speed_bound_rpm = amplitude * per_speed
+    # the JOG's speed step: rounded up to it
+    steps = math.ceil(BIAS_MARGIN * speed_bound_rpm / SPEED_STEP_RPM - 1e-9) if bias else 0
+    bias_rpm = round(steps * SPEED_STEP_RPM, 6)
     return ExcitationPlan(
         amplitude_rpm=amplitude, hold_periods=hold, period_samples=period, records=RECORDS,
         travel_bound_deg=travel, travel_limit_deg=TRAVEL_MARGIN * travel + 0.01,
-        peak_current_a=amplitude * RPM * per_a, f_max_hz=0.4 * rate / hold, settle_s=settle,
-        duration_s=RECORDS * (settle + period * dt),
+        peak_current_a=amplitude * RPM * per_a + friction_a, f_max_hz=0.4 * rate / hold, settle_s=settle,
+        duration_s=RECORDS * (settle + period * dt), bias_rpm=bias_rpm, speed_bound_rpm=speed_bound_rpm,
     )

@@ -12,10 +12,13 @@ the linear model here, period for period as ``physics._kernel.run`` computes:
 - PI speed controller: i = Kv x (e + integral), the integral summed per period (backward Euler);
 - position loop: speed command = Kp x (command - position) + FF x command speed.
 
-Friction, quantisation and the current limit are not in the linear model (the excitation stays
-well inside the current limit; quantisation is noise). The trace records the speed at the end of
-each period, so the measured closed loop and plant carry one period's advance (``z``) against the
-loop's own signals: ``speed_closed_loop`` and ``plant`` include it.
+Viscous friction (the model's effect, on the motor side as the kernel puts it) is part of the
+plant: it is linear. Coulomb friction, quantisation and the current limit are not in the linear
+model: the excitation rides on a bias speed so the Coulomb friction is a constant torque
+(``excitation``), it stays well inside the current limit, and quantisation is noise.
+The trace records the speed at the end of each period, so the measured closed loop and plant
+carry one period's advance (``z``) against the loop's own signals: ``speed_closed_loop`` and
+``plant`` include it.
 
 Two-mass prediction (the catalogue's K1 and the declared load): anti-resonance
 sqrt(K1 / J_load) and resonance sqrt(K1 x (1/J_motor + 1/J_load)), in Hz.
@@ -77,12 +80,12 @@ def _discrete_plant(model: AxisModel, servo_rate_hz: float) -> Any:
         jm, jl, k, c = p.jm, p.jl, p.k1, p.damping
         # states [xm, vm, twist, vl]; xm only to read its change over the period
         a = np.array([[0, 1, 0, 0],
-                      [0, -c / jm, -k / jm, c / jm],
+                      [0, -(c + p.visc) / jm, -k / jm, c / jm],
                       [0, 1, 0, -1],
                       [0, c / jl, k / jl, -c / jl]], float)
         b = np.array([[0], [p.kt / jm], [0], [0]], float)
     else:
-        a = np.array([[0, 1], [0, 0]], float)
+        a = np.array([[0, 1], [0, -p.visc / p.j_total]], float)
         b = np.array([[0], [p.kt / p.j_total]], float)
     n = a.shape[0]
     disc = control.c2d(control.ss(a, b, np.eye(n), np.zeros((n, 1))), p.dt, method="zoh")

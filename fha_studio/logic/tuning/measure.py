@@ -1,12 +1,14 @@
 """Measure the speed loop's frequency response on a drive, over the client and the protocol.
 
 The drive adds its PRBS to the speed command (EXA / EXL / EXG, docs/protocol.md) while the
-position loop holds the axis; the drive-side trace records the speed command (monitor 109), the
-output speed (110, fine), the torque (108: Kt x the current, finer steps than the current's mA)
-and the position (100) at the servo rate (TDV 1), one PRBS period per capture. Before a record the
-loop settles for the plan's ``settle_s``. The excitation is renewed at every look at the drive like
-a held JOG (the drive stops it without a renewal after 100 ms), and always stopped at the end (also
-on an error or a STOP: ``should_stop``).
+position loop holds the axis, on a JOG at the plan's bias speed (so the axis never reverses: see
+``excitation``; the JOG is started first and its ramp and the loop's lag settle before the
+excitation starts, and it is renewed with it and stopped, STP, at the end). The drive-side trace
+records the speed command (monitor 109), the output speed (110, fine), the torque (108: Kt x the
+current, finer steps than the current's mA) and the position (100) at the servo rate (TDV 1), one
+PRBS period per capture. Before a record the loop settles for the plan's ``settle_s``. The
+excitation is renewed at every look at the drive like a held JOG (the drive stops it without a
+renewal after 100 ms), and always stopped at the end (also on an error or a STOP: ``should_stop``).
 
 Time is the drive's own, from what it reports: a capture's state and sample count (``TST``)
 measure the settling and each record, and ``pace(seconds)`` is called between two looks (a stepped
@@ -52,6 +54,7 @@ class Records:
 
     records: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], ...]
     sample_rate_hz: float
+    bias_rad_s: float = 0.0  # the jog the excitation rode on
 
     def closed_loop(self) -> list[tuple[np.ndarray, np.ndarray]]:
         return [(r[0], r[1]) for r in self.records]
@@ -59,9 +62,30 @@ class Records:
     def plant(self) -> list[tuple[np.ndarray, np.ndarray]]:
         return [(r[2], r[1]) for r in self.records]
 
+    def reversal_share(self) -> float:
+        """The share of the samples at which the output speed changed sign or stood still: where
+        the axis sticks on its Coulomb friction (0 on a bias speed that kept it turning one way)."""
+        speeds = [r[1] for r in self.records if len(r[1]) > 1]
+        if not speeds:
+            return 0.0
+        stuck = sum(int(np.count_nonzero(np.sign(v[1:]) != np.sign(v[:-1])) + np.count_nonzero(v == 0.0))
+                    for v in speeds)
+        return stuck / sum(len(v) for v in speeds)
+
     def travel_deg(self) -> float:
-        pos = np.concatenate([r[3] for r in self.records])
-        return float(np.degrees(np.max(np.abs(pos - pos[0])))) if len(pos) else 0.0
+        """How far the excitation took the output from where it started; on a bias speed, half
+        the largest swing within a record about the jog's path (the records' starts are apart by
+        read-outs of unknown length)."""
+        if not self.records or not len(self.records[0][3]):
+            return 0.0
+        if self.bias_rad_s == 0.0:
+            pos = np.concatenate([r[3] for r in self.records])
+            return float(np.degrees(np.max(np.abs(pos - pos[0]))))
+        swings = []
+        for r in self.records:
+            about = r[3] - self.bias_rad_s * np.arange(len(r[3])) / self.sample_rate_hz
+            swings.append(0.5 * float(np.ptp(about)))
+        return float(np.degrees(max(swings)))
 
 
 def check_excitable(client: Any) -> None:
@@ -81,21 +105,32 @@ def check_excitable(client: Any) -> None:
 
 def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, pace: Callable[[float], None],
             now: Callable[[], float] = time.monotonic, should_stop: Callable[[], bool] = lambda: False,
-            output_ppr: int = 1) -> Records:
-    """Run ``plan`` on the drive and read the captures (see the module docstring)."""
+            output_ppr: int = 1, jog_accel_rpm_s: float = 1.0) -> Records:
+    """Run ``plan`` on the drive and read the captures (see the module docstring);
+    ``jog_accel_rpm_s``: the drive's JOG acceleration (test item 1), how soon the bias is reached."""
     check_excitable(client)
     client.set_excitation(plan.amplitude_rpm, plan.travel_limit_deg)
     records = []
+    biased = plan.bias_rpm > 0.0
+    exciting = False
 
     def renew() -> None:
         if should_stop():
             client.excite(0)
             client.stop()
             raise Stopped("STOP: the excitation was stopped")
-        client.excite(plan.hold_periods)
+        if biased:
+            client.jog(plan.bias_rpm)
+        if exciting:
+            client.excite(plan.hold_periods)
 
     running = False  # the excitation ran without a break since the loop settled
     try:
+        if biased:  # the jog's ramp, then the loop's lag behind it, before the excitation
+            renew()
+            wait_drive_time(client, plan.bias_rpm / max(jog_accel_rpm_s, 1e-9) + plan.settle_s, servo_rate_hz,
+                            pace, look=renew)
+        exciting = True
         for _ in range(plan.records):
             renew()
             if not running:
@@ -115,7 +150,10 @@ def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, pace: Calla
                 cols[MonitorItem.FEEDBACK_POSITION] * (2.0 * math.pi / output_ppr),
             ))
     finally:
-        # the link may be gone: the drive's watchdog then stops it within 100 ms
+        # the link may be gone: the drive's watchdog then stops both within 100 ms
         with contextlib.suppress(Exception):
             client.excite(0)
-    return Records(tuple(records), servo_rate_hz)
+        if biased:
+            with contextlib.suppress(Exception):
+                client.stop()
+    return Records(tuple(records), servo_rate_hz, plan.bias_rpm * RPM)

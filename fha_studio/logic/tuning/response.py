@@ -9,8 +9,9 @@
   the anti-resonance is the dip and the resonance the peak above it (parabolic interpolation
   between the bins).
 - ``fit_two_mass``: the plant (torque -> speed) fitted with the two-mass shape
-  1/(J s) x (1 + 2 za s/wa + s^2/wa^2)/(1 + 2 zr s/wr + s^2/wr^2): the total inertia from the
-  low-frequency gain 1/(J s) and the resonance and anti-resonance between the bins;
+  1/(J s + B) x (1 + 2 za s/wa + s^2/wa^2)/(1 + 2 zr s/wr + s^2/wr^2): the total inertia from the
+  low-frequency gain, the viscous friction B apart from it (at the lowest bins it would otherwise
+  pass for inertia), and the resonance and anti-resonance between the bins;
   ``inertia_from_move``: least squares of torque against
   acceleration (with Coulomb and viscous friction) over a move, as the HA-800A estimates it.
 - ``loop_figures``: gain margin, phase margin, crossover, -3 dB bandwidth (python-control).
@@ -132,12 +133,14 @@ def find_resonance(plant: FrequencyResponse, min_depth_db: float = 3.0) -> Reson
 
 @dataclass(frozen=True)
 class TwoMassFit:
-    """The plant (torque -> speed) fitted with 1/(J s) x (anti-resonance pair)/(resonance pair):
-    the total inertia J (kg m^2) and the two frequencies (Hz; None for a rigid-looking axis)."""
+    """The plant (torque -> speed) fitted with 1/(J s + B) x (anti-resonance pair)/(resonance
+    pair): the total inertia J (kg m^2), the two frequencies (Hz; None for a rigid-looking axis)
+    and the viscous friction B (N m s/rad)."""
 
     total_inertia_kgm2: float
     resonance_hz: float | None
     antiresonance_hz: float | None
+    viscous_nm_s_per_rad: float = 0.0
 
 
 def _rigid_factor(w: np.ndarray, dt: float) -> np.ndarray:
@@ -149,7 +152,7 @@ def _rigid_factor(w: np.ndarray, dt: float) -> np.ndarray:
 def fit_two_mass(plant: FrequencyResponse, sample_rate_hz: float) -> TwoMassFit | None:
     """Least squares (scipy.optimize) of the two-mass shape to the trusted bins of ``plant``
     (torque -> speed), started from the dip and peak ``find_resonance`` finds; a rigid body's
-    1/(J s) when there is no dip. None without trusted bins."""
+    1/(J s + B) when there is no dip. None without trusted bins."""
     ok = plant.trusted()
     f = plant.freq_hz[ok]
     if len(f) < 3:
@@ -162,27 +165,33 @@ def fit_two_mass(plant: FrequencyResponse, sample_rate_hz: float) -> TwoMassFit 
     j0 = float(np.median(np.abs(rigid[: max(3, len(f) // 10)]) / np.abs(h[: max(3, len(f) // 10)])))
     if guess.antiresonance_hz is None or guess.resonance_hz is None:
         use = f <= 0.1 * sample_rate_hz
-        j = float(np.median(np.abs(rigid[use]) / np.abs(h[use]))) if np.any(use) else j0
-        return TwoMassFit(j, None, None)
+        if np.count_nonzero(use) < 3:
+            return TwoMassFit(j0, None, None)
+        # rigid / h = J + B x rigid: linear in J and B (real), least squares over both parts
+        a = np.column_stack([np.ones(np.count_nonzero(use)), rigid[use]])
+        a2 = np.vstack([a.real, a.imag])
+        y = rigid[use] / h[use]
+        (j, b), *_ = np.linalg.lstsq(a2, np.concatenate([y.real, y.imag]), rcond=None)
+        return TwoMassFit(float(j), None, None, max(float(b), 0.0))
     wa0, wr0 = TWO_PI * guess.antiresonance_hz, TWO_PI * guess.resonance_hz
     use = f <= 3.0 * guess.resonance_hz
     wu, hu, ru = w[use], h[use], rigid[use]
 
     def model(x: np.ndarray) -> np.ndarray:
-        j, wa, wr, za, zr = math.exp(x[0]), math.exp(x[1]), math.exp(x[2]), x[3], x[4]
+        j, wa, wr, za, zr, b = math.exp(x[0]), math.exp(x[1]), math.exp(x[2]), x[3], x[4], x[5]
         num = 1.0 - (wu / wa) ** 2 + 2j * za * wu / wa
         den = 1.0 - (wu / wr) ** 2 + 2j * zr * wu / wr
-        return np.asarray(ru / j * num / den)
+        return np.asarray(ru / (j + b * ru) * num / den)
 
     def residual(x: np.ndarray) -> np.ndarray:
         r = np.log(hu / model(x))
         return np.concatenate([r.real, r.imag])
 
-    x0 = np.array([math.log(j0), math.log(wa0), math.log(wr0), 0.05, 0.05])
-    fit = optimize.least_squares(residual, x0, bounds=([-np.inf, -np.inf, -np.inf, 0.0, 0.0],
-                                                       [np.inf, np.inf, np.inf, 1.0, 1.0]))
+    x0 = np.array([math.log(j0), math.log(wa0), math.log(wr0), 0.05, 0.05, 0.0])
+    fit = optimize.least_squares(residual, x0, bounds=([-np.inf, -np.inf, -np.inf, 0.0, 0.0, 0.0],
+                                                       [np.inf, np.inf, np.inf, 1.0, 1.0, np.inf]))
     j, wa, wr = (math.exp(v) for v in fit.x[:3])
-    return TwoMassFit(j, wr / TWO_PI, wa / TWO_PI)
+    return TwoMassFit(j, wr / TWO_PI, wa / TWO_PI, float(fit.x[5]))
 
 
 def inertia_from_move(t_s: np.ndarray, speed_rad_s: np.ndarray, torque_nm: np.ndarray) -> float:

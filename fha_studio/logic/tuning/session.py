@@ -71,22 +71,40 @@ def tuner_for(client: Any, parameters: ParameterModel, model: AxisModel,
 def measure_report(client: Any, tuner: Tuner, pace: Callable[[float], None],
                    now: Callable[[], float] = time.monotonic, amplitude_rpm: float | None = None,
                    announce: Callable[[str], None] = lambda _s: None,
-                   should_stop: Callable[[], bool] = lambda: False) -> dict[str, Any]:
+                   should_stop: Callable[[], bool] = lambda: False, bias: bool = True) -> dict[str, Any]:
     """Excite, measure and analyse; the JSON of ``tune measure``. ``pace`` and ``now``: as
-    ``measure.measure`` takes them (the drive's own time)."""
+    ``measure.measure`` takes them (the drive's own time); ``bias``: on a bias speed (False: about
+    standstill, for an axis that may not turn that far; the friction then shows, and is warned of)."""
     lm: LoopModel = tuner.loop({})
-    plan = plan_excitation(lm, amplitude_rpm)
+    plan = plan_excitation(lm, amplitude_rpm, bias)
     announce(plan.describe())
     records = measure(client, plan, tuner.servo_rate_hz, pace, now, should_stop,
-                      output_ppr=tuner.model.output_resolution_ppr)
+                      output_ppr=tuner.model.output_resolution_ppr,
+                      jog_accel_rpm_s=float(tuner.items.get("jog_acceleration", 1)))
     closed = estimate_response(records.closed_loop(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
     plant = estimate_response(records.plant(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
     return {
         **response_figures(tuner, lm, closed, plant, records.sample_rate_hz),
+        "stick_slip_warning": stick_slip_warning(records.reversal_share()),
         "excitation": {"amplitude_rpm": plan.amplitude_rpm, "travel_bound_deg": plan.travel_bound_deg,
                        "travel_limit_deg": plan.travel_limit_deg, "hold_periods": plan.hold_periods,
-                       "records": plan.records, "travelled_deg": records.travel_deg()},
+                       "records": plan.records, "travelled_deg": records.travel_deg(),
+                       "bias_rpm": plan.bias_rpm, "bias_travel_deg": plan.bias_travel_deg},
     }
+
+
+#: speed reversals at more than this share of the samples: the friction spoils the response
+REVERSALS_SHARE = 0.001
+
+
+def stick_slip_warning(reversal_share: float) -> str | None:
+    """Why a measurement whose speed reversed is not to be trusted at low frequency, or None. The
+    coherence does not show it: the stick-slip repeats with the periodic excitation."""
+    if reversal_share <= REVERSALS_SHARE:
+        return None
+    return (f"the output speed reversed or stood still at {reversal_share:.1%} of the samples: the axis "
+            "sticks on its friction at each reversal, so the response loses gain at low frequency and the "
+            "load inertia estimate is not to be trusted; measure on a bias speed (the default)")
 
 
 def response_figures(tuner: Tuner, lm: LoopModel, closed: FrequencyResponse, plant: FrequencyResponse,
@@ -107,6 +125,9 @@ def response_figures(tuner: Tuner, lm: LoopModel, closed: FrequencyResponse, pla
         "predicted_resonance_hz": predicted.resonance_hz,
         "predicted_antiresonance_hz": predicted.antiresonance_hz,
         "load_inertia_estimate_kgm2": None if fit is None else fit.total_inertia_kgm2 - own,
+        # the viscous friction fitted apart from the inertia (on a bias speed; about standstill the
+        # stick-slip passes for it too)
+        "viscous_friction_estimate_nm_s_per_rad": None if fit is None else fit.viscous_nm_s_per_rad,
         "gain_margin_db": measured.gain_margin_db,
         "phase_margin_deg": measured.phase_margin_deg,
         "crossover_hz": measured.crossover_hz,
