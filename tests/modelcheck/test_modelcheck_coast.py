@@ -4,9 +4,9 @@ The captures are made as a technician makes them on a real HA-655 (bench_capture
 controller's moves, then a move at speed, an alarm on the drive and the de-energised axis coasting,
 with the ALARM line recorded beside the encoder, the command pulses and IN-POS. Asserted against
 the friction hidden in the simulated drive: viscous friction (which the servo-on part cannot tell
-from the loop's speed lag) named from the coast within 35 %, with Coulomb friction; a frictionless
-coast, one too short and one a brake stops name nothing from it and say why; the servo-on part's
-findings are those of the same recording cut before the alarm.
+from the loop's speed lag) named from the coast within 35 %, with Coulomb friction and beside a
+gravity load; a frictionless coast, one too short and one a brake stops name nothing from it and
+say why; the servo-on part's findings are those of the same recording cut before the alarm.
 """
 
 from __future__ import annotations
@@ -31,6 +31,16 @@ VISCOUS_17C = BenchCase(MEDIUM_17C, {"viscous_friction": {"coefficient_nm_s_per_
 BOTH_40C = BenchCase(
     MEDIUM_40C,
     {"viscous_friction": {"coefficient_nm_s_per_rad": 25.0}, "coulomb_friction": {"torque_nm": 25.0}},
+    coast_s=1.0,
+    coast_rpm=15.0,
+)
+#: a pendulum: the coast is mostly the gravity the servo-on part names, the drag beside it
+GRAVITY_17C = BenchCase(
+    MEDIUM_17C,
+    {
+        "gravity_load": {"amplitude_nm": 7.8, "phase_deg": 30.0},
+        "viscous_friction": {"coefficient_nm_s_per_rad": 1.95},
+    },
     coast_s=1.0,
     coast_rpm=15.0,
 )
@@ -65,7 +75,7 @@ def _truth(case: BenchCase) -> dict[str, float]:
     return {k: v for effect in hidden.values() for k, v in effect.items()}
 
 
-@pytest.mark.parametrize("case", [VISCOUS_17C, BOTH_40C, CATALOGUE_17C, CATALOGUE_40C],
+@pytest.mark.parametrize("case", [VISCOUS_17C, BOTH_40C, GRAVITY_17C, CATALOGUE_17C, CATALOGUE_40C],
                          ids=lambda c: c.name)
 def test_the_coast_after_an_alarm_names_viscous_friction(case, checked):
     _, result = checked(case)

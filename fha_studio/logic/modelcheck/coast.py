@@ -4,13 +4,13 @@ On an alarm the HA-655 de-energises the motor and the axis coasts (no dynamic br
 the encoder outputs keep counting and the ALARM line says when it began. With no current, no loop
 and the declared inertia J, the axis obeys
 
-    J a = -c s - b w - T_known(pos),   s = sign(w) (constant within one coast),
+    J a = -c s - b w - g T_known(pos),   s = sign(w) (constant within one coast),
 
 c the friction level in the coast's direction (Coulomb friction and any constant load torque, one
 number per direction: two coasts in opposite directions separate them), b viscous friction, and
-T_known the load's torques already named (gravity). For T_known = 0 the speed is
-w(t) = (w0 + c s / b) e^(-b t / J) - c s / b, so the position is linear in (pos0, w0, c) for a
-given k = b / J: the fit searches k alone and solves the rest by least squares on the recorded
+T_known the load's torques already named (gravity), its size g fitted again. For T_known = 0 the
+speed is w(t) = (w0 + c s / b) e^(-b t / J) - c s / b, so the position is linear in (pos0, w0, c,
+g) for a given k = b / J: the fit searches k alone and solves the rest by least squares on the recorded
 position (no second difference of a quantised encoder is taken). The uncertainties come from the
 residual, widened by its correlation from row to row; an effect below three of them, or whose
 torque stays under the channel's floor, is not named. A coast that stops faster than any friction
@@ -97,6 +97,7 @@ class CoastFit:
     pos_nominal_rad: np.ndarray
     braked: bool = False  # stopped faster than friction could stop it
     why_not: str = ""  # a coast that tells nothing: why
+    load_nm: np.ndarray | None = None  # the named load's torque along the coast (gravity), N m
 
     def speed_with(self, level_nm: float, viscous_nm_s_per_rad: float, inertia_kgm2: float) -> np.ndarray:
         """The speed from the coast's start with the given friction (rad/s, zero once stopped)."""
@@ -105,6 +106,8 @@ class CoastFit:
         w0 = self.speed_at_start_rad_s
         s = self.direction
         w = w0 * np.exp(-k * t) - s * level_nm / inertia_kgm2 * _h(k, t)
+        if self.load_nm is not None:
+            w = w + np.gradient(_known_response(k, t, self.load_nm, inertia_kgm2), t)
         w[s * w < 0] = 0.0  # friction holds it once at rest
         return w
 
@@ -213,14 +216,22 @@ def fit_coast(
     tr = t - t[0]
     known = known_torque_nm(pos) if known_torque_nm is not None else np.zeros_like(t)
 
-    def solve(k: float) -> tuple[np.ndarray, np.ndarray]:
+    def design(k: float) -> np.ndarray:
         x = _design(k, tr, direction, inertia_kgm2)
-        y = pos - _known_response(k, tr, known, inertia_kgm2)
-        beta, _ = ols(y, x)
+        if known_torque_nm is None:
+            return x
+        # the named load's torque with its size free: a few per cent off in it would otherwise
+        # read as friction (a pendulum's coast is mostly its gravity)
+        return np.column_stack([x, _known_response(k, tr, known, inertia_kgm2)])
+
+    def solve(k: float) -> tuple[np.ndarray, np.ndarray]:
+        x = design(k)
+        beta, _ = ols(pos, x)
         if beta[2] < 0:
             # no pushing friction: at a steady speed a drag and a push would cancel in any size
-            beta = np.append(ols(y, x[:, :2])[0], 0.0)
-        return y - x @ beta, beta
+            keep = [i for i in range(x.shape[1]) if i != 2]
+            beta = np.insert(ols(pos, x[:, keep])[0], 2, 0.0)
+        return pos - x @ beta, beta
 
     k_max = 1.0 / (FASTEST_DECAY_SHARE * duration)
     best = minimize_scalar(lambda u: float(np.sum(solve(u**2)[0] ** 2)), bounds=(0.0, math.sqrt(k_max)),
@@ -230,11 +241,12 @@ def fit_coast(
     if r0 <= float(best.fun):
         k = 0.0
     resid, beta = solve(k)
-    # the uncertainties: the Jacobian in (pos0, w0, c, k), the residual's variance, widened by the
-    # residual's correlation from row to row (quantisation and smoothing make neighbours alike)
+    # the uncertainties: the Jacobian in (pos0, w0, c[, the load's size], k), the residual's
+    # variance, widened by the residual's correlation from row to row (quantisation and smoothing
+    # make neighbours alike)
     dk = 1e-4 * k_max
-    x = _design(k, tr, direction, inertia_kgm2)
-    dx = (_design(k + dk, tr, direction, inertia_kgm2) @ beta - x @ beta) / dk
+    x = design(k)
+    dx = (design(k + dk) @ beta - x @ beta) / dk
     jac = np.column_stack([x, dx])
     n, p = jac.shape
     var = float(np.sum(resid**2)) / max(n - p, 1)
@@ -242,11 +254,13 @@ def fit_coast(
     rho = min(max(rho, 0.0), 0.999)
     cov = np.linalg.pinv(jac.T @ jac) * var * (1.0 + rho) / (1.0 - rho)
     sigma = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    b, b_sigma = k * inertia_kgm2, float(sigma[3]) * inertia_kgm2
+    b, b_sigma = k * inertia_kgm2, float(sigma[-1]) * inertia_kgm2
     c, c_sigma = float(beta[2]), float(sigma[2])
     if c > most_friction_nm:
         return braked(c)
     w_fit = beta[1] * np.exp(-k * tr) - direction * c / inertia_kgm2 * _h(k, tr)
+    if known_torque_nm is not None:  # the load's share of the speed: the derivative of its response
+        w_fit = w_fit + beta[3] * np.gradient(_known_response(k, tr, known, inertia_kgm2), tr)
     return CoastFit(
         alarm_s=alarm_s,
         direction=direction,
@@ -263,6 +277,7 @@ def fit_coast(
         speed_fitted_rad_s=w_fit,
         pos_measured_rad=pos,
         pos_nominal_rad=beta[0] + beta[1] * tr,
+        load_nm=None if known_torque_nm is None else known,
     )
 
 
