@@ -75,6 +75,8 @@ class BenchCase:
     coast_rpm: float = 0.0
     #: the controller drops the brake's 24 V with the alarm (an actuator with the brake option)
     brake: bool = False
+    #: after the coast the alarm is cleared, the servo turned on again and the same done the other way
+    both_ways: bool = False
     catalogue_friction: bool = False
 
     @property
@@ -84,6 +86,7 @@ class BenchCase:
             name += "-catalogue"
         if self.coast_s:
             name += f"-coast{self.coast_s:g}s-{self.coast_rpm:g}rpm{'-brake' if self.brake else ''}"
+            name += "-both-ways" if self.both_ways else ""
         return name
 
     def url(self) -> str:
@@ -163,7 +166,12 @@ def make_capture(case: BenchCase, directory: Path) -> BenchCapture:
                 instrument.keep(0.02)
             instrument.keep(dwell)
         if case.coast_s:
-            _coast(drive, instrument, case, accel)
+            _coast(drive, instrument, case, accel, 720.0)
+        if case.both_ways:
+            drive.clear_alarm()  # ACL: alarm 60 clears; the technician turns the servo on again
+            drive.set_servo(True)
+            instrument.keep(0.3)
+            _coast(drive, instrument, case, accel, -720.0)
         instrument.write(capture, "sr")
         values = {("system", n): drive.memory.value(key) for n, key in PARAMETERS.items()}
         parameters = directory / f"{case.name}.params.toml"
@@ -188,12 +196,13 @@ def make_capture(case: BenchCase, directory: Path) -> BenchCapture:
     return BenchCapture(read_recording(path).with_declared_load(case.axis.load_kgm2), capture, parameters)
 
 
-def _coast(drive: SimDrive, instrument: VirtualBenchInstrument, case: BenchCase, accel_rpm_s: float) -> None:
-    """A long move at the case's coast speed, the alarm once the axis runs steadily at it, and the
-    coast recorded (the controller stops sending pulses: the drive is in alarm)."""
+def _coast(drive: SimDrive, instrument: VirtualBenchInstrument, case: BenchCase, accel_rpm_s: float,
+           angle_deg: float) -> None:
+    """A long move (``angle_deg``) at the case's coast speed, the alarm once the axis runs steadily
+    at it, and the coast recorded (the controller stops sending pulses: the drive is in alarm)."""
     drive.write_parameter("test", 1, max(1, round(accel_rpm_s)))
     drive.set_move_speed(case.coast_rpm)
-    drive.controller_command(720.0)
+    drive.controller_command(angle_deg)
     instrument.keep(case.coast_rpm / accel_rpm_s + 0.15)  # up to speed, the loop settled
     assert drive.moving, "the coast's move ended before the alarm"
     drive.raise_alarm(COAST_ALARM)

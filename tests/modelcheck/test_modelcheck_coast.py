@@ -46,6 +46,9 @@ GRAVITY_17C = BenchCase(
 )
 CATALOGUE_17C = BenchCase(MEDIUM_17C, catalogue_friction=True, coast_s=0.8, coast_rpm=15.0)
 CATALOGUE_40C = BenchCase(MEDIUM_40C, catalogue_friction=True, coast_s=1.3, coast_rpm=15.0)
+#: coasts both ways (the alarm cleared and the servo on again between them) with a load pulling one way
+BOTH_WAYS_17C = BenchCase(MEDIUM_17C, {"load_torque_offset": {"torque_nm": 1.0}}, coast_s=0.6, coast_rpm=15.0,
+                          catalogue_friction=True, both_ways=True)
 FRICTIONLESS_17C = BenchCase(MEDIUM_17C, coast_s=0.5, coast_rpm=15.0)
 TOO_SHORT_17C = BenchCase(MEDIUM_17C, catalogue_friction=True, coast_s=0.02, coast_rpm=15.0)
 BRAKED_17C = BenchCase(MEDIUM_17C, catalogue_friction=True, coast_s=0.3, coast_rpm=15.0, brake=True)
@@ -175,3 +178,23 @@ def test_the_command_during_the_alarm_and_too_little_before_it(checked):
         with pytest.raises(ModelCheckError, match=refused) as err:
             run_modelcheck(rec.slice(start, len(rec)))
         assert said in str(err.value)
+
+
+def test_coasts_both_ways_separate_coulomb_friction_from_a_constant_load_torque(checked):
+    """Forward the coast's level is Coulomb friction plus the load torque, in reverse minus it: the
+    mean is named Coulomb friction, half the difference a load torque offset (or friction that
+    differs by direction, which no coast tells from it: said)."""
+    _, result = checked(BOTH_WAYS_17C)
+    text = "\n".join(result.summary_lines())
+    truth = _truth(BOTH_WAYS_17C)
+    effects = {e.id: e for e in result.effects}
+    assert effects["coulomb_friction"].params["torque_nm"] == pytest.approx(truth["torque_nm"], rel=TOL), text
+    viscous = effects["viscous_friction"].params["coefficient_nm_s_per_rad"]
+    assert viscous == pytest.approx(truth["coefficient_nm_s_per_rad"], rel=TOL), text
+    offset = effects["load_torque_offset"]
+    assert offset.params["torque_nm"] == pytest.approx(1.0, rel=TOL), text
+    assert offset.alternatives == ["asymmetric_friction"]
+    assert "from the coasts after the alarm at" in offset.basis
+    assert "The coasts' friction differs by direction" in text
+    assert len(result.coasts) == 2
+    assert all(c.rms_after_rpm < 0.2 * c.rms_before_rpm for c in result.coasts), text

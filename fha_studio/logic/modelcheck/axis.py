@@ -185,9 +185,12 @@ def _check_other_columns(rec: Recording, axis: DeclaredAxis, span: float) -> Non
             )
     cmd = rec.cmd_pos_deg
     alarm = rec.channels.get("alarm")
-    if cmd is not None and alarm is not None:
-        # while the ALARM line is on the motor is de-energised: the axis coasts away from the command
-        cmd, pos = cmd[alarm <= 0.5], pos[alarm <= 0.5]
+    if cmd is not None and alarm is not None and np.any(alarm > 0.5):
+        # from the first alarm on the command does not hold the axis: it coasts away, and a
+        # controller resumes from its own count, the coast's travel off (the closed loop is read
+        # before it)
+        first = int(np.argmax(alarm > 0.5))
+        cmd, pos = cmd[:first], pos[:first]
     if cmd is not None and len(cmd):
         err = float(np.sqrt(np.mean((cmd - pos) ** 2)))
         if err > max(0.5 * span, 5.0):

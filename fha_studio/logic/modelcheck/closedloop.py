@@ -254,7 +254,8 @@ def not_identifiable_lines(
         "Without a torque measurement (no current, no torque column) these cannot be seen: a constant "
         "load torque and the part of friction that differs by direction are held by the speed loop's "
         "integral and leave no trace in the following error; an inertia error trades off against the "
-        f"loop's gain scale; {viscous}. Record the current (or an output torque sensor) to see them.",
+        f"loop's gain scale; {viscous}. Record the current (or an output torque sensor) to see them."
+        + (" A coast after an alarm reads friction without the loop: what it named is above." * coast),
         "Every torque above, in N m, rests on the declared inertia "
         f"({axis.nominal_inertia_kgm2:.4g} kg m^2): an inertia off by x % scales them all by x %.",
         *gear,

@@ -374,10 +374,16 @@ def name_from_coasts(
         if abs(offset) > NAMED_SIGMAS * offset_sigma and abs(offset) >= floor_nm:
             out.lines.append(
                 f"The coasts' friction differs by direction: {fmt_pm(up, su, 'N m')} forward, "
-                f"{fmt_pm(down, sd, 'N m')} in reverse ({where}): a constant load torque of "
-                f"{fmt_pm(offset, offset_sigma, 'N m')} (or friction that differs by direction) besides "
-                "Coulomb friction."
+                f"{fmt_pm(down, sd, 'N m')} in reverse ({where}): half the difference is a constant load "
+                "torque, or friction that differs by direction (no coast tells them apart)."
             )
+            effect = _effect("load_torque_offset", "torque_nm", offset, offset_sigma, abs(offset), where)
+            effect.alternatives = ["asymmetric_friction"]
+            effect.advice = (
+                f"{effect.advice}; or friction that differs by direction: record the current through "
+                "slow runs both ways to tell them apart"
+            )
+            out.effects.append(effect)
     else:
         ((d, (level, level_sigma)),) = by_dir.items()
         basis = f"{'forward' if d > 0 else 'reverse'} only, so any constant load torque is in it too"
@@ -439,15 +445,16 @@ def _effect(effect_id: str, param: str, value: float, sigma: float, size: float,
 
 def coast_gaps(fits: list[CoastFit], inertia_kgm2: float, effects: list[Effect]) -> list[CoastGap]:
     """Each coast's speed from its start: recorded, the nominal model's (no friction) and the
-    updated model's (the Coulomb and viscous friction it names)."""
+    updated model's (the Coulomb and viscous friction and the constant load torque it names)."""
     by_id = {e.id: e for e in effects}
     fc = by_id["coulomb_friction"].params["torque_nm"] if "coulomb_friction" in by_id else 0.0
+    offset = by_id["load_torque_offset"].params["torque_nm"] if "load_torque_offset" in by_id else 0.0
     b = by_id["viscous_friction"].params["coefficient_nm_s_per_rad"] if "viscous_friction" in by_id else 0.0
     gaps = []
     for f in fits:
         measured = f.speed_measured_rad_s * RPM_PER_RAD_S
         nominal = f.speed_nominal_rad_s * RPM_PER_RAD_S
-        updated = f.speed_with(fc, b, inertia_kgm2) * RPM_PER_RAD_S
+        updated = f.speed_with(fc + f.direction * offset, b, inertia_kgm2) * RPM_PER_RAD_S
         gaps.append(CoastGap(f.alarm_s, f.t_s, measured, nominal, updated, rms(measured - nominal),
                              rms(measured - updated)))
     return gaps
