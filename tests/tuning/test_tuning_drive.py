@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 
 from fha_studio.cli import main as cli_main
@@ -16,7 +17,9 @@ from fha_studio.hardware.errors import DriveRefused
 from fha_studio.hardware.parameters import load_parameter_model
 from fha_studio.logic.tuning.excitation import NotExcitable, plan_excitation
 from fha_studio.logic.tuning.measure import measure
+from fha_studio.logic.tuning.response import estimate_response
 from fha_studio.logic.tuning.session import declared_model, tuner_for
+from fha_studio.physics import catalogue_effects
 
 PARAMETERS = load_parameter_model("HA-655")
 CODE = "FHA-25C-50-US250"
@@ -153,3 +156,37 @@ def test_in_place_on_friction_warns_of_stick_slip(drives, tmp_path,
     assert plant["magnitude_db"][0] < rigid_db - 6.0
     (drive,) = drives
     assert not drive.excitation.active and not drive.moving
+
+
+def test_a_read_out_longer_than_the_watchdog_restarts_the_jog_before_the_excitation() -> None:
+    """A link slower than the watchdog (a real line at 19200 baud takes seconds to read a record):
+    the drive stops the excitation and the jog under it while a record is read, and the axis stops
+    on its friction. Before the next record the jog runs steadily again before the excitation
+    starts anew, so no record holds the restart: the response stays within test_tuning_cases.py's
+    tolerances of the drive's linearisation (its viscous friction in it)."""
+    model = declared_model(CODE, 0.81)
+    with DriveClient.open(_url(CODE, 0.81, "&catalogue_friction=1")) as client:
+        drive = _sim(client)
+        client.servo(True)
+        stopped_during_read_out = []
+
+        def slow_read_out() -> float:  # each look at the clock around a read-out: 0.2 s of the drive's time
+            drive.advance(0.2)
+            stopped_during_read_out.append(not drive.excitation.active and not drive.moving)
+            return drive.clock_s
+
+        tuner = tuner_for(client, PARAMETERS, model, quantised_feedback=False)
+        plan = plan_excitation(tuner.loop({}))
+        records = measure(client, plan, tuner.servo_rate_hz, drive.advance, slow_read_out,
+                          output_ppr=model.output_resolution_ppr,
+                          jog_accel_rpm_s=tuner.items["jog_acceleration"])
+        actual = tuner_for(client, PARAMETERS, model.replace(effects=catalogue_effects(model)),
+                           quantised_feedback=False).loop({})
+    assert plan.bias_rpm > 0 and any(stopped_during_read_out)
+    assert records.reversal_share() == 0.0
+    plant = estimate_response(records.plant(), records.sample_rate_hz, f_max_hz=plan.f_max_hz)
+    trusted = plant.trusted()
+    assert trusted.sum() > 0.8 * len(trusted)
+    mag, phase = actual.response("plant", plant.freq_hz)
+    assert np.max(np.abs(plant.magnitude_db - mag)[trusted]) <= 1.0
+    assert np.max(np.abs((plant.phase_deg - phase + 180.0) % 360.0 - 180.0)[trusted]) <= 5.0

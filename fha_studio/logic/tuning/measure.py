@@ -16,7 +16,9 @@ simulated drive's ``advance``; nothing on a drive that runs by itself, whose lin
 The read-out of a record holds the link without renewals: the excitation ran on through it when
 it took less than the watchdog's 100 ms of the drive's time. ``now()`` tells how long it took at
 most (the stepped drive's clock, or the computer's: a drive's time never runs faster than it),
-and a longer read-out lets the loop settle again before the next record.
+and after a longer read-out the drive has stopped the excitation and the jog (the axis may have
+stuck on its friction): the jog runs steadily again, then the excitation starts anew and settles,
+before the next record (a line at 19200 baud reads a record for seconds: every record so).
 """
 
 from __future__ import annotations
@@ -124,17 +126,28 @@ def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, pace: Calla
         if exciting:
             client.excite(plan.hold_periods)
 
-    running = False  # the excitation ran without a break since the loop settled
-    try:
-        if biased:  # the jog's ramp, then the loop's lag behind it, before the excitation
+    def start() -> None:
+        """At the start and after a break (a read-out longer than the watchdog: the drive stopped
+        the excitation, and the jog, whose axis may then have stuck on its friction): the jog's
+        ramp and the loop's lag behind it settle first, then the excitation starts and settles."""
+        nonlocal exciting
+        if biased:
+            exciting = False
+            client.excite(0)  # started anew once the jog runs steadily (its travel limit from there)
             renew()
             wait_drive_time(client, plan.bias_rpm / max(jog_accel_rpm_s, 1e-9) + plan.settle_s, servo_rate_hz,
                             pace, look=renew)
         exciting = True
+        renew()
+        wait_drive_time(client, plan.settle_s, servo_rate_hz, pace, look=renew)
+
+    running = False  # the excitation ran without a break since the loop settled
+    try:
         for _ in range(plan.records):
-            renew()
-            if not running:
-                wait_drive_time(client, plan.settle_s, servo_rate_hz, pace, look=renew)
+            if running:
+                renew()
+            else:
+                start()
             channels = client.configure_trace(CHANNELS, divider=1)
             client.arm_trace(plan.period_samples)
             until_trace_done(client, pace, look=renew)
