@@ -91,7 +91,7 @@ class CoastFit:
     viscous_sigma_nm_s_per_rad: float
     t_s: np.ndarray
     speed_measured_rad_s: np.ndarray  # from the recorded position, smoothed over SPEED_SPAN_S
-    speed_nominal_rad_s: np.ndarray  # no friction: the speed at the alarm held
+    speed_nominal_rad_s: np.ndarray  # no friction: the speed at the coast's start held
     speed_fitted_rad_s: np.ndarray  # the fit's own curve (before naming)
     pos_measured_rad: np.ndarray
     pos_nominal_rad: np.ndarray
@@ -281,8 +281,6 @@ def fit_coast(
     )
 
 
-
-
 @dataclass
 class CoastFindings:
     """What the coasts of a recording named, said and showed."""
@@ -294,7 +292,7 @@ class CoastFindings:
 
 
 def most_friction_nm(model: AxisModel) -> float:
-    """More than friction of the actuator could be: a brake's (BRAKE_TIMES_CATALOGUE_FRICTION)."""
+    """The torque beyond which a brake, not friction, stopped a coast (BRAKE_TIMES_CATALOGUE_FRICTION)."""
     tf = model.friction_torque_nm
     if tf:
         return BRAKE_TIMES_CATALOGUE_FRICTION * tf
