@@ -65,4 +65,6 @@ def test_a_spectrum_of_an_angle_names_its_lines_in_arc_sec(qtbot):
     assert set(lines) == {"16.60", "233.40"}
     assert lines["16.60"].endswith(" arc-sec") and 30.0 < float(lines["16.60"].split()[0]) < 41.0
     assert lines["233.40"] == "0.036 arc-sec"  # 1e-5 deg, not 1e-05 deg
-    assert panel.spectrum_plot.getPlotItem().getAxis("left").labelText == "amplitude (deg)"
+    axis = panel.spectrum_plot.getPlotItem().getAxis("left")  # the plot in arc-sec too, no SI scale
+    assert axis.labelText == "amplitude (arc-sec)" and "(x" not in axis.labelString()
+    assert 30.0 < 10 ** max(panel.spectrum_curve.getData()[1]) < 41.0  # as drawn: its log10

@@ -44,6 +44,8 @@ class SpectrumPanel(QWidget):
         self.spectrum_plot.showGrid(x=True, y=True, alpha=0.25)
         self.spectrum_plot.setLabel("bottom", "frequency", units="Hz")
         self.spectrum_plot.setLogMode(y=True)
+        # decades as they are: pyqtgraph's SI scale put "(x0.001)" after a logarithmic axis's unit
+        self.spectrum_plot.getAxis("left").enableAutoSIPrefix(False)
         self.spectrum_curve = self.spectrum_plot.plot(pen=pg.mkPen("#4fc3f7"))
         lay.addWidget(self.spectrum_plot, 1)
         self.spectrum_label = QLabel("Capture a trace (uniform sampling), then compute its spectrum.")
@@ -68,12 +70,14 @@ class SpectrumPanel(QWidget):
 
     def show_spectrum(self, spec, unit: str) -> None:
         """Plot ``spec`` (analysis.Spectrum) without its DC bin and name its prominent peaks."""
-        f, a = spec.frequency_hz[1:], np.maximum(spec.amplitude[1:], 1e-12)
+        # an angle's lines in arc-sec, as its peaks are named (a kinematic error is tens of them)
+        shown_unit, scale = ("arc-sec", ARCSEC_PER_DEG) if unit == "deg" else (unit, 1.0)
+        f, a = spec.frequency_hz[1:], np.maximum(spec.amplitude[1:] * scale, 1e-12)
         self.spectrum_curve.setData(f, a)
         if not len(f):
             self.message("Peaks: none")
             return
-        self.spectrum_plot.setLabel("left", f"amplitude ({unit})" if unit else "amplitude")
+        self.spectrum_plot.setLabel("left", f"amplitude ({shown_unit})" if shown_unit else "amplitude")
         peaks = spec.prominent_peaks(4, min_hz=f[0])
         text = ", ".join(f"{hz:.2f} Hz ({peak_amplitude(amp, unit)})" for hz, amp in peaks)
         text = text or "none stand out"
