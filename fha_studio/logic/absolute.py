@@ -266,7 +266,7 @@ def rotary_direction_check(before: int, after: int, parameter_8: int | None, rat
     sense = turned_sense(change)
     values: dict[str, Any] = {"before_counts": before, "after_counts": after, "turned": sense,
                               "rotary_direction": parameter_8}
-    angle = f" ({output_deg(change, ratio):+.2f}°)" if ratio else ""
+    angle = f", {output_deg(change, ratio):+.2f}°" if ratio else ""  # one parenthesis, not two nested
     if sense is None:
         return False, ("the position did not change: no FWD command reached the axis (was the servo on? "
                        "did the controller send the command?)"), values
