@@ -277,6 +277,10 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
                    help="the instrument's output rate [samples/s] (default 10000)")
     q.add_argument("--periods", type=whole(3, 100), default=6, metavar="N",
                    help="periods played; the first settles the loop (default 6)")
+    q.add_argument("--in-place", action="store_true",
+                   help="about standstill, not on a bias speed (the constant FWD speed under the periods "
+                   "that keeps the axis from sticking on its friction): for an axis that may not turn that "
+                   "far; the friction then spoils the response at low frequency")
     q.add_argument("-o", "--output", required=True, type=output_path, metavar="EXC",
                    help="the file to write: .csv (time and volts), .wav (16-bit, its full scale stated), "
                    ".txt (one cycle normalised to ±1)")
@@ -330,7 +334,8 @@ def run_excitation(args: argparse.Namespace) -> int:
 
     tuner, _values = _bench_tuner(args)
     try:
-        excitation = design_excitation(tuner, args.form, args.amplitude_rpm, args.rate, args.periods)
+        excitation = design_excitation(tuner, args.form, args.amplitude_rpm, args.rate, args.periods,
+                                       bias=not args.in_place)
     except NotInSpeedMode as exc:
         return _stopped("excitation", exc, EXIT_NOT_EXCITABLE)
     except ValueError as exc:

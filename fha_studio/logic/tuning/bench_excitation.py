@@ -14,6 +14,12 @@ one of three forms, each with its band [f_lo, f_hi] (f_lo = 1 / period):
 - ``chirp``: a linear sweep from f_lo to f_hi over each period (its power as flat as the
   multisine's over the band).
 
+The excitation rides on a bias speed (a constant on SPD-CMD, ramped up in ``BIAS_RAMP_S`` before
+the periods and down after them): ``excitation.BIAS_MARGIN`` x the largest speed the excitation
+itself reaches, so the axis turns one way throughout and never sticks on its friction at a
+reversal (``excitation`` says why; the analysis takes each record's mean out, the constant Coulomb
+friction with it). ``bias=False``: about standstill.
+
 The band reaches 5 x the resonance the catalogue's stiffness and the declared load predict (or
 500 Hz without one), at most 0.2 x the drive's servo rate; the period resolves the anti-resonance
 with 40 bins below it (1 ... 8 s). The file starts and ends at 0 V (a DAQ holds its last value:
@@ -35,7 +41,14 @@ from scipy import signal
 
 from fha_studio.hardware.bench.waveform import Waveform
 from fha_studio.logic.tuning.bench_names import EXCITATION_FORMS
-from fha_studio.logic.tuning.excitation import CURRENT_SHARE, GEAR_TORQUE_SHARE, RPM, SPEED_SHARE
+from fha_studio.logic.tuning.excitation import (
+    BIAS_MARGIN,
+    BIAS_SHARE,
+    CURRENT_SHARE,
+    GEAR_TORQUE_SHARE,
+    RPM,
+    SPEED_SHARE,
+)
 from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
 from fha_studio.logic.tuning.propose import Tuner
 
@@ -51,6 +64,8 @@ SERVO_SHARE = 0.2
 #: bins below the predicted anti-resonance
 BINS_BELOW_ANTIRESONANCE = 40
 PERIOD_LIMITS_S = (1.0, 8.0)
+#: the bias speed is ramped up (and down) in this long, before (after) the periods [s]
+BIAS_RAMP_S = 0.2
 
 
 class NotInSpeedMode(ValueError):
@@ -74,6 +89,7 @@ class BenchExcitation:
     peak_gear_torque_nm: float | None
     drift_rpm_per_mv: float  # output speed of 1 mV of offset on SPD-CMD
     top_rpm: float  # the largest amplitude the shares allow
+    bias_rpm: float = 0.0  # the constant speed the excitation rides on (output, FWD; 0: none)
 
     @property
     def peak_v(self) -> float:
@@ -89,10 +105,13 @@ class BenchExcitation:
         w = self.waveform
         travel = f"{self.travel_bound_deg:.3g}" + ("°" if manual_units else " deg")
         periods = (len(w.volts) - 2 * w.start_sample) // max(1, w.period_samples)
-        return (f"excitation on SPD-CMD: {self.form} of ±{self.amplitude_rpm:.3g} r/min at the output "
+        bias = (f" on a bias of {self.bias_rpm:.3g} r/min FWD (so the axis never reverses and sticks on its "
+                "friction)" if self.bias_rpm > 0 else "")
+        travels = f"at most {travel} FWD" if self.bias_rpm > 0 else f"at most ±{travel}"
+        return (f"excitation on SPD-CMD: {self.form} of ±{self.amplitude_rpm:.3g} r/min at the output{bias} "
                 f"(peak {self.peak_v:.3g} V), {self.f_lo_hz:.3g} ... {self.f_hi_hz:.3g} Hz, "
                 f"{periods} periods of {self.period_s:.3g} s at {w.rate_hz:g} samples/s "
-                f"({w.duration_s:.1f} s); the output travels at most ±{travel}, "
+                f"({w.duration_s:.1f} s); the output travels {travels}, "
                 f"current at most {self.peak_current_a:.3g} A of {self.max_current_a:g} A, speed at most "
                 f"{self.peak_speed_rpm:.3g} r/min; 1 mV of offset on SPD-CMD turns the output at "
                 f"{self.drift_rpm_per_mv:.2g} r/min (tune item 5 cancels it)")
@@ -103,7 +122,7 @@ class BenchExcitation:
                 "rate_hz": self.waveform.rate_hz, "duration_s": self.waveform.duration_s,
                 "travel_bound_deg": self.travel_bound_deg, "peak_current_a": self.peak_current_a,
                 "peak_speed_rpm": self.peak_speed_rpm, "peak_gear_torque_nm": self.peak_gear_torque_nm,
-                "drift_rpm_per_mv": self.drift_rpm_per_mv}
+                "drift_rpm_per_mv": self.drift_rpm_per_mv, "bias_rpm": self.bias_rpm}
 
 
 def volts_per_output_rpm(tuner: Tuner) -> float:
@@ -186,9 +205,10 @@ def linear_run(lm: LoopModel, speed_rad_s: np.ndarray) -> dict[str, np.ndarray]:
 
 def design_excitation(tuner: Tuner, form: str = "multisine", amplitude_rpm: float | None = None,
                       rate_hz: float = 10000.0, periods: int = PERIODS,
-                      period_s: float | None = None) -> BenchExcitation:
-    """The excitation for ``tuner``'s axis (its items say speed mode). ValueError for an amplitude
-    above what the axis allows, an absurd rate or period count."""
+                      period_s: float | None = None, bias: bool = True) -> BenchExcitation:
+    """The excitation for ``tuner``'s axis (its items say speed mode), on a bias speed unless
+    ``bias`` is False. ValueError for an amplitude above what the axis allows, an absurd rate or
+    period count."""
     lm = speed_mode_loop(tuner)
     if not (math.isfinite(rate_hz) and 1000.0 <= rate_hz <= 1e6):
         raise ValueError(f"rate {rate_hz:g} samples/s: 1000 ... 1000000")
@@ -202,16 +222,31 @@ def design_excitation(tuner: Tuner, form: str = "multisine", amplitude_rpm: floa
     cycle, f_hi = unit_cycle(form, n, rate_hz, top)
     n = len(cycle)
     lead = round(LEAD_S * rate_hz)
+    servo = lm.settings.servo_rate_hz
     unit = np.concatenate([np.zeros(lead), np.tile(cycle, periods), np.zeros(lead)])
-    vpr = volts_per_output_rpm(tuner)
-    # the loop driven by the file at 1 r/min, scaled (linear)
-    run = linear_run(lm, _at_servo_rate(unit, rate_hz, lm.settings.servo_rate_hz) * RPM)
-    per_current = float(np.max(np.abs(run["current"])))
-    per_speed = float(np.max(np.abs(run["speed"]))) / RPM
+    # the loop driven by the file at 1 r/min, scaled (linear): the excitation's own speed
+    own = linear_run(lm, _at_servo_rate(unit, rate_hz, servo) * RPM)
+    per_speed = float(np.max(np.abs(own["speed"]))) / RPM
     model = tuner.model
-    limits = [CURRENT_SHARE * model.max_current_a / per_current,
+    bias_unit, friction_a = 0.0, 0.0
+    if bias:  # a constant under the periods, ramped: the speed never crosses zero
+        bias_unit = BIAS_MARGIN * per_speed
+        ramp = round(BIAS_RAMP_S * rate_hz)
+        up = np.linspace(0.0, bias_unit, ramp, endpoint=False)
+        unit = np.concatenate([np.zeros(lead), up, np.tile(cycle, periods) + bias_unit, up[::-1],
+                               np.zeros(lead)])
+        lead += ramp
+        # the friction the bias turns against is drawn too: TF (2-4-4) kept in reserve
+        friction_a = (model.friction_torque_nm or 0.0) / model.torque_constant_nm_per_a
+    vpr = volts_per_output_rpm(tuner)
+    run = linear_run(lm, _at_servo_rate(unit, rate_hz, servo) * RPM)
+    per_current = float(np.max(np.abs(run["current"])))
+    limits = [max(CURRENT_SHARE * model.max_current_a - friction_a, 0.0) / per_current,
               SPEED_SHARE * (model.max_speed_rpm or 60.0) / per_speed,
-              SPD_CMD_MAX_V / vpr]
+              SPD_CMD_MAX_V / vpr / float(np.max(np.abs(unit)))]
+    if bias:
+        limits.append(BIAS_SHARE * (model.max_speed_rpm or 60.0) / bias_unit)
+    per_speed = float(np.max(np.abs(run["speed"]))) / RPM  # the bias with it
     per_torque = None
     if model.stiffness is not None:
         per_torque = float(np.max(np.abs(run["gear_torque"])))
@@ -222,16 +257,18 @@ def design_excitation(tuner: Tuner, form: str = "multisine", amplitude_rpm: floa
         raise ValueError(f"excitation amplitude {amplitude:g} r/min: allowed 0 ... {top_rpm:.3g} r/min for "
                          f"this axis (current within {CURRENT_SHARE:.0%} of {model.max_current_a:g} A, speed "
                          f"within {SPEED_SHARE:.0%} of the maximum, the gear on its first slope, SPD-CMD "
-                         f"within ±{SPD_CMD_MAX_V:g} V)")
+                         f"within ±{SPD_CMD_MAX_V:g} V" + (f", the bias within {BIAS_SHARE:.0%} of the "
+                                                          "maximum speed)" if bias else ")"))
     wave = Waveform(rate_hz, unit * amplitude * vpr,
                     f"{form}, ±{amplitude:.4g} r/min at the output, period {n / rate_hz:.6g} s",
                     period_samples=n, start_sample=lead)
     return BenchExcitation(
         form=form, amplitude_rpm=amplitude, volts_per_rpm=vpr, waveform=wave,
         f_lo_hz=rate_hz / n, f_hi_hz=f_hi,
-        travel_bound_deg=math.degrees(amplitude * RPM * float(np.max(np.abs(run["angle"])))),
-        peak_current_a=amplitude * per_current, max_current_a=model.max_current_a,
+        # the run's angle is already in rad per r/min of amplitude
+        travel_bound_deg=math.degrees(amplitude * float(np.max(np.abs(run["angle"])))),
+        peak_current_a=amplitude * per_current + friction_a, max_current_a=model.max_current_a,
         peak_speed_rpm=amplitude * per_speed,
         peak_gear_torque_nm=None if per_torque is None else amplitude * per_torque,
-        drift_rpm_per_mv=1e-3 / vpr, top_rpm=top_rpm,
+        drift_rpm_per_mv=1e-3 / vpr, top_rpm=top_rpm, bias_rpm=amplitude * bias_unit,
     )
