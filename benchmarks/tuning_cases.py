@@ -4,7 +4,10 @@ items the response was measured with (the defaults, or the proposal where the de
 loop unstable with the load and the drive is not excited); beyond 2-1 the standard aim's proposal
 ("standard") beside the softer one.
 
-    python benchmarks/tuning_cases.py [CODE-RATIO ...]      e.g. FHA-25C-50-US250-10
+    python benchmarks/tuning_cases.py [--friction] [CODE-RATIO ...]      e.g. FHA-25C-50-US250-10
+
+``--friction``: on a drive with the catalogue's friction (``catalogue_friction=1``, TF of FHA-C
+manual 2-4-4, as the Connect dialog gives a simulated drive), the excitation on its bias speed.
 """
 
 from __future__ import annotations
@@ -45,6 +48,8 @@ def _worst(case: Case) -> str:
 
 
 def main(argv: list[str]) -> int:
+    friction = "--friction" in argv
+    argv = [a for a in argv if a != "--friction"]
     wanted = {a.rsplit("-", 1)[0] + "-" + a.rsplit("-", 1)[1] for a in argv}
     print("case | measured with | response gap | resonance meas/pred Hz | load est/declared kg m^2 | "
           "GM dB / PM deg | settle before -> after (overshoot) | items (standard) | s")
@@ -53,7 +58,7 @@ def main(argv: list[str]) -> int:
             continue
         started = time.perf_counter()
         with tempfile.TemporaryDirectory() as tmp:
-            case = run_case(code, ratio, Path(tmp))
+            case = run_case(code, ratio, Path(tmp), friction)
         took = time.perf_counter() - started
         m, p = case.measured, case.proposal.proposed
         pred = two_mass_prediction(case.model).resonance_hz
