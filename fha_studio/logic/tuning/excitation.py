@@ -43,7 +43,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from fha_studio.hardware.protocol import SPEED_STEP_RPM, excitation_period_periods
+from fha_studio.hardware.protocol import JOG_HOLD_S, SPEED_STEP_RPM, excitation_period_periods
 from fha_studio.logic.tuning.linear import LoopModel, LoopPolynomials, two_mass_prediction
 from fha_studio.logic.wording import with_unit
 from fha_studio.physics import PanelGains
@@ -110,9 +110,11 @@ class ExcitationPlan:
 
     @property
     def bias_travel_deg(self) -> float:
-        """The angle the bias speed turns the axis through during the measurement (its start's
-        settling included)."""
-        return self.bias_rpm * 6.0 * (self.duration_s + self.settle_s)
+        """The angle the bias speed turns the axis through during the measurement, at most: each
+        record after a restart (a read-out longer than the jog watchdog, which the jog coasts on
+        for): the jog's settling, the excitation's, the record (the jog's ramp is not counted: at
+        the default JOG acceleration it takes milliseconds)."""
+        return self.bias_rpm * 6.0 * (self.duration_s + self.records * (self.settle_s + JOG_HOLD_S))
 
     def describe(self, manual_units: bool = False) -> str:
         """The excitation in a line. ``manual_units``: "±" and "°" as the FHA-C manual prints them
@@ -125,7 +127,7 @@ class ExcitationPlan:
         periods = f"{self.hold_periods} servo period" + ("" if self.hold_periods == 1 else "s")
         if self.bias_rpm > 0:
             where = (f" on a jog of {self.bias_rpm:.3g} r/min FWD (so the axis never reverses and sticks on "
-                     f"its friction; it turns about {deg(self.bias_travel_deg)})")
+                     f"its friction; it turns up to about {deg(self.bias_travel_deg)})")
             about = " about the jog's path"
         else:
             where = about = ""
