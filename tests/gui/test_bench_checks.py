@@ -36,8 +36,8 @@ def test_a_controller_move_on_cn2_is_checked_and_recorded_with_its_source(window
     checks = {c.check: c for c in checked.args[0]}
     assert {name: c.passed for name, c in checks.items()} == {
         "bench_encoder": True, "bench_direction": True, "bench_in_position": True, "bench_alarm": True}
-    source = "from the bench instrument sim-cn2 (encoder ENC_A,ENC_B, command CMD_A,CMD_B, IN-POS IN_POS, " \
-        "ALARM ALARM)"
+    source = "from the bench instrument sim-cn2 (encoder A, B on ENC_A, ENC_B; command pulses on CMD_A, " \
+        "CMD_B; IN-POS; ALARM)"
     assert all(source in c.detail for c in checks.values())
     assert "a FWD command (+13889 counts) turned the axis FWD" in checks["bench_direction"].detail
     assert "encoder outputs follow the command: pass" in bench.move_label.text()

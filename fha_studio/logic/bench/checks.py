@@ -51,6 +51,30 @@ class BenchCheck:
     values: dict[str, Any] = field(default_factory=dict)
 
 
+def _same_name(channel: str, signal: str) -> bool:
+    """A channel named after the signal it reads (``ALM_A`` for ALM-A, ``in pos`` for IN-POS)."""
+    def key(text: str) -> str:
+        return "".join(ch for ch in text.upper() if ch.isalnum())
+    return key(channel) == key(signal)
+
+
+def source_words(instrument: str, wired: Sequence[tuple[str, Sequence[str]]]) -> str:
+    """Where a bench move's figures came from, as a technician reads it: the instrument, then each
+    CN2 signal by its manual name with the instrument's channel once ("IN-POS on D4"); a channel
+    named after its signal (a capture's ``ALM_A``) is not repeated beside it. ``wired``: (the
+    signal's words, its channels) for each signal mapped, e.g. ("encoder A, B", ("D0", "D1"))."""
+    parts = []
+    for signal, channels in wired:
+        named = [c.strip() for c in channels if c.strip()]
+        if not named:
+            continue
+        if len(named) == 1 and _same_name(named[0], signal):
+            parts.append(signal)
+        else:
+            parts.append(f"{signal} on {', '.join(named)}")
+    return f"the bench instrument {instrument}" + (f" ({'; '.join(parts)})" if parts else "")
+
+
 def bench_checks(t_s: ArrayLike, command_counts: ArrayLike, encoder_counts: ArrayLike, *,
                  in_position: ArrayLike | None = None, alarm: ArrayLike | None = None,
                  in_position_time_s: float | None = None, parameter_8: int | None = None,

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from fha_studio.hardware.parameters import load_cn2
-from fha_studio.logic.bench.checks import bench_checks, flange_direction
+from fha_studio.logic.bench.checks import bench_checks, flange_direction, source_words
 
 T = np.arange(0, 1.0, 1e-3)
 CMD = np.clip((T - 0.1) / 0.3, 0, 1) * 5000.0
@@ -130,3 +130,16 @@ def test_the_simulated_drives_encoder_outputs_and_parameter_8_give_the_flanges_d
     assert checks["bench_encoder"].passed and checks["bench_direction"].passed
     assert (checks["bench_direction"].values["rotation"], checks["bench_direction"].values["flange"]) == (
         "REV rotation", "CCW")
+
+
+def test_the_source_names_each_cn2_signal_once_with_its_instrument_channel_only_where_it_differs():
+    # a capture whose channels are named after the signals (the simulated CN2's ALARM, ALM_A):
+    # the signal's name alone, never "ALARM ALARM, ALM-A ALM_A"
+    words = source_words("sim-cn2", [("encoder A, B", ("ENC_A", "ENC_B")),
+                                     ("command pulses", ("CMD_A", "CMD_B")), ("IN-POS", ("IN_POS",)),
+                                     ("ALARM", ("ALARM",)), ("ALM-A", ("ALM_A",)), ("ALM-B", ("",))])
+    assert words == ("the bench instrument sim-cn2 (encoder A, B on ENC_A, ENC_B; command pulses on CMD_A, "
+                     "CMD_B; IN-POS; ALARM; ALM-A)")
+    # a logic analyzer's D0 ... D7: the channel once, after the signal it carries
+    words = source_words("demo", [("encoder A, B", ("D0", " D1")), ("IN-POS", ("D4",)), ("ALARM", ("",))])
+    assert words == "the bench instrument demo (encoder A, B on D0, D1; IN-POS on D4)"

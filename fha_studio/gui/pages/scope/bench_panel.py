@@ -41,7 +41,7 @@ from fha_studio.gui.widgets import hint_whole
 from fha_studio.hardware.bench import sigrok
 from fha_studio.hardware.parameters import load_cn2
 from fha_studio.logic.bench import alarm_code
-from fha_studio.logic.bench.checks import BenchCheck, bench_checks
+from fha_studio.logic.bench.checks import BenchCheck, bench_checks, source_words
 from fha_studio.logic.bench.display import CHANGED, peak_rows
 from fha_studio.logic.bench.importer import DriveSettings
 from fha_studio.logic.bench.move import BenchMoveFigures, bench_move_figures
@@ -746,14 +746,15 @@ class BenchPanel(QWidget):
             code = sum((rows[start:, c] >= CHANGED).astype(int) << bit for bit, c in enumerate(alm_columns)
                        if c is not None)
         unmapped = [line for line, c in zip(alarm_code.LINES, alm_columns, strict=True) if c is None]
-        wired = [f"encoder {self.encoder_edit.text().strip()}", f"command {self.command_edit.text().strip()}"]
-        wired += [f"{what} {name}" for what, name in (("IN-POS", in_position), ("ALARM", alarm_name)) if name]
-        wired += [f"{line} {name}" for line, name in zip(alarm_code.LINES, self._alm_names(), strict=True)
-                  if name]
+        wired: list[tuple[str, Sequence[str]]] = [
+            ("encoder A, B", self.encoder_edit.text().split(",")),
+            ("command pulses", self.command_edit.text().split(",")),
+            ("IN-POS", (in_position,)), ("ALARM", (alarm_name,))]
+        wired += [(line, (name,)) for line, name in zip(alarm_code.LINES, self._alm_names(), strict=True)]
         self.checks = bench_checks(t[start:], cmd[start:], enc[start:], in_position=in_pos, alarm=alarm,
                                    in_position_time_s=figures.in_position_time_s,
                                    parameter_8=self.parameter_8,
-                                   source=f"the bench instrument {started.device} ({', '.join(wired)})",
+                                   source=source_words(started.device, wired),
                                    alarm_code=code, alarm_lines_unmapped=unmapped)
         m = figures.metrics
 
