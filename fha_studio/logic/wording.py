@@ -23,8 +23,14 @@ UNIT_WORDS = {
 
 
 def unit_words(unit: str) -> str:
-    """``unit`` as the manual prints it ("N m" -> "N·m"); any other unit unchanged."""
-    return UNIT_WORDS.get(unit.strip(), unit)
+    """``unit`` as the manual prints it ("N m" -> "N·m", a rate "deg/s" -> "°/s"); any other unit
+    unchanged."""
+    unit = unit.strip()
+    if unit in UNIT_WORDS:
+        return UNIT_WORDS[unit]
+    if unit.endswith("/s") and unit[:-2] in UNIT_WORDS:
+        return f"{UNIT_WORDS[unit[:-2]]}/s"
+    return unit
 
 
 def with_unit(text: str, unit: str) -> str:
@@ -66,6 +72,15 @@ def fixed_number(value: float, unit: str) -> str:
     """``value`` with the fixed decimals of ``unit`` (a rate ``X/s`` as ``X``), its unit after it:
     "0.32 r/min" whatever the value's size. A unit without its decimals gets four significant
     digits (:func:`plain_number`)."""
+    return f"{_fixed_digits(value, unit)} {unit.strip()}".strip()
+
+
+def fixed_words(value: float, unit: str) -> str:
+    """:func:`fixed_number` with the unit as the manual prints it ("90.0000°", "0.32 r/min")."""
+    return with_unit(_fixed_digits(value, unit), unit)
+
+
+def _fixed_digits(value: float, unit: str) -> str:
     unit = unit.strip()
     decimals = UNIT_DECIMALS.get(unit)
     if decimals is None and unit.endswith("/s"):
@@ -76,7 +91,8 @@ def fixed_number(value: float, unit: str) -> str:
         text = f"{value:.{decimals}f}"
         if float(text) == 0.0:
             text = text.lstrip("-")  # "-0.00" reads as a sign the signal does not have
-    return f"{text} {unit}".strip()
+    return text
 
 
-__all__ = ["UNIT_DECIMALS", "UNIT_WORDS", "fixed_number", "plain_number", "unit_words", "with_unit"]
+__all__ = ["UNIT_DECIMALS", "UNIT_WORDS", "fixed_number", "fixed_words", "plain_number", "unit_words",
+           "with_unit"]

@@ -232,6 +232,14 @@ def test_triggered_move_is_captured_saved_and_loads_everywhere(qtbot, scope, sim
     _the_png_has_the_legend_above_the_plots(view, tmp_path / "view.png")
     csv = np.loadtxt(view.export_csv(tmp_path / "view.csv"), delimiter=",", skiprows=1)
     assert csv.shape == (1024, 5)
+    # a person reads degrees as the manual prints them (°); the files keep their ASCII units
+    assert "command_position [deg]" in (tmp_path / "view.csv").read_text("utf-8").splitlines()[0]
+    assert "°" not in path.read_text("utf-8")
+    position_plot = view.time_plot.plot_of("command_position")
+    assert position_plot is not None and position_plot.getAxis("left").labelText == "°"
+    units = {view.channel_table.item(row, 0).text(): view.channel_table.item(row, 1).text()
+             for row in range(view.channel_table.rowCount())}
+    assert "deg" not in units.values() and "°" in units.values()
 
 
 def _the_png_has_the_legend_above_the_plots(view, png) -> None:
@@ -265,7 +273,9 @@ def test_move_and_step_tests_report_overshoot_settling_and_in_position(qtbot, sc
     assert m.in_position_time_s is not None and m.settling_time_s is not None
     assert abs(m.final_error) < 0.05
     assert result.capture.method == "trace"
-    assert view.result_labels["overshoot"].text().endswith("deg)")
+    assert view.result_labels["overshoot"].text().endswith("°)")
+    assert view.test_angle.suffix() == "°"
+    assert view.tests.test_message.text() == "move test of 30° at 30 r/min done."
     with qtbot.waitSignal(view.sigTestDone, timeout=20000) as done:
         view.run_test("step")
     step = done.args[0]

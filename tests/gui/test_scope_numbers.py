@@ -9,7 +9,7 @@ import numpy as np
 from fha_studio.gui.pages.scope.cursor_table import CursorRow, CursorTable
 from fha_studio.gui.pages.scope.spectrum_panel import SpectrumPanel
 from fha_studio.logic.scope.analysis import spectrum
-from fha_studio.logic.wording import fixed_number, plain_number
+from fha_studio.logic.wording import fixed_number, fixed_words, plain_number, unit_words
 
 
 def test_plain_numbers_never_use_exponent_notation():
@@ -18,6 +18,12 @@ def test_plain_numbers_never_use_exponent_notation():
     assert plain_number(1.2e6, 4) == "1200000"
     assert plain_number(-0.28355, 5) == "-0.28355"
     assert plain_number(0.0) == "0"
+
+
+def test_degrees_read_as_the_manual_prints_them_and_files_keep_ascii():
+    assert unit_words("deg") == "°" and unit_words("deg/s") == "°/s" and unit_words("r/min/s") == "r/min/s"
+    assert fixed_words(90.0, "deg") == "90.0000°" and fixed_words(2.5, "deg/s") == "2.5000 °/s"
+    assert fixed_number(90.0, "deg") == "90.0000 deg"  # for a file or a terminal
 
 
 def test_the_cursor_table_writes_a_small_current_in_plain_figures(qtbot):
@@ -44,7 +50,7 @@ def test_the_cursor_table_gives_each_unit_its_own_fixed_digits(qtbot):
     got = {table.cell_text(r, 0): [table.cell_text(r, c) for c in range(1, 5)] for r in range(1, 5)}
     assert got == {
         "Output speed": ["0.32 r/min", "12.00 r/min", "11.68 r/min", "23.35 r/min/s"],
-        "Output position": ["0.3333 deg", "90.0000 deg", "89.6667 deg", "179.3333 deg/s"],
+        "Output position": ["0.3333°", "90.0000°", "89.6667°", "179.3333 °/s"],
         "Position error": ["3 pulse", "-12 pulse", "-15 pulse", "-30 pulse/s"],
         "Output torque": ["0.12 N·m", "7.00 N·m", "6.88 N·m", "13.75 N·m/s"],
     }

@@ -145,8 +145,7 @@ def test_the_cursor_table_has_a_row_per_channel_with_the_values_at_a_and_b(scope
     assert table.isVisible() and table.rowCount() == 1 + len(channels)
     assert table.cell_text(0, 3) == "2000.0 ms"
     got = {table.cell_text(r, 0): [table.cell_text(r, c) for c in range(1, 5)] for r in range(1, 4)}
-    assert got["Feedback position (output)"] == ["100.0000 deg", "300.0000 deg", "200.0000 deg",
-                                                 "100.0000 deg/s"]
+    assert got["Feedback position (output)"] == ["100.0000°", "300.0000°", "200.0000°", "100.0000 °/s"]
     assert got["Output speed"] == ["10.00 r/min", "10.00 r/min", "0.00 r/min", "0.00 r/min/s"]
     assert got["Motor current"] == ["0.500 A", "1.500 A", "1.000 A", "0.500 A/s"]
     # each unit its own plot, time axes linked for still data too

@@ -9,6 +9,7 @@ from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import QAbstractItemView, QDoubleSpinBox, QTableWidget, QTableWidgetItem
 
 from fha_studio.logic.scope.channels import ScopeChannel
+from fha_studio.logic.wording import unit_words
 
 
 class ChannelTable(QTableWidget):
@@ -43,13 +44,14 @@ class ChannelTable(QTableWidget):
             name.setCheckState(Qt.CheckState.Checked if shown else Qt.CheckState.Unchecked)
             name.setForeground(pg.mkColor(color(c.key)))
             self.setItem(row, 0, name)
-            unit = QTableWidgetItem(c.unit)
+            unit = QTableWidgetItem(unit_words(c.unit))  # as the manual prints it: °, not deg
             unit.setFlags(Qt.ItemFlag.ItemIsEnabled)
             self.setItem(row, 1, unit)
             spin = QDoubleSpinBox()
             spin.setRange(1e-4, 1e4)
             spin.setDecimals(3)
-            spin.setToolTip(f"Multiply {c.name} by this factor on the plot (cursors read {c.unit})")
+            spin.setToolTip(f"Multiply {c.name} by this factor on the plot "
+                            f"(cursors read {unit_words(c.unit)})")
             spin.setValue(scale.get(c.key, 1.0))
             spin.valueChanged.connect(lambda v, k=c.key: self.sigScaleChanged.emit(k, float(v)))
             self.setCellWidget(row, 2, spin)

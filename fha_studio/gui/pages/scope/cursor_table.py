@@ -10,7 +10,7 @@ import pyqtgraph as pg
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableWidget, QTableWidgetItem
 
-from fha_studio.logic.wording import fixed_number
+from fha_studio.logic.wording import fixed_words
 
 COLUMNS = ("Channel", "At A", "At B", "Δ (B − A)", "Slope")
 #: Rows on show before the table scrolls (the plots keep the rest of the height).
@@ -30,7 +30,7 @@ class CursorRow:
 
 
 def _number(value: float, unit: str) -> str:
-    return fixed_number(value, unit)  # "0.325 A" and "12.000 A": the digits line up, no exponent
+    return fixed_words(value, unit)  # "0.325 A" and "12.000 A": the digits line up, no exponent
 
 
 class CursorTable(QTableWidget):

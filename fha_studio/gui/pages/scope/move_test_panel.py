@@ -15,7 +15,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio.logic.scope.acquisition import MoveTestResult
-from fha_studio.logic.wording import plain_number
+from fha_studio.logic.wording import plain_number, unit_words, with_unit
 
 RESULTS = (("overshoot", "Overshoot"), ("rise", "Rise time 10-90 %"), ("settling", "Settling time"),
            ("in_position", "In-position after command end"), ("final_error", "Final error"),
@@ -40,7 +40,7 @@ class MoveTestPanel(QWidget):
         self.test_angle.setRange(-3600.0, 3600.0)
         self.test_angle.setDecimals(2)
         self.test_angle.setValue(90.0)
-        self.test_angle.setSuffix(" deg")
+        self.test_angle.setSuffix(unit_words("deg"))
         form.addRow("Move by", self.test_angle)
         self.test_speed = QDoubleSpinBox()
         self.test_speed.setRange(0.1, max_speed_rpm)
@@ -51,7 +51,7 @@ class MoveTestPanel(QWidget):
         self.step_angle.setRange(-10.0, 10.0)
         self.step_angle.setDecimals(3)
         self.step_angle.setValue(0.5)
-        self.step_angle.setSuffix(" deg")
+        self.step_angle.setSuffix(unit_words("deg"))
         form.addRow("Step", self.step_angle)
         lay.addLayout(form)
         row = QHBoxLayout()
@@ -107,7 +107,8 @@ class MoveTestPanel(QWidget):
         return self.step_angle.value() if kind == "step" else self.test_angle.value()
 
     def started(self, kind: str, angle_deg: float, speed_rpm: float) -> None:
-        self.test_message.setText(f"{kind} test running: {angle_deg:g} deg at {speed_rpm:g} r/min …")
+        angle = with_unit(f"{angle_deg:g}", "deg")
+        self.test_message.setText(f"{kind} test running: {angle} at {speed_rpm:g} r/min …")
         for label in self.result_labels.values():
             label.setText("…")
 
@@ -121,16 +122,16 @@ class MoveTestPanel(QWidget):
                 label.setText("—")
             self.test_message.setText(result.describe())
         else:
-            overshoot = f"{m.overshoot_percent:.2f} % ({plain_number(m.overshoot)} deg)"
+            overshoot = f"{m.overshoot_percent:.2f} % ({with_unit(plain_number(m.overshoot), 'deg')})"
             self.result_labels["overshoot"].setText(overshoot)
             self.result_labels["rise"].setText(_ms(m.rise_time_s))
-            band = f" (band ±{m.settling_band:.3g} deg)"
+            band = f" (band ±{with_unit(f'{m.settling_band:.3g}', 'deg')})"
             self.result_labels["settling"].setText(_ms(m.settling_time_s) + band)
             window = result.in_position_range_deg
-            inpos = "" if window is None else f" (±{window:.3g} deg)"
+            inpos = "" if window is None else f" (±{with_unit(f'{window:.3g}', 'deg')})"
             self.result_labels["in_position"].setText(_ms(m.in_position_time_s) + inpos)
-            self.result_labels["final_error"].setText(f"{plain_number(m.final_error)} deg")
-            self.test_message.setText(f"{result.kind} test of {result.angle_deg:g} deg at "
+            self.result_labels["final_error"].setText(with_unit(plain_number(m.final_error), "deg"))
+            self.test_message.setText(f"{result.kind} test of {with_unit(f'{result.angle_deg:g}', 'deg')} at "
                                       f"{result.speed_rpm:g} r/min done.")
         c = result.capture
         if c is not None:

@@ -10,7 +10,7 @@ from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from fha_studio.logic.scope.channels import ScopeChannel
-from fha_studio.logic.wording import plain_number
+from fha_studio.logic.wording import plain_number, unit_words
 
 #: Arc-seconds per degree: a line of an angle's spectrum is read in arc-sec, as the manual gives
 #: the actuator's accuracy (a kinematic error of 40 arc-sec, not 0.011 deg or 7.41e-05 deg).
@@ -57,7 +57,7 @@ class SpectrumPanel(QWidget):
         self.spectrum_channel.clear()
         for c in channels:
             if not c.is_bit:
-                self.spectrum_channel.addItem(f"{c.name} [{c.unit}]", c.key)
+                self.spectrum_channel.addItem(f"{c.name} [{unit_words(c.unit)}]", c.key)
 
     def channel_key(self) -> str | None:
         return self.spectrum_channel.currentData()

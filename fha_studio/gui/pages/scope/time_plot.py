@@ -30,6 +30,7 @@ from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 from fha_studio import clock, fileio
 from fha_studio.logic.scope.channels import ScopeChannel
 from fha_studio.logic.scope.levels import MinMaxLevels
+from fha_studio.logic.wording import unit_words
 
 from .cursor_table import CursorTable
 
@@ -153,7 +154,7 @@ class TimePlot(QWidget):
             # stacked plots: a tick label at a plot's edge would sit on the next plot's ("1.0"
             # over "0"); only the labels within their own plot's height are drawn
             item.getAxis("left").setStyle(hideOverlappingLabels=True)
-            item.setLabel("left", unit or "value")
+            item.setLabel("left", unit_words(unit) or "value")
             self.plot.addItem(item, row=row, col=0)
             plot = _UnitPlot(item, unit)
             item.vb.sigYRangeChanged.connect(lambda *_a, p=plot: self._update_grid_lines(p))
@@ -230,7 +231,7 @@ class TimePlot(QWidget):
         for c in shown:
             plot = self._plots[units.index(c.unit)]
             factor = scale.get(c.key, 1.0)
-            label = f"{c.name} [{c.unit}]" + (f" ×{factor:g}" if factor != 1 else "")
+            label = f"{c.name} [{unit_words(c.unit)}]" + (f" ×{factor:g}" if factor != 1 else "")
             curve = plot.item.plot(pen=pg.mkPen(color(c.key), width=1.5 if not live else 1))
             if live:  # already decimated and finite (MinMaxLevels)
                 curve.setDownsampling(ds=1, auto=False)

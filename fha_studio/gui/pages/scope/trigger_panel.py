@@ -20,6 +20,7 @@ from fha_studio.hardware import protocol as p
 from fha_studio.hardware.parameters import MonitorItem
 from fha_studio.logic.scope.acquisition import TraceSettings, Trigger
 from fha_studio.logic.scope.channels import ScopeChannel
+from fha_studio.logic.wording import unit_words
 
 TRIGGERS = (
     ("Immediate", p.TriggerKind.IMMEDIATE),
@@ -111,7 +112,7 @@ class TriggerPanel(QWidget):
         if kind in _LEVELS:
             for c in self._channels:
                 if not c.is_bit:
-                    self.trigger_channel.addItem(f"{c.name} [{c.unit}]", c.key)
+                    self.trigger_channel.addItem(f"{c.name} [{unit_words(c.unit)}]", c.key)
         elif kind in _EDGES:
             for c in self._bits:
                 self.trigger_channel.addItem(c.name, c.key)
