@@ -33,12 +33,19 @@ def unit_words(unit: str) -> str:
     return unit
 
 
-def with_unit(text: str, unit: str) -> str:
-    """``"28.3 N·m"``: a value and its unit in the manual's spelling ("°" follows the number)."""
+#: The space that joins a number to its unit on a page: a label that wraps never leaves the
+#: number at a line's end and its unit on the next ("crossover 22" / "Hz"). Only for what a
+#: page shows: a file, a terminal and the register keep the plain space.
+NO_BREAK_SPACE = "\u00a0"
+
+
+def with_unit(text: str, unit: str, *, on_page: bool = False) -> str:
+    """``"28.3 N·m"``: a value and its unit in the manual's spelling ("°" follows the number).
+    ``on_page``: joined by :data:`NO_BREAK_SPACE`, for a label that may wrap."""
     words = unit_words(unit)
     if not words:
         return text
-    return f"{text}{words}" if words == "°" else f"{text} {words}"
+    return f"{text}{words}" if words == "°" else f"{text}{NO_BREAK_SPACE if on_page else ' '}{words}"
 
 
 def plain_number(value: float, significant: int = 4) -> str:
@@ -94,5 +101,5 @@ def _fixed_digits(value: float, unit: str) -> str:
     return text
 
 
-__all__ = ["UNIT_DECIMALS", "UNIT_WORDS", "fixed_number", "fixed_words", "plain_number", "unit_words",
-           "with_unit"]
+__all__ = ["NO_BREAK_SPACE", "UNIT_DECIMALS", "UNIT_WORDS", "fixed_number", "fixed_words", "plain_number",
+           "unit_words", "with_unit"]

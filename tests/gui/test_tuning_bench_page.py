@@ -66,6 +66,8 @@ def test_a_documented_drive_tuned_from_the_bench(make_window, qtbot, tmp_path: P
     check = verified.args[0]
     assert check["items"] == {k: int(v) for k, v in typed.items()}
     assert bench.status.text().startswith("Verified from the bench")
+    # a figure and its unit never part where the label wraps: a no-break space joins them
+    assert f"{check['deviation']['magnitude_db']:.2g}\u00a0dB and" in bench.status.text()
     # the capture agrees with the proposal's prediction, not with the items before the worksheet
     with qtbot.waitSignal(bench.sigAnalysed, timeout=60000) as before:
         bench.analyse()

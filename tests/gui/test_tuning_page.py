@@ -60,7 +60,7 @@ def test_measure_propose_apply_end_to_end(make_window, qtbot, tmp_path):
     present_gm = page.table.item(len(page.proposal.proposed.items), 0).text()
     assert "(model)" in page.table.horizontalHeaderItem(0).text()
     if result["gain_margin_db"] is None and page.proposal.present.gain_margin_db is not None:
-        assert f"gain margin {float(present_gm):.3g} dB by the model" in page.result_label.text()
+        assert f"gain margin {float(present_gm):.3g}\u00a0dB by the model" in page.result_label.text()
     assert page.apply_button.isEnabled()
     with qtbot.waitSignal(page.sigApplied, timeout=180000) as applied:
         page.apply_button.click()

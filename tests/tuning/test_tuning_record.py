@@ -38,11 +38,13 @@ def test_a_gain_margin_beyond_the_measured_band_is_the_models_not_none() -> None
     result = {**BEFORE, "gain_margin_db": None, "measured_to_hz": 500.0,
               "predicted": {"gain_margin_db": 28.16}}
     words = result_figure_words(result, "gain_margin_db", "dB", manual_units=True)
-    assert words == "28.2 dB by the model (the measured phase stays above −180° up to 500 Hz)"
+    # on a page: a number and its unit joined by a no-break space (a wrapping label keeps them together)
+    assert words == "28.2\u00a0dB by the model (the measured phase stays above −180° up to 500\u00a0Hz)"
     ((text, _who),) = tuning_notes([TuningRecord(at="2026-12-04 02:30:00 UTC", who="ana", before=result)])
     assert "gain margin 28.2 dB by the model" in text and "none" not in text
     # a measured margin is the measurement's; manual units for a page, ASCII for the command line
     assert result_figure_words(BEFORE, "gain_margin_db", "dB") == "20.4 dB"
+    assert result_figure_words(BEFORE, "gain_margin_db", "dB", manual_units=True) == "20.4\u00a0dB"
     assert result_figure_words(BEFORE, "phase_margin_deg", "deg", manual_units=True) == "67.2°"
     assert result_figure_words(BEFORE, "phase_margin_deg", "deg") == "67.2 deg"
 

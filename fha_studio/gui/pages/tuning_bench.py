@@ -43,6 +43,7 @@ from fha_studio.logic.tuning.bench_session import (
     is_move,
     move_samples,
 )
+from fha_studio.logic.wording import NO_BREAK_SPACE as NB
 from fha_studio.logic.wording import with_unit
 
 #: the roles the panel maps, with their words on CN2
@@ -314,14 +315,14 @@ class BenchTuningPanel(QGroupBox):
 
 
 def _n(value: float | None, unit: str, digits: str = ".3g") -> str:
-    return "—" if value is None else with_unit(f"{value:{digits}}", unit)
+    return "—" if value is None else with_unit(f"{value:{digits}}", unit, on_page=True)
 
 
 def analysis_words(result: dict[str, Any]) -> str:
     """What an analysis from the bench gave, in a sentence."""
     load, spread = result.get("load_inertia_estimate_kgm2"), result.get("load_inertia_uncertainty_kgm2")
     inertia = ("the load inertia cannot be told from it" if load is None else
-               f"load inertia {load:.3g} kg·m²" + (f" ± {spread:.2g}" if spread else ""))
+               f"load inertia {load:.3g}{NB}kg·m²" + (f" ± {spread:.2g}" if spread else ""))
     if result.get("kind") == "fitted from a move":
         fit = result["fit"]
         return (f"The loop fitted to the move ({fit['samples']} samples, the position within "
@@ -329,8 +330,8 @@ def analysis_words(result: dict[str, Any]) -> str:
     dev = result["deviation"]
     if dev["magnitude_db"] is None:
         return f"Analysed from the bench: no frequency bin was trusted (coherence below 0.9); {inertia}."
-    return (f"Analysed from the bench: {dev['trusted_bins']} trusted bins, within {dev['magnitude_db']:.2g} "
-            f"dB and {dev['phase_deg']:.2g}° of the linearised loop (dashed); {inertia}.")
+    return (f"Analysed from the bench: {dev['trusted_bins']} trusted bins, within {dev['magnitude_db']:.2g}"
+            f"{NB}dB and {dev['phase_deg']:.2g}° of the linearised loop (dashed); {inertia}.")
 
 
 def verification_words(result: dict[str, Any]) -> str:
@@ -339,19 +340,20 @@ def verification_words(result: dict[str, Any]) -> str:
         m, p = result["measured"], result["predicted"]
 
         def ms(v: float | None) -> str:
-            return "not settled" if v is None else f"{v:.0f} ms"
+            return "not settled" if v is None else f"{v:.0f}{NB}ms"
 
         return (f"Verified from the bench (a move with the proposed items): following error at most "
                 f"{m['following_error_peak_counts']:.0f} counts (predicted "
-                f"{p['following_error_peak_counts']:.0f}), overshoot {m['overshoot_pct']:.2f} % (predicted "
-                f"{p['overshoot_pct']:.2f} %), settling {ms(m['settling_ms'])} (predicted "
+                f"{p['following_error_peak_counts']:.0f}), overshoot {m['overshoot_pct']:.2f}{NB}% "
+                f"(predicted "
+                f"{p['overshoot_pct']:.2f}{NB}%), settling {ms(m['settling_ms'])} (predicted "
                 f"{ms(p['settling_ms'])}); the capture is within {result['difference_rms_counts']:.2g} "
                 "counts rms of the prediction.")
     dev, predicted = result["deviation"], result["predicted"]
     if dev["magnitude_db"] is None:
         return "Verified from the bench: no frequency bin was trusted (coherence below 0.9)."
     return (f"Verified from the bench (the response with the proposed items): within "
-            f"{dev['magnitude_db']:.2g} dB and {dev['phase_deg']:.2g}° of the prediction over "
+            f"{dev['magnitude_db']:.2g}{NB}dB and {dev['phase_deg']:.2g}° of the prediction over "
             f"{dev['trusted_bins']} trusted bins; phase margin {_n(result['phase_margin_deg'], 'deg')} "
             f"(predicted {_n(predicted['phase_margin_deg'], 'deg')}), crossover "
             f"{_n(result['crossover_hz'], 'Hz')} (predicted {_n(predicted['crossover_hz'], 'Hz')}).")

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from fha_studio.hardware.parameters import ParameterModel, load_parameter_model
-from fha_studio.logic.wording import with_unit
+from fha_studio.logic.wording import NO_BREAK_SPACE, with_unit
 
 FIGURES = (("resonance_hz", "resonance", "Hz"), ("antiresonance_hz", "anti-resonance", "Hz"),
            ("load_inertia_estimate_kgm2", "load inertia estimate", "kg·m²"),
@@ -40,7 +40,7 @@ def figure_words(key: str, value: float | None, unit: str, manual_units: bool = 
         if key != "gain_margin_db":
             return "none found"
         return NO_PHASE_CROSSING.replace("-180 deg", "−180°") if manual_units else NO_PHASE_CROSSING
-    return with_unit(f"{value:.3g}", unit) if manual_units else f"{value:.3g} {unit}"
+    return with_unit(f"{value:.3g}", unit, on_page=True) if manual_units else f"{value:.3g} {unit}"
 
 
 def result_figure_words(result: Mapping[str, Any], key: str, unit: str, manual_units: bool = False) -> str:
@@ -52,8 +52,9 @@ def result_figure_words(result: Mapping[str, Any], key: str, unit: str, manual_u
         return figure_words(key, value, unit, manual_units)
     predicted = (result.get("predicted") or {}).get("gain_margin_db")
     minus_180 = "−180°" if manual_units else "-180 deg"
-    model = f"{predicted:.3g} dB by the model" if predicted is not None else "none by the model either"
-    return f"{model} (the measured phase stays above {minus_180} up to {top_hz:.0f} Hz)"
+    space = NO_BREAK_SPACE if manual_units else " "  # a page's label may wrap: never between figure and unit
+    model = f"{predicted:.3g}{space}dB by the model" if predicted is not None else "none by the model either"
+    return f"{model} (the measured phase stays above {minus_180} up to {top_hz:.0f}{space}Hz)"
 
 
 def _figures(result: Mapping[str, Any]) -> str:
