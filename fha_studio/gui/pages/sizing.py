@@ -182,13 +182,20 @@ class SizingPage(BasePage):
         self.assumption.setObjectName("sizingAssumption")
         self.assumption.setStyleSheet("color: #444;")
         r_layout.addWidget(self.assumption)
-        self.plot = pg.PlotWidget(background="w")
+        self.plot = pg.GraphicsLayoutWidget()
+        self.plot.setBackground("w")
         self.plot.setObjectName("torqueSpeedPlot")
-        self.plot.setLabel("bottom", "Output speed", units="r/min")
-        self.plot.setLabel("left", "Output torque", units="N·m")
-        self.plot.showGrid(x=True, y=True, alpha=0.25)
-        self.plot.addLegend(offset=(-10, 10))
-        self.plot.setMenuEnabled(False)
+        # the legend in a row of its own above the plot (as the scope's and the tuning page's):
+        # inside it, at 1280 x 720, its last row sat on the continuous range's edge, and a duty's
+        # points can fall anywhere in the plane
+        self.legend = pg.LegendItem(colCount=2, labelTextColor="#303030")
+        self.legend.layout.setContentsMargins(4, 0, 4, 0)
+        self.plot.addItem(self.legend, row=0, col=0)
+        self.plot_item = self.plot.addPlot(row=1, col=0)
+        self.plot_item.setLabel("bottom", "Output speed", units="r/min")
+        self.plot_item.setLabel("left", "Output torque", units="N·m")
+        self.plot_item.showGrid(x=True, y=True, alpha=0.25)
+        self.plot_item.setMenuEnabled(False)
         self.plot.setMinimumHeight(220)
         r_layout.addWidget(self.plot, 3)
         self.checks_table = QTableWidget(0, 5)
@@ -389,7 +396,7 @@ class SizingPage(BasePage):
         self.assumption.setText("")
         self.verdict.setText(f"<span style='color:#b00020'>{why}</span>" if why else "")
         self.checks_table.setRowCount(0)
-        self.plot.clear()
+        self._clear_plot()
 
     def duty(self):
         from fha_studio.logic.sizing import DutyCycle
@@ -481,23 +488,32 @@ class SizingPage(BasePage):
                     item.setFont(font)
                 self.checks_table.setItem(row, col, item)
 
+    def _clear_plot(self) -> None:
+        self.plot_item.clear()
+        self.legend.clear()
+
+    def _curve(self, *args, **kwargs) -> None:
+        """A curve on the plot, named in the legend above it."""
+        item = self.plot_item.plot(*args, **kwargs)
+        self.legend.addItem(item, kwargs["name"])
+
     def _draw(self, result) -> None:
         env = result.envelope()
-        self.plot.clear()
+        self._clear_plot()
         tm, nm = env["max_torque_nm"], env["max_speed_rpm"]
         tc, nc = env["continuous_torque_nm"], env["continuous_speed_rpm"]
-        self.plot.plot(
+        self._curve(
             [0, nm, nm, 0],
             [tm, tm, -tm, -tm],
             pen=pg.mkPen("#c62828", width=2, style=Qt.PenStyle.DashLine),
             name="maximum range",
         )
-        self.plot.plot(
+        self._curve(
             [0, nc, nc, 0], [tc, tc, -tc, -tc], pen=pg.mkPen("#1565c0", width=2), name="continuous range"
         )
         points = result.operating_points()
         duty = [p for p in points if p.phase != "effective"]
-        self.plot.plot(
+        self._curve(
             [p.speed_rpm for p in duty],
             [p.torque_nm for p in duty],
             pen=pg.mkPen("#555", width=1.5),
@@ -509,7 +525,7 @@ class SizingPage(BasePage):
         eff = [p for p in points if p.phase == "effective"]
         if eff:
             ok = result.effective_torque_nm <= tc and result.average_speed_rpm <= nc
-            self.plot.plot(
+            self._curve(
                 [eff[0].speed_rpm],
                 [eff[0].torque_nm],
                 pen=None,
@@ -518,5 +534,5 @@ class SizingPage(BasePage):
                 symbolBrush="#2e7d32" if ok else "#b00020",
                 name="effective torque at average speed",
             )
-        self.plot.setXRange(0, max(nm, self.speed_spin.value()) * 1.1, padding=0)
-        self.plot.setYRange(-tm * 1.15, tm * 1.15, padding=0)
+        self.plot_item.setXRange(0, max(nm, self.speed_spin.value()) * 1.1, padding=0)
+        self.plot_item.setYRange(-tm * 1.15, tm * 1.15, padding=0)
