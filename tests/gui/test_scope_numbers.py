@@ -4,7 +4,10 @@ gives the actuator's accuracy, with the plot's amplitude axis named."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
+from PySide6.QtGui import QImage, QPainter
 
 from fha_studio.gui.pages.scope.cursor_table import CursorRow, CursorTable
 from fha_studio.gui.pages.scope.spectrum_panel import SpectrumPanel
@@ -60,6 +63,9 @@ def test_the_cursor_table_gives_each_unit_its_own_fixed_digits(qtbot):
 def test_a_spectrum_of_an_angle_names_its_lines_in_arc_sec(qtbot):
     panel = SpectrumPanel()
     qtbot.addWidget(panel)
+    panel.resize(600, 400)
+    panel.show()
+    qtbot.waitExposed(panel)
     t = np.arange(2048) / 1000.0
     line_deg = 40.0 / 3600.0  # a kinematic error of 40 arc-sec at 16.6 Hz
     angle = 120.0 + 10.0 * t + line_deg * np.sin(2 * np.pi * 16.6 * t) + 1e-5 * np.sin(2 * np.pi * 233.4 * t)
@@ -74,3 +80,16 @@ def test_a_spectrum_of_an_angle_names_its_lines_in_arc_sec(qtbot):
     axis = panel.spectrum_plot.getPlotItem().getAxis("left")  # the plot in arc-sec too, no SI scale
     assert axis.labelText == "amplitude (arc-sec)" and "(x" not in axis.labelString()
     assert 30.0 < 10 ** max(panel.spectrum_curve.getData()[1]) < 41.0  # as drawn: its log10
+    # the decades in plain numbers, all alike: "10" beside "1" and "0.1", never "10¹" or "10⁻⁴"
+    def labels() -> list[str]:
+        image = QImage(10, 10, QImage.Format.Format_RGB32)
+        painter = QPainter(image)
+        try:
+            return [text for _rect, _flags, text in axis.generateDrawSpecs(painter)[2]]
+        finally:
+            painter.end()
+
+    qtbot.waitUntil(lambda: "1" in labels(), timeout=5000)  # the view took the curve's range
+    shown = labels()
+    assert {"10", "1", "0.1", "0.001"} <= set(shown)
+    assert all(re.fullmatch(r"\d+(\.\d+)?", text) for text in shown), shown

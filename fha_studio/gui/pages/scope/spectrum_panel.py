@@ -17,6 +17,20 @@ from fha_studio.logic.wording import plain_number, unit_words
 ARCSEC_PER_DEG = 3600.0
 
 
+class PlainDecadeAxis(pg.AxisItem):
+    """A logarithmic axis labelled 1, 2, 5 per decade in plain numbers (0.001, 0.1, 1, 10, 100):
+    pyqtgraph writes the decades from 10 up as "10¹", "10²" beside "1" and "0.1" below them, and
+    small ones as "10⁻⁴", a mix a person reads twice."""
+
+    def logTickStrings(self, values, scale, spacing):  # pyqtgraph calls it by this name
+        words = []
+        for v in values:
+            x = 10.0 ** float(v) * scale
+            lead = x / 10.0 ** np.floor(np.log10(x) + 1e-9)
+            words.append(plain_number(x, 1) if any(abs(lead - d) < 1e-6 for d in (1.0, 2.0, 5.0)) else "")
+        return words
+
+
 class SpectrumPanel(QWidget):
     """Channel and detrend choice, the log-amplitude plot and a line naming the peaks."""
 
@@ -39,7 +53,7 @@ class SpectrumPanel(QWidget):
         go.clicked.connect(self.sigCompute)
         row.addWidget(go)
         lay.addLayout(row)
-        self.spectrum_plot = pg.PlotWidget()
+        self.spectrum_plot = pg.PlotWidget(axisItems={"left": PlainDecadeAxis("left")})
         self.spectrum_plot.setBackground("#111")
         self.spectrum_plot.showGrid(x=True, y=True, alpha=0.25)
         self.spectrum_plot.setLabel("bottom", "frequency", units="Hz")
