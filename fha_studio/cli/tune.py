@@ -1,8 +1,8 @@
 """``fha-studio tune measure|propose|excitation|analyse``: the speed loop's frequency response and
 proposed gains, over CN3 or from the bench.
 
-    fha-studio tune measure --url URL --actuator CODE --load-inertia KGM2 [--amplitude-rpm R] [--in-place]
-                            [--json OUT]
+    fha-studio tune measure --url URL --actuator CODE --load-inertia KGM2 [--amplitude-rpm R]
+                            [--bias fwd|rev|none] [--limit-switches LS1,LS2] [--json OUT]
     fha-studio tune propose --url URL --actuator CODE --load-inertia KGM2 [--aim stiff|standard|soft]
                             [--json OUT]
     fha-studio tune excitation --actuator CODE --parameters P.toml --load-inertia KGM2
@@ -60,10 +60,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         if name == "measure":
             q.add_argument("--amplitude-rpm", type=float, metavar="R",
                            help="excitation amplitude [r/min] (default: the largest the axis allows)")
-            q.add_argument("--in-place", action="store_true",
-                           help="excite about standstill, not on a slow FWD jog (the bias speed that keeps "
-                           "the axis from sticking on its friction): for an axis that may not turn that "
-                           "far; the friction then spoils the response at low frequency (warned of)")
+            q.add_argument("--bias", choices=("fwd", "rev", "none"), default=None,
+                           help="the slow jog the excitation rides on (the bias speed that keeps the axis "
+                           "from sticking on its friction): FWD (the default) or REV command, or none: "
+                           "about standstill, for an axis that may not turn that far; the friction then "
+                           "spoils the response at low frequency (warned of)")
+            q.add_argument("--in-place", action="store_true", help="the same as --bias none")
+            q.add_argument("--limit-switches", type=_switch_angles, metavar="LS1,LS2",
+                           help="the switching angles of limit switch 1 (CCW end) and 2 (CW end) [deg of "
+                           "the output's feedback position, as the procedures record them]: the plan is "
+                           "refused where its travel does not fit the room to them (write "
+                           "--limit-switches=-120,95 for a negative first angle)")
             q.set_defaults(func=run_measure)
         else:
             q.add_argument("--aim", choices=("stiff", "standard", "soft"), default="standard")
@@ -140,6 +147,28 @@ def _model(args: argparse.Namespace) -> Any:
         raise CliError(f"--actuator {args.actuator}: {exc}") from None
 
 
+def _switch_angles(text: str) -> dict[str, float]:
+    """``--limit-switches LS1,LS2``: two finite angles (deg)."""
+    import math
+
+    parts = text.split(",")
+    try:
+        one, two = (float(v) for v in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: two angles in deg, --limit-switches=LS1,LS2 "
+                                         "(e.g. =-120,95)") from None
+    if not (math.isfinite(one) and math.isfinite(two)) or one == two:
+        raise argparse.ArgumentTypeError(f"{text!r}: two different finite angles in deg")
+    return {"limit_switch_1": one, "limit_switch_2": two}
+
+
+def _bias(args: argparse.Namespace) -> str:
+    """--bias, or --in-place (the same as --bias none); both, only where they agree."""
+    if args.in_place and args.bias not in (None, "none"):
+        raise CliError(f"--in-place with --bias {args.bias}: choose one (--in-place is --bias none)")
+    return "none" if args.in_place else (args.bias or "fwd")
+
+
 def run_measure(args: argparse.Namespace) -> int:
     from fha_studio.hardware.parameters import load_parameter_model
     from fha_studio.logic.tuning.measure import check_excitable
@@ -147,6 +176,7 @@ def run_measure(args: argparse.Namespace) -> int:
     from fha_studio.logic.tuning.session import drive_clock, measure_report, tuner_for
 
     model = _model(args)
+    bias = _bias(args)
     parameters = load_parameter_model("HA-655")
     try:
         with _open(args.url) as client:
@@ -154,7 +184,8 @@ def run_measure(args: argparse.Namespace) -> int:
             tuner = tuner_for(client, parameters, model)
             pace, now = drive_clock(client)
             result = measure_report(client, tuner, pace, now, args.amplitude_rpm,
-                                    announce=lambda s: print(s, file=sys.stderr), bias=not args.in_place)
+                                    announce=lambda s: print(s, file=sys.stderr), bias=bias,
+                                    switch_angles_deg=args.limit_switches)
     except _TuneStop as stop:
         return _stopped("measure", stop, stop.code)
     except ValueError as exc:

@@ -187,10 +187,14 @@ def test_the_marker_labels_keep_off_the_curves_and_the_page_fits(make_window, qt
     page = window.show_page(PageId.TUNING)
     qtbot.waitExposed(window)
     result = _two_mass_result(*predicted_hz)
-    page.plan_label.setText("excitation: PRBS of ±0.753 r/min on the speed command, bits of 4 servo periods, "
-                            "5 records of 4092 samples (4.8 s); the output travels at most ±0.113° (the "
-                            "drive stops at 0.236°), current at most 2.77 A. Servo on, the axis free to move "
-                            "that far; STOP ends it at once.")
+    # the longest plan: on a jog within a known range (in place, with its warning, is shorter)
+    page.plan_label.setText(
+        "Excitation: PRBS of ±0.753 r/min on the speed command on a jog of 1.82 r/min REV (CCW seen from "
+        "the flange), which turns the axis up to about 66.7° REV (so it never reverses and sticks on its "
+        "friction), bits of 4 servo periods, 5 records of 4092 samples (4.8 s); the output travels at most "
+        "±0.113° about the jog's path (the drive stops at 0.236°), current at most 3.25 A; within the "
+        "movable range (120° to limit switch 1 (CCW end), 135° to limit switch 2 (CW end)). Servo on, the "
+        "axis free to move that far; STOP ends it at once.")
     page.show_result(result)
     page.warning_label.setText("Warning: the load is 10 x the actuator's inertia, beyond the about 3 x "
                                "of 2-1: tuned softer")
@@ -236,3 +240,55 @@ def test_the_marker_labels_keep_off_the_curves_and_the_page_fits(make_window, qt
             for top, low in itertools.pairwise(rows):
                 crossed = min(top, low) < box.bottom() and box.top() < max(top, low)
                 assert not crossed, (marker.label.toPlainText(), key)
+
+
+def _plan_with(page, qtbot, window, bias: str) -> str:
+    """Choose the bias speed by keyboard (the combo box's arrow keys) and show the plan: its text."""
+    page.bias_combo.setFocus()
+    target = page.bias_combo.findData(bias)
+    for _ in range(page.bias_combo.count()):
+        if page.bias_combo.currentIndex() == target:
+            break
+        down = page.bias_combo.currentIndex() < target
+        qtbot.keyClick(page.bias_combo, Qt.Key.Key_Down if down else Qt.Key.Key_Up)
+    assert page.bias_combo.currentData() == bias
+    with qtbot.waitSignal(window.link.sigResult, timeout=20000):
+        page.plan_button.click()
+    return page.plan_label.text()
+
+
+def test_the_bias_direction_is_chosen_shown_checked_and_remembered(make_window, qtbot, tmp_path):
+    """REV: the plan says the jog's command and rotation in the manual's words (CCW with rotary
+    direction 0) and how far, and that the range is not known; limit switches recorded in the
+    procedures that leave too little room refuse the start in one line, naming the other choice;
+    in place: the stick-slip warning before it starts. The choice is remembered with the window."""
+    window, page = _planned(make_window, qtbot)
+    assert page.bias_combo.currentData() == "fwd" and page.start_button.isEnabled()
+    assert page.bias_combo.focusPolicy() & Qt.FocusPolicy.TabFocus
+    label = next(w for w in page.findChildren(type(page.plan_label)) if w.buddy() is page.bias_combo)
+    assert "&" in label.text()  # an Alt letter reaches it
+    text = _plan_with(page, qtbot, window, "rev")
+    assert "r/min REV (CCW seen from the flange)" in text and "° REV" in text
+    assert "the movable range is not known" in text and page.start_button.isEnabled()
+    # the procedures recorded limit switch 1 (CCW end) 20° from the axis, limit switch 2 far
+    procedures = window.show_page(PageId.PROCEDURES)
+    procedures.new_session(tmp_path / "axis1.json", CODE, operator="A. Tuner")
+    procedures.session.sensor_angles_deg.update({"limit_switch_1": -20.0, "limit_switch_2": 300.0})
+    window.show_page(PageId.TUNING)
+    with qtbot.waitSignal(window.link.sigResult, timeout=20000):
+        page.plan_button.click()
+    refused = page.plan_label.text()
+    assert refused.startswith("No excitation: the excitation on a REV (CCW seen from the flange) jog would "
+                              "turn the axis up to about") and "\n" not in refused
+    assert "only 20° to limit switch 1 (CCW end)" in refused
+    assert "choose FWD (CW seen from the flange)" in refused
+    assert not page.start_button.isEnabled() and not page.hold_button.isEnabled()
+    text = _plan_with(page, qtbot, window, "fwd")
+    assert "within the movable range" in text and "limit switch 2 (CW end)" in text
+    assert page.start_button.isEnabled()
+    text = _plan_with(page, qtbot, window, "none")
+    assert "jog" not in text and "sticks on its friction at every reversal" in text
+    assert "not to be trusted" in text
+    window.save_layout()
+    again = make_window()
+    assert again.show_page(PageId.TUNING).bias_combo.currentData() == "none"

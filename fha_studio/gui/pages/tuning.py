@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pyqtgraph as pg
 from pyqtgraph import exporters
-from PySide6.QtCore import QBuffer, QIODevice, QRectF, Qt, QTimer, Signal
+from PySide6.QtCore import QBuffer, QIODevice, QRectF, QSettings, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
@@ -45,17 +45,23 @@ from fha_studio import clock, fileio
 from fha_studio.gui.link import JOG_LEASE_RENEW_MS, JOG_LEASE_S
 from fha_studio.gui.link_requests import Call, LinkInfo, LinkReply
 from fha_studio.gui.motion_controls import HoldButton
-from fha_studio.gui.pages.base import BasePage
+from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.pages.tuning_bench import BenchTuningPanel
 from fha_studio.gui.widgets import HiddenWhileEmptyLabel, scrolling
 from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
-from fha_studio.logic.tuning.excitation import plan_excitation
+from fha_studio.logic.tuning.excitation import BiasDirection, plan_excitation
 from fha_studio.logic.tuning.measure import NEEDED
 from fha_studio.logic.tuning.propose import AIMS, TUNE_KEYS, Proposal, Tuner
 from fha_studio.logic.tuning.record import TuningRecord, result_figure_words, tuning_notes
 from fha_studio.logic.tuning.response import COHERENCE_TRUSTED
-from fha_studio.logic.tuning.session import declared_model, drive_clock, measure_report, tuner_for
+from fha_studio.logic.tuning.session import (
+    declared_model,
+    drive_clock,
+    measure_report,
+    planned_travel,
+    tuner_for,
+)
 
 COUNTDOWN_S = 3
 #: the plots' rows (magnitude, phase, coherence): the least height of each [px] and its share of more;
@@ -67,10 +73,19 @@ MARKER_LABEL_MARGIN_PX = 3.0
 MARKER_LABEL_ROOM_PX = 28
 #: the plots' margin and the space between their rows [px]
 PLOTS_SPACING_PX = 2
+#: the space between the page's rows above the plots [px]
+PANEL_SPACING_PX = 3
 #: the plots' least height: the rows', the legend's line (22 px), the spaces between and the margins
 PLOTS_MIN_HEIGHT_PX = sum(least_px for least_px, _stretch in PLOT_ROWS.values()) + 22 + 5 * PLOTS_SPACING_PX
 HOLD_TIP = ("Hold (mouse or Space key) to run the excitation until the measurement is done; letting go, "
             "leaving the page or the window ends it")
+#: the bias speed's choices: (words, BiasDirection); the jog's rotation (CW/CCW) is in the plan
+BIAS_CHOICES = (("FWD jog", BiasDirection.FWD), ("REV jog", BiasDirection.REV),
+                ("In place (no jog)", BiasDirection.NONE))
+BIAS_TIP = ("The slow jog the excitation rides on, so the axis never reverses and sticks on its friction: "
+            "FWD or REV, whichever way the axis has room to turn (the plan says how far, and checks it "
+            "against the limit switches' angles where the procedures recorded them). In place: for an "
+            "axis that may not turn that far; the friction then spoils the low frequencies")
 FIGURE_ROWS = ("gain_margin_db", "phase_margin_deg", "overshoot_pct", "settling_ms")
 #: the table's words for the figures beside the tune items
 FIGURE_WORDS = {"gain_margin_db": "Gain margin [dB]", "phase_margin_deg": "Phase margin [°]",
@@ -210,6 +225,7 @@ class TuningPage(BasePage):
     def __init__(self, session: Any, main_window: Any = None) -> None:
         super().__init__()
         self.session = session
+        self.main_window = main_window
         self.link = session.link
         self.result: dict[str, Any] | None = None
         self.proposal: Proposal | None = None
@@ -237,16 +253,24 @@ class TuningPage(BasePage):
         self.amplitude_spin.setDecimals(4)
         self.amplitude_spin.setSpecialValueText("the largest the axis allows")
         self.amplitude_spin.setSuffix(" r/min")
+        self.bias_combo = QComboBox()
+        for words, direction in BIAS_CHOICES:
+            self.bias_combo.addItem(words, direction.value)
+        self.bias_combo.setToolTip(BIAS_TIP)
+        # a new choice is a new plan: the excitation is shown again before it starts
+        self.bias_combo.currentIndexChanged.connect(self._plan_outdated)
+        # three fields a row: more rows took the height the plots need at 1280 x 720
         for n, (words, field) in enumerate((("Actuator", self.actuator_edit),
                                             ("Declared load inertia", self.load_spin),
                                             ("Aim", self.aim_combo),
-                                            ("Excitation amplitude", self.amplitude_spin))):
+                                            ("Excitation amplitude", self.amplitude_spin),
+                                            ("&Bias speed", self.bias_combo))):
             label = QLabel(words)
             label.setBuddy(field)
-            form.addWidget(label, n // 2, 2 * (n % 2))
-            form.addWidget(field, n // 2, 2 * (n % 2) + 1)
-        form.setColumnStretch(1, 1)
-        form.setColumnStretch(3, 1)
+            form.addWidget(label, n // 3, 2 * (n % 3))
+            form.addWidget(field, n // 3, 2 * (n % 3) + 1)
+        for column in (1, 3, 5):
+            form.setColumnStretch(column, 1)
 
         buttons = QHBoxLayout()
         self.plan_button = QPushButton("Show the excitation")
@@ -374,6 +398,9 @@ class TuningPage(BasePage):
         self.bench = BenchTuningPanel(self)
         panel = QWidget()
         layout = QVBoxLayout(panel)
+        # rows closer than the style's 6 px: the plan of a jog within a known range takes three lines
+        # at 1280 x 720, and the plots keep their height
+        layout.setSpacing(PANEL_SPACING_PX)
         layout.addLayout(form)
         layout.addLayout(buttons)
         layout.addWidget(self.bench)
@@ -387,6 +414,32 @@ class TuningPage(BasePage):
         outer = QVBoxLayout(self)
         outer.setContentsMargins(0, 0, 0, 0)
         outer.addWidget(scrolling(panel))
+
+    # ----- settings ------------------------------------------------------------------------------
+    def restore_settings(self, settings: QSettings) -> None:
+        index = self.bias_combo.findData(str(settings.value("tuning/bias", BiasDirection.FWD.value)))
+        self.bias_combo.setCurrentIndex(max(index, 0))
+
+    def save_settings(self, settings: QSettings) -> None:
+        settings.setValue("tuning/bias", self.bias_combo.currentData())
+
+    def bias(self) -> BiasDirection:
+        return BiasDirection(self.bias_combo.currentData())
+
+    def switch_angles_deg(self) -> dict[str, float]:
+        """The limit switches' switching angles the procedures recorded for this axis (none where
+        no procedure session is open or they are not recorded yet)."""
+        if self.main_window is None:
+            return {}
+        procedures = self.main_window.built_page(PageId.PROCEDURES)
+        session = getattr(procedures, "session", None)
+        return dict(session.sensor_angles_deg) if session is not None else {}
+
+    def _plan_outdated(self) -> None:
+        if self.start_button.isEnabled() or self.hold_button.isEnabled():
+            self.plan_label.setText("The bias speed changed: show the excitation again before it starts.")
+        self.start_button.setEnabled(False)
+        self.hold_button.setEnabled(False)
 
     # ----- the link ------------------------------------------------------------------------------
     def link_connected(self, info: LinkInfo) -> None:
@@ -428,26 +481,30 @@ class TuningPage(BasePage):
     def show_plan(self) -> None:
         """Compute and show the excitation (in the link thread: it reads the drive's items)."""
         code, load, amplitude = self._code(), self.load_spin.value(), self._amplitude()
+        bias, angles = self.bias(), self.switch_angles_deg()
 
         def plan(client: Any) -> Any:
             if NEEDED - set(client.capabilities.commands):
                 return None
             tuner = tuner_for(client, self.session.parameter_model, declared_model(code, load))
-            return plan_excitation(tuner.loop({}), amplitude)
+            planned = plan_excitation(tuner.loop({}), amplitude, bias)
+            return planned, planned_travel(client, tuner, planned, angles, manual_units=True)
 
         self.link.send(Call(plan), self._planned)
 
     def _planned(self, reply: LinkReply[Any]) -> None:
-        if not reply.ok:
+        if not reply.ok:  # nothing may start on an earlier plan either
+            self.start_button.setEnabled(False)
+            self.hold_button.setEnabled(False)
             self.plan_label.setText(f"No excitation: {reply.error}")
             return
         if reply.value is None:
             self.plan_label.setText("This drive has no excitation over CN3: the proposal is a front-panel "
                                     "worksheet.")
             return
-        self.plan = reply.value
-        self.plan_label.setText(reply.value.describe(manual_units=True) + ". Servo on, the axis free to move "
-                                "that far; STOP ends it at once.")
+        self.plan, words = reply.value
+        self.plan_label.setText(f"{words[0].upper()}{words[1:]}. Servo on, the axis free to move that far; "
+                                "STOP ends it at once.")
         self.start_button.setEnabled(True)
         self.hold_button.setEnabled(True)
 
@@ -499,6 +556,7 @@ class TuningPage(BasePage):
 
     def measure(self, then: Any = None, held: bool = False) -> None:
         code, load, amplitude = self._code(), self.load_spin.value(), self._amplitude()
+        bias, angles = self.bias(), self.switch_angles_deg()
         abort = self.link.abort_event.is_set
         stop = (lambda: abort() or self.hold_let_go()) if held else abort
         self.status_label.setText("Measuring while the button is held: let go to stop …" if held else
@@ -507,7 +565,8 @@ class TuningPage(BasePage):
         def run(client: Any) -> dict[str, Any]:
             tuner = tuner_for(client, self.session.parameter_model, declared_model(code, load))
             pace, now = drive_clock(client)
-            return measure_report(client, tuner, pace, now, amplitude, should_stop=stop)
+            return measure_report(client, tuner, pace, now, amplitude, should_stop=stop, bias=bias,
+                                  switch_angles_deg=angles)
 
         self.link.send(Call(run), partial(self._measured, then, held))
 

@@ -10,7 +10,8 @@ L1 norm from the added speed command to the position (the position loop closed: 
 axis). The drive stops the excitation if the output ever travels farther than that bound (with
 a margin) from where it started.
 
-The axis turns one way throughout (a bias speed): a real axis has friction, and Coulomb friction
+The axis turns one way throughout (a bias speed, FWD or REV as the person chooses: the axis's
+room decides, ``travel``): a real axis has friction, and Coulomb friction
 flips at every reversal of the speed, where the axis sticks until the loop's torque breaks it away
 again, so the torque -> speed response of an excitation about standstill loses its gain at low
 frequency and what is fitted to it (inertia, resonance) is wrong. The excitation therefore runs
@@ -40,6 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from enum import StrEnum
 
 import numpy as np
 
@@ -68,6 +70,38 @@ HORIZON_S = 30.0
 BIAS_MARGIN = 1.2
 #: the bias speed at most this share of the maximum speed (the amplitude is lowered to keep it)
 BIAS_SHARE = 0.05
+
+
+class BiasDirection(StrEnum):
+    """Which way the bias speed turns the axis (the JOG's FWD or REV command), or none: about
+    standstill (an axis that may not turn that far; the friction then shows, and is warned of)."""
+
+    FWD = "fwd"
+    REV = "rev"
+    NONE = "none"
+
+    @property
+    def sign(self) -> int:
+        """+1 FWD, -1 REV, 0 about standstill: the sign of the JOG's speed (command sense)."""
+        return {"fwd": 1, "rev": -1, "none": 0}[self.value]
+
+    @classmethod
+    def of(cls, bias: BiasDirection | bool | str) -> BiasDirection:
+        """``True``: FWD (the default), ``False``: about standstill; a name as ``tune measure
+        --bias`` takes it."""
+        if isinstance(bias, bool):
+            return cls.FWD if bias else cls.NONE
+        return cls(str(bias).lower())
+
+
+def rotation_words(sign: int, fwd_is_cw: bool | None) -> str:
+    """The JOG's command and the rotation it gives in the manual's words (1-10: a FWD command turns
+    the output CW seen from the flange with rotary direction 0, CCW with 1): "FWD (CW seen from
+    the flange)"; the command alone where the rotary direction is not known."""
+    command = "FWD" if sign > 0 else "REV"
+    if fwd_is_cw is None:
+        return command
+    return f"{command} ({'CW' if (sign > 0) == fwd_is_cw else 'CCW'} seen from the flange)"
 
 
 class NotExcitable(Exception):
@@ -105,8 +139,20 @@ class ExcitationPlan:
     f_max_hz: float
     settle_s: float  # before each record: the slowest closed-loop mode decays (6 time constants)
     duration_s: float
-    bias_rpm: float = 0.0  # the JOG the excitation rides on (0: about standstill)
+    bias_rpm: float = 0.0  # the JOG's speed the excitation rides on (0: about standstill)
     speed_bound_rpm: float = 0.0  # the linear bound of the excitation's own speed (either way)
+    bias_sign: int = 1  # the JOG's direction: +1 FWD, -1 REV (command sense)
+
+    @property
+    def bias_direction(self) -> BiasDirection:
+        if self.bias_rpm <= 0:
+            return BiasDirection.NONE
+        return BiasDirection.FWD if self.bias_sign > 0 else BiasDirection.REV
+
+    @property
+    def jog_speed_rpm(self) -> float:
+        """The JOG command's speed, signed (command sense: + FWD)."""
+        return self.bias_sign * self.bias_rpm
 
     @property
     def bias_travel_deg(self) -> float:
@@ -116,9 +162,10 @@ class ExcitationPlan:
         the default JOG acceleration it takes milliseconds)."""
         return self.bias_rpm * 6.0 * (self.duration_s + self.records * (self.settle_s + JOG_HOLD_S))
 
-    def describe(self, manual_units: bool = False) -> str:
+    def describe(self, manual_units: bool = False, fwd_is_cw: bool | None = None) -> str:
         """The excitation in a line. ``manual_units``: "±" and "°" as the FHA-C manual prints them
-        (what a person reads on a page); else plain ASCII ("+/-", "deg") for a terminal or a log."""
+        (what a person reads on a page); else plain ASCII ("+/-", "deg") for a terminal or a log.
+        ``fwd_is_cw``: the rotary direction (1-10), so the jog's rotation is named too."""
         pm = "±" if manual_units else "+/-"
 
         def deg(value: float) -> str:
@@ -126,8 +173,10 @@ class ExcitationPlan:
 
         periods = f"{self.hold_periods} servo period" + ("" if self.hold_periods == 1 else "s")
         if self.bias_rpm > 0:
-            where = (f" on a jog of {self.bias_rpm:.3g} r/min FWD (so the axis never reverses and sticks on "
-                     f"its friction; it turns up to about {deg(self.bias_travel_deg)})")
+            way = rotation_words(self.bias_sign, fwd_is_cw)
+            where = (f" on a jog of {self.bias_rpm:.3g} r/min {way}, which turns the axis up to about "
+                     f"{deg(self.bias_travel_deg)} {'FWD' if self.bias_sign > 0 else 'REV'} (so it never "
+                     "reverses and sticks on its friction)")
             about = " about the jog's path"
         else:
             where = about = ""
@@ -167,12 +216,16 @@ def _settle_s(h: np.ndarray, rate: float) -> float:
     return settle
 
 
-def plan_excitation(lm: LoopModel, requested_rpm: float | None = None, bias: bool = True) -> ExcitationPlan:
+def plan_excitation(lm: LoopModel, requested_rpm: float | None = None,
+                    bias: BiasDirection | bool | str = BiasDirection.FWD) -> ExcitationPlan:
     """The excitation for ``lm``'s axis: bits held so that the PRBS covers ~5 x the predicted
     resonance (or 2 x the speed loop's reach), the largest amplitude within the current and speed
     shares and the gear's torque on its first slope (or ``requested_rpm`` when lower; a higher
     request raises ValueError; an unstable loop NotExcitable), on a bias speed that keeps the axis
-    turning one way (``bias=False``: about standstill)."""
+    turning one way, FWD or REV (``BiasDirection.NONE`` or False: about standstill)."""
+    direction = BiasDirection.of(bias)
+    sign = direction.sign
+    biased = sign != 0
     check_stable(lm)
     model = lm.model
     rate = lm.settings.servo_rate_hz
@@ -188,29 +241,30 @@ def plan_excitation(lm: LoopModel, requested_rpm: float | None = None, bias: boo
     speed_loop = LoopModel(model, replace(lm.settings, position_loop_gain_per_s=0.0)).polynomials()
     per_a, per_nm = (float(v) for v in np.abs(_followed(speed_loop, rate)[:, 1:]).sum(axis=0))
     # the friction the bias speed turns against is drawn too: TF (2-4-4) kept in reserve
-    friction_a = (model.friction_torque_nm or 0.0) / model.torque_constant_nm_per_a if bias else 0.0
+    friction_a = (model.friction_torque_nm or 0.0) / model.torque_constant_nm_per_a if biased else 0.0
     top_rpm = min(max(CURRENT_SHARE * model.max_current_a - friction_a, 0.0) / per_a / RPM,
                   SPEED_SHARE * (model.max_speed_rpm or 60.0))
     if model.stiffness is not None and per_nm > 0.0:  # the gear stays on its first slope (K1, 1-9-2)
         top_rpm = min(top_rpm, GEAR_TORQUE_SHARE * model.stiffness.t1_nm / per_nm / RPM)
-    if bias:  # a lightly damped loop swings far: a smaller amplitude keeps the bias within its share
+    if biased:  # a lightly damped loop swings far: a smaller amplitude keeps the bias within its share
         top_rpm = min(top_rpm, BIAS_SHARE * (model.max_speed_rpm or 60.0) / (BIAS_MARGIN * per_speed))
     amplitude = top_rpm if requested_rpm is None else float(requested_rpm)
     if not 0.0 < amplitude <= top_rpm * (1 + 1e-9):
         raise ValueError(f"excitation amplitude {amplitude:g} r/min: allowed 0 ... {top_rpm:.3g} r/min "
                          f"for this axis (current within {CURRENT_SHARE:.0%} of {model.max_current_a:g} A, "
                          f"speed within {SPEED_SHARE:.0%} of the maximum"
-                         + (f", the bias speed within {BIAS_SHARE:.0%} of it)" if bias else ")"))
+                         + (f", the bias speed within {BIAS_SHARE:.0%} of it)" if biased else ")"))
     travel = math.degrees(amplitude * RPM * per_rad)
     period = excitation_period_periods(hold)
     settle = min(max(_settle_s(h, rate), 0.1), HORIZON_S)
     speed_bound_rpm = amplitude * per_speed
     # the JOG's speed step: rounded up to it
-    steps = math.ceil(BIAS_MARGIN * speed_bound_rpm / SPEED_STEP_RPM - 1e-9) if bias else 0
+    steps = math.ceil(BIAS_MARGIN * speed_bound_rpm / SPEED_STEP_RPM - 1e-9) if biased else 0
     bias_rpm = round(steps * SPEED_STEP_RPM, 6)
     return ExcitationPlan(
         amplitude_rpm=amplitude, hold_periods=hold, period_samples=period, records=RECORDS,
         travel_bound_deg=travel, travel_limit_deg=TRAVEL_MARGIN * travel + 0.01,
         peak_current_a=amplitude * RPM * per_a + friction_a, f_max_hz=0.4 * rate / hold, settle_s=settle,
         duration_s=RECORDS * (settle + period * dt), bias_rpm=bias_rpm, speed_bound_rpm=speed_bound_rpm,
+        bias_sign=sign or 1,
     )

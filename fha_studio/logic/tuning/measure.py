@@ -1,7 +1,7 @@
 """Measure the speed loop's frequency response on a drive, over the client and the protocol.
 
 The drive adds its PRBS to the speed command (EXA / EXL / EXG, docs/protocol.md) while the
-position loop holds the axis, on a JOG at the plan's bias speed (so the axis never reverses: see
+position loop holds the axis, on a JOG at the plan's bias speed, FWD or REV (so the axis never reverses: see
 ``excitation``; the JOG is started first and its ramp and the loop's lag settle before the
 excitation starts, and it is renewed with it and stopped, STP, at the end). The drive-side trace
 records the speed command (monitor 109), the output speed (110, fine), the torque (108: Kt x the
@@ -122,7 +122,7 @@ def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, pace: Calla
             client.stop()
             raise Stopped("STOP: the excitation was stopped")
         if biased:
-            client.jog(plan.bias_rpm)
+            client.jog(plan.jog_speed_rpm)  # FWD or REV as planned
         if exciting:
             client.excite(plan.hold_periods)
 
@@ -169,4 +169,4 @@ def measure(client: Any, plan: ExcitationPlan, servo_rate_hz: float, pace: Calla
         if biased:
             with contextlib.suppress(Exception):
                 client.stop()
-    return Records(tuple(records), servo_rate_hz, plan.bias_rpm * RPM)
+    return Records(tuple(records), servo_rate_hz, plan.jog_speed_rpm * RPM)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -11,7 +11,8 @@ from fha_studio.hardware.parameters import Mode, ParameterModel
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
 from fha_studio.logic.drive_session import WriteEntry, read_parameters, write_parameters
 from fha_studio.logic.paramfile import dump_parameter_file
-from fha_studio.logic.tuning.excitation import plan_excitation
+from fha_studio.logic.procedures.live import output_angle_deg
+from fha_studio.logic.tuning.excitation import BiasDirection, ExcitationPlan, plan_excitation
 from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
 from fha_studio.logic.tuning.measure import measure
 from fha_studio.logic.tuning.move import VERIFY_MOVE_DEG, MoveFigures, measure_move
@@ -24,10 +25,12 @@ from fha_studio.logic.tuning.response import (
     loop_figures,
     measured_loop_figures,
 )
+from fha_studio.logic.tuning.travel import MovableRange, check_travel
 from fha_studio.physics import AxisModel, Effects
 
 __all__ = ["VERIFY_MOVE_DEG", "backup_parameters", "declared_model", "drive_clock", "drive_items",
-           "measure_report", "response_figures", "tuner_for", "verify_move", "write_tune_items"]
+           "fwd_is_cw", "measure_report", "planned_travel", "response_figures", "tuner_for", "verify_move",
+           "write_tune_items"]
 
 
 def drive_clock(client: Any) -> tuple[Callable[[float], None], Callable[[], float]]:
@@ -68,16 +71,41 @@ def tuner_for(client: Any, parameters: ParameterModel, model: AxisModel,
     return Tuner(model, items, parameters, DEFAULT_SERVO_RATE_HZ, quantised_feedback)
 
 
+def fwd_is_cw(tuner: Tuner) -> bool | None:
+    """What a FWD command turns the output, seen from the flange (1-10: CW with rotary direction 0),
+    from the drive's rotary direction item; None where it was not read."""
+    value = tuner.items.get("rotary_direction")
+    return None if value is None else int(value) == 0
+
+
+def planned_travel(client: Any, tuner: Tuner, plan: ExcitationPlan,
+                   switch_angles_deg: Mapping[str, float] | None = None, manual_units: bool = False) -> str:
+    """The plan in words with the room it has: the limit switches' switching angles (as the
+    procedures record them) against the present position read from the drive, or that the
+    movable range is not known. Raises ``travel.TravelRefused`` (one line) where it does not fit."""
+    movable = None
+    if switch_angles_deg:
+        position_deg = output_angle_deg(client, tuner.model.output_resolution_ppr)[0]
+        movable = MovableRange.from_switch_angles(switch_angles_deg, position_deg)
+    room = check_travel(plan, movable, fwd_is_cw(tuner), manual_units)
+    warning = f"; {IN_PLACE_WARNING}" if plan.bias_direction is BiasDirection.NONE else ""
+    return f"{plan.describe(manual_units, fwd_is_cw(tuner))}; {room}{warning}"
+
+
 def measure_report(client: Any, tuner: Tuner, pace: Callable[[float], None],
                    now: Callable[[], float] = time.monotonic, amplitude_rpm: float | None = None,
                    announce: Callable[[str], None] = lambda _s: None,
-                   should_stop: Callable[[], bool] = lambda: False, bias: bool = True) -> dict[str, Any]:
+                   should_stop: Callable[[], bool] = lambda: False,
+                   bias: BiasDirection | bool | str = BiasDirection.FWD,
+                   switch_angles_deg: Mapping[str, float] | None = None) -> dict[str, Any]:
     """Excite, measure and analyse; the JSON of ``tune measure``. ``pace`` and ``now``: as
-    ``measure.measure`` takes them (the drive's own time); ``bias``: on a bias speed (False: about
-    standstill, for an axis that may not turn that far; the friction then shows, and is warned of)."""
+    ``measure.measure`` takes them (the drive's own time); ``bias``: the bias speed's direction,
+    FWD or REV (NONE or False: about standstill, for an axis that may not turn that far; the
+    friction then shows, and is warned of); ``switch_angles_deg``: the limit switches' angles,
+    where known: a plan that does not fit the room to them is refused before anything moves."""
     lm: LoopModel = tuner.loop({})
     plan = plan_excitation(lm, amplitude_rpm, bias)
-    announce(plan.describe())
+    announce(planned_travel(client, tuner, plan, switch_angles_deg))
     records = measure(client, plan, tuner.servo_rate_hz, pace, now, should_stop,
                       output_ppr=tuner.model.output_resolution_ppr,
                       jog_accel_rpm_s=float(tuner.items.get("jog_acceleration", 1)))
@@ -89,9 +117,14 @@ def measure_report(client: Any, tuner: Tuner, pace: Callable[[float], None],
         "excitation": {"amplitude_rpm": plan.amplitude_rpm, "travel_bound_deg": plan.travel_bound_deg,
                        "travel_limit_deg": plan.travel_limit_deg, "hold_periods": plan.hold_periods,
                        "records": plan.records, "travelled_deg": records.travel_deg(),
-                       "bias_rpm": plan.bias_rpm, "bias_travel_deg": plan.bias_travel_deg},
+                       "bias_rpm": plan.bias_rpm, "bias_direction": str(plan.bias_direction),
+                       "bias_travel_deg": plan.bias_travel_deg},
     }
 
+
+#: what the plan says of a measurement about standstill, before it starts
+IN_PLACE_WARNING = ("in place the axis sticks on its friction at every reversal: the low frequencies and the "
+                    "inertia estimate are not to be trusted")
 
 #: speed reversals at more than this share of the samples: the friction spoils the response
 REVERSALS_SHARE = 0.001
