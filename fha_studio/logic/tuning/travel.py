@@ -109,10 +109,10 @@ def alternatives(plan: ExcitationPlan, movable: MovableRange, fwd_is_cw: bool | 
     if plan.bias_rpm > 0:  # the other way: the same speed and travel (the loop is the same)
         other = replace(plan, bias_sign=-plan.bias_sign)
         if all(travel_deg(other, s) <= movable.room_deg(s) for s in (1, -1)):
-            fits.append(f"choose {rotation_words(other.bias_sign, fwd_is_cw)} "
-                        f"({deg(max(movable.room_deg(other.bias_sign), 0.0))} free that way)")
+            fits.append(f"choose {rotation_words(other.bias_sign, fwd_is_cw)}, "
+                        f"{deg(max(movable.room_deg(other.bias_sign), 0.0))} free that way")
         if all(plan.travel_limit_deg <= movable.room_deg(s) for s in (1, -1)):
             fits.append("measure in place (the friction then spoils the low frequencies)")
     if not fits:
         return "move the axis towards the middle of its range first"
-    return " or ".join(fits)
+    return ", or ".join(fits)
