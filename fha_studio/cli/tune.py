@@ -6,7 +6,8 @@ proposed gains, over CN3 or from the bench.
     fha-studio tune propose --url URL --actuator CODE --load-inertia KGM2 [--aim stiff|standard|soft]
                             [--json OUT]
     fha-studio tune excitation --actuator CODE --parameters P.toml --load-inertia KGM2
-                               [--form multisine|prbs|chirp] [--amplitude-rpm R] [--rate HZ] -o EXC
+                               [--form multisine|prbs|chirp] [--amplitude-rpm R] [--rate HZ]
+                               [--bias fwd|rev|none] -o EXC
     fha-studio tune analyse --actuator CODE --parameters P.toml --load-inertia KGM2
                             --signal ROLE=FILE[#CHANNEL] ... [--excitation EXC] [--json OUT]
 
@@ -308,10 +309,12 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
                    help="the instrument's output rate [samples/s] (default 10000)")
     q.add_argument("--periods", type=whole(3, 100), default=6, metavar="N",
                    help="periods played; the first settles the loop (default 6)")
-    q.add_argument("--in-place", action="store_true",
-                   help="about standstill, not on a bias speed (the constant FWD speed under the periods "
-                   "that keeps the axis from sticking on its friction): for an axis that may not turn that "
-                   "far; the friction then spoils the response at low frequency")
+    q.add_argument("--bias", choices=("fwd", "rev", "none"), default=None,
+                   help="the constant speed under the periods that keeps the axis from sticking on its "
+                   "friction: FWD (the default, SPD-CMD positive) or REV, whichever way the axis has room, "
+                   "or none: about standstill, for an axis that may not turn that far; the friction then "
+                   "spoils the response at low frequency")
+    q.add_argument("--in-place", action="store_true", help="the same as --bias none")
     q.add_argument("-o", "--output", required=True, type=output_path, metavar="EXC",
                    help="the file to write: .csv (time and volts), .wav (16-bit, its full scale stated), "
                    ".txt (one cycle normalised to ±1)")
@@ -366,7 +369,7 @@ def run_excitation(args: argparse.Namespace) -> int:
     tuner, _values = _bench_tuner(args)
     try:
         excitation = design_excitation(tuner, args.form, args.amplitude_rpm, args.rate, args.periods,
-                                       bias=not args.in_place)
+                                       bias=_bias(args))
     except NotInSpeedMode as exc:
         return _stopped("excitation", exc, EXIT_NOT_EXCITABLE)
     except ValueError as exc:

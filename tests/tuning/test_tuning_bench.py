@@ -46,12 +46,12 @@ def _values(extra: dict[tuple[str, int], int] | None = None) -> dict[tuple[str, 
 
 
 def _bench_run(folder: Path, load: float, *, with_command: bool, periods: int = 6,
-               friction: bool = False) -> tuple[Path, Path]:
+               friction: bool = False, bias: str = "fwd") -> tuple[Path, Path]:
     """The excitation file written, played into the speed-mode drive's SPD-CMD (``friction``: a
-    drive with the catalogue's friction), the capture written as a sigrok session: (excitation
-    file, capture file)."""
+    drive with the catalogue's friction; ``bias``: its direction), the capture written as a sigrok
+    session: (excitation file, capture file)."""
     tuner = bench_tuner(CODE, load, PARAMETERS, _values(SPEED_MODE))
-    excitation = design_excitation(tuner, periods=periods)
+    excitation = design_excitation(tuner, periods=periods, bias=bias)
     exc_path = write_waveform(folder / "excitation.csv", excitation.waveform, "csv")
     with SimDrive(CODE, load_inertia_kgm2=load, effects={"torsional_compliance": {}}, quantised=False,
                   preset=(("system", 0, 1),), catalogue_friction=friction) as drive:
@@ -60,7 +60,8 @@ def _bench_run(folder: Path, load: float, *, with_command: bool, periods: int = 
         drive.advance(0.05)
         # the DAQ plays the file as written while the instrument records CN2
         instrument = record_playback(drive, exc_path, RATE_HZ, speed_command=with_command)
-        travelled = np.degrees(drive.axis.output_pos_rad)  # one way, on the bias speed
+        # one way, on the bias speed: FWD turns the output CW (+) with rotary direction 0, REV CCW
+        travelled = np.degrees(drive.axis.output_pos_rad) * (1 if bias == "fwd" else -1)
         assert excitation.bias_rpm > 0  # the bound shown before (the linear loop's: within 5 %)
         assert 0.95 * excitation.travel_bound_deg <= travelled <= 1.05 * excitation.travel_bound_deg
         capture = instrument.write(folder / "capture.sr", "sr")
@@ -103,15 +104,19 @@ def test_the_response_from_spd_cmd_and_spd_mon_matches_the_linearisation(one_x: 
     assert result["crossover_hz"] == pytest.approx(result["predicted"]["crossover_hz"], rel=0.05)
 
 
-@pytest.mark.parametrize("friction", [False, True], ids=["frictionless", "catalogue-friction"])
-def test_at_three_times_the_load_and_the_file_as_the_only_input(tmp_path: Path, friction: bool) -> None:
+@pytest.mark.parametrize(("friction", "bias"), [(False, "fwd"), (True, "fwd"), (True, "rev")],
+                         ids=["frictionless", "catalogue-friction", "catalogue-friction-rev"])
+def test_at_three_times_the_load_and_the_file_as_the_only_input(tmp_path: Path, friction: bool,
+                                                                bias: str) -> None:
     """3 x the actuator's own inertia, SPD-CMD not recorded: the excitation file is the input, put in
     the capture's time by cross-correlation (start, and the DAQ's clock 30 ppm off the drive's). The
     phase then rests on the model's delay at low frequencies: within 8 deg here. Also on a drive with
     the catalogue's friction (TF, 2-4-4): on its bias speed the axis never reverses, and the same
-    tolerances hold (about standstill it was 3.6 dB and 23 deg off, the load 13 % low)."""
+    tolerances hold (about standstill it was 3.6 dB and 23 deg off, the load 13 % low), on a REV
+    bias too (the file's constant negative, the axis turning CCW)."""
     load = 3.0 * OWN
-    exc, capture = _bench_run(tmp_path, load, with_command=False, periods=4, friction=friction)  # 1.8 s each
+    exc, capture = _bench_run(tmp_path, load, with_command=False, periods=4, friction=friction,
+                              bias=bias)  # 1.8 s each
     tuner = bench_tuner(CODE, load, PARAMETERS, _values(SPEED_MODE), quantised_feedback=False)
     result = bench_response_report(tuner, [RoleSignal("speed_monitor", str(capture), "SPD_MON")], str(exc),
                                    MONITOR_HZ)
@@ -187,8 +192,15 @@ def test_cli_excitation_states_its_bounds_and_writes_the_file(tmp_path: Path,
     assert cli_main(["tune", "excitation", "--actuator", CODE, "--parameters", str(params), "--load-inertia",
                      str(OWN), "--rate", "4096", "--in-place", "-o", str(tmp_path / "still.csv")]) == 0
     assert "bias" not in capsys.readouterr().out
+    # --bias rev: the constant negative on SPD-CMD (REV), said so
+    assert cli_main(["tune", "excitation", "--actuator", CODE, "--parameters", str(params), "--load-inertia",
+                     str(OWN), "--rate", "4096", "--bias", "rev", "-o", str(tmp_path / "rev.csv")]) == 0
+    out = capsys.readouterr().out
+    assert "r/min REV (so the axis never reverses" in out and "FWD" not in out
     biased, still = read_waveform(tmp_path / "exc.csv").volts, read_waveform(tmp_path / "still.csv").volts
+    rev = read_waveform(tmp_path / "rev.csv").volts
     assert np.mean(biased) > 0.3 * np.max(np.abs(biased))
+    assert np.mean(rev) < -0.3 * np.max(np.abs(rev))
     assert abs(np.mean(still)) < 0.05 * np.max(np.abs(still))
 
 

@@ -195,7 +195,8 @@ class BenchTuningPanel(QGroupBox):
 
     def plan_excitation(self) -> Any:
         """The excitation for the page's axis and the drive's items, its bounds shown."""
-        excitation = design_excitation(self._tuner(), amplitude_rpm=self.page._amplitude())
+        excitation = design_excitation(self._tuner(), amplitude_rpm=self.page._amplitude(),
+                                       bias=self.page.bias())  # the page's choice, FWD, REV or in place
         self.status.setText(excitation.describe(manual_units=True) + ". Speed mode, the servo on from the "
                             "controller, the axis free to move that far; the file ends at 0 V.")
         return excitation

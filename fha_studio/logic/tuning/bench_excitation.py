@@ -18,7 +18,8 @@ The excitation rides on a bias speed (a constant on SPD-CMD, ramped up in ``BIAS
 the periods and down after them): ``excitation.BIAS_MARGIN`` x the largest speed the excitation
 itself reaches, so the axis turns one way throughout and never sticks on its friction at a
 reversal (``excitation`` says why; the analysis takes each record's mean out, the constant Coulomb
-friction with it). ``bias=False``: about standstill.
+friction with it), FWD (SPD-CMD positive) or REV (negative), as the axis has room. ``bias``
+``BiasDirection.NONE`` (or False): about standstill.
 
 The band reaches 5 x the resonance the catalogue's stiffness and the declared load predict (or
 500 Hz without one), at most 0.2 x the drive's servo rate; the period resolves the anti-resonance
@@ -48,6 +49,7 @@ from fha_studio.logic.tuning.excitation import (
     GEAR_TORQUE_SHARE,
     RPM,
     SPEED_SHARE,
+    BiasDirection,
 )
 from fha_studio.logic.tuning.linear import LoopModel, two_mass_prediction
 from fha_studio.logic.tuning.propose import Tuner
@@ -89,7 +91,8 @@ class BenchExcitation:
     peak_gear_torque_nm: float | None
     drift_rpm_per_mv: float  # output speed of 1 mV of offset on SPD-CMD
     top_rpm: float  # the largest amplitude the shares allow
-    bias_rpm: float = 0.0  # the constant speed the excitation rides on (output, FWD; 0: none)
+    bias_rpm: float = 0.0  # the constant speed the excitation rides on (output; 0: none)
+    bias_sign: int = 1  # its direction: +1 FWD (SPD-CMD positive), -1 REV
 
     @property
     def peak_v(self) -> float:
@@ -105,9 +108,10 @@ class BenchExcitation:
         w = self.waveform
         travel = f"{self.travel_bound_deg:.3g}" + ("°" if manual_units else " deg")
         periods = (len(w.volts) - 2 * w.start_sample) // max(1, w.period_samples)
-        bias = (f" on a bias of {self.bias_rpm:.3g} r/min FWD (so the axis never reverses and sticks on its "
-                "friction)" if self.bias_rpm > 0 else "")
-        travels = f"at most {travel} FWD" if self.bias_rpm > 0 else f"at most ±{travel}"
+        way = "FWD" if self.bias_sign > 0 else "REV"
+        bias = (f" on a bias of {self.bias_rpm:.3g} r/min {way} (so the axis never reverses and sticks on "
+                "its friction)" if self.bias_rpm > 0 else "")
+        travels = f"at most {travel} {way}" if self.bias_rpm > 0 else f"at most ±{travel}"
         return (f"excitation on SPD-CMD: {self.form} of ±{self.amplitude_rpm:.3g} r/min at the output{bias} "
                 f"(peak {self.peak_v:.3g} V), {self.f_lo_hz:.3g} ... {self.f_hi_hz:.3g} Hz, "
                 f"{periods} periods of {self.period_s:.3g} s at {w.rate_hz:g} samples/s "
@@ -122,7 +126,8 @@ class BenchExcitation:
                 "rate_hz": self.waveform.rate_hz, "duration_s": self.waveform.duration_s,
                 "travel_bound_deg": self.travel_bound_deg, "peak_current_a": self.peak_current_a,
                 "peak_speed_rpm": self.peak_speed_rpm, "peak_gear_torque_nm": self.peak_gear_torque_nm,
-                "drift_rpm_per_mv": self.drift_rpm_per_mv, "bias_rpm": self.bias_rpm}
+                "drift_rpm_per_mv": self.drift_rpm_per_mv, "bias_rpm": self.bias_rpm,
+                "bias_direction": ("fwd" if self.bias_sign > 0 else "rev") if self.bias_rpm > 0 else "none"}
 
 
 def volts_per_output_rpm(tuner: Tuner) -> float:
@@ -205,10 +210,13 @@ def linear_run(lm: LoopModel, speed_rad_s: np.ndarray) -> dict[str, np.ndarray]:
 
 def design_excitation(tuner: Tuner, form: str = "multisine", amplitude_rpm: float | None = None,
                       rate_hz: float = 10000.0, periods: int = PERIODS,
-                      period_s: float | None = None, bias: bool = True) -> BenchExcitation:
-    """The excitation for ``tuner``'s axis (its items say speed mode), on a bias speed unless
-    ``bias`` is False. ValueError for an amplitude above what the axis allows, an absurd rate or
-    period count."""
+                      period_s: float | None = None,
+                      bias: BiasDirection | bool | str = BiasDirection.FWD) -> BenchExcitation:
+    """The excitation for ``tuner``'s axis (its items say speed mode), on a bias speed FWD or REV
+    (``BiasDirection.NONE`` or False: about standstill). ValueError for an amplitude above what the
+    axis allows, an absurd rate or period count."""
+    sign = BiasDirection.of(bias).sign
+    biased = sign != 0
     lm = speed_mode_loop(tuner)
     if not (math.isfinite(rate_hz) and 1000.0 <= rate_hz <= 1e6):
         raise ValueError(f"rate {rate_hz:g} samples/s: 1000 ... 1000000")
@@ -229,8 +237,8 @@ def design_excitation(tuner: Tuner, form: str = "multisine", amplitude_rpm: floa
     per_speed = float(np.max(np.abs(own["speed"]))) / RPM
     model = tuner.model
     bias_unit, friction_a = 0.0, 0.0
-    if bias:  # a constant under the periods, ramped: the speed never crosses zero
-        bias_unit = BIAS_MARGIN * per_speed
+    if biased:  # a constant under the periods, ramped: the speed never crosses zero (REV: negative)
+        bias_unit = sign * BIAS_MARGIN * per_speed
         ramp = round(BIAS_RAMP_S * rate_hz)
         up = np.linspace(0.0, bias_unit, ramp, endpoint=False)
         unit = np.concatenate([np.zeros(lead), up, np.tile(cycle, periods) + bias_unit, up[::-1],
@@ -244,8 +252,8 @@ def design_excitation(tuner: Tuner, form: str = "multisine", amplitude_rpm: floa
     limits = [max(CURRENT_SHARE * model.max_current_a - friction_a, 0.0) / per_current,
               SPEED_SHARE * (model.max_speed_rpm or 60.0) / per_speed,
               SPD_CMD_MAX_V / vpr / float(np.max(np.abs(unit)))]
-    if bias:
-        limits.append(BIAS_SHARE * (model.max_speed_rpm or 60.0) / bias_unit)
+    if biased:
+        limits.append(BIAS_SHARE * (model.max_speed_rpm or 60.0) / abs(bias_unit))
     per_speed = float(np.max(np.abs(run["speed"]))) / RPM  # the bias with it
     per_torque = None
     if model.stiffness is not None:
@@ -258,7 +266,7 @@ def design_excitation(tuner: Tuner, form: str = "multisine", amplitude_rpm: floa
                          f"this axis (current within {CURRENT_SHARE:.0%} of {model.max_current_a:g} A, speed "
                          f"within {SPEED_SHARE:.0%} of the maximum, the gear on its first slope, SPD-CMD "
                          f"within ±{SPD_CMD_MAX_V:g} V" + (f", the bias within {BIAS_SHARE:.0%} of the "
-                                                          "maximum speed)" if bias else ")"))
+                                                          "maximum speed)" if biased else ")"))
     wave = Waveform(rate_hz, unit * amplitude * vpr,
                     f"{form}, ±{amplitude:.4g} r/min at the output, period {n / rate_hz:.6g} s",
                     period_samples=n, start_sample=lead)
@@ -270,5 +278,6 @@ def design_excitation(tuner: Tuner, form: str = "multisine", amplitude_rpm: floa
         peak_current_a=amplitude * per_current + friction_a, max_current_a=model.max_current_a,
         peak_speed_rpm=amplitude * per_speed,
         peak_gear_torque_nm=None if per_torque is None else amplitude * per_torque,
-        drift_rpm_per_mv=1e-3 / vpr, top_rpm=top_rpm, bias_rpm=amplitude * bias_unit,
+        drift_rpm_per_mv=1e-3 / vpr, top_rpm=top_rpm, bias_rpm=amplitude * abs(bias_unit),
+        bias_sign=sign or 1,
     )
