@@ -23,7 +23,7 @@ def test_bench_traces_are_drawn_beside_cn3s_named_with_their_source(window, qtbo
     view.start_live()
     qtbot.waitUntil(lambda: view.time_plot.live, timeout=10000)
     bench_streaming(qtbot, bench, "ENC_A,ENC_B,IN_POS,SPD_MON", "100k", "ENC_A,ENC_B")
-    label = "bench sim-cn2: ENC_A/ENC_B position (output) [deg]"
+    label = "bench sim-cn2: ENC_A/ENC_B position (output) [°]"  # degrees as the manual prints them
     plot = view.time_plot
     qtbot.waitUntil(lambda: label in plot._bench and plot._bench[label][0].getData()[0] is not None,
                     timeout=10000)

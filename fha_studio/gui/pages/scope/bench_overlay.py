@@ -1,7 +1,7 @@
 """A bench instrument's stream on the scope's Time plot, beside the CN3 channels.
 
 The Bench tab's rows (``[t_s, channels..., counts, command]``) become traces named with their
-source, ``bench sim-cn2: ENC_A/ENC_B position (output) [deg]``: the encoder and command counts
+source, ``bench sim-cn2: ENC_A/ENC_B position (output) [°]``: the encoder and command counts
 in output degrees (the axis's counts per output turn), so they share the plot of CN3's positions;
 other logic channels as bits (not the lines decoded into those counts), analog ones in volts. Drawn
 as the live view draws, time before now.
@@ -15,6 +15,7 @@ import numpy as np
 
 from fha_studio.logic.bench.display import peak_rows
 from fha_studio.logic.scope.recorder import BesideColumns
+from fha_studio.logic.wording import unit_words
 
 from .bench_source import BenchStarted
 
@@ -44,7 +45,7 @@ def bench_traces(started: BenchStarted, rows: np.ndarray, counts_per_output_turn
             what = "position (output)" if extra == "counts" else "command position (output)"
             lines = label.rsplit(" ", 1 if extra == "counts" else 2)[0]
             degrees = values * 360.0 / counts_per_output_turn
-            traces[f"bench {device}: {lines} {what} [deg]"] = ("deg", t, degrees)
+            traces[f"bench {device}: {lines} {what} [{unit_words('deg')}]"] = ("deg", t, degrees)
         else:
             traces[f"bench {device}: {label} [counts]"] = ("counts", t, values)
     return traces
