@@ -34,8 +34,10 @@ def test_bench_traces_are_drawn_beside_cn3s_named_with_their_source(window, qtbo
     assert item is units["deg"]
     assert next(p.keys for p in plot._plots if p.unit == "deg")  # CN3's position on the same plot
     assert {"bench sim-cn2: SPD_MON [V]", "bench sim-cn2: IN_POS [bit]"} <= set(plot._bench)
-    assert "V" in units and "bench sim-cn2: SPD_MON [V]" in plot.legend.text()
-    assert label in plot.legend.text()
+    # each legend entry in one piece: the legend wraps between entries, never inside a name (its
+    # spaces, hyphens and slashes in their no-break forms)
+    assert "V" in units and "bench&nbsp;sim\u2011cn2:&nbsp;SPD_MON&nbsp;[V]" in plot.legend.text()
+    assert "&nbsp;ENC_A/\u2060ENC_B&nbsp;position&nbsp;(output)&nbsp;[°]" in plot.legend.text()
     # a plot of it saved for the report says where its bench traces came from
     procedures = window.page(PageId.PROCEDURES)
     procedures.new_session(tmp_path / "session.json", CODE, "T. Trainee")

@@ -243,7 +243,7 @@ class TimePlot(QWidget):
             plot.keys.append(c.key)
             self._curves[c.key] = curve
             entries.append(f"<span style='color:{color(c.key)}; font-weight:bold'>━━</span>&nbsp;"
-                           f"{html.escape(label)}")
+                           f"{_unbroken(label)}")
         self._legend_entries = entries
         self.set_note(note)
         self._show_which_hold_data()
@@ -475,7 +475,7 @@ class TimePlot(QWidget):
                 lo, hi = self._bench_ranges.get(unit, (np.inf, -np.inf))
                 self._bench_ranges[unit] = min(lo, float(np.min(values))), max(hi, float(np.max(values)))
             entries.append(f"<span style='color:{color}; font-weight:bold'>╌╌</span>&nbsp;"
-                           f"{html.escape(label)}")
+                           f"{_unbroken(label)}")
         for plot in self._plots:  # a plot of bench traces only follows them here (CN3's: each frame)
             if not plot.keys and self.autoscale and plot.unit in self._bench_ranges:
                 self._follow_y(plot, *self._bench_ranges[plot.unit])
@@ -525,3 +525,15 @@ class TimePlot(QWidget):
         if not writer.write(image):
             raise OSError(f"{path}: the plot could not be turned into a PNG ({writer.errorString()})")
         fileio.write_bytes(path, bytes(buffer.data().data()))  # whole or not at all
+
+
+#: Where Qt would break a line inside a legend entry, and what keeps it whole there: a space, a
+#: hyphen ("sim-cn2") and a slash ("CMD_A/CMD_B") take their no-break forms (a word joiner after
+#: the slash).
+_NO_BREAK = {" ": "&nbsp;", "-": "\u2011", "/": "/\u2060"}
+
+
+def _unbroken(label: str) -> str:
+    """A legend entry as HTML that wraps between entries, never inside one ("bench sim-" at a
+    line's end and "cn2: ALM_A [bit]" on the next)."""
+    return "".join(_NO_BREAK.get(ch, ch) for ch in html.escape(label))
