@@ -193,7 +193,7 @@ def test_the_marker_labels_keep_off_the_curves_and_the_page_fits(make_window, qt
         "the flange), which turns the axis up to about 66.7° REV (so it never reverses and sticks on its "
         "friction), bits of 4 servo periods, 5 records of 4092 samples (4.8 s); the output travels at most "
         "±0.113° about the jog's path (the drive stops at 0.236°), current at most 3.25 A; within the "
-        "movable range (120° to limit switch 1 (CCW end), 135° to limit switch 2 (CW end)). Servo on, the "
+        "movable range: 120° to limit switch 1 (CCW end), 135° to limit switch 2 (CW end). Servo on, the "
         "axis free to move that far; STOP ends it at once.")
     page.show_result(result)
     page.warning_label.setText("Warning: the load is 10 x the actuator's inertia, beyond the about 3 x "
@@ -278,11 +278,13 @@ def test_the_bias_direction_is_chosen_shown_checked_and_remembered(make_window, 
     with qtbot.waitSignal(window.link.sigResult, timeout=20000):
         page.plan_button.click()
     refused = page.plan_label.text()
-    assert refused.startswith("No excitation: the excitation on a REV (CCW seen from the flange) jog would "
+    assert refused.startswith("No excitation: on a REV (CCW seen from the flange) jog the excitation would "
                               "turn the axis up to about") and "\n" not in refused
     assert "only 20° to limit switch 1 (CCW end)" in refused
     assert "choose FWD (CW seen from the flange)" in refused
     assert not page.start_button.isEnabled() and not page.hold_button.isEnabled()
+    latest = window.message_area.latest()  # the plan's answer, not a failed drive request
+    assert latest is None or "failed" not in latest.text
     text = _plan_with(page, qtbot, window, "fwd")
     assert "within the movable range" in text and "limit switch 2 (CW end)" in text
     assert page.start_button.isEnabled()

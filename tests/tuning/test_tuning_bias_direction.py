@@ -63,8 +63,8 @@ def test_the_plan_refuses_what_does_not_fit_the_movable_range(position_deg: floa
     for plan, fits, end, other_end in cases:
         if fits:
             line = check_travel(plan, movable, fwd_is_cw=True)
-            assert line == (f"within the movable range ({abs(room_to(end) - position_deg):.3g}° to {end}, "
-                            f"{abs(room_to(other_end) - position_deg):.3g}° to {other_end})")
+            assert line == (f"within the movable range: {abs(room_to(end) - position_deg):.3g}° to {end}, "
+                            f"{abs(room_to(other_end) - position_deg):.3g}° to {other_end}")
             continue
         with pytest.raises(TravelRefused) as refused:
             check_travel(plan, movable, fwd_is_cw=True)
@@ -73,7 +73,8 @@ def test_the_plan_refuses_what_does_not_fit_the_movable_range(position_deg: floa
         way = "FWD (CW" if plan.bias_sign > 0 else "REV (CCW"
         room = abs(100.0 - abs(position_deg))
         if abs(position_deg) < 90:  # refused for the jog's own way: how far, and the room to that end
-            assert f"a {way} seen from the flange) jog would turn the axis up to about" in line
+            assert line.startswith(f"on a {way} seen from the flange) jog the excitation would turn the axis "
+                                   f"up to about {travel_deg(plan, plan.bias_sign):.3g}° that way")
             assert f"only {room:.3g}° to {end}" in line
         other = "REV (CCW" if plan.bias_sign > 0 else "FWD (CW"
         assert (f"choose {other}" in line) == (fits_fwd or fits_rev)
@@ -172,7 +173,7 @@ def test_cli_refuses_a_bias_the_limit_switches_leave_no_room_for(drives,
     code = cli_main([*base, "--bias", "rev", "--limit-switches=-20,200"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 4 and len(err) == 1, err
-    assert "REV (CCW seen from the flange) jog would turn the axis up to about" in err[0]
+    assert "on a REV (CCW seen from the flange) jog the excitation would turn the axis up to about" in err[0]
     assert "only 20 deg to limit switch 1 (CCW end)" in err[0]
     assert "choose FWD (CW seen from the flange)" in err[0] and "measure in place" in err[0]
     (drive,) = drives

@@ -62,6 +62,7 @@ from fha_studio.logic.tuning.session import (
     planned_travel,
     tuner_for,
 )
+from fha_studio.logic.tuning.travel import TravelRefused
 
 COUNTDOWN_S = 3
 #: the plots' rows (magnitude, phase, coherence): the least height of each [px] and its share of more;
@@ -488,21 +489,32 @@ class TuningPage(BasePage):
                 return None
             tuner = tuner_for(client, self.session.parameter_model, declared_model(code, load))
             planned = plan_excitation(tuner.loop({}), amplitude, bias)
-            return planned, planned_travel(client, tuner, planned, angles, manual_units=True)
+            try:
+                return planned, planned_travel(client, tuner, planned, angles, manual_units=True)
+            except TravelRefused as refused:  # the plan's answer, not a failed request: said on the page
+                return None, str(refused)
 
         self.link.send(Call(plan), self._planned)
 
+    def _no_plan(self, why: str) -> None:
+        """No excitation, and nothing may start on an earlier plan either."""
+        self.start_button.setEnabled(False)
+        self.hold_button.setEnabled(False)
+        self.plan_label.setText(f"No excitation: {why}")
+
     def _planned(self, reply: LinkReply[Any]) -> None:
-        if not reply.ok:  # nothing may start on an earlier plan either
-            self.start_button.setEnabled(False)
-            self.hold_button.setEnabled(False)
-            self.plan_label.setText(f"No excitation: {reply.error}")
+        if not reply.ok:
+            self._no_plan(str(reply.error))
             return
         if reply.value is None:
             self.plan_label.setText("This drive has no excitation over CN3: the proposal is a front-panel "
                                     "worksheet.")
             return
-        self.plan, words = reply.value
+        plan, words = reply.value
+        if plan is None:  # it does not fit the movable range
+            self._no_plan(words)
+            return
+        self.plan = plan
         self.plan_label.setText(f"{words[0].upper()}{words[1:]}. Servo on, the axis free to move that far; "
                                 "STOP ends it at once.")
         self.start_button.setEnabled(True)

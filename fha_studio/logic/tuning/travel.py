@@ -11,7 +11,8 @@ the plan says so beside the travel, and the person confirms that the axis may tu
 Angles are the output's feedback position (monitor 100, as the procedures record the switching
 angles: ``procedures.live.output_angle_deg``), in the command's sense: a FWD command increases it.
 So the FWD end of the range is the larger of the two switching angles, whatever the rotary
-direction (1-10) makes of FWD on the flange.
+direction (1-10) makes of FWD on the flange. With an incremental encoder the feedback position starts at 0
+at power-on: angles recorded before the drive was last switched on do not hold.
 """
 
 from __future__ import annotations
@@ -83,12 +84,13 @@ def check_travel(plan: ExcitationPlan, movable: MovableRange | None, fwd_is_cw: 
     if not short:
         sign = plan.bias_sign
         ahead, behind = (deg(max(movable.room_deg(s), 0.0)) for s in (sign, -sign))
-        return (f"within the movable range ({ahead} to {movable.end_name(sign)}, {behind} to "
-                f"{movable.end_name(-sign)})")
+        return (f"within the movable range: {ahead} to {movable.end_name(sign)}, {behind} to "
+                f"{movable.end_name(-sign)}")
     sign, needed, room = short[0]
-    what = (f"the excitation on a {way(plan.bias_sign)} jog" if direction is not BiasDirection.NONE
-            else "the excitation in place")
-    raise TravelRefused(f"{what} would turn the axis up to about {deg(needed)} {way(sign)}, and there are "
+    biased = direction is not BiasDirection.NONE
+    what = f"on a {way(plan.bias_sign)} jog the excitation" if biased else "in place the excitation"
+    towards = "that way" if biased and sign == plan.bias_sign else way(sign)
+    raise TravelRefused(f"{what} would turn the axis up to about {deg(needed)} {towards}, and there are "
                         f"only {deg(max(room, 0.0))} to {movable.end_name(sign)}: "
                         f"{alternatives(plan, movable, fwd_is_cw, manual_units)}")
 
