@@ -89,7 +89,10 @@ def test_a_spectrum_of_an_angle_names_its_lines_in_arc_sec(qtbot):
         finally:
             painter.end()
 
-    qtbot.waitUntil(lambda: "1" in labels(), timeout=5000)  # the view took the curve's range
+    # which decades are drawn follows the plot's height (the layout's, not this test's): the
+    # words for given decades are checked as such, then every drawn one is a plain number
+    decades = np.log10([0.001, 0.1, 1.0, 2.0, 3.0, 10.0, 50.0, 1e5])
+    assert axis.logTickStrings(decades, 1.0, 1.0) == ["0.001", "0.1", "1", "2", "", "10", "50", "100000"]
+    qtbot.waitUntil(lambda: len(labels()) >= 2, timeout=5000)  # the view took the curve's range
     shown = labels()
-    assert {"10", "1", "0.1", "0.001"} <= set(shown)
     assert all(re.fullmatch(r"\d+(\.\d+)?", text) for text in shown), shown
