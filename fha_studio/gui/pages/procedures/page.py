@@ -58,6 +58,7 @@ from fha_studio.logic.procedures import (
 from fha_studio.logic.procedures.report import build_report
 from fha_studio.logic.procedures.report_inputs import ReportInputs, collect_for_report
 from fha_studio.logic.register.report_signing import report_file_bytes
+from fha_studio.logic.wording import NO_BREAK_SPACE
 
 log = logging.getLogger(__name__)
 
@@ -451,7 +452,8 @@ class ProceduresPage(BasePage):
             self._message(f"The tuning plots were not saved: {exc}")
             return
         by_path = {p["path"]: p for p in self.session.plots}
-        for title, path in plots:
+        for shown, path in plots:
+            title = shown.replace(NO_BREAK_SPACE, " ")  # the page's no-break spaces stay on the page
             if str(path) in by_path:
                 by_path[str(path)]["title"] = title
             else:
