@@ -47,6 +47,7 @@ from fha_studio.gui.link_requests import Call, LinkInfo, LinkReply
 from fha_studio.gui.motion_controls import HoldButton
 from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.pages.tuning_bench import BenchTuningPanel
+from fha_studio.gui.plot_axes import PlainDecadeAxis
 from fha_studio.gui.widgets import HiddenWhileEmptyLabel, scrolling
 from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
@@ -158,9 +159,10 @@ def export_response_png(record: TuningRecord, title: str, path: Path) -> Path:
                   row=0, col=0, color="k", size="10pt")
     legend = pg.LegendItem(colCount=2, labelTextColor="k")
     view.addItem(legend, row=1, col=0)
-    mag = view.addPlot(row=2, col=0, title="Magnitude [dB]", axisItems={"bottom": FrequencyAxis("bottom")})
-    phase = view.addPlot(row=3, col=0, title="Phase [°]", axisItems={"bottom": FrequencyAxis("bottom")})
+    mag = view.addPlot(row=2, col=0, title="Magnitude [dB]", axisItems={"bottom": PlainDecadeAxis("bottom")})
+    phase = view.addPlot(row=3, col=0, title="Phase [°]", axisItems={"bottom": PlainDecadeAxis("bottom")})
     phase.setLabel("bottom", "frequency (bins of coherence at least 0.9)", units="Hz")
+    phase.getAxis("bottom").enableAutoSIPrefix(False)  # a Bode plot in Hz, 1000 not 1 kHz
     for plot in (mag, phase):
         plot.setLogMode(x=True, y=False)
         plot.showGrid(x=True, y=True, alpha=0.3)
@@ -201,19 +203,6 @@ def _same_place(measured_hz: float, predicted_hz: float) -> bool:
 def _overlaps(bands: list[tuple[float, float]], low: float, high: float) -> int:
     """How many of the (bottom, top) ``bands`` reach into ``low`` ... ``high``."""
     return sum(1 for bottom, top in bands if bottom < high and low < top)
-
-
-class FrequencyAxis(pg.AxisItem):
-    """A logarithmic frequency axis labelled 1, 2, 5 per decade in plain numbers (pyqtgraph labels
-    every minor tick as 2·10¹, 3·10¹, ..., which run into each other)."""
-
-    def logTickStrings(self, values, scale, spacing):  # pyqtgraph calls it by this name
-        words = []
-        for v in values:
-            f = 10.0 ** float(v)
-            lead = f / 10.0 ** np.floor(np.log10(f) + 1e-9)
-            words.append(f"{f:g}" if any(abs(lead - d) < 1e-6 for d in (1.0, 2.0, 5.0)) else "")
-        return words
 
 
 class TuningPage(BasePage):
@@ -320,9 +309,9 @@ class TuningPage(BasePage):
         self.plots.addItem(self.legend, row=0, col=0)
         # each plot's quantity on its value axis, not in a title line of its own: the page fits
         # at 1280 x 720 with the magnitude plot high enough for its markers' labels
-        self.mag_plot = self.plots.addPlot(row=1, col=0, axisItems={"bottom": FrequencyAxis("bottom")})
-        self.phase_plot = self.plots.addPlot(row=2, col=0, axisItems={"bottom": FrequencyAxis("bottom")})
-        self.coh_plot = self.plots.addPlot(row=3, col=0, axisItems={"bottom": FrequencyAxis("bottom")})
+        self.mag_plot = self.plots.addPlot(row=1, col=0, axisItems={"bottom": PlainDecadeAxis("bottom")})
+        self.phase_plot = self.plots.addPlot(row=2, col=0, axisItems={"bottom": PlainDecadeAxis("bottom")})
+        self.coh_plot = self.plots.addPlot(row=3, col=0, axisItems={"bottom": PlainDecadeAxis("bottom")})
         for plot, words, units in ((self.mag_plot, "Magnitude", "dB"), (self.phase_plot, "Phase", "°"),
                                    (self.coh_plot, "Coherence", None)):
             plot.setLogMode(x=True, y=False)
@@ -333,6 +322,7 @@ class TuningPage(BasePage):
         self.phase_plot.setXLink(self.mag_plot)
         self.coh_plot.setXLink(self.mag_plot)
         self.coh_plot.setLabel("bottom", "frequency", units="Hz")
+        self.coh_plot.getAxis("bottom").enableAutoSIPrefix(False)  # a Bode plot in Hz, 1000 not 1 kHz
         for plot in (self.mag_plot, self.phase_plot):  # one frequency scale, under the three (a Bode plot's)
             plot.getAxis("bottom").setStyle(showValues=False)
         self.mag_plot.getViewBox().sigRangeChanged.connect(self._place_marker_labels)

@@ -9,26 +9,13 @@ import pyqtgraph as pg
 from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
+from fha_studio.gui.plot_axes import PlainDecadeAxis
 from fha_studio.logic.scope.channels import ScopeChannel
 from fha_studio.logic.wording import plain_number, unit_words
 
 #: Arc-seconds per degree: a line of an angle's spectrum is read in arc-sec, as the manual gives
 #: the actuator's accuracy (a kinematic error of 40 arc-sec, not 0.011 deg or 7.41e-05 deg).
 ARCSEC_PER_DEG = 3600.0
-
-
-class PlainDecadeAxis(pg.AxisItem):
-    """A logarithmic axis labelled 1, 2, 5 per decade in plain numbers (0.001, 0.1, 1, 10, 100):
-    pyqtgraph writes the decades from 10 up as "10¹", "10²" beside "1" and "0.1" below them, and
-    small ones as "10⁻⁴", a mix a person reads twice."""
-
-    def logTickStrings(self, values, scale, spacing):  # pyqtgraph calls it by this name
-        words = []
-        for v in values:
-            x = 10.0 ** float(v) * scale
-            lead = x / 10.0 ** np.floor(np.log10(x) + 1e-9)
-            words.append(plain_number(x, 1) if any(abs(lead - d) < 1e-6 for d in (1.0, 2.0, 5.0)) else "")
-        return words
 
 
 class SpectrumPanel(QWidget):
