@@ -39,3 +39,17 @@ def bench_streaming(qtbot: Any, bench: Any, *start: Any) -> None:
         bench.scan()
     with qtbot.waitSignal(bench.source.sigStarted, timeout=10000):
         bench.start(bench.device_box.itemText(0), *start)
+
+
+def bench_standing(qtbot: Any, bench: Any, seconds: float = 0.3) -> None:
+    """Waits until the bench's stream holds ``seconds`` more of the axis as it stands now (the
+    stream's own time, not the wall clock's): a move's figures start from the rows before it."""
+    ring = bench.source.started.ring
+
+    def newest_s() -> float | None:
+        rows = ring.window(1, copy=True)
+        return float(rows[-1, 0]) if len(rows) else None
+
+    qtbot.waitUntil(lambda: newest_s() is not None, timeout=10000)
+    since = newest_s()
+    qtbot.waitUntil(lambda: (newest_s() or 0.0) - since >= seconds, timeout=20000)

@@ -11,7 +11,7 @@ import pytest
 
 from fha_studio.gui.pages.base import PageId
 from fha_studio.logic.procedures.report_inputs import dgr_check_notes
-from tests.gui.controller import bench_streaming, panel_done
+from tests.gui.controller import bench_standing, bench_streaming, panel_done
 
 CODE = "FHA-25C-50-US250"
 
@@ -29,7 +29,7 @@ def test_a_controller_move_on_cn2_is_checked_and_recorded_with_its_source(window
                     "CMD_A,CMD_B", "IN_POS", "ALARM")
     panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
-    qtbot.wait(300)  # standing under servo: what the move starts from
+    bench_standing(qtbot, bench)  # standing under servo: what the move starts from
     window.sim_panel.command_spin.setValue(10.0)
     with qtbot.waitSignal(bench.sigChecks, timeout=30000) as checked:
         panel_done(window, qtbot, window.sim_panel.fwd_button.click)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from fha_studio.hardware.sim import cn2_live
-from tests.gui.controller import bench_streaming, documented_url, panel_done
+from tests.gui.controller import bench_standing, bench_streaming, documented_url, panel_done
 
 CODE = "FHA-25C-50-US250"
 URL = documented_url(CODE)
@@ -41,7 +41,7 @@ def test_a_controller_move_is_shown_live_from_cn2_with_the_move_tests_figures(wi
 
     panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
-    qtbot.wait(300)  # standing under servo: what the move starts from
+    bench_standing(qtbot, bench)  # standing under servo: what the move starts from
     with drive.lock:
         before = drive.axis.feedback_pulses
     window.sim_panel.command_spin.setValue(10.0)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import re
 
-from tests.gui.controller import panel_done
+from tests.gui.controller import bench_standing, panel_done
 
 CODE = "FHA-25C-50-US250"
 
@@ -36,7 +36,7 @@ def test_the_fwd_step_and_the_flange_are_taken_from_the_bench(documented_window,
         "has settled.")
     panel_done(window, qtbot, lambda: window.sim_panel.servo_check.setChecked(True))
     qtbot.waitUntil(lambda: window.link.status is not None and window.link.status.servo_on, timeout=10000)
-    qtbot.wait(300)  # standing under servo: what the move starts from
+    bench_standing(qtbot, bench)  # standing under servo: what the move starts from
     window.sim_panel.command_spin.setValue(10.0)
     with qtbot.waitSignal(bench.sigChecks, timeout=30000):
         panel_done(window, qtbot, window.sim_panel.fwd_button.click)
