@@ -294,3 +294,28 @@ def test_the_bias_direction_is_chosen_shown_checked_and_remembered(make_window, 
     window.save_layout()
     again = make_window()
     assert again.show_page(PageId.TUNING).bias_combo.currentData() == "none"
+
+
+def test_a_start_refused_by_the_range_is_said_once_on_the_page(make_window, qtbot, tmp_path):
+    """The plan fitted the movable range; limit switch 2 (CW end) was recorded again since, only 30°
+    from the axis (as after the axis was moved towards it): the check at the start refuses in the
+    page's words, nothing moves, and the message bar does not call it a failed drive request."""
+    window, page = _planned(make_window, qtbot)
+    procedures = window.show_page(PageId.PROCEDURES)
+    procedures.new_session(tmp_path / "axis1.json", CODE, operator="A. Tuner")
+    procedures.session.sensor_angles_deg.update({"limit_switch_1": -300.0, "limit_switch_2": 300.0})
+    window.show_page(PageId.TUNING)
+    text = _plan_with(page, qtbot, window, "fwd")
+    assert "within the movable range" in text and page.start_button.isEnabled()
+    procedures.session.sensor_angles_deg["limit_switch_2"] = 30.0  # FWD: CW with rotary direction 0
+    drive = window.link._worker._client.transaction.transport.inner.sim_drive
+    before = drive.axis.output_pos_rad
+    shown = window.message_area.latest()
+    page.measure()  # where the countdown ends
+    qtbot.waitUntil(lambda: page.status_label.text().startswith("Measurement not done"), timeout=60000)
+    latest = window.message_area.latest()  # the range check's answer, not a failed drive request
+    assert latest is shown or "failed" not in latest.text, latest.text
+    said = page.status_label.text()
+    assert "only 30° to limit switch 2 (CW end)" in said and " deg" not in said, said
+    assert "\n" not in said and said.count("Measurement not done") == 1
+    assert drive.axis.output_pos_rad == pytest.approx(before, abs=1e-6) and page.result is None

@@ -564,34 +564,41 @@ class TuningPage(BasePage):
         self.status_label.setText("Measuring while the button is held: let go to stop …" if held else
                                   "Measuring: the axis is excited …")
 
-        def run(client: Any) -> dict[str, Any]:
+        def run(client: Any) -> dict[str, Any] | str:
             tuner = tuner_for(client, self.session.parameter_model, declared_model(code, load))
             pace, now = drive_clock(client)
-            return measure_report(client, tuner, pace, now, amplitude, should_stop=stop, bias=bias,
-                                  switch_angles_deg=angles)
+            try:
+                return measure_report(client, tuner, pace, now, amplitude, should_stop=stop, bias=bias,
+                                      switch_angles_deg=angles, manual_units=True)
+            except TravelRefused as refused:  # the range check's answer (the axis moved since the
+                return str(refused)  # plan), not a failed request: said on the page, once
 
         self.link.send(Call(run), partial(self._measured, then, held))
 
-    def _measured(self, then: Any, held: bool, reply: LinkReply[dict[str, Any]]) -> None:
+    def _measured(self, then: Any, held: bool, reply: LinkReply[dict[str, Any] | str]) -> None:
         self.start_button.setEnabled(True)
         let_go = held and self.hold_let_go()
         if held:
             self.hold_button.release()
-        if not reply.ok or reply.value is None:
+        result = reply.value
+        if isinstance(result, str):  # refused before anything moved
+            self.status_label.setText(f"Measurement not done: {result}")
+            return
+        if not reply.ok or result is None:
             if let_go:
                 self.status_label.setText("Let go: the excitation stopped, nothing measured (hold until "
                                           "the measurement is done).")
             else:
                 self.status_label.setText(f"Measurement not done: {reply.error}")
             return
-        self.show_result(reply.value)
+        self.show_result(result)
         if then is None:
             stamp = clock.now_utc().strftime("%Y-%m-%d %H:%M:%S UTC")
-            self.records.append(TuningRecord(at=stamp, who="", before=reply.value))
+            self.records.append(TuningRecord(at=stamp, who="", before=result))
         if then is not None:
-            then(reply.value)
+            then(result)
         else:
-            self.sigMeasured.emit(reply.value)
+            self.sigMeasured.emit(result)
 
     def show_result(self, result: dict[str, Any]) -> None:
         """Plot a measurement (tune measure's dict) and mark the resonances."""

@@ -97,15 +97,17 @@ def measure_report(client: Any, tuner: Tuner, pace: Callable[[float], None],
                    announce: Callable[[str], None] = lambda _s: None,
                    should_stop: Callable[[], bool] = lambda: False,
                    bias: BiasDirection | bool | str = BiasDirection.FWD,
-                   switch_angles_deg: Mapping[str, float] | None = None) -> dict[str, Any]:
+                   switch_angles_deg: Mapping[str, float] | None = None,
+                   manual_units: bool = False) -> dict[str, Any]:
     """Excite, measure and analyse; the JSON of ``tune measure``. ``pace`` and ``now``: as
     ``measure.measure`` takes them (the drive's own time); ``bias``: the bias speed's direction,
     FWD or REV (NONE or False: about standstill, for an axis that may not turn that far; the
     friction then shows, and is warned of); ``switch_angles_deg``: the limit switches' angles,
-    where known: a plan that does not fit the room to them is refused before anything moves."""
+    where known: a plan that does not fit the room to them is refused before anything moves
+    (``travel.TravelRefused``, in the manual's units with ``manual_units``, as a page says it)."""
     lm: LoopModel = tuner.loop({})
     plan = plan_excitation(lm, amplitude_rpm, bias)
-    announce(planned_travel(client, tuner, plan, switch_angles_deg))
+    announce(planned_travel(client, tuner, plan, switch_angles_deg, manual_units))
     records = measure(client, plan, tuner.servo_rate_hz, pace, now, should_stop,
                       output_ppr=tuner.model.output_resolution_ppr,
                       jog_accel_rpm_s=float(tuner.items.get("jog_acceleration", 1)))
