@@ -67,6 +67,7 @@ def test_a_controller_move_is_shown_live_from_cn2_with_the_move_tests_figures(wi
     for words in ("Move from the bench: +10.000°", "overshoot", "settling time", "in-position (IN-POS)",
                   "following error (command − encoder)", "at the end"):
         assert words in text, text
+    assert f"overshoot {m.overshoot_percent:.2f}\u00a0%" in text  # its unit kept on its line
     # counted as a sentence counts: "1 count", "11 channels", never "1 counts" or "channel(s)"
     assert " 1 counts" not in text and "(s)" not in bench.status_label.text()
     x, y = bench._curves[0].getData()

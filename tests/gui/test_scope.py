@@ -275,7 +275,7 @@ def test_move_and_step_tests_report_overshoot_settling_and_in_position(qtbot, sc
     assert result.capture.method == "trace"
     assert view.result_labels["overshoot"].text().endswith("°)")
     assert view.test_angle.suffix() == "°"
-    assert view.tests.test_message.text() == "move test of 30° at 30 r/min done."
+    assert view.tests.test_message.text() == "move test of 30° at 30\u00a0r/min done."  # unit kept
     with qtbot.waitSignal(view.sigTestDone, timeout=20000) as done:
         view.run_test("step")
     step = done.args[0]

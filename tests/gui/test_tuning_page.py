@@ -269,6 +269,7 @@ def test_the_bias_direction_is_chosen_shown_checked_and_remembered(make_window, 
     assert "&" in label.text()  # an Alt letter reaches it
     text = _plan_with(page, qtbot, window, "rev")
     assert "r/min REV (CCW seen from the flange)" in text and "° REV" in text
+    assert "\u00a0r/min REV" in text and "\u00a0A" in text  # each figure keeps its unit where the line wraps
     assert "the movable range is not known" in text and page.start_button.isEnabled()
     # the procedures recorded limit switch 1 (CCW end) 20° from the axis, limit switch 2 far
     procedures = window.show_page(PageId.PROCEDURES)

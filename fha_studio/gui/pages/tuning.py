@@ -48,6 +48,7 @@ from fha_studio.gui.motion_controls import HoldButton
 from fha_studio.gui.pages.base import BasePage, PageId
 from fha_studio.gui.pages.tuning_bench import BenchTuningPanel
 from fha_studio.gui.plot_axes import PlainDecadeAxis
+from fha_studio.gui.unit_spacing import units_kept
 from fha_studio.gui.widgets import HiddenWhileEmptyLabel, scrolling
 from fha_studio.hardware.parameters import Mode
 from fha_studio.hardware.sim.axis import DEFAULT_SERVO_RATE_HZ
@@ -490,7 +491,7 @@ class TuningPage(BasePage):
         """No excitation, and nothing may start on an earlier plan either."""
         self.start_button.setEnabled(False)
         self.hold_button.setEnabled(False)
-        self.plan_label.setText(f"No excitation: {why}")
+        self.plan_label.setText(units_kept(f"No excitation: {why}"))
 
     def _planned(self, reply: LinkReply[Any]) -> None:
         if not reply.ok:
@@ -505,8 +506,8 @@ class TuningPage(BasePage):
             self._no_plan(words)
             return
         self.plan = plan
-        self.plan_label.setText(f"{words[0].upper()}{words[1:]}. Servo on, the axis free to move that far; "
-                                "STOP ends it at once.")
+        self.plan_label.setText(units_kept(f"{words[0].upper()}{words[1:]}. Servo on, the axis free to move "
+                                           "that far; STOP ends it at once."))
         self.start_button.setEnabled(True)
         self.hold_button.setEnabled(True)
 
@@ -582,7 +583,7 @@ class TuningPage(BasePage):
             self.hold_button.release()
         result = reply.value
         if isinstance(result, str):  # refused before anything moved
-            self.status_label.setText(f"Measurement not done: {result}")
+            self.status_label.setText(units_kept(f"Measurement not done: {result}"))
             return
         if not reply.ok or result is None:
             if let_go:

@@ -37,6 +37,7 @@ from PySide6.QtWidgets import (
 )
 
 from fha_studio import clock
+from fha_studio.gui.unit_spacing import units_kept
 from fha_studio.gui.widgets import hint_whole
 from fha_studio.hardware.bench import sigrok
 from fha_studio.hardware.parameters import load_cn2
@@ -762,14 +763,14 @@ class BenchPanel(QWidget):
             return "not reached" if value is None else f"{value * 1000:.1f} ms"
 
         inpos = ms(figures.in_position_time_s) if in_pos is not None else "no IN-POS channel"
-        self.move_label.setText(
+        self.move_label.setText(units_kept(
             f"Move from the bench: {m.target - m.start:+.3f}°; overshoot {m.overshoot_percent:.2f} % "
             f"({m.overshoot:.4f}°); settling time {ms(m.settling_time_s)} "
             f"(band ±{m.settling_band:.3g}°); in-position (IN-POS) {inpos} after the command ended; "
             f"following error (command − encoder) at most "
             f"{_counted(figures.following_error_peak_counts, 'count')}, "
             f"{_counted(figures.following_error_end_counts, 'count')} at the end\n"
-            + "; ".join(f"{CHECK_WORDS[c.check]}: {VERDICT[c.passed]}{_flange(c)}" for c in self.checks))
+            + "; ".join(f"{CHECK_WORDS[c.check]}: {VERDICT[c.passed]}{_flange(c)}" for c in self.checks)))
         self.sigChecks.emit(list(self.checks))
 
     def _on_stopped(self, why: str) -> None:

@@ -14,6 +14,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from fha_studio.gui.unit_spacing import units_kept
 from fha_studio.logic.scope.acquisition import MoveTestResult
 from fha_studio.logic.wording import plain_number, unit_words, with_unit
 
@@ -108,19 +109,23 @@ class MoveTestPanel(QWidget):
 
     def started(self, kind: str, angle_deg: float, speed_rpm: float) -> None:
         angle = with_unit(f"{angle_deg:g}", "deg")
-        self.test_message.setText(f"{kind} test running: {angle} at {speed_rpm:g} r/min …")
+        self._say(f"{kind} test running: {angle} at {speed_rpm:g} r/min …")
         for label in self.result_labels.values():
             label.setText("…")
 
     def set_message(self, text: str) -> None:
-        self.test_message.setText(text)
+        self._say(text)
+
+    def _say(self, text: str) -> None:
+        """The tab's message line, its figures kept with their units where it wraps."""
+        self.test_message.setText(units_kept(text))
 
     def show_result(self, result: MoveTestResult) -> None:
         m = result.metrics
         if m is None:
             for label in self.result_labels.values():
                 label.setText("—")
-            self.test_message.setText(result.describe())
+            self._say(result.describe())
         else:
             overshoot = f"{m.overshoot_percent:.2f} % ({with_unit(plain_number(m.overshoot), 'deg')})"
             self.result_labels["overshoot"].setText(overshoot)
@@ -131,7 +136,7 @@ class MoveTestPanel(QWidget):
             inpos = "" if window is None else f" (±{with_unit(f'{window:.3g}', 'deg')})"
             self.result_labels["in_position"].setText(_ms(m.in_position_time_s) + inpos)
             self.result_labels["final_error"].setText(with_unit(plain_number(m.final_error), "deg"))
-            self.test_message.setText(f"{result.kind} test of {with_unit(f'{result.angle_deg:g}', 'deg')} at "
+            self._say(f"{result.kind} test of {with_unit(f'{result.angle_deg:g}', 'deg')} at "
                                       f"{result.speed_rpm:g} r/min done.")
         c = result.capture
         if c is not None:
