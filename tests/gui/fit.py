@@ -27,6 +27,20 @@ from PySide6.QtWidgets import (
 )
 
 
+def laid_out(qtbot, top: QWidget) -> None:
+    """Waits until ``top`` is laid out: every shown widget's geometry the same on two looks in a
+    row (a wrapped label's new height asks its layout once more), not a fixed wait."""
+    last: list[object] = []
+
+    def settled() -> bool:
+        now = [(w, w.geometry().getRect()) for w in top.findChildren(QWidget) if w.isVisible()]
+        same = now == last
+        last[:] = now
+        return same
+
+    qtbot.waitUntil(settled, timeout=10000)
+
+
 def _name(widget: QWidget) -> str:
     parent = widget.parentWidget()
     where = widget.objectName() or (type(parent).__name__ if parent is not None else "")

@@ -12,6 +12,7 @@ from PySide6.QtCore import QPointF
 
 from fha_studio.gui.pages.scope.bench_panel import LANE_PX, TRACE_VIEW_MIN_PX
 from tests.gui.controller import bench_streaming, panel_done
+from tests.gui.fit import laid_out
 
 CODE = "FHA-25C-50-US250"
 CHANNELS = "ENC_A,ENC_B,CMD_A,CMD_B,IN_POS,ALARM,ALM_A,ALM_B,ALM_C,ALM_D,SPD_MON"
@@ -61,7 +62,7 @@ def test_the_bench_lanes_and_plots_fit_small_screens(documented_window, qtbot):
     for size in ((1366, 740), (1280, 720), (1024, 600)):
         window.resize(*size)
         qtbot.waitUntil(lambda size=size: (window.width(), window.height()) == size, timeout=10000)
-        qtbot.wait(20)  # let the tab lay out
+        laid_out(qtbot, window)
         found = hidden_actions(window) + cut_texts(window) + cut_hints(window) + lane_problems(bench)
         problems += [f"{size[0]}x{size[1]}: {p}" for p in found]
     assert not problems, "\n".join(problems)

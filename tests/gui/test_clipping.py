@@ -88,7 +88,7 @@ def test_every_page_shows_its_controls_and_its_text_whole(window, qtbot, size):
     from PySide6.QtWidgets import QTabWidget
 
     from fha_studio.gui.pages.base import PageId
-    from tests.gui.fit import cut_hints, cut_texts, hidden_actions
+    from tests.gui.fit import cut_hints, cut_texts, hidden_actions, laid_out
 
     window.resize(*size)
     qtbot.waitUntil(lambda: (window.width(), window.height()) == size, timeout=10000)
@@ -105,7 +105,7 @@ def test_every_page_shows_its_controls_and_its_text_whole(window, qtbot, size):
                     if not tabs.isVisible():
                         break
                     tabs.setCurrentIndex(index)
-                qtbot.wait(20)  # let the page lay out
+                laid_out(qtbot, window)
                 problems |= {f"{page_id}: {p}" for p in hidden_actions(window) + cut_texts(window)}
                 problems |= {f"{page_id}: {p}" for p in cut_hints(window)}
     assert not problems, "\n".join(sorted(problems))
@@ -163,7 +163,7 @@ def test_the_machine_window_fits_with_every_axis_and_says_it_whole(qtbot, tmp_pa
     the status bar are whole."""
     from fha_studio.gui.machine_window import MachineWindow
     from fha_studio.logic.machine import MachineProject
-    from tests.gui.fit import cut_hints, cut_texts, hidden_actions
+    from tests.gui.fit import cut_hints, cut_texts, hidden_actions, laid_out
     from tests.support.windows import torn_down
 
     project = MachineProject("Line 3 positioner", site="Plant A, hall 2")
@@ -183,7 +183,7 @@ def test_the_machine_window_fits_with_every_axis_and_says_it_whole(qtbot, tmp_pa
                 window.resize(*size)
                 qtbot.waitUntil(lambda size=size: window.size().toTuple() == size, timeout=3000)
                 window.select_axis(name)
-                qtbot.wait(50)  # let the chosen axis lay out
+                laid_out(qtbot, window)
                 hint = window.minimumSizeHint()
                 if hint.width() > size[0] or hint.height() > size[1]:
                     problems.append(f"{name}: the window needs {hint.width()} x {hint.height()}")

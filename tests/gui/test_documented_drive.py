@@ -14,6 +14,7 @@ from fha_studio.gui.link import PROBE_INTERVAL_MS, SERVO_ON_NOTE, SERVO_ON_PROBE
 from fha_studio.hardware import protocol as p
 from fha_studio.hardware.transport import pipe_pair
 from tests.gui.controller import panel, panel_done
+from tests.gui.fit import laid_out
 from tests.support.documented import DocumentedDrive
 from tests.support.scripted import ScriptedDrive
 
@@ -362,7 +363,7 @@ def test_walk_every_page_with_the_servo_off_and_on(window, qtbot):
                 switch_servo(window, qtbot, True)
             for entry in PAGES:
                 page = window.show_page(entry.id)
-                qtbot.wait(50)  # let the page settle; behaviour is asserted, not timing
+                laid_out(qtbot, window)
                 _page_facts(window, entry.id, page, servo_on)
             scope = window.show_page("scope").view
             label = "NOT LIVE: servo on (controller)" if servo_on else "LIVE: position only (DGR, servo off)"
@@ -394,7 +395,7 @@ def test_the_front_panel_worksheet_shows_every_cell_whole_on_a_small_screen(wind
     for size in ((1366, 740), (1280, 720)):
         window.resize(*size)
         qtbot.waitUntil(lambda size=size: window.size().toTuple() == size, timeout=10000)
-        qtbot.wait(20)  # let the table lay out its columns
+        laid_out(qtbot, window)
         assert not elided_cells(page.table) and not cut_texts(page), size
 
 

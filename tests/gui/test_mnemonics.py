@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QAbstractButton, QGroupBox, QLabel, QTabBar, QToolButton
+from PySide6.QtWidgets import QAbstractButton, QApplication, QGroupBox, QLabel, QTabBar, QToolButton
 
 from fha_studio.gui.mnemonics import mnemonic
 
@@ -78,7 +78,7 @@ def test_space_jogs_on_the_jog_buttons_only(make_window, qtbot):
         button.setFocus()
         qtbot.keyPress(button, Qt.Key.Key_Space)
         qtbot.keyRelease(button, Qt.Key.Key_Space)
-    qtbot.wait(50)
+    QApplication.processEvents()  # a key is handled as it is delivered: what it sends is sent by now
     assert MoveBy not in sent and Servo not in sent
     page.motion.fwd_button.setEnabled(True)
     page.motion.fwd_button.setFocus()

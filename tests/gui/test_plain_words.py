@@ -22,6 +22,7 @@ from PySide6.QtWidgets import (
 
 from fha_studio.gui.link import MoveBy
 from fha_studio.gui.pages.registry import PAGES
+from tests.gui.fit import laid_out
 
 SIM_URL = "sim://FHA-25C-50-US250?paced=0"
 
@@ -168,8 +169,9 @@ def test_every_page_speaks_the_manuals_words(make_window, qtbot):
     qtbot.waitUntil(lambda: window.alarm_lamp.state is True, timeout=15000)
     problems = []
     for entry in PAGES:
-        window.show_page(entry.id.value if hasattr(entry.id, "value") else entry.id)
-        qtbot.wait(100)  # let the page lay out and take its first status
+        with qtbot.waitSignal(window.link.sigStatus, timeout=15000):  # the page takes a status shown
+            window.show_page(entry.id.value if hasattr(entry.id, "value") else entry.id)
+        laid_out(qtbot, window)
         problems += [f"{entry.title}: {p}" for p in leaks(window)]
     problems = sorted(set(problems))
     assert not problems, "\n".join(problems)
@@ -186,7 +188,7 @@ def test_the_model_checks_findings_speak_the_manuals_words(make_window, qtbot, f
     problems = []
     for tab in range(page.steps.count()):
         page.steps.setCurrentIndex(tab)
-        qtbot.wait(20)
+        laid_out(qtbot, page)
         problems += [f"{page.steps.tabText(tab)}: {p}" for p in leaks(page)]
         if page.where_channel.isVisible():  # the residual against each variable, of each channel
             for channel in range(page.where_channel.count()):

@@ -12,6 +12,7 @@ from fha_studio.gui.pages.base import PageId
 from fha_studio.gui.training import ScoreSheetDialog, briefing_html
 from fha_studio.hardware.parameters import Mode
 from fha_studio.logic.training.scenario import find_scenario
+from tests.gui.fit import laid_out
 from tests.gui.test_plain_words import visible_texts
 
 WAIT_MS = 20000  # generous: a loaded 2-core machine
@@ -47,7 +48,7 @@ def test_a_trainee_finds_one_fault_and_misses_the_other(make_window, qtbot, tmp_
     seen = []
     for page in PageId:
         window.show_page(page)
-        qtbot.wait(50)
+        laid_out(qtbot, window)
         seen += [text for _, text in visible_texts(window)]
     seen += [w.toolTip() for w in window.findChildren(QWidget) if w.toolTip()]
     seen += [window.windowTitle(), window.caps_label.toolTip(), window.link_lamp.toolTip()]

@@ -9,7 +9,7 @@ import pytest
 
 from fha_studio.logic.register import Register
 from fha_studio.logic.register.window_axis import default_machine_name
-from tests.gui.fit import cut_texts, hidden_actions
+from tests.gui.fit import cut_texts, hidden_actions, laid_out
 
 FULL = "sim://FHA-25C-50-US250?paced=0"
 #: As a real HA-655: DGR and OWW only; the drive names no actuator.
@@ -161,7 +161,7 @@ def test_the_register_line_fits_beside_the_toolbar(make_window, qtbot, tmp_path,
     qtbot.waitUntil(lambda: (window.width(), window.height()) == size, timeout=30000)
     window.alarm_banner_action.setVisible(True)
     window.alarm_banner.setText("NEW ALARM 82 — show it")
-    qtbot.wait(20)
+    laid_out(qtbot, window)
     assert not hidden_actions(window) and not cut_texts(window)
     text = window.window_register.button.text()
     assert text.startswith("Register: ") and "…" in text
