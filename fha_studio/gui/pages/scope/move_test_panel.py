@@ -137,7 +137,7 @@ class MoveTestPanel(QWidget):
             self.result_labels["in_position"].setText(_ms(m.in_position_time_s) + inpos)
             self.result_labels["final_error"].setText(with_unit(plain_number(m.final_error), "deg"))
             self._say(f"{result.kind} test of {with_unit(f'{result.angle_deg:g}', 'deg')} at "
-                                      f"{result.speed_rpm:g} r/min done.")
+                      f"{result.speed_rpm:g} r/min done.")
         c = result.capture
         if c is not None:
             self.result_labels["method"].setText(
