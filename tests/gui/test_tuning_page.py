@@ -8,6 +8,7 @@ manual's commands gets a front-panel worksheet."""
 
 from __future__ import annotations
 
+import numpy as np
 import pyqtgraph as pg
 import pytest
 from PySide6.QtCore import Qt
@@ -320,3 +321,15 @@ def test_a_start_refused_by_the_range_is_said_once_on_the_page(make_window, qtbo
     assert "only 30° to limit switch 2 (CW end)" in said and " deg" not in said, said
     assert "\n" not in said and said.count("Measurement not done") == 1
     assert drive.axis.output_pos_rad == pytest.approx(before, abs=1e-6) and page.result is None
+
+
+def test_the_frequency_axis_reads_hz_in_plain_numbers_above_1_khz(make_window, qtbot):
+    """The Bode plots' frequency in Hz whatever the range (1000, 2000; never "1" under "kHz"),
+    labelled 1, 2, 5 per decade as the scope's spectrum amplitude (one axis class)."""
+    page = make_window().show_page(PageId.TUNING)
+    page.coh_plot.setXRange(0.0, float(np.log10(2500.0)), padding=0)
+    axis = page.coh_plot.getAxis("bottom")
+    qtbot.waitUntil(lambda: axis.range[1] > 3.0, timeout=5000)
+    assert axis.labelString().endswith("frequency (Hz)</span>"), axis.labelString()
+    words = axis.logTickStrings(np.log10([1.0, 3.0, 1000.0, 2000.0]), axis.autoSIPrefixScale, 1.0)
+    assert words == ["1", "", "1000", "2000"]
