@@ -19,6 +19,7 @@ from bench_capture_gen import BenchCase, make_capture
 from test_modelcheck_bench_captures import MEDIUM_17C, MEDIUM_40C
 
 from fha_studio.logic.modelcheck import ModelCheckError, run_modelcheck
+from fha_studio.logic.modelcheck.candidates import CANDIDATES
 from fha_studio.main import main as cli_main
 from fha_studio.physics import AxisModel, catalogue_effects
 from fha_studio.recording import Recording
@@ -93,6 +94,9 @@ def test_the_coast_after_an_alarm_names_viscous_friction(case, checked):
     if "torque_nm" in truth:  # Coulomb friction: from the servo-on part, checked against the coast
         coulomb = effects["coulomb_friction"].params["torque_nm"]
         assert coulomb == pytest.approx(truth["torque_nm"], rel=TOL), text
+        # what to do next adds the value named (the weighted mean), not the servo-on part's
+        assert effects["coulomb_friction"].advice == CANDIDATES["coulomb_friction"].advice(
+            effects["coulomb_friction"].params)
         assert "Coulomb friction: the servo-on moves give" in text, text
     else:
         assert "coulomb_friction" not in effects, text

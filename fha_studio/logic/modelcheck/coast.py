@@ -431,6 +431,7 @@ def _check_coulomb(
         return
     loop.params["torque_nm"], loop.uncertainty["torque_nm"] = value, sigma
     loop.size = value
+    loop.advice = CANDIDATES[loop.id].advice(loop.params)  # says the value named, not the servo-on one
 
 
 def _effect(effect_id: str, param: str, value: float, sigma: float, size: float, basis: str) -> Effect:
