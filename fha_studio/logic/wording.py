@@ -7,6 +7,7 @@ file and a script read them); a page shows "N·m" and "kg·m²" as the manual do
 from __future__ import annotations
 
 import math
+import re
 
 #: ASCII unit -> the manual's spelling.
 UNIT_WORDS = {
@@ -31,6 +32,27 @@ def unit_words(unit: str) -> str:
     if unit.endswith("/s") and unit[:-2] in UNIT_WORDS:
         return f"{UNIT_WORDS[unit[:-2]]}/s"
     return unit
+
+
+#: Units written in plain ASCII inside a sentence (a finding, a note) -> the manual's spelling: the
+#: longer first, each only where it stands as a unit (not inside a word)
+_TEXT_UNITS = (
+    (re.compile(r"(?<![\w·])kg m\^2(?![\w^])"), "kg·m²"),
+    (re.compile(r"(?<![\w·])N m s/rad(?![\w^])"), "N·m·s/rad"),
+    (re.compile(r"(?<![\w·])N m/rad(?![\w^])"), "N·m/rad"),
+    (re.compile(r"(?<![\w·])N m(?![\w^/·])"), "N·m"),
+    (re.compile(r"(?<![\w·])rad/s\^2(?![\w^])"), "rad/s²"),
+    (re.compile(r"(?<=\d) deg(?![\w^])"), "°"),
+    (re.compile(r"(?<![\w-])arcsec(?![\w^])"), "arc-sec"),
+)
+
+
+def manual_units_in_text(text: str) -> str:
+    """A sentence's ASCII units ("0.67 kg m^2", "2.5 N m", "30 deg") as the manual prints them, for
+    a page: the command line and the files keep the sentence as it is."""
+    for pattern, words in _TEXT_UNITS:
+        text = pattern.sub(words, text)
+    return text
 
 
 #: The space that joins a number to its unit on a page: a label that wraps never leaves the

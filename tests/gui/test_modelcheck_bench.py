@@ -142,3 +142,6 @@ def test_the_coast_after_an_alarm_is_shown_beside_the_gaps(make_window, qtbot, t
     assert not page.gap_empty.isVisible()
     assert "Coast after the alarm at 0.33 s" in page.summary.toPlainText(), page.summary.toPlainText()
     assert "Viscous friction: named from the coast after the alarm at 0.33 s" in page.findings.toPlainText()
+    for text in (page.summary.toPlainText(), page.findings.toPlainText()):  # the manual's units on a page
+        assert "kg·m²" in text or "N·m" in text
+        assert not any(ascii_unit in text for ascii_unit in ("kg m^2", " N m", "arcsec")), text

@@ -15,7 +15,7 @@ from fha_studio.logic.modelcheck.bandwidth import BandwidthPoint
 from fha_studio.logic.modelcheck.candidates import LABELS, PARAM_WORDS, label_of
 from fha_studio.logic.modelcheck.consistency import Refused
 from fha_studio.logic.modelcheck.selection import BIC_MIN, SelectionStep
-from fha_studio.logic.wording import unit_words
+from fha_studio.logic.wording import manual_units_in_text, unit_words
 from fha_studio.physics import AxisModel
 
 
@@ -353,7 +353,8 @@ class ModelCheckResult:
             )
         lines.extend(c.line(to) for c in self.coasts)
         lines.extend(self.notes)
-        return lines
+        # the notes and the lines above were written with the terminal's units
+        return [manual_units_in_text(line) for line in lines] if manual_units else lines
 
     def _status_lines(self) -> list[str]:
         """One line per channel that was not checked, and what was checked instead."""

@@ -37,7 +37,7 @@ from fha_studio.gui.state import AxisState
 from fha_studio.logic.modelcheck import ModelCheckError, ModelCheckResult, run_modelcheck
 from fha_studio.logic.modelcheck.candidates import LABELS, label_of, param_words
 from fha_studio.logic.modelcheck.signals import bandwidth_bounds_hz, window_for_bandwidth
-from fha_studio.logic.wording import unit_words
+from fha_studio.logic.wording import manual_units_in_text, unit_words
 from fha_studio.recording import Recording, RecordingError, read_recording
 
 COLORS = {"measured": "#1f77b4", "nominal": "#d62728", "updated": "#2ca02c", "residual": "#555555"}
@@ -610,7 +610,7 @@ class ModelCheckPage(BasePage):
         else:
             table.clearSpans()
         table.resizeRowsToContents()
-        self.findings.setPlainText("\n".join(_findings_in_words(r)))
+        self.findings.setPlainText(manual_units_in_text("\n".join(_findings_in_words(r))))
 
     def _remove_gap_plots(self) -> None:
         """Take the held-out gap plots of the last result off the gap tab."""
