@@ -25,13 +25,21 @@ def bench_recording(tmp_path):
     instrument.record(0.03)
     axis.move_by_pulses(9000, speed_rad_s=8 * RPM)
     instrument.record(0.4)
-    capture = tmp_path / "capture.sr"
+    return _imported(instrument, tmp_path, "capture", "bench",
+                     {"speed_monitor": "SPD_MON", "in_position": "IN_POS"})
+
+
+def _imported(instrument, tmp_path, capture_name: str, recording_name: str, more_roles: dict[str, str]):
+    """The instrument's capture written as ``capture_name``.sr, the encoder and the command
+    pulses with ``more_roles`` imported, the recording written as ``recording_name``.csv:
+    (capture, recording's path)."""
+    capture = tmp_path / f"{capture_name}.sr"
     instrument.write(capture, "sr")
     roles = {"encoder_a": "ENC_A", "encoder_b": "ENC_B", "command_a": "CMD_A", "command_b": "CMD_B",
-             "speed_monitor": "SPD_MON", "in_position": "IN_POS"}
+             **more_roles}
     result = import_bench([SignalSpec(r, str(capture), c) for r, c in roles.items()],
                           AxisFacts.for_actuator(CODE), DriveSettings(0, 4, 1, 1, 3000.0))
-    path = tmp_path / "bench.csv"
+    path = tmp_path / f"{recording_name}.csv"
     write_recording(path, result.recording)
     return capture, path
 
@@ -118,14 +126,7 @@ def test_the_coast_after_an_alarm_is_shown_beside_the_gaps(make_window, qtbot, t
     alarm[0] = 60  # the deviation counter overflowed: the drive de-energises the motor
     axis.servo_off()
     instrument.record(0.4)
-    capture = tmp_path / "coast.sr"
-    instrument.write(capture, "sr")
-    roles = {"encoder_a": "ENC_A", "encoder_b": "ENC_B", "command_a": "CMD_A", "command_b": "CMD_B",
-             "in_position": "IN_POS", "alarm": "ALARM"}
-    result = import_bench([SignalSpec(r, str(capture), c) for r, c in roles.items()],
-                          AxisFacts.for_actuator(CODE), DriveSettings(0, 4, 1, 1, 3000.0))
-    path = tmp_path / "coast.csv"
-    write_recording(path, result.recording)
+    _, path = _imported(instrument, tmp_path, "coast", "coast", {"in_position": "IN_POS", "alarm": "ALARM"})
     window = make_window()
     window.session.state.set_load_inertia(0.3)
     page = window.page(PageId.MODELCHECK)

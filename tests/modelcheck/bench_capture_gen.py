@@ -209,3 +209,19 @@ def _coast(drive: SimDrive, instrument: VirtualBenchInstrument, case: BenchCase,
     if case.brake:
         drive.set_inputs(0)  # the controller takes the brake's 24 V away with the alarm: it holds
     instrument.keep(case.coast_s)
+
+
+def checked_captures(directory: Path):
+    """``get(case)``: the case captured into ``directory`` and model-checked once, then
+    (capture, result) from the cache (a module fixture's, so every test of a case shares it)."""
+    from fha_studio.logic.modelcheck import run_modelcheck
+
+    cache: dict[str, tuple[BenchCapture, object]] = {}
+
+    def get(case: BenchCase):
+        if case.name not in cache:
+            capture = make_capture(case, directory)
+            cache[case.name] = (capture, run_modelcheck(capture.recording))
+        return cache[case.name]
+
+    return get

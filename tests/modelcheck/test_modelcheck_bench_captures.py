@@ -17,9 +17,15 @@ from __future__ import annotations
 import json
 
 import pytest
-from bench_capture_gen import LOAD_COUNTS_PER_TURN, LOAD_ROLES, ROLES, BenchAxis, BenchCase, make_capture
+from bench_capture_gen import (
+    LOAD_COUNTS_PER_TURN,
+    LOAD_ROLES,
+    ROLES,
+    BenchAxis,
+    BenchCase,
+    checked_captures,
+)
 
-from fha_studio.logic.modelcheck import run_modelcheck
 from fha_studio.main import main as cli_main
 from fha_studio.physics import AxisModel, PanelGains
 
@@ -125,16 +131,7 @@ FRICTIONS = {"coulomb_friction", "stribeck_friction"}
 @pytest.fixture(scope="module")
 def checked(tmp_path_factory):
     """Each case captured and checked once per module (the captures under the pytest tmp dir)."""
-    directory = tmp_path_factory.mktemp("bench-captures")
-    cache = {}
-
-    def get(case: BenchCase):
-        if case.name not in cache:
-            capture = make_capture(case, directory)
-            cache[case.name] = (capture, run_modelcheck(capture.recording))
-        return cache[case.name]
-
-    return get
+    return checked_captures(tmp_path_factory.mktemp("bench-captures"))
 
 
 def _assert_named_within(case: BenchCase, result) -> None:

@@ -15,7 +15,7 @@ import json
 
 import numpy as np
 import pytest
-from bench_capture_gen import BenchCase, make_capture
+from bench_capture_gen import BenchCase, checked_captures
 from test_modelcheck_bench_captures import MEDIUM_17C, MEDIUM_40C
 
 from fha_studio.logic.modelcheck import ModelCheckError, run_modelcheck
@@ -58,16 +58,7 @@ BRAKED_17C = BenchCase(MEDIUM_17C, catalogue_friction=True, coast_s=0.3, coast_r
 @pytest.fixture(scope="module")
 def checked(tmp_path_factory):
     """Each case captured and checked once per module."""
-    directory = tmp_path_factory.mktemp("coast-captures")
-    cache = {}
-
-    def get(case: BenchCase):
-        if case.name not in cache:
-            capture = make_capture(case, directory)
-            cache[case.name] = (capture, run_modelcheck(capture.recording))
-        return cache[case.name]
-
-    return get
+    return checked_captures(tmp_path_factory.mktemp("coast-captures"))
 
 
 def _truth(case: BenchCase) -> dict[str, float]:
